@@ -1,0 +1,194 @@
+// simsoccer bench physics: N Naos on the field, every joint tracking a slow
+// sinusoid, stepped on one thread; prints steps/s, real-time factor and
+// where the time goes.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer bench physics [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
+    "                               [--csv FILE]\n"
+    "\n"
+    "Places N Naos on the field in side-by-side pairs, all joints tracking slow sinusoids\n"
+    "around the stand pose, runs the settling time and then the timed interval on one thread.\n"
+    "Prints per N: steps/s, real-time factor, ms per step, contacts per step (all, and robot\n"
+    "against robot), robots standing at the end, and the share of the step spent in each stage.\n"
+    "\n"
+    "  --config FILE   benchmark scenario (default configs/bench/physics.yaml)\n"
+    "  --robots LIST   robot counts (default from the config)\n"
+    "  --seconds S     simulated seconds timed per robot count (default from the config)\n"
+    "  --csv FILE      also write the table as CSV (one row per robot count)\n";
+
+struct JointWave {
+  int joint;
+  double amplitude;
+};
+
+struct BenchConfig {
+  world::Scenario base;
+  std::vector<int> robots;
+  double settle = 1.0;
+  double seconds = 10.0;
+  double pair_gap = 0.3;
+  double frequency = 0.5;
+  std::vector<std::pair<std::string, double>> motion;  // joint name, amplitude
+};
+
+BenchConfig loadBenchConfig(const std::filesystem::path& file) {
+  BenchConfig c;
+  c.base = world::loadScenario(file);
+  const auto root = engine::ConfigNode::loadFile(file);
+  const auto b = root["bench"];
+  b.allowOnly({"robots", "settle", "seconds", "pair_gap", "motion"});
+  for (const auto& n : b["robots"].items()) {
+    const int v = n.integer();
+    if (v < 1) n.fail("robot counts must be >= 1");
+    c.robots.push_back(v);
+  }
+  c.settle = b["settle"].nonNegative();
+  c.seconds = b["seconds"].positive();
+  c.pair_gap = b["pair_gap"].positive();
+  const auto m = b["motion"];
+  m.allowOnly({"frequency", "joints"});
+  c.frequency = m["frequency"].positive();
+  for (const auto& [name, amp] : m["joints"].entries()) c.motion.emplace_back(name, amp.number());
+  return c;
+}
+
+// Pairs of robots side by side on a 4 x 3 grid over the field, alternating teams.
+world::Scenario placeRobots(const BenchConfig& c, int n, double half_length, double half_width) {
+  world::Scenario s = c.base;
+  s.robots.clear();
+  const int columns = 4, rows = 3;
+  int numbers[2] = {0, 0};
+  for (int i = 0; i < n; ++i) {
+    const int pair = i / 2;
+    const int col = pair % columns, row = (pair / columns) % rows;
+    const int layer = pair / (columns * rows);  // beyond 24 robots: shift the grid
+    world::RobotPlacement p;
+    p.team = i % 2;
+    p.number = ++numbers[p.team];
+    p.x = -half_length + (col + 0.5) * (2 * half_length / columns) + 0.4 * layer;
+    p.y = -half_width + (row + 0.5) * (2 * half_width / rows) + (i % 2 ? 0.5 : -0.5) * c.pair_gap;
+    p.yaw = 0.0;
+    s.robots.push_back(p);
+  }
+  return s;
+}
+
+}  // namespace
+
+int benchPhysics(int argc, char** argv, int first) {
+  const Options opt(argc, argv, first, {"help"}, {"config", "robots", "seconds", "csv"});
+  if (opt.flag("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (!opt.positional().empty()) throw UsageError("unexpected argument '" + opt.positional()[0] + "'");
+  const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
+  BenchConfig cfg = loadBenchConfig(config_file);
+  const std::vector<int> counts = opt.intList("robots", cfg.robots);
+  cfg.seconds = opt.number("seconds", cfg.seconds);
+  if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
+  const std::string csv = opt.get("csv", "");
+
+  const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
+  const double dt = cfg.base.physics.dt;
+  std::printf("simsoccer bench physics: %s, field %s, dt %.1f ms, control %.1f ms, %d solver "
+              "iterations, %.1f s settling + %.1f s timed per row, one thread\n",
+              config_file.string().c_str(), field.name.c_str(), dt * 1e3,
+              cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations,
+              cfg.settle, cfg.seconds);
+  std::fflush(stdout);
+
+  Table table;
+  table.header = {"robots",       "steps_per_s", "real_time_factor", "ms_per_step",
+                  "contacts_per_step", "robot_contacts_per_step", "standing", "collision_pct", "dynamics_pct",
+                  "solver_pct",   "integrate_pct", "servo_pct", "other_pct"};
+  for (const int n : counts) {
+    world::World w(placeRobots(cfg, n, field.halfLength(), field.halfWidth()));
+    const auto& model = *w.robot(0).model;
+    std::vector<JointWave> waves;
+    for (const auto& [name, amp] : cfg.motion) {
+      const int j = model.body->jointIndex(name);
+      if (j < 0) {
+        // H21 has no wrists: skip joints the model lacks, but never a typo of a real name.
+        if (model.actuatorIndex(name) >= 0) continue;
+        throw engine::ConfigError(config_file.string(), "bench.motion.joints." + name,
+                                  "unknown joint for robot model '" + model.name + "'");
+      }
+      waves.push_back({j, amp});
+    }
+    const auto& stand = model.pose("stand");
+    const int per_control = w.stepsPerControlPeriod();
+    // Each robot has its own phase; the amplitude ramps in over the settling time so no
+    // target jumps at the start.
+    auto command = [&](double t) {
+      const double ramp = cfg.settle > 0 ? std::min(1.0, t / cfg.settle) : 1.0;
+      for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+        const double phase = 2.0 * std::numbers::pi * r / static_cast<double>(w.robotCount());
+        const double s = ramp * std::sin(2.0 * std::numbers::pi * cfg.frequency * t + phase);
+        for (const JointWave& jw : waves)
+          w.setJointTarget(r, jw.joint, stand[static_cast<size_t>(jw.joint)] + jw.amplitude * s, 1.0);
+      }
+    };
+    const auto settle_steps = static_cast<long>(std::lround(cfg.settle / dt));
+    const auto timed_steps = static_cast<long>(std::lround(cfg.seconds / dt));
+    for (long i = 0; i < settle_steps; ++i) {
+      if (i % per_control == 0) command(w.time());
+      w.step();
+    }
+    w.physics().resetStageTimes();
+    w.physics().enableStageTimers(true);
+    long contacts = 0, robot_contacts = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long i = 0; i < timed_steps; ++i) {
+      if (i % per_control == 0) command(w.time());
+      w.step();
+      const engine::ContactCount cc = w.physics().contactCount();
+      contacts += cc.total;
+      robot_contacts += cc.between_articulations;
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    w.physics().enableStageTimers(false);
+    int standing = 0;
+    for (world::RobotId r = 0; r < w.robotCount(); ++r) standing += w.isStanding(r) ? 1 : 0;
+    const auto& st = w.physics().stageTimes();
+    const double steps_per_s = static_cast<double>(timed_steps) / wall;
+    auto pct = [&](double x) { return fmt(100.0 * x / wall, 1); };
+    const double other = wall - st.collision_s - st.dynamics_s - st.solver_s - st.integrate_s -
+                         st.servo_s;
+    table.rows.push_back({std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
+                          fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
+                          fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
+                          fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
+                          std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
+                          pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s),
+                          pct(st.servo_s), pct(other)});
+    std::fprintf(stderr, "  %d robots done: %.0f steps/s\n", n, steps_per_s);
+  }
+  std::printf("\n");
+  table.print(stdout);
+  std::printf("\nStages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
+              "dynamics; solver = contact and joint-limit constraints; integrate = positions; "
+              "servo = joint PD torques; other = everything else in the step and the loop "
+              "(commands, contact counting).\n");
+  if (!csv.empty()) {
+    table.writeCsv(csv);
+    std::printf("wrote %s\n", csv.c_str());
+  }
+  return 0;
+}
+
+}  // namespace simsoccer::apps

@@ -1,0 +1,51 @@
+// Small helpers shared by the subcommands: option parsing and tables.
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace simsoccer::apps {
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// --key value / --flag options after the subcommand words.
+class Options {
+ public:
+  Options(int argc, char** argv, int first, const std::vector<std::string>& flags,
+          const std::vector<std::string>& valued);
+  bool flag(const std::string& name) const { return flags_.count(name) > 0; }
+  bool has(const std::string& name) const { return values_.count(name) > 0; }
+  std::string get(const std::string& name, const std::string& fallback) const;
+  double number(const std::string& name, double fallback) const;
+  std::vector<int> intList(const std::string& name, const std::vector<int>& fallback) const;
+  const std::vector<std::string>& positional() const { return positional_; }
+
+ private:
+  std::map<std::string, bool> flags_;
+  std::map<std::string, std::string> values_;
+  std::vector<std::string> positional_;
+};
+
+// A config file given on the command line, or the default one looked up in
+// the working directory and then in the source tree.
+std::filesystem::path findConfig(const std::string& given, const std::string& default_relative);
+
+// Prints rows as an aligned table to stdout and optionally as CSV.
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  void print(FILE* out) const;
+  void writeCsv(const std::filesystem::path& file) const;  // throws on I/O error
+};
+
+std::string fmt(double value, int decimals);
+
+int benchPhysics(int argc, char** argv, int first);
+
+}  // namespace simsoccer::apps

@@ -1,0 +1,128 @@
+// The physics engine: a Bullet Featherstone world holding articulated robots
+// (one btMultiBody each), free rigid bodies (the ball) and static geometry
+// (ground, goals), stepped at a fixed time step.
+//
+// One step is a fixed sequence of stages (see step()): servo torques from
+// the joint servo batch, then Bullet's collision detection, articulated-body
+// dynamics, constraint solve and integration. No wall clock is read inside a
+// step except by the optional stage timers, which only measure.
+//
+// Handles are plain indices (ArticulationId, BodyId) handed out in order of
+// creation; nothing outside this component sees a Bullet pointer.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "simsoccer/engine/joint_servo.hpp"
+#include "simsoccer/engine/model.hpp"
+
+namespace simsoccer::engine {
+
+using ArticulationId = uint32_t;
+using BodyId = uint32_t;
+
+struct PhysicsSettings {
+  double dt = 0.005;            // s, physics step
+  int solver_iterations = 10;   // sequential-impulse iterations per step
+  int friction_directions = 1;  // friction rows per contact: 1 (along the slip) or 2
+  Vec3 gravity{0.0, 0.0, -9.81};
+};
+
+// Wall time spent per stage, accumulated over steps (only when enabled).
+struct StageTimes {
+  double servo_s = 0.0;       // joint servo torques
+  double collision_s = 0.0;   // broadphase + narrowphase
+  double dynamics_s = 0.0;    // articulated-body forward dynamics
+  double solver_s = 0.0;      // contact/limit constraint solve
+  double integrate_s = 0.0;   // position integration
+  double total_s = 0.0;       // the whole step
+  uint64_t steps = 0;
+};
+
+struct ContactCount {
+  int total = 0;                  // contact points in all manifolds
+  int between_articulations = 0;  // of which robot against robot
+};
+
+struct RigidBodyState {
+  Pose pose = Pose::Identity();
+  Vec3 linear_velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+};
+
+class PhysicsWorld {
+ public:
+  explicit PhysicsWorld(const PhysicsSettings& settings);
+  ~PhysicsWorld();
+  PhysicsWorld(const PhysicsWorld&) = delete;
+  PhysicsWorld& operator=(const PhysicsWorld&) = delete;
+
+  const PhysicsSettings& settings() const { return settings_; }
+
+  // --- building --------------------------------------------------------------
+  // Infinite ground plane z = 0.
+  void addGround(const Material& material);
+  // A fixed collision primitive; shape.pose is in the world frame.
+  void addStaticShape(const Shape& shape, const Material& material);
+  // A free rigid body; shape.pose is ignored (the body frame is the shape's).
+  BodyId addRigidBody(const Shape& shape, double mass, const Material& material,
+                      double linear_damping, double angular_damping, const Pose& pose);
+  // An articulated body; root_pose is the root link's joint frame in the world.
+  // `collision_group` >= 0: links sharing a group never collide with each other
+  // (self-collision off); different groups and everything else do collide.
+  ArticulationId addArticulation(std::shared_ptr<const ArticulatedModel> model,
+                                 const Pose& root_pose, std::span<const double> joint_positions,
+                                 int collision_group);
+
+  // --- commands ----------------------------------------------------------------
+  // Servo target and stiffness of one joint. Mimic joints follow their master:
+  // commanding the master also commands them.
+  void setJointTarget(ArticulationId a, int joint, double target_rad, double stiffness);
+  // Teleports an articulation (zero velocities); for placement and tests.
+  void resetArticulation(ArticulationId a, const Pose& root_pose,
+                         std::span<const double> joint_positions);
+  void setRigidBodyState(BodyId b, const RigidBodyState& state);
+  // Root velocity in the world frame (for tests and scenario set-up).
+  void setRootVelocity(ArticulationId a, const Vec3& linear, const Vec3& angular);
+
+  // --- stepping ----------------------------------------------------------------
+  void step();
+  uint64_t stepCount() const { return step_count_; }
+  void enableStageTimers(bool on) { timers_on_ = on; }
+  const StageTimes& stageTimes() const;
+  void resetStageTimes();
+
+  // --- reading -----------------------------------------------------------------
+  size_t articulationCount() const;
+  size_t rigidBodyCount() const;
+  const ArticulatedModel& model(ArticulationId a) const;
+  // Joint frame of a link in the world.
+  Pose linkPose(ArticulationId a, int link) const;
+  Vec3 rootLinearVelocity(ArticulationId a) const;
+  Vec3 rootAngularVelocity(ArticulationId a) const;
+  double jointPosition(ArticulationId a, int joint) const;
+  double jointVelocity(ArticulationId a, int joint) const;
+  // Torque the servo applied in the last step (motor + passive damping).
+  double jointTorque(ArticulationId a, int joint) const;
+  double jointTarget(ArticulationId a, int joint) const;
+  RigidBodyState rigidBodyState(BodyId b) const;
+  // Contact points in the contact manifolds after the last step.
+  ContactCount contactCount() const;
+
+  // Appends the full dynamic state (every root pose and velocity, joint
+  // positions and velocities, rigid bodies) as raw values in creation order:
+  // the canonical byte image that state hashes are computed over.
+  void appendState(std::vector<double>& out) const;
+
+ private:
+  struct Impl;
+  PhysicsSettings settings_;
+  std::unique_ptr<Impl> impl_;
+  uint64_t step_count_ = 0;
+  bool timers_on_ = false;
+};
+
+}  // namespace simsoccer::engine

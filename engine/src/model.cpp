@@ -1,0 +1,37 @@
+#include "simsoccer/engine/model.hpp"
+
+namespace simsoccer::engine {
+
+int ArticulatedModel::linkIndex(const std::string& link_name) const {
+  for (size_t i = 0; i < links.size(); ++i)
+    if (links[i].name == link_name) return static_cast<int>(i);
+  return -1;
+}
+
+int ArticulatedModel::jointIndex(const std::string& joint_name) const {
+  for (size_t i = 0; i < joints.size(); ++i)
+    if (joints[i].name == joint_name) return static_cast<int>(i);
+  return -1;
+}
+
+double ArticulatedModel::totalMass() const {
+  double m = 0.0;
+  for (const Link& l : links) m += l.mass;
+  return m;
+}
+
+std::vector<Pose> ArticulatedModel::linkFramesAt(const std::vector<double>& q) const {
+  std::vector<Pose> frames(links.size(), Pose::Identity());
+  for (size_t j = 0; j < joints.size(); ++j) {
+    const Joint& joint = joints[j];
+    const double angle = j < q.size() ? q[j] : 0.0;
+    Pose local = Pose::Identity();
+    local.translate(joint.origin);
+    local.rotate(Eigen::AngleAxisd(angle, joint.axis));
+    frames[static_cast<size_t>(joint.child_link)] =
+        frames[static_cast<size_t>(joint.parent_link)] * local;
+  }
+  return frames;
+}
+
+}  // namespace simsoccer::engine

@@ -1,0 +1,65 @@
+// A robot description (Nao H25, Nao H21, ...) loaded from YAML: the physical
+// model the engine simulates plus what the robot's software sees of it: the
+// actuator order of its command/sensor arrays, hands, sensor frames and
+// named poses.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "simsoccer/engine/model.hpp"
+
+namespace simsoccer::robots {
+
+using engine::Pose;
+
+// Where each entry of the robot's actuator arrays (LoLA order on a Nao) goes.
+struct Actuator {
+  enum class Kind { Joint, Hand, Absent };
+  std::string name;
+  Kind kind = Kind::Absent;
+  int index = -1;  // joint index in the body model, or hand index
+};
+
+// A gripper without a physical hinge (massless fingers): commanded and
+// sensed, rigid for contacts.
+struct Hand {
+  std::string name;
+  int link = -1;
+  double lower = 0.0, upper = 1.0;
+  int motor = -1;
+};
+
+struct SensorFrame {
+  std::string name;
+  std::string type;  // accelerometer, gyroscope, camera, sonar, fsr, bumper, touch
+  int link = -1;
+  Pose pose = Pose::Identity();  // in the link's joint frame
+};
+
+struct RobotModel {
+  std::string name;
+  std::string source_file;
+  std::shared_ptr<const engine::ArticulatedModel> body;
+  std::vector<Actuator> actuators;  // the robot's command order
+  std::vector<Hand> hands;
+  std::vector<SensorFrame> sensors;
+  std::map<std::string, std::vector<double>> poses;  // per body joint, rad
+
+  // Joint angles (one per body joint) of a named pose; throws if unknown.
+  const std::vector<double>& pose(const std::string& pose_name) const;
+  int actuatorIndex(const std::string& actuator_name) const;  // -1 if absent
+  const SensorFrame* sensor(const std::string& sensor_name) const;
+  // Height of the sole (lowest point of the feet's collision boxes) below
+  // the torso origin at the given joint angles, torso upright.
+  double soleDepth(const std::vector<double>& joint_positions) const;
+};
+
+// Loads and validates a robot file; throws engine::ConfigError naming the
+// file, key path and reason.
+RobotModel loadRobotModel(const std::filesystem::path& file);
+
+}  // namespace simsoccer::robots

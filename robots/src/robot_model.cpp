@@ -1,0 +1,318 @@
+#include "simsoccer/robots/robot_model.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+#include "simsoccer/engine/config.hpp"
+
+namespace simsoccer::robots {
+
+using engine::ConfigNode;
+using engine::Joint;
+using engine::Link;
+using engine::Mat3;
+using engine::Vec3;
+
+namespace {
+
+Mat3 readInertia(const ConfigNode& n) {
+  const auto v = n.numbers(6);  // ixx, iyy, izz, ixy, ixz, iyz
+  Mat3 I;
+  I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I);
+  const Vec3 d = eig.eigenvalues();
+  if (d.minCoeff() <= 0.0) n.fail("inertia tensor must be positive definite");
+  // Triangle inequality of principal moments (a physical rigid body).
+  if (d[0] + d[1] < d[2] * (1.0 - 1e-6)) n.fail("inertia tensor violates the triangle inequality");
+  return I;
+}
+
+// Moves the mass, inertia and shapes of `child` (attached rigidly at `origin`
+// in parent's frame) into `parent`.
+void mergeFixed(Link& parent, const Link& child, const Vec3& origin) {
+  const double m = parent.mass + child.mass;
+  const Vec3 child_com = origin + child.com;
+  const Vec3 com = (parent.mass * parent.com + child.mass * child_com) / m;
+  auto shifted = [](const Mat3& I, double mass, const Vec3& d) {
+    return Mat3(I + mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose()));
+  };
+  parent.inertia = shifted(parent.inertia, parent.mass, parent.com - com) +
+                   shifted(child.inertia, child.mass, child_com - com);
+  parent.mass = m;
+  parent.com = com;
+  for (engine::Shape s : child.shapes) {
+    s.pose.pretranslate(origin);
+    parent.shapes.push_back(s);
+  }
+}
+
+struct RawJoint {
+  ConfigNode node;
+  std::string name, type, parent, child;
+  Vec3 origin;
+};
+
+}  // namespace
+
+const std::vector<double>& RobotModel::pose(const std::string& pose_name) const {
+  auto it = poses.find(pose_name);
+  if (it == poses.end())
+    throw std::out_of_range("robot '" + name + "' has no pose '" + pose_name + "'");
+  return it->second;
+}
+
+int RobotModel::actuatorIndex(const std::string& actuator_name) const {
+  for (size_t i = 0; i < actuators.size(); ++i)
+    if (actuators[i].name == actuator_name) return static_cast<int>(i);
+  return -1;
+}
+
+const SensorFrame* RobotModel::sensor(const std::string& sensor_name) const {
+  for (const SensorFrame& s : sensors)
+    if (s.name == sensor_name) return &s;
+  return nullptr;
+}
+
+double RobotModel::soleDepth(const std::vector<double>& q) const {
+  const auto frames = body->linkFramesAt(q);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < body->links.size(); ++i) {
+    for (const engine::Shape& s : body->links[i].shapes) {
+      if (s.type != engine::ShapeType::Box) continue;
+      const Pose p = frames[i] * s.pose;
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 corner(((c & 1) ? 0.5 : -0.5) * s.extents.x(),
+                          ((c & 2) ? 0.5 : -0.5) * s.extents.y(),
+                          ((c & 4) ? 0.5 : -0.5) * s.extents.z());
+        lowest = std::min(lowest, (p * corner).z());
+      }
+    }
+  }
+  return -lowest;
+}
+
+RobotModel loadRobotModel(const std::filesystem::path& file) {
+  const ConfigNode root = ConfigNode::loadFile(file);
+  root.allowOnly({"robot", "material", "motors", "links", "joints", "actuators",
+                  "absent_actuators", "hands", "sensors", "poses"});
+  RobotModel robot;
+  robot.name = root["robot"].string();
+  robot.source_file = file.string();
+  auto body = std::make_shared<engine::ArticulatedModel>();
+  body->name = robot.name;
+  if (auto m = root.optional("material")) body->material = engine::readMaterial(*m, {});
+
+  // Motors.
+  std::map<std::string, double> motor_damping;
+  for (const auto& [name, n] : root["motors"].entries()) {
+    n.allowOnly({"motor_type", "gear_ratio", "stall_torque", "no_load_speed", "armature", "kp",
+                 "kd", "damping"});
+    engine::Motor m;
+    m.name = name;
+    m.stall_torque = n["stall_torque"].positive();
+    m.no_load_speed = n["no_load_speed"].positive();
+    m.armature = n["armature"].nonNegative();
+    m.kp = n["kp"].nonNegative();
+    m.kd = n["kd"].nonNegative();
+    if (auto g = n.optional("gear_ratio")) g->positive();
+    motor_damping[name] = n.has("damping") ? n["damping"].nonNegative() : 0.0;
+    body->motors.push_back(m);
+  }
+  auto motorIndex = [&](const ConfigNode& n) {
+    const std::string name = n.string();
+    for (size_t i = 0; i < body->motors.size(); ++i)
+      if (body->motors[i].name == name) return static_cast<int>(i);
+    n.fail("unknown motor '" + name + "' (not in 'motors')");
+  };
+
+  // Links, by name.
+  std::map<std::string, Link> links;
+  std::vector<std::string> link_order;
+  for (const ConfigNode& n : root["links"].items()) {
+    n.allowOnly({"name", "mass", "com", "inertia", "collision"});
+    Link l;
+    l.name = n["name"].string();
+    if (links.count(l.name)) n["name"].fail("duplicate link name '" + l.name + "'");
+    l.mass = n["mass"].positive();
+    l.com = n["com"].vec3();
+    l.inertia = readInertia(n["inertia"]);
+    if (auto c = n.optional("collision"))
+      for (const ConfigNode& s : c->items()) l.shapes.push_back(engine::readShape(s));
+    links[l.name] = l;
+    link_order.push_back(l.name);
+  }
+
+  // Joints: fixed joints are merged into their parent link first.
+  std::vector<RawJoint> raw;
+  std::set<std::string> joint_names;
+  for (const ConfigNode& n : root["joints"].items()) {
+    n.allowOnly({"name", "type", "parent", "child", "origin", "axis", "limits", "motor", "mimic",
+                 "damping"});
+    RawJoint j{n, n["name"].string(), n.has("type") ? n["type"].string() : "revolute",
+               n["parent"].string(), n["child"].string(), n["origin"].vec3()};
+    if (!joint_names.insert(j.name).second) n["name"].fail("duplicate joint name '" + j.name + "'");
+    if (j.type != "revolute" && j.type != "fixed")
+      n["type"].fail("unknown joint type '" + j.type + "' (revolute or fixed)");
+    if (!links.count(j.parent)) n["parent"].fail("unknown link '" + j.parent + "'");
+    if (!links.count(j.child)) n["child"].fail("unknown link '" + j.child + "'");
+    raw.push_back(j);
+  }
+  std::map<std::string, std::string> merged_into;  // fixed child -> parent it joined
+  std::map<std::string, Vec3> merged_offset;
+  auto resolve = [&](std::string link, Vec3& offset) {
+    offset = Vec3::Zero();
+    while (merged_into.count(link)) {
+      offset += merged_offset[link];
+      link = merged_into[link];
+    }
+    return link;
+  };
+  for (const RawJoint& j : raw) {
+    if (j.type != "fixed") continue;
+    Vec3 off;
+    const std::string parent = resolve(j.parent, off);
+    mergeFixed(links[parent], links[j.child], off + j.origin);
+    merged_into[j.child] = parent;
+    merged_offset[j.child] = off + j.origin;
+  }
+
+  std::set<std::string> children;
+  for (const RawJoint& j : raw) children.insert(j.child);
+  std::vector<std::string> roots;
+  for (const std::string& name : link_order)
+    if (!children.count(name)) roots.push_back(name);
+  if (roots.size() != 1)
+    root["links"].fail("expected exactly one root link (a link that is no joint's child), found " +
+                       std::to_string(roots.size()));
+  body->links.push_back(links[roots[0]]);
+  for (const RawJoint& j : raw) {
+    if (j.type == "fixed") continue;
+    Vec3 off;
+    const std::string parent = resolve(j.parent, off);
+    Joint joint;
+    joint.name = j.name;
+    joint.parent_link = body->linkIndex(parent);
+    if (joint.parent_link < 0)
+      j.node["parent"].fail("link '" + j.parent + "' must be attached by an earlier joint (tree order)");
+    joint.child_link = static_cast<int>(body->links.size());
+    joint.origin = off + j.origin;
+    joint.axis = j.node["axis"].vec3();
+    if (std::abs(joint.axis.norm() - 1.0) > 1e-3) j.node["axis"].fail("must be a unit vector");
+    joint.axis.normalize();
+    const auto lim = j.node["limits"].numbers(2);
+    if (!(lim[0] < lim[1])) j.node["limits"].fail("lower limit must be below upper limit");
+    joint.lower = lim[0];
+    joint.upper = lim[1];
+    if (auto m = j.node.optional("motor")) {
+      joint.motor = motorIndex(*m);
+      joint.damping = motor_damping[m->string()];
+    }
+    if (auto d = j.node.optional("damping")) joint.damping = d->nonNegative();
+    body->links.push_back(links[j.child]);
+    body->joints.push_back(joint);
+  }
+  // Mimic joints (after all joints exist, so the master may come later).
+  for (const RawJoint& j : raw) {
+    auto mimic = j.node.optional("mimic");
+    if (!mimic) continue;
+    if (j.type == "fixed") mimic->fail("a fixed joint cannot mimic");
+    mimic->allowOnly({"joint", "multiplier"});
+    const int self = body->jointIndex(j.name);
+    const int master = body->jointIndex((*mimic)["joint"].string());
+    if (master < 0) (*mimic)["joint"].fail("unknown joint '" + (*mimic)["joint"].string() + "'");
+    if (master == self) (*mimic)["joint"].fail("a joint cannot mimic itself");
+    body->joints[static_cast<size_t>(self)].mimic_of = master;
+    body->joints[static_cast<size_t>(self)].mimic_multiplier = mimic->number("multiplier", 1.0);
+  }
+
+  // Hands.
+  if (auto hands = root.optional("hands")) {
+    for (const ConfigNode& n : hands->items()) {
+      n.allowOnly({"name", "link", "limits", "motor"});
+      Hand h;
+      h.name = n["name"].string();
+      Vec3 off;
+      h.link = body->linkIndex(resolve(n["link"].string(), off));
+      if (h.link < 0) n["link"].fail("unknown link '" + n["link"].string() + "'");
+      const auto lim = n["limits"].numbers(2);
+      if (!(lim[0] < lim[1])) n["limits"].fail("lower limit must be below upper limit");
+      h.lower = lim[0];
+      h.upper = lim[1];
+      h.motor = motorIndex(n["motor"]);
+      robot.hands.push_back(h);
+    }
+  }
+
+  // Actuators (the command order).
+  std::set<std::string> absent;
+  if (auto a = root.optional("absent_actuators"))
+    for (const ConfigNode& n : a->items()) absent.insert(n.string());
+  std::set<std::string> seen;
+  for (const ConfigNode& n : root["actuators"].items()) {
+    Actuator a;
+    a.name = n.string();
+    if (!seen.insert(a.name).second) n.fail("duplicate actuator '" + a.name + "'");
+    const int joint = body->jointIndex(a.name);
+    int hand = -1;
+    for (size_t i = 0; i < robot.hands.size(); ++i)
+      if (robot.hands[i].name == a.name) hand = static_cast<int>(i);
+    if (joint >= 0) {
+      if (body->joints[static_cast<size_t>(joint)].motor < 0)
+        n.fail("joint '" + a.name + "' has no motor and cannot be an actuator");
+      a.kind = Actuator::Kind::Joint;
+      a.index = joint;
+    } else if (hand >= 0) {
+      a.kind = Actuator::Kind::Hand;
+      a.index = hand;
+    } else if (absent.count(a.name)) {
+      a.kind = Actuator::Kind::Absent;
+    } else {
+      n.fail("unknown actuator '" + a.name + "' (not a joint, a hand or in absent_actuators)");
+    }
+    robot.actuators.push_back(a);
+  }
+
+  // Sensor frames.
+  if (auto sensors = root.optional("sensors")) {
+    for (const ConfigNode& n : sensors->items()) {
+      n.allowOnly({"name", "type", "link", "position", "rpy"});
+      SensorFrame s;
+      s.name = n["name"].string();
+      s.type = n["type"].string();
+      Vec3 off;
+      s.link = body->linkIndex(resolve(n["link"].string(), off));
+      if (s.link < 0) n["link"].fail("unknown link '" + n["link"].string() + "'");
+      s.pose = engine::readPose(n);
+      s.pose.pretranslate(off);
+      robot.sensors.push_back(s);
+    }
+  }
+
+  // Named poses, validated against the joint limits.
+  if (auto poses = root.optional("poses")) {
+    for (const auto& [pose_name, n] : poses->entries()) {
+      std::vector<double> q(body->joints.size(), 0.0);
+      if (!n.raw().IsMap()) n.fail("expected a mapping of joint names to angles");
+      for (const auto& [joint_name, v] : n.entries()) {
+        const int j = body->jointIndex(joint_name);
+        if (j < 0) v.fail("unknown joint '" + joint_name + "'");
+        q[static_cast<size_t>(j)] = v.number();
+      }
+      for (size_t j = 0; j < q.size(); ++j) {
+        const Joint& joint = body->joints[j];
+        if (joint.mimic_of >= 0)
+          q[j] = joint.mimic_multiplier * q[static_cast<size_t>(joint.mimic_of)];
+        if (q[j] < joint.lower - 1e-9 || q[j] > joint.upper + 1e-9)
+          n.failKey(joint.name, "angle " + std::to_string(q[j]) + " is outside the joint limits");
+      }
+      robot.poses[pose_name] = q;
+    }
+  }
+  robot.body = std::move(body);
+  return robot;
+}
+
+}  // namespace simsoccer::robots

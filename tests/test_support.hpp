@@ -1,0 +1,37 @@
+// Shared helpers for the test suites: paths to the project's data files and
+// small scenarios built in code.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "simsoccer/world/scenario.hpp"
+
+namespace simsoccer::test {
+
+inline std::filesystem::path sourceDir() { return SIMSOCCER_SOURCE_DIR; }
+inline std::filesystem::path dataDir() { return sourceDir() / "tests" / "data"; }
+inline std::filesystem::path naoH25() { return sourceDir() / "robots" / "nao_v6_h25.yaml"; }
+inline std::filesystem::path naoH21() { return sourceDir() / "robots" / "nao_h21.yaml"; }
+inline std::filesystem::path splField() { return sourceDir() / "fields" / "spl.yaml"; }
+
+// An SPL field scenario with the given robots (team 0, numbers 1..n, in a row).
+inline world::Scenario scenario(int robots, uint64_t seed = 1) {
+  world::Scenario s;
+  s.name = "test";
+  s.field_file = splField();
+  s.robot_model_file = naoH25();
+  s.seed = seed;
+  s.ball_position = {3.0, 2.0, -1.0};
+  for (int i = 0; i < robots; ++i) {
+    world::RobotPlacement p;
+    p.team = i % 2;
+    p.number = i / 2 + 1;
+    p.x = -3.5 + 0.7 * (i % 10);
+    p.y = -1.0 + 1.0 * (i / 10);
+    s.robots.push_back(p);
+  }
+  return s;
+}
+
+}  // namespace simsoccer::test

@@ -1,0 +1,101 @@
+// The simulated world: a field, a ball and Nao robots in one physics engine,
+// advanced at a fixed time step. The step count is the clock.
+//
+// Robots are addressed by index (RobotId), in scenario order. Commands are
+// per robot, in the robot model's actuator order (LoLA order for a Nao),
+// and hold until replaced.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "simsoccer/engine/physics_world.hpp"
+#include "simsoccer/fields/field_model.hpp"
+#include "simsoccer/robots/robot_model.hpp"
+#include "simsoccer/world/scenario.hpp"
+
+namespace simsoccer::world {
+
+using RobotId = uint32_t;
+using engine::Pose;
+using engine::Vec3;
+
+struct RobotInfo {
+  int team = 0;
+  int number = 0;
+  std::shared_ptr<const robots::RobotModel> model;
+  engine::ArticulationId body = 0;
+};
+
+struct RobotState {
+  Pose torso = Pose::Identity();     // torso frame in the field frame
+  Vec3 linear_velocity = Vec3::Zero();   // torso origin... root, world frame
+  Vec3 angular_velocity = Vec3::Zero();
+  std::vector<double> joint_positions;   // per body joint, rad
+  std::vector<double> joint_velocities;  // rad/s
+};
+
+struct WorldSnapshot {
+  uint64_t step = 0;
+  double time = 0.0;  // s
+  std::vector<RobotState> robots;
+  engine::RigidBodyState ball;
+};
+
+class World {
+ public:
+  explicit World(const Scenario& scenario);
+  static World fromFile(const std::filesystem::path& scenario_file);
+
+  const Scenario& scenario() const { return scenario_; }
+  const fields::FieldModel& field() const { return *field_; }
+  size_t robotCount() const { return robots_.size(); }
+  const RobotInfo& robot(RobotId r) const { return robots_.at(r); }
+  int stepsPerControlPeriod() const { return steps_per_control_; }
+
+  // --- commands -----------------------------------------------------------------
+  // Targets (rad) and stiffnesses (0..1) in actuator order; sizes must match
+  // the robot's actuator count. Non-finite values are rejected (throws).
+  void setCommand(RobotId r, std::span<const double> positions, std::span<const double> stiffness);
+  // One body joint by index (mimic joints follow their master).
+  void setJointTarget(RobotId r, int joint, double target_rad, double stiffness);
+  // A named pose of the robot model at one stiffness for every joint.
+  void setPoseTarget(RobotId r, const std::string& pose_name, double stiffness);
+
+  // --- time -----------------------------------------------------------------------
+  void step();                // one physics step (dt)
+  void stepControlPeriod();   // control_period / dt physics steps
+  uint64_t stepCount() const { return physics_->stepCount(); }
+  double time() const { return static_cast<double>(stepCount()) * scenario_.physics.dt; }
+
+  // --- state ------------------------------------------------------------------------
+  Pose torsoPose(RobotId r) const;
+  Pose linkPose(RobotId r, int link) const;
+  double jointPosition(RobotId r, int joint) const;
+  engine::RigidBodyState ballState() const;
+  void setBallState(const engine::RigidBodyState& state);
+  // Upright: torso origin above `min_height` and tilted less than `max_tilt`.
+  bool isStanding(RobotId r, double min_height = 0.22, double max_tilt = 0.785) const;
+
+  WorldSnapshot snapshot() const;
+  // 64-bit hash over the full dynamic state and the step count.
+  uint64_t stateHash() const;
+
+  engine::PhysicsWorld& physics() { return *physics_; }
+  const engine::PhysicsWorld& physics() const { return *physics_; }
+
+ private:
+  Scenario scenario_;
+  std::shared_ptr<const fields::FieldModel> field_;
+  std::unique_ptr<engine::PhysicsWorld> physics_;
+  std::vector<RobotInfo> robots_;
+  engine::BodyId ball_ = 0;
+  int steps_per_control_ = 1;
+};
+
+}  // namespace simsoccer::world

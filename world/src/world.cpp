@@ -1,0 +1,203 @@
+#include "simsoccer/world/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/engine/state_hash.hpp"
+
+namespace simsoccer::world {
+
+namespace {
+
+[[noreturn]] void scenarioError(const Scenario& s, const std::string& key,
+                                const std::string& reason) {
+  throw engine::ConfigError(s.source_file.empty() ? "<scenario " + s.name + ">" : s.source_file,
+                            key, reason);
+}
+
+std::string robotKey(size_t i, const char* field) {
+  return "robots[" + std::to_string(i) + "]." + field;
+}
+
+}  // namespace
+
+World World::fromFile(const std::filesystem::path& scenario_file) {
+  return World(loadScenario(scenario_file));
+}
+
+World::World(const Scenario& scenario) : scenario_(scenario) {
+  const PhysicsConfig& pc = scenario_.physics;
+  if (!(pc.dt > 0.0)) scenarioError(scenario_, "physics.dt", "must be > 0");
+  const double ratio = pc.control_period / pc.dt;
+  if (!(ratio >= 1.0) || std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
+    scenarioError(scenario_, "physics.control_period", "must be a whole multiple of dt");
+  steps_per_control_ = static_cast<int>(std::lround(ratio));
+
+  field_ = std::make_shared<const fields::FieldModel>(fields::loadFieldModel(scenario_.field_file));
+  engine::PhysicsSettings settings;
+  settings.dt = pc.dt;
+  settings.solver_iterations = pc.solver_iterations;
+  settings.friction_directions = pc.friction_directions;
+  settings.gravity = Vec3(0, 0, pc.gravity);
+  physics_ = std::make_unique<engine::PhysicsWorld>(settings);
+  fields::addFieldToPhysics(*physics_, *field_);
+
+  // Ball.
+  const fields::BallModel& bm = field_->ball;
+  engine::Shape ball_shape;
+  ball_shape.type = engine::ShapeType::Sphere;
+  ball_shape.radius = bm.radius;
+  Pose ball_pose = Pose::Identity();
+  Vec3 bp = scenario_.ball_position;
+  if (bp.z() < 0.0) bp.z() = bm.radius;
+  if (!field_->onCarpet(bp.x(), bp.y())) scenarioError(scenario_, "ball.position", "outside the carpet");
+  ball_pose.translation() = bp;
+  ball_ = physics_->addRigidBody(ball_shape, bm.mass, bm.material, bm.linear_damping,
+                                 bm.angular_damping, ball_pose);
+  physics_->setRigidBodyState(ball_, {ball_pose, scenario_.ball_velocity, Vec3::Zero()});
+
+  // Robots, in scenario order; each model file is loaded once and shared.
+  std::map<std::string, std::shared_ptr<const robots::RobotModel>> models;
+  std::map<std::pair<int, int>, size_t> numbers;
+  std::mt19937_64 rng(scenario_.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (size_t i = 0; i < scenario_.robots.size(); ++i) {
+    const RobotPlacement& p = scenario_.robots[i];
+    if (auto [it, fresh] = numbers.emplace(std::pair{p.team, p.number}, i); !fresh)
+      scenarioError(scenario_, robotKey(i, "number"),
+                    "duplicate player number " + std::to_string(p.number) + " in team " +
+                        std::to_string(p.team) + " (also robots[" + std::to_string(it->second) +
+                        "])");
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw))
+      scenarioError(scenario_, robotKey(i, "pose"), "must be finite");
+    if (!field_->onCarpet(p.x, p.y))
+      scenarioError(scenario_, robotKey(i, "pose"),
+                    "robot placed outside the field: (" + std::to_string(p.x) + ", " +
+                        std::to_string(p.y) + ") is beyond the carpet (|x| <= " +
+                        std::to_string(field_->halfLength() + field_->border) + ", |y| <= " +
+                        std::to_string(field_->halfWidth() + field_->border) + ")");
+    const std::string file =
+        p.model_file.empty() ? scenario_.robot_model_file.string() : p.model_file;
+    auto& model = models[file];
+    if (!model) model = std::make_shared<const robots::RobotModel>(robots::loadRobotModel(file));
+    if (!model->poses.count(p.posture))
+      scenarioError(scenario_, robotKey(i, "posture"),
+                    "robot model '" + model->name + "' has no pose '" + p.posture + "'");
+    std::vector<double> q = model->pose(p.posture);
+    const auto& joints = model->body->joints;
+    double x = p.x, y = p.y, yaw = p.yaw;
+    if (scenario_.noise.position > 0) {
+      x += scenario_.noise.position * normal(rng);
+      y += scenario_.noise.position * normal(rng);
+    }
+    if (scenario_.noise.yaw > 0) yaw += scenario_.noise.yaw * normal(rng);
+    if (scenario_.noise.joints > 0) {
+      for (size_t j = 0; j < q.size(); ++j)
+        if (joints[j].mimic_of < 0)
+          q[j] = std::clamp(q[j] + scenario_.noise.joints * normal(rng), joints[j].lower,
+                            joints[j].upper);
+      for (size_t j = 0; j < q.size(); ++j)
+        if (joints[j].mimic_of >= 0)
+          q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+    }
+    // Upright, soles 1 mm above the carpet.
+    Pose torso = Pose::Identity();
+    torso.translation() = Vec3(x, y, model->soleDepth(q) + 0.001);
+    torso.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+    RobotInfo info;
+    info.team = p.team;
+    info.number = p.number;
+    info.model = model;
+    info.body = physics_->addArticulation(model->body, torso, q, static_cast<int>(i));
+    robots_.push_back(info);
+    // Hold the posture at full stiffness until commanded otherwise.
+    for (size_t j = 0; j < joints.size(); ++j)
+      if (joints[j].motor >= 0 && joints[j].mimic_of < 0)
+        physics_->setJointTarget(info.body, static_cast<int>(j), q[j], 1.0);
+  }
+}
+
+void World::setCommand(RobotId r, std::span<const double> positions,
+                       std::span<const double> stiffness) {
+  const RobotInfo& info = robots_.at(r);
+  const auto& actuators = info.model->actuators;
+  if (positions.size() != actuators.size() || stiffness.size() != actuators.size())
+    throw std::invalid_argument("command for robot " + std::to_string(r) + " needs " +
+                                std::to_string(actuators.size()) + " positions and stiffnesses");
+  for (size_t i = 0; i < actuators.size(); ++i)
+    if (!std::isfinite(positions[i]) || !std::isfinite(stiffness[i]))
+      throw std::invalid_argument("command for robot " + std::to_string(r) +
+                                  ": non-finite value for " + actuators[i].name);
+  for (size_t i = 0; i < actuators.size(); ++i)
+    if (actuators[i].kind == robots::Actuator::Kind::Joint)
+      physics_->setJointTarget(info.body, actuators[i].index, positions[i], stiffness[i]);
+}
+
+void World::setJointTarget(RobotId r, int joint, double target_rad, double stiffness) {
+  physics_->setJointTarget(robots_.at(r).body, joint, target_rad, stiffness);
+}
+
+void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffness) {
+  const RobotInfo& info = robots_.at(r);
+  const auto& q = info.model->pose(pose_name);
+  const auto& joints = info.model->body->joints;
+  for (size_t j = 0; j < joints.size(); ++j)
+    if (joints[j].motor >= 0 && joints[j].mimic_of < 0)
+      physics_->setJointTarget(info.body, static_cast<int>(j), q[j], stiffness);
+}
+
+void World::step() { physics_->step(); }
+
+void World::stepControlPeriod() {
+  for (int i = 0; i < steps_per_control_; ++i) physics_->step();
+}
+
+Pose World::torsoPose(RobotId r) const { return physics_->linkPose(robots_.at(r).body, 0); }
+Pose World::linkPose(RobotId r, int link) const {
+  return physics_->linkPose(robots_.at(r).body, link);
+}
+double World::jointPosition(RobotId r, int joint) const {
+  return physics_->jointPosition(robots_.at(r).body, joint);
+}
+engine::RigidBodyState World::ballState() const { return physics_->rigidBodyState(ball_); }
+void World::setBallState(const engine::RigidBodyState& state) {
+  physics_->setRigidBodyState(ball_, state);
+}
+
+bool World::isStanding(RobotId r, double min_height, double max_tilt) const {
+  const Pose torso = torsoPose(r);
+  const double up_z = torso.linear()(2, 2);
+  return torso.translation().z() > min_height && up_z > std::cos(max_tilt);
+}
+
+WorldSnapshot World::snapshot() const {
+  WorldSnapshot s;
+  s.step = stepCount();
+  s.time = time();
+  for (const RobotInfo& info : robots_) {
+    RobotState rs;
+    rs.torso = physics_->linkPose(info.body, 0);
+    rs.linear_velocity = physics_->rootLinearVelocity(info.body);
+    rs.angular_velocity = physics_->rootAngularVelocity(info.body);
+    const int n = static_cast<int>(info.model->body->joints.size());
+    for (int j = 0; j < n; ++j) {
+      rs.joint_positions.push_back(physics_->jointPosition(info.body, j));
+      rs.joint_velocities.push_back(physics_->jointVelocity(info.body, j));
+    }
+    s.robots.push_back(std::move(rs));
+  }
+  s.ball = ballState();
+  return s;
+}
+
+uint64_t World::stateHash() const {
+  std::vector<double> values;
+  physics_->appendState(values);
+  const uint64_t step = stepCount();
+  return engine::hashValues(values, engine::hashBytes(&step, sizeof step));
+}
+
+}  // namespace simsoccer::world
