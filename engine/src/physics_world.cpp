@@ -277,6 +277,10 @@ BodyId PhysicsWorld::addRigidBody(const Shape& shape, double mass, const Materia
   auto body = std::make_unique<btRigidBody>(info);
   body->setDamping(static_cast<btScalar>(linear_damping), static_cast<btScalar>(angular_damping));
   body->setActivationState(DISABLE_DEACTIVATION);  // a ball at rest must still react
+  // Swept-sphere CCD so a fast shot cannot tunnel through a 20 mm net.
+  const double r = shape.type == ShapeType::Sphere ? shape.radius : 0.05;
+  body->setCcdMotionThreshold(static_cast<btScalar>(0.5 * r));
+  body->setCcdSweptSphereRadius(static_cast<btScalar>(0.9 * r));
   body->setUserIndex(-1);
   applyMaterial(body.get(), material);
   m.world->addRigidBody(body.get());
@@ -375,8 +379,16 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     m.world->addMultiBodyConstraint(limit.get());
     m.constraints.push_back(std::move(limit));
     if (joint.motor >= 0) {
-      art.servo[static_cast<size_t>(j)] = static_cast<int>(m.servos.add(
-          model.motors[static_cast<size_t>(joint.motor)], joint.damping, joint.lower, joint.upper));
+      // Lower bound of the inertia this joint moves: the armature plus its own
+      // link about the joint axis (the rest of the chain only adds to it).
+      const Link& link = model.links[static_cast<size_t>(joint.child_link)];
+      const Motor& motor = model.motors[static_cast<size_t>(joint.motor)];
+      const Vec3 a = joint.axis.normalized();
+      const Mat3 about_joint = link.inertia + link.mass * (link.com.squaredNorm() * Mat3::Identity() -
+                                                           link.com * link.com.transpose());
+      const double min_inertia = motor.armature + a.dot(about_joint * a);
+      art.servo[static_cast<size_t>(j)] = static_cast<int>(
+          m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia));
       m.servo_body.push_back(raw);
       m.servo_link.push_back(j);
     }
@@ -426,6 +438,8 @@ void PhysicsWorld::resetArticulation(ArticulationId a, const Pose& root_pose,
                           : 0.0;
     mb->setJointPos(j, static_cast<btScalar>(q0));
     mb->setJointVel(j, 0);
+    const int s = art.servo.empty() ? -1 : art.servo[static_cast<size_t>(j)];
+    if (s >= 0) m.servos.resetHistory(static_cast<size_t>(s));
   }
   m.updateKinematics(mb);
 }
@@ -456,7 +470,7 @@ void PhysicsWorld::step() {
     m.q[i] = m.servo_body[i]->getJointPos(m.servo_link[i]);
     m.qdot[i] = m.servo_body[i]->getJointVel(m.servo_link[i]);
   }
-  m.servos.computeTorques(m.q, m.qdot, m.tau);
+  m.servos.computeTorques(m.q, m.qdot, m.tau, settings_.dt);
   for (size_t i = 0; i < n; ++i)
     m.servo_body[i]->addJointTorque(m.servo_link[i], static_cast<btScalar>(m.tau[i]));
   if (timers_on_) m.times.servo_s += std::chrono::duration<double>(Clock::now() - t0).count();

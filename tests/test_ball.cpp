@@ -1,0 +1,77 @@
+// The ball on the carpet and against the goal (real Bullet).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "simsoccer/world/world.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using engine::Vec3;
+
+namespace {
+
+world::Scenario emptyField() {
+  world::Scenario s = test::scenario(0);
+  s.ball_position = {-3.0, 0.0, -1.0};
+  return s;
+}
+
+// Rolls the ball from rest at `speed` along +x (rolling, not sliding) and
+// returns the distance until it stops.
+double rollDistance(double speed) {
+  world::World w(emptyField());
+  auto b = w.ballState();
+  const double r = w.field().ball.radius;
+  b.linear_velocity = Vec3(speed, 0, 0);
+  b.angular_velocity = Vec3(0, speed / r, 0);
+  w.setBallState(b);
+  const double x0 = b.pose.translation().x();
+  for (int i = 0; i < 4000; ++i) {
+    w.step();
+    if (w.ballState().linear_velocity.norm() < 0.005) break;
+  }
+  return w.ballState().pose.translation().x() - x0;
+}
+
+}  // namespace
+
+TEST(Ball, RollingDistanceInBand) {
+  const double d = rollDistance(2.0);
+  std::printf("ball rolled at 2 m/s stops after %.2f m\n", d);
+  EXPECT_GE(d, 3.0);
+  EXPECT_LE(d, 6.0);
+  EXPECT_LT(rollDistance(1.0), d);  // slower ball, shorter roll
+}
+
+TEST(Ball, RestsOnTheCarpet) {
+  world::World w(emptyField());
+  for (int i = 0; i < 400; ++i) w.step();
+  const auto b = w.ballState();
+  EXPECT_NEAR(b.pose.translation().z(), w.field().ball.radius, 0.002);
+  EXPECT_LT(b.linear_velocity.norm(), 1e-3);
+}
+
+TEST(Ball, BouncesOffGoalPost) {
+  world::Scenario s = emptyField();
+  const double post_x = 4.5, post_y = 0.8;  // left post of the +x goal (field frame)
+  s.ball_position = {post_x - 1.0, post_y, -1.0};
+  world::World w(s);
+  auto b = w.ballState();
+  b.linear_velocity = Vec3(3.0, 0, 0);
+  b.angular_velocity = Vec3(0, 3.0 / w.field().ball.radius, 0);
+  w.setBallState(b);
+  double min_gap = 1e9;
+  for (int i = 0; i < 200; ++i) {
+    w.step();
+    const Vec3 p = w.ballState().pose.translation();
+    min_gap = std::min(min_gap, std::hypot(p.x() - post_x, p.y() - post_y));
+  }
+  const auto end = w.ballState();
+  std::printf("ball after hitting the post: x %.3f, vx %.3f, closest centre distance %.3f\n",
+              end.pose.translation().x(), end.linear_velocity.x(), min_gap);
+  EXPECT_LT(end.linear_velocity.x(), -0.2);                  // came back
+  EXPECT_LT(end.pose.translation().x(), post_x - 0.1);      // in front of the post
+  // Never passed through it (a 5 ms step at 3 m/s moves the ball 15 mm).
+  EXPECT_GT(min_gap, w.field().ball.radius + 0.05 - 0.02);
+}

@@ -1,0 +1,58 @@
+// End to end: the real `simsoccer bench physics` program, its table and CSV.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+std::string runCommand(const std::string& cmd, int& status) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) out += buf;
+  status = pclose(p);
+  return out;
+}
+
+}  // namespace
+
+TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
+  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_test.csv";
+  std::filesystem::remove(csv);
+  int status = -1;
+  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
+                                         " bench physics --robots 1,2 --seconds 0.5 --csv " +
+                                         csv.string(),
+                                     status);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("steps_per_s"), std::string::npos);
+  EXPECT_NE(out.find("real_time_factor"), std::string::npos);
+  std::ifstream f(csv);
+  std::string header, row1, row2, extra;
+  std::getline(f, header);
+  std::getline(f, row1);
+  std::getline(f, row2);
+  EXPECT_EQ(header.rfind("robots,", 0), 0u) << header;
+  EXPECT_EQ(row1.rfind("1,", 0), 0u) << row1;
+  EXPECT_EQ(row2.rfind("2,", 0), 0u) << row2;
+  EXPECT_FALSE(std::getline(f, extra) && !extra.empty());
+  // Both robots of the pair still stand: "2/2" in the standing column.
+  EXPECT_NE(row2.find(",2/2,"), std::string::npos) << row2;
+  std::filesystem::remove(csv);
+}
+
+TEST(BenchPhysicsApp, RejectsBadOptions) {
+  int status = -1;
+  const std::string out = runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 0", status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("--robots"), std::string::npos) << out;
+  const std::string help = runCommand(std::string(SIMSOCCER_BIN) + " bench physics --help", status);
+  EXPECT_EQ(status, 0);
+  EXPECT_NE(help.find("--csv"), std::string::npos);
+}

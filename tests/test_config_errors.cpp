@@ -1,0 +1,165 @@
+// Every config error stops at load with a message naming the file, the key
+// path and the reason.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/fields/field_model.hpp"
+#include "simsoccer/robots/robot_model.hpp"
+#include "simsoccer/world/world.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readFile(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+class ConfigErrors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("simsoccer_cfg_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    robot_ = readFile(test::naoH25());
+    scenario_ = readFile(test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml");
+    // Point the copied scenario at the copied robot file and the real field.
+    replace(scenario_, "../../fields/spl.yaml", test::splField().string());
+    replace(scenario_, "../../robots/nao_v6_h25.yaml", (dir_ / "robot.yaml").string());
+    replace(scenario_, "../../robots/nao_h21.yaml", test::naoH21().string());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static void replace(std::string& s, const std::string& from, const std::string& to) {
+    const size_t at = s.find(from);
+    ASSERT_NE(at, std::string::npos) << "test set-up: '" << from << "' not found";
+    s.replace(at, from.size(), to);
+  }
+
+  // Writes both files and loads the world; returns the error.
+  engine::ConfigError load() {
+    std::ofstream(dir_ / "robot.yaml") << robot_;
+    std::ofstream(dir_ / "scenario.yaml") << scenario_;
+    try {
+      world::World w = world::World::fromFile(dir_ / "scenario.yaml");
+    } catch (const engine::ConfigError& e) {
+      return e;
+    }
+    ADD_FAILURE() << "no ConfigError";
+    return engine::ConfigError("", "", "");
+  }
+
+  void expectError(const std::string& file, const std::string& key, const std::string& reason) {
+    const engine::ConfigError e = load();
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file), std::string::npos) << what;
+    EXPECT_EQ(e.key(), key) << what;
+    EXPECT_NE(what.find(reason), std::string::npos) << what;
+  }
+
+  fs::path dir_;
+  std::string robot_, scenario_;
+};
+
+}  // namespace
+
+TEST_F(ConfigErrors, ValidFilesLoad) {
+  std::ofstream(dir_ / "robot.yaml") << robot_;
+  std::ofstream(dir_ / "scenario.yaml") << scenario_;
+  world::World w = world::World::fromFile(dir_ / "scenario.yaml");
+  EXPECT_EQ(w.robotCount(), 10u);
+  EXPECT_EQ(w.robot(9).model->name, "nao_h21");
+}
+
+TEST_F(ConfigErrors, MissingKey) {
+  replace(scenario_, "  dt: 0.005               # s, physics step\n", "");
+  expectError("scenario.yaml", "physics.dt", "missing required key");
+}
+
+TEST_F(ConfigErrors, WrongType) {
+  replace(scenario_, "solver_iterations: 10", "solver_iterations: many");
+  expectError("scenario.yaml", "physics.solver_iterations", "expected an integer");
+}
+
+TEST_F(ConfigErrors, UnknownKeyIsATypo) {
+  replace(scenario_, "seed: 7", "seed: 7\nsede: 8");
+  expectError("scenario.yaml", "sede", "unknown key");
+}
+
+TEST_F(ConfigErrors, UnknownJointName) {
+  replace(robot_, "stand: {LHipPitch: -0.45", "stand: {LHipPich: -0.45");
+  expectError("robot.yaml", "poses.stand.LHipPich", "unknown joint 'LHipPich'");
+}
+
+TEST_F(ConfigErrors, UnknownMimicJoint) {
+  replace(robot_, "mimic: {joint: LHipYawPitch", "mimic: {joint: LHipYawPich");
+  expectError("robot.yaml", "joints[18].mimic.joint", "unknown joint 'LHipYawPich'");
+}
+
+TEST_F(ConfigErrors, UnknownLinkName) {
+  replace(robot_, "parent: LThigh, child: LTibia", "parent: LThig, child: LTibia");
+  expectError("robot.yaml", "joints[15].parent", "unknown link 'LThig'");
+}
+
+TEST_F(ConfigErrors, NonPositiveMass) {
+  replace(robot_, "mass: 0.65973", "mass: 0");
+  expectError("robot.yaml", "links[2].mass", "must be > 0");
+}
+
+TEST_F(ConfigErrors, RobotOutsideTheField) {
+  replace(scenario_, "pose: [-3.0, 1.0, 0.0]", "pose: [-3.0, 9.0, 0.0]");
+  expectError("scenario.yaml", "robots[1].pose", "outside the field");
+}
+
+TEST_F(ConfigErrors, DuplicatePlayerNumber) {
+  replace(scenario_, "{team: 0, number: 3,", "{team: 0, number: 2,");
+  expectError("scenario.yaml", "robots[2].number", "duplicate player number 2 in team 0");
+}
+
+TEST_F(ConfigErrors, ControlPeriodNotAMultipleOfDt) {
+  replace(scenario_, "control_period: 0.010", "control_period: 0.012");
+  expectError("scenario.yaml", "physics.control_period", "whole multiple of dt");
+}
+
+TEST_F(ConfigErrors, UnknownPosture) {
+  replace(scenario_, "posture: stand", "posture: crouch");
+  expectError("scenario.yaml", "robots[4].posture", "has no pose 'crouch'");
+}
+
+TEST_F(ConfigErrors, PoseOutsideJointLimits) {
+  replace(robot_, "LKneePitch: 0.9", "LKneePitch: 2.5");
+  expectError("robot.yaml", "poses.stand.LKneePitch", "outside the joint limits");
+}
+
+TEST_F(ConfigErrors, MissingFile) {
+  replace(scenario_, test::splField().string(), "no_such_field.yaml");
+  expectError("scenario.yaml", "field", "file not found");
+}
+
+TEST_F(ConfigErrors, SyntaxError) {
+  scenario_ += "\nrobots: [unclosed\n";
+  expectError("scenario.yaml", "", "YAML syntax error at line");
+}
+
+TEST_F(ConfigErrors, BadFieldValue) {
+  std::string field = readFile(test::splField());
+  replace(field, "width: 6.0", "width: -6.0");
+  std::ofstream(dir_ / "field.yaml") << field;
+  try {
+    fields::loadFieldModel(dir_ / "field.yaml");
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "width");
+    EXPECT_NE(std::string(e.what()).find("field.yaml"), std::string::npos);
+  }
+}

@@ -1,0 +1,46 @@
+// Field descriptions: dimensions, derived markings and goal geometry.
+#include <gtest/gtest.h>
+
+#include "simsoccer/fields/field_model.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+
+TEST(Field, SplDimensions) {
+  const auto f = fields::loadFieldModel(test::splField());
+  EXPECT_DOUBLE_EQ(f.length, 9.0);
+  EXPECT_DOUBLE_EQ(f.width, 6.0);
+  EXPECT_DOUBLE_EQ(f.border, 0.7);
+  EXPECT_DOUBLE_EQ(f.centre_circle_radius, 0.75);
+  EXPECT_DOUBLE_EQ(f.ball.radius, 0.05);
+  EXPECT_DOUBLE_EQ(f.ball.mass, 0.044);
+  ASSERT_TRUE(f.penalty_area && f.goal_area);
+  // 4 boundary lines + halfway line + 3 lines per area and side.
+  EXPECT_EQ(f.lines.size(), 5u + 2u * 2u * 3u);
+  EXPECT_EQ(f.marks.size(), 3u);
+  EXPECT_DOUBLE_EQ(f.marks[0].x(), -3.2);  // penalty marks at (+-3.2, 0)
+  EXPECT_TRUE(f.onCarpet(5.2, 3.7));
+  EXPECT_FALSE(f.onCarpet(5.25, 0.0));
+}
+
+TEST(Field, GoalPostsAndCrossbar) {
+  const auto f = fields::loadFieldModel(test::splField());
+  const auto shapes = f.goalShapes(+1);
+  ASSERT_GE(shapes.size(), 3u);
+  // Posts centred on the goal line, inner faces 1.5 m apart.
+  EXPECT_DOUBLE_EQ(shapes[0].pose.translation().x(), 4.5);
+  EXPECT_NEAR(shapes[1].pose.translation().y() - shapes[0].pose.translation().y() -
+                  2 * shapes[0].radius, 1.5, 1e-12);
+  // Crossbar underside at 0.8 m.
+  EXPECT_NEAR(shapes[2].pose.translation().z() - shapes[2].radius, 0.8, 1e-12);
+  const auto other = f.goalShapes(-1);
+  EXPECT_DOUBLE_EQ(other[0].pose.translation().x(), -4.5);
+}
+
+TEST(Field, SimLeagueField) {
+  const auto f = fields::loadFieldModel(test::sourceDir() / "fields" / "simleague.yaml");
+  EXPECT_DOUBLE_EQ(f.length, 30.0);
+  EXPECT_DOUBLE_EQ(f.width, 20.0);
+  EXPECT_FALSE(f.goal_area.has_value());
+  EXPECT_DOUBLE_EQ(f.goal.inner_width, 2.1);
+}

@@ -1,0 +1,150 @@
+// The Nao models: data loaded from YAML against the reference, and the
+// Bullet multibody built from it (real Bullet).
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+
+#include "simsoccer/engine/physics_world.hpp"
+#include "simsoccer/robots/robot_model.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using engine::Vec3;
+
+namespace {
+
+// Joint placement in a floating, gravity-free world, so nothing moves.
+struct FloatingRobot {
+  engine::PhysicsWorld physics{[] {
+    engine::PhysicsSettings s;
+    s.gravity = Vec3::Zero();
+    return s;
+  }()};
+  engine::ArticulationId id;
+  explicit FloatingRobot(const robots::RobotModel& model, const std::vector<double>& q) {
+    engine::Pose root = engine::Pose::Identity();
+    root.translation() = Vec3(0, 0, 1.0);
+    id = physics.addArticulation(model.body, root, q, 0);
+  }
+};
+
+}  // namespace
+
+TEST(RobotModel, H25TotalMassMatchesReferenceSum) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  // nao.md 1: sum of the V6 URDF link masses 5.360 kg (fingers massless).
+  EXPECT_NEAR(nao.body->totalMass(), 5.360, 0.01 * 5.360);
+  EXPECT_EQ(nao.body->links.size(), 25u);  // torso + 24 hinge links
+  EXPECT_EQ(nao.body->joints.size(), 24u);
+  EXPECT_EQ(nao.actuators.size(), 25u);    // LoLA arrays
+  EXPECT_EQ(nao.hands.size(), 2u);
+}
+
+TEST(RobotModel, H21TotalMassMatchesReference) {
+  const auto nao = robots::loadRobotModel(test::naoH21());
+  EXPECT_NEAR(nao.body->totalMass(), 5.029, 0.01 * 5.029);  // nao.md 1: H21 (V4) 5.029 kg
+  EXPECT_EQ(nao.body->joints.size(), 22u);  // 21 DOF + the mimic RHipYawPitch hinge
+  EXPECT_EQ(nao.body->jointIndex("LWristYaw"), -1);
+  EXPECT_EQ(nao.actuators.size(), 25u);
+  EXPECT_EQ(nao.actuators[static_cast<size_t>(nao.actuatorIndex("LHand"))].kind,
+            robots::Actuator::Kind::Absent);
+}
+
+TEST(RobotModel, ZeroPoseSoleToTorsoHeight) {
+  for (const auto& file : {test::naoH25(), test::naoH21()}) {
+    const auto nao = robots::loadRobotModel(file);
+    const std::vector<double> zero(nao.body->joints.size(), 0.0);
+    // nao.md 1: 85 + 100 + 102.9 + 45.19 = 333.09 mm.
+    EXPECT_NEAR(nao.soleDepth(zero), 0.33309, 0.001) << file;
+    // The same through Bullet: the left foot's joint frame and its sole face.
+    FloatingRobot robot(nao, zero);
+    const int foot = nao.body->linkIndex("LFoot");
+    const engine::Pose torso = robot.physics.linkPose(robot.id, 0);
+    const engine::Pose foot_pose = robot.physics.linkPose(robot.id, foot);
+    const Vec3 ankle = torso.inverse() * foot_pose.translation();
+    EXPECT_NEAR(ankle.x(), 0.0, 1e-4);
+    EXPECT_NEAR(ankle.y(), 0.050, 1e-4);
+    EXPECT_NEAR(ankle.z(), -0.2879, 1e-4);  // nao.md 2.2: LAnkle (0, 50, -287.9)
+    const auto& box = nao.body->links[static_cast<size_t>(foot)].shapes.at(0);
+    const double sole = ankle.z() + box.pose.translation().z() - 0.5 * box.extents.z();
+    EXPECT_NEAR(sole, -0.33309, 0.001);
+  }
+}
+
+TEST(RobotModel, JointLimitsAndAxesAsInTheData) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  // Read the file independently of the loader.
+  const YAML::Node doc = YAML::LoadFile(test::naoH25().string());
+  ASSERT_EQ(doc["joints"].size(), nao.body->joints.size());
+  const std::vector<double> zero(nao.body->joints.size(), 0.0);
+  for (const YAML::Node& j : doc["joints"]) {
+    const std::string name = j["name"].as<std::string>();
+    const int idx = nao.body->jointIndex(name);
+    ASSERT_GE(idx, 0) << name;
+    const auto& joint = nao.body->joints[static_cast<size_t>(idx)];
+    const auto axis = j["axis"].as<std::vector<double>>();
+    const auto limits = j["limits"].as<std::vector<double>>();
+    EXPECT_NEAR(joint.lower, limits[0], 1e-12) << name;
+    EXPECT_NEAR(joint.upper, limits[1], 1e-12) << name;
+    const Vec3 data_axis = Vec3(axis[0], axis[1], axis[2]).normalized();
+    EXPECT_LT((joint.axis - data_axis).norm(), 1e-9) << name;
+
+    // Bullet rotates the child link about that axis: turn the joint by 0.3 rad.
+    std::vector<double> q = zero;
+    q[static_cast<size_t>(idx)] = 0.3;
+    FloatingRobot robot(nao, q);
+    const engine::Pose parent = robot.physics.linkPose(robot.id, joint.parent_link);
+    const engine::Pose child = robot.physics.linkPose(robot.id, joint.child_link);
+    const Eigen::AngleAxisd rel(parent.linear().transpose() * child.linear());
+    EXPECT_NEAR(rel.angle(), 0.3, 1e-4) << name;
+    EXPECT_LT((rel.axis() - data_axis).norm(), 1e-3) << name;
+    const Vec3 origin = parent.inverse() * child.translation();
+    EXPECT_LT((origin - joint.origin).norm(), 1e-5) << name;
+  }
+  // Spot checks against the reference table (nao.md 2.2).
+  const auto& hyp = nao.body->joints[static_cast<size_t>(nao.body->jointIndex("LHipYawPitch"))];
+  EXPECT_LT((hyp.axis - Vec3(0, std::sqrt(0.5), -std::sqrt(0.5))).norm(), 1e-6);
+  EXPECT_NEAR(hyp.lower, -1.14529, 1e-9);
+  EXPECT_NEAR(hyp.upper, 0.740718, 1e-9);
+  const auto& knee = nao.body->joints[static_cast<size_t>(nao.body->jointIndex("RKneePitch"))];
+  EXPECT_NEAR(knee.lower, -0.0923279, 1e-9);
+  EXPECT_NEAR(knee.upper, 2.11255, 1e-9);
+  EXPECT_NEAR(knee.origin.z(), -0.100, 1e-12);
+}
+
+TEST(RobotModel, ActuatorsFollowLolaOrder) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  const char* lola[25] = {"HeadYaw",        "HeadPitch",     "LShoulderPitch", "LShoulderRoll",
+                          "LElbowYaw",      "LElbowRoll",    "LWristYaw",      "LHipYawPitch",
+                          "LHipRoll",       "LHipPitch",     "LKneePitch",     "LAnklePitch",
+                          "LAnkleRoll",     "RHipRoll",      "RHipPitch",      "RKneePitch",
+                          "RAnklePitch",    "RAnkleRoll",    "RShoulderPitch", "RShoulderRoll",
+                          "RElbowYaw",      "RElbowRoll",    "RWristYaw",      "LHand",
+                          "RHand"};
+  for (int i = 0; i < 25; ++i) EXPECT_EQ(nao.actuators[static_cast<size_t>(i)].name, lola[i]);
+  // The right HipYawPitch is no actuator: it mimics the left one.
+  const auto& r = nao.body->joints[static_cast<size_t>(nao.body->jointIndex("RHipYawPitch"))];
+  EXPECT_EQ(r.mimic_of, nao.body->jointIndex("LHipYawPitch"));
+}
+
+TEST(RobotModel, SensorFramesFromReference) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  const auto* cam = nao.sensor("CameraTop");
+  ASSERT_NE(cam, nullptr);
+  EXPECT_EQ(nao.body->links[static_cast<size_t>(cam->link)].name, "Head");
+  EXPECT_NEAR(cam->pose.translation().x(), 0.05871, 1e-9);
+  EXPECT_NEAR(cam->pose.translation().z(), 0.06364, 1e-9);
+  int fsr = 0;
+  for (const auto& s : nao.sensors) fsr += s.type == "fsr";
+  EXPECT_EQ(fsr, 8);
+}
+
+TEST(RobotModel, StandPoseHasFlatFeetAndUprightTorso) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  const auto frames = nao.body->linkFramesAt(nao.pose("stand"));
+  for (const char* foot : {"LFoot", "RFoot"}) {
+    const auto& f = frames[static_cast<size_t>(nao.body->linkIndex(foot))];
+    EXPECT_NEAR(f.linear()(2, 2), 1.0, 1e-9) << foot;  // sole parallel to the torso's xy plane
+  }
+}

@@ -1,0 +1,202 @@
+// Joint servos on a real robot in real Bullet: step response, speed limit,
+// joint limits, stiffness, and the shared HipYawPitch motor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "simsoccer/engine/joint_servo.hpp"
+#include "simsoccer/world/world.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+
+TEST(JointServoBatch, TorqueEnvelope) {
+  // A huge inertia bound: the predicted speed is the current one (explicit envelope).
+  engine::JointServoBatch batch;
+  engine::Motor m;
+  m.stall_torque = 2.0;
+  m.no_load_speed = 5.0;
+  m.kp = 100.0;
+  m.kd = 0.0;
+  batch.add(m, 0.0, -1.0, 1.0, 1e12);
+  std::vector<double> tau(1);
+  const double dt = 0.005;
+  auto torque = [&](double q, double qd) {
+    batch.resetHistory(0);
+    batch.computeTorques(std::vector<double>{q}, std::vector<double>{qd}, tau, dt);
+    return tau[0];
+  };
+  batch.setTarget(0, 0.5, 1.0);
+  EXPECT_NEAR(torque(0.0, 0.0), 2.0, 1e-9);  // saturates at stall torque
+  EXPECT_NEAR(torque(0.0, 2.5), 1.0, 1e-9);  // half the no-load speed: half the torque left
+  EXPECT_NEAR(torque(0.0, 5.0), 0.0, 1e-9);  // no torque at no-load speed
+  EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9); // unsaturated: plain P
+  batch.setTarget(0, 0.5, 0.25);
+  EXPECT_NEAR(torque(0.0, 0.0), 0.5, 1e-9);  // stiffness scales the available torque
+  batch.setTarget(0, 0.5, 0.0);
+  EXPECT_EQ(torque(0.0, 0.0), 0.0);          // limp
+  batch.setTarget(0, 3.0, 1.0);
+  EXPECT_DOUBLE_EQ(batch.target(0), 1.0);    // targets clamp to the limits
+}
+
+TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
+  // A free joint of inertia I driven from rest: integrating with the torques
+  // the batch returns, the speed approaches but never passes the no-load speed,
+  // even though one step of stall torque alone would overshoot it.
+  engine::JointServoBatch batch;
+  engine::Motor m;
+  m.stall_torque = 2.0;
+  m.no_load_speed = 5.0;
+  m.kp = 1000.0;
+  const double inertia = 1e-3, dt = 0.005;  // stall * dt / I = 10 rad/s > 5 rad/s
+  batch.add(m, 0.0, -10.0, 10.0, inertia);
+  batch.setTarget(0, 9.0, 1.0);
+  std::vector<double> q{0.0}, qd{0.0}, tau(1);
+  double peak = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    batch.computeTorques(q, qd, tau, dt);
+    qd[0] += tau[0] / inertia * dt;
+    q[0] += qd[0] * dt;
+    peak = std::max(peak, qd[0]);
+  }
+  EXPECT_LE(peak, 5.0 + 1e-9);
+  EXPECT_GT(peak, 4.5);
+}
+
+TEST(JointServoBatch, LoadedJointGetsFullStallTorque) {
+  // Held against a constant load at rest, the torque converges to stall.
+  engine::JointServoBatch batch;
+  engine::Motor m;
+  m.stall_torque = 2.0;
+  m.no_load_speed = 5.0;
+  m.kp = 1000.0;
+  batch.add(m, 0.0, -1.0, 1.0, 1e-3);
+  batch.setTarget(0, 0.5, 1.0);
+  std::vector<double> tau(1);
+  for (int i = 0; i < 400; ++i)
+    batch.computeTorques(std::vector<double>{0.0}, std::vector<double>{0.0}, tau, 0.005);
+  EXPECT_NEAR(tau[0], 2.0, 1e-3);
+}
+
+namespace {
+
+struct HeadStep {
+  double settle_time = -1.0;  // s, last time outside the 2% band
+  double max_speed = 0.0;     // rad/s
+  double final_angle = 0.0;
+};
+
+HeadStep stepHeadYaw(world::World& w, double target, double seconds) {
+  const int head_yaw = w.robot(0).model->body->jointIndex("HeadYaw");
+  const double start = w.jointPosition(0, head_yaw);
+  const double band = 0.02 * std::abs(target - start);
+  w.setJointTarget(0, head_yaw, target, 1.0);
+  HeadStep r;
+  const double t0 = w.time();
+  for (int i = 0; i < static_cast<int>(std::lround(seconds / w.scenario().physics.dt)); ++i) {
+    w.step();
+    const double q = w.jointPosition(0, head_yaw);
+    r.max_speed = std::max(r.max_speed, std::abs(w.physics().jointVelocity(w.robot(0).body, head_yaw)));
+    if (std::abs(q - target) > band) r.settle_time = w.time() - t0;
+  }
+  r.final_angle = w.jointPosition(0, head_yaw);
+  return r;
+}
+
+}  // namespace
+
+TEST(Servo, HeadYawStepSettlesWithinSpeedLimit) {
+  world::World w(test::scenario(1));
+  for (int i = 0; i < 100; ++i) w.step();
+  const HeadStep r = stepHeadYaw(w, 0.5, 1.0);
+  const auto& motor = w.robot(0).model->body->motors[static_cast<size_t>(
+      w.robot(0).model->body->joints[0].motor)];
+  std::printf("HeadYaw 0.5 rad step: settled (2%%) after %.3f s, peak speed %.3f rad/s "
+              "(no-load %.2f)\n", r.settle_time, r.max_speed, motor.no_load_speed);
+  EXPECT_LT(r.settle_time, 0.3);
+  EXPECT_NEAR(r.final_angle, 0.5, 0.01);
+  EXPECT_LE(r.max_speed, motor.no_load_speed);
+  EXPECT_GT(r.max_speed, 0.5 * motor.no_load_speed);  // it does use the motor's speed
+}
+
+TEST(Servo, TargetBeyondLimitStopsAtLimit) {
+  world::World w(test::scenario(1));
+  const auto& joints = w.robot(0).model->body->joints;
+  const double upper = joints[0].upper;  // HeadYaw
+  const HeadStep r = stepHeadYaw(w, 3.5, 1.5);
+  EXPECT_NEAR(r.final_angle, upper, 0.01);
+  EXPECT_LE(r.final_angle, upper + 0.005);
+}
+
+TEST(Servo, LimpRobotCollapsesWithinJointLimits) {
+  // The Bullet limit constraints hold the joints when gravity, not the servo,
+  // drives them: a limp robot folds onto its limits but not beyond.
+  world::World w(test::scenario(1));
+  const auto& joints = w.robot(0).model->body->joints;
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) w.setJointTarget(0, j, 0.0, 0.0);
+  double worst = 0.0;
+  for (int i = 0; i < 800; ++i) {
+    w.step();
+    for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
+      const double q = w.jointPosition(0, j);
+      const auto& jt = joints[static_cast<size_t>(j)];
+      worst = std::max({worst, jt.lower - q, q - jt.upper});
+    }
+  }
+  std::printf("largest excursion beyond a limit while collapsing: %.4f rad\n", worst);
+  EXPECT_LT(worst, 0.05);
+}
+
+TEST(Servo, TorqueNeverExceedsStiffnessTimesStall) {
+  world::World w(test::scenario(1));
+  const auto& body = *w.robot(0).model->body;
+  w.setPoseTarget(0, "stand", 0.3);
+  for (int i = 0; i < 400; ++i) {
+    w.step();
+    for (int j = 0; j < static_cast<int>(body.joints.size()); ++j) {
+      const auto& jt = body.joints[static_cast<size_t>(j)];
+      if (jt.motor < 0) continue;
+      const auto& m = body.motors[static_cast<size_t>(jt.motor)];
+      const double qd = w.physics().jointVelocity(w.robot(0).body, j);
+      // Motor part: total minus the passive damping.
+      const double motor_tau = w.physics().jointTorque(w.robot(0).body, j) + jt.damping * qd;
+      // A backdriven motor brakes with more than stall torque (up to the speed-dependent
+      // envelope), never more.
+      ASSERT_LE(std::abs(motor_tau),
+                0.3 * m.stall_torque * (1.0 + (std::abs(qd) + 1.0) / m.no_load_speed))
+          << jt.name;
+    }
+  }
+}
+
+TEST(Servo, SharedHipMotorMovesBothHipsMirrored) {
+  world::Scenario s = test::scenario(1);
+  s.physics.gravity = 0.0;  // floating, so the feet are free
+  world::World w(s);
+  const auto& body = *w.robot(0).model->body;
+  const int left = body.jointIndex("LHipYawPitch"), right = body.jointIndex("RHipYawPitch");
+  const int lfoot = body.linkIndex("LFoot"), rfoot = body.linkIndex("RFoot");
+  // One command, for the left joint only (LoLA has no right entry).
+  std::vector<double> pos(25), stiff(25, 1.0);
+  const auto& stand = w.robot(0).model->pose("stand");
+  for (size_t a = 0; a < 25; ++a) {
+    const auto& act = w.robot(0).model->actuators[a];
+    if (act.kind == robots::Actuator::Kind::Joint) pos[a] = stand[static_cast<size_t>(act.index)];
+  }
+  pos[static_cast<size_t>(w.robot(0).model->actuatorIndex("LHipYawPitch"))] = -0.5;
+  w.setCommand(0, pos, stiff);
+  for (int i = 0; i < 300; ++i) w.step();
+  const double ql = w.jointPosition(0, left), qr = w.jointPosition(0, right);
+  std::printf("LHipYawPitch %.4f RHipYawPitch %.4f\n", ql, qr);
+  EXPECT_NEAR(ql, -0.5, 0.02);
+  EXPECT_NEAR(qr, ql, 0.01);
+  // Mirrored: the feet are mirror images of each other in the torso's xz plane.
+  const engine::Pose torso = w.torsoPose(0);
+  const engine::Vec3 l = torso.inverse() * w.linkPose(0, lfoot).translation();
+  const engine::Vec3 r = torso.inverse() * w.linkPose(0, rfoot).translation();
+  EXPECT_NEAR(l.x(), r.x(), 0.005);
+  EXPECT_NEAR(l.y(), -r.y(), 0.005);
+  EXPECT_NEAR(l.z(), r.z(), 0.005);
+  EXPECT_GT(std::abs(l.x() - 0.0), 0.01);  // and they did move (yawed legs swing the feet)
+}
