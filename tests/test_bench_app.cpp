@@ -56,3 +56,23 @@ TEST(BenchPhysicsApp, RejectsBadOptions) {
   EXPECT_EQ(status, 0);
   EXPECT_NE(help.find("--csv"), std::string::npos);
 }
+
+TEST(CheckApp, ValidScenarioAndConfigError) {
+  int status = -1;
+  const std::string ok = runCommand(std::string(SIMSOCCER_BIN) + " check " + SIMSOCCER_SOURCE_DIR +
+                                        "/configs/scenarios/lineup_5v5.yaml",
+                                    status);
+  EXPECT_EQ(status, 0) << ok;
+  EXPECT_NE(ok.find("robot 9: team 1 number 5, nao_h21"), std::string::npos) << ok;
+  const auto bad = std::filesystem::temp_directory_path() / "simsoccer_check_bad.yaml";
+  std::ofstream(bad) << "scenario: bad\nfield: " << SIMSOCCER_SOURCE_DIR
+                     << "/fields/spl.yaml\nrobot_model: " << SIMSOCCER_SOURCE_DIR
+                     << "/robots/nao_v6_h25.yaml\nphysics: {dt: 0.005, control_period: 0.012}\n"
+                        "seed: 1\n";
+  const std::string err = runCommand(std::string(SIMSOCCER_BIN) + " check " + bad.string(), status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(err.find("simsoccer_check_bad.yaml: physics.control_period: must be a whole multiple"),
+            std::string::npos)
+      << err;
+  std::filesystem::remove(bad);
+}

@@ -28,6 +28,8 @@ const char* kHelp =
     "  --config FILE   benchmark scenario (default configs/bench/physics.yaml)\n"
     "  --robots LIST   robot counts (default from the config)\n"
     "  --seconds S     simulated seconds timed per robot count (default from the config)\n"
+    "  --repeat N      time each robot count N times (fresh world each) and report the run\n"
+    "                  with the median steps/s (default 1)\n"
     "  --csv FILE      also write the table as CSV (one row per robot count)\n";
 
 struct JointWave {
@@ -90,7 +92,7 @@ world::Scenario placeRobots(const BenchConfig& c, int n, double half_length, dou
 }  // namespace
 
 int benchPhysics(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help"}, {"config", "robots", "seconds", "csv"});
+  const Options opt(argc, argv, first, {"help"}, {"config", "robots", "seconds", "repeat", "csv"});
   if (opt.flag("help")) {
     std::fputs(kHelp, stdout);
     return 0;
@@ -102,6 +104,10 @@ int benchPhysics(int argc, char** argv, int first) {
   cfg.seconds = opt.number("seconds", cfg.seconds);
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
   const std::string csv = opt.get("csv", "");
+  const double repeat_value = opt.number("repeat", 1);
+  if (repeat_value < 1 || repeat_value != std::floor(repeat_value))
+    throw UsageError("--repeat must be a whole number >= 1");
+  const int repeat = static_cast<int>(repeat_value);
 
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
   const double dt = cfg.base.physics.dt;
@@ -116,7 +122,8 @@ int benchPhysics(int argc, char** argv, int first) {
   table.header = {"robots",       "steps_per_s", "real_time_factor", "ms_per_step",
                   "contacts_per_step", "robot_contacts_per_step", "standing", "collision_pct", "dynamics_pct",
                   "solver_pct",   "integrate_pct", "servo_pct", "other_pct"};
-  for (const int n : counts) {
+  // One timed run with n robots: (steps/s, table row).
+  auto measure = [&](int n) {
     world::World w(placeRobots(cfg, n, field.halfLength(), field.halfWidth()));
     const auto& model = *w.robot(0).model;
     std::vector<JointWave> waves;
@@ -169,14 +176,22 @@ int benchPhysics(int argc, char** argv, int first) {
     auto pct = [&](double x) { return fmt(100.0 * x / wall, 1); };
     const double other = wall - st.collision_s - st.dynamics_s - st.solver_s - st.integrate_s -
                          st.servo_s;
-    table.rows.push_back({std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
+    return std::pair<double, std::vector<std::string>>{steps_per_s, {std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
                           fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
                           fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
                           fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
                           std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
                           pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s),
-                          pct(st.servo_s), pct(other)});
-    std::fprintf(stderr, "  %d robots done: %.0f steps/s\n", n, steps_per_s);
+                          pct(st.servo_s), pct(other)}};
+  };
+  for (const int n : counts) {
+    std::vector<std::pair<double, std::vector<std::string>>> runs;
+    for (int rep = 0; rep < repeat; ++rep) runs.push_back(measure(n));
+    std::sort(runs.begin(), runs.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    const auto& median = runs[runs.size() / 2];
+    table.rows.push_back(median.second);
+    std::fprintf(stderr, "  %d robots done: %.0f steps/s (median of %d)\n", n, median.first, repeat);
   }
   std::printf("\n");
   table.print(stdout);

@@ -47,5 +47,6 @@ struct Table {
 std::string fmt(double value, int decimals);
 
 int benchPhysics(int argc, char** argv, int first);
+int check(int argc, char** argv, int first);
 
 }  // namespace simsoccer::apps

@@ -122,6 +122,7 @@ const char* kUsage =
     "usage: simsoccer <command> [options]\n"
     "\n"
     "commands:\n"
+    "  check SCENARIO  load and validate a scenario file, print what it contains\n"
     "  bench physics   physics scaling benchmark (steps/s against robot count)\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
@@ -136,6 +137,7 @@ int main(int argc, char** argv) {
     return cmd.empty() ? 2 : 0;
   }
   try {
+    if (cmd == "check") return check(argc, argv, 2);
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);

@@ -1,6 +1,7 @@
 #include "simsoccer/engine/config.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace simsoccer::engine {
 
@@ -156,6 +157,12 @@ int ConfigNode::integer(const std::string& key, int fallback) const {
 }
 bool ConfigNode::boolean(const std::string& key, bool fallback) const {
   return has(key) ? (*this)[key].boolean() : fallback;
+}
+
+std::string formatNumber(double value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", value);
+  return buf;
 }
 
 std::filesystem::path resolveBeside(const std::string& base_file, const std::string& relative) {

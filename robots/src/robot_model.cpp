@@ -306,7 +306,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
         if (joint.mimic_of >= 0)
           q[j] = joint.mimic_multiplier * q[static_cast<size_t>(joint.mimic_of)];
         if (q[j] < joint.lower - 1e-9 || q[j] > joint.upper + 1e-9)
-          n.failKey(joint.name, "angle " + std::to_string(q[j]) + " is outside the joint limits");
+          n.failKey(joint.name, "angle " + engine::formatNumber(q[j]) + " is outside the joint limits");
       }
       robot.poses[pose_name] = q;
     }

@@ -34,8 +34,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
   const double ratio = s.physics.control_period / s.physics.dt;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || std::round(ratio) < 1.0)
     ph.failKey("control_period", "must be a whole multiple of dt (" +
-                                     std::to_string(s.physics.dt) + " s), got " +
-                                     std::to_string(s.physics.control_period) + " s");
+                                     engine::formatNumber(s.physics.dt) + " s), got " +
+                                     engine::formatNumber(s.physics.control_period) + " s");
 
   const int seed = root["seed"].integer();
   if (seed < 0) root.failKey("seed", "must be >= 0");

@@ -75,10 +75,10 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
       scenarioError(scenario_, robotKey(i, "pose"), "must be finite");
     if (!field_->onCarpet(p.x, p.y))
       scenarioError(scenario_, robotKey(i, "pose"),
-                    "robot placed outside the field: (" + std::to_string(p.x) + ", " +
-                        std::to_string(p.y) + ") is beyond the carpet (|x| <= " +
-                        std::to_string(field_->halfLength() + field_->border) + ", |y| <= " +
-                        std::to_string(field_->halfWidth() + field_->border) + ")");
+                    "robot placed outside the field: (" + engine::formatNumber(p.x) + ", " +
+                        engine::formatNumber(p.y) + ") is beyond the carpet (|x| <= " +
+                        engine::formatNumber(field_->halfLength() + field_->border) + ", |y| <= " +
+                        engine::formatNumber(field_->halfWidth() + field_->border) + ")");
     const std::string file =
         p.model_file.empty() ? scenario_.robot_model_file.string() : p.model_file;
     auto& model = models[file];

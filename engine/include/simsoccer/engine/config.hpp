@@ -72,6 +72,9 @@ class ConfigNode {
   std::string path_;
 };
 
+// A number as it reads in a message: 0.005, not 0.005000.
+std::string formatNumber(double value);
+
 // Resolves `relative` against the folder of the file `base` was read from.
 std::filesystem::path resolveBeside(const std::string& base_file, const std::string& relative);
 
