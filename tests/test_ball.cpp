@@ -70,8 +70,8 @@ TEST(Ball, BouncesOffGoalPost) {
   const auto end = w.ballState();
   std::printf("ball after hitting the post: x %.3f, vx %.3f, closest centre distance %.3f\n",
               end.pose.translation().x(), end.linear_velocity.x(), min_gap);
-  EXPECT_LT(end.linear_velocity.x(), -0.2);                  // came back
-  EXPECT_LT(end.pose.translation().x(), post_x - 0.1);      // in front of the post
+  EXPECT_LT(end.linear_velocity.x(), -0.2);             // came back
+  EXPECT_LT(end.pose.translation().x(), post_x - 0.1);  // in front of the post
   // Never passed through it (a 5 ms step at 3 m/s moves the ball 15 mm).
   EXPECT_GT(min_gap, w.field().ball.radius + 0.05 - 0.02);
 }

@@ -25,10 +25,10 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_test.csv";
   std::filesystem::remove(csv);
   int status = -1;
-  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
-                                         " bench physics --robots 1,2 --seconds 0.5 --csv " +
-                                         csv.string(),
-                                     status);
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 1,2 --seconds 0.5 --csv " +
+                     csv.string(),
+                 status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("steps_per_s"), std::string::npos);
@@ -49,7 +49,8 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
 
 TEST(BenchPhysicsApp, RejectsBadOptions) {
   int status = -1;
-  const std::string out = runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 0", status);
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 0", status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--robots"), std::string::npos) << out;
   const std::string help = runCommand(std::string(SIMSOCCER_BIN) + " bench physics --help", status);

@@ -28,7 +28,8 @@ class ConfigErrors : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("simsoccer_cfg_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("simsoccer_cfg_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     robot_ = readFile(test::naoH25());

@@ -1,8 +1,10 @@
 // Same config + seed + commands => same state hash, bit for bit (real Bullet).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
+#include "simsoccer/world/realtime_driver.hpp"
 #include "simsoccer/world/world.hpp"
 #include "test_support.hpp"
 
@@ -25,7 +27,8 @@ uint64_t run(uint64_t seed, double amplitude, int steps = 2000) {
         const auto& stand = model.pose("stand");
         for (size_t j = 0; j < model.body->joints.size(); ++j)
           w.setJointTarget(r, static_cast<int>(j),
-                           stand[j] + amplitude * std::sin(6.0 * w.time() + 0.7 * r + 0.3 * j), 1.0);
+                           stand[j] + amplitude * std::sin(6.0 * w.time() + 0.7 * r + 0.3 * j),
+                           1.0);
       }
     }
     w.step();
@@ -42,9 +45,13 @@ TEST(Determinism, SameSeedAndCommandsGiveSameHash) {
   EXPECT_EQ(a, b);
 }
 
-TEST(Determinism, DifferentSeedGivesDifferentHash) { EXPECT_NE(run(11, 0.1), run(12, 0.1)); }
+TEST(Determinism, DifferentSeedGivesDifferentHash) {
+  EXPECT_NE(run(11, 0.1), run(12, 0.1));
+}
 
-TEST(Determinism, DifferentCommandGivesDifferentHash) { EXPECT_NE(run(11, 0.1), run(11, 0.11)); }
+TEST(Determinism, DifferentCommandGivesDifferentHash) {
+  EXPECT_NE(run(11, 0.1), run(11, 0.11));
+}
 
 TEST(Determinism, HashCoversTheState) {
   world::World a(test::scenario(2)), b(test::scenario(2));
@@ -68,4 +75,16 @@ TEST(Determinism, SnapshotMatchesWorld) {
   ASSERT_EQ(s.robots.size(), 3u);
   EXPECT_TRUE(s.robots[1].torso.isApprox(w.torsoPose(1)));
   EXPECT_EQ(s.robots[2].joint_positions.size(), w.robot(2).model->body->joints.size());
+}
+
+TEST(RealTimeDriver, NeverRunsAheadOfTheWallClockAndMatchesFreeRunning) {
+  // Pacing changes when steps happen, not what they compute.
+  world::World paced(test::scenario(2)), free_running(test::scenario(2));
+  const auto t0 = std::chrono::steady_clock::now();
+  world::RealTimeDriver(paced, 2.0).run(0.4);  // 0.4 s simulated at twice real time
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (int i = 0; i < 40; ++i) free_running.stepControlPeriod();
+  EXPECT_GE(wall, 0.2 - 1e-3);  // a lower bound only: never faster than asked
+  EXPECT_EQ(paced.stepCount(), free_running.stepCount());
+  EXPECT_EQ(paced.stateHash(), free_running.stateHash());
 }

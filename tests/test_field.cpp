@@ -29,8 +29,9 @@ TEST(Field, GoalPostsAndCrossbar) {
   ASSERT_GE(shapes.size(), 3u);
   // Posts centred on the goal line, inner faces 1.5 m apart.
   EXPECT_DOUBLE_EQ(shapes[0].pose.translation().x(), 4.5);
-  EXPECT_NEAR(shapes[1].pose.translation().y() - shapes[0].pose.translation().y() -
-                  2 * shapes[0].radius, 1.5, 1e-12);
+  EXPECT_NEAR(
+      shapes[1].pose.translation().y() - shapes[0].pose.translation().y() - 2 * shapes[0].radius,
+      1.5, 1e-12);
   // Crossbar underside at 0.8 m.
   EXPECT_NEAR(shapes[2].pose.translation().z() - shapes[2].radius, 0.8, 1e-12);
   const auto other = f.goalShapes(-1);

@@ -37,14 +37,14 @@ TEST(RobotModel, H25TotalMassMatchesReferenceSum) {
   EXPECT_NEAR(nao.body->totalMass(), 5.360, 0.01 * 5.360);
   EXPECT_EQ(nao.body->links.size(), 25u);  // torso + 24 hinge links
   EXPECT_EQ(nao.body->joints.size(), 24u);
-  EXPECT_EQ(nao.actuators.size(), 25u);    // LoLA arrays
+  EXPECT_EQ(nao.actuators.size(), 25u);  // LoLA arrays
   EXPECT_EQ(nao.hands.size(), 2u);
 }
 
 TEST(RobotModel, H21TotalMassMatchesReference) {
   const auto nao = robots::loadRobotModel(test::naoH21());
   EXPECT_NEAR(nao.body->totalMass(), 5.029, 0.01 * 5.029);  // nao.md 1: H21 (V4) 5.029 kg
-  EXPECT_EQ(nao.body->joints.size(), 22u);  // 21 DOF + the mimic RHipYawPitch hinge
+  EXPECT_EQ(nao.body->joints.size(), 22u);                  // 21 DOF + the mimic RHipYawPitch hinge
   EXPECT_EQ(nao.body->jointIndex("LWristYaw"), -1);
   EXPECT_EQ(nao.actuators.size(), 25u);
   EXPECT_EQ(nao.actuators[static_cast<size_t>(nao.actuatorIndex("LHand"))].kind,
@@ -115,13 +115,12 @@ TEST(RobotModel, JointLimitsAndAxesAsInTheData) {
 
 TEST(RobotModel, ActuatorsFollowLolaOrder) {
   const auto nao = robots::loadRobotModel(test::naoH25());
-  const char* lola[25] = {"HeadYaw",        "HeadPitch",     "LShoulderPitch", "LShoulderRoll",
-                          "LElbowYaw",      "LElbowRoll",    "LWristYaw",      "LHipYawPitch",
-                          "LHipRoll",       "LHipPitch",     "LKneePitch",     "LAnklePitch",
-                          "LAnkleRoll",     "RHipRoll",      "RHipPitch",      "RKneePitch",
-                          "RAnklePitch",    "RAnkleRoll",    "RShoulderPitch", "RShoulderRoll",
-                          "RElbowYaw",      "RElbowRoll",    "RWristYaw",      "LHand",
-                          "RHand"};
+  const char* lola[25] = {
+      "HeadYaw",    "HeadPitch",   "LShoulderPitch", "LShoulderRoll",  "LElbowYaw",
+      "LElbowRoll", "LWristYaw",   "LHipYawPitch",   "LHipRoll",       "LHipPitch",
+      "LKneePitch", "LAnklePitch", "LAnkleRoll",     "RHipRoll",       "RHipPitch",
+      "RKneePitch", "RAnklePitch", "RAnkleRoll",     "RShoulderPitch", "RShoulderRoll",
+      "RElbowYaw",  "RElbowRoll",  "RWristYaw",      "LHand",          "RHand"};
   for (int i = 0; i < 25; ++i) EXPECT_EQ(nao.actuators[static_cast<size_t>(i)].name, lola[i]);
   // The right HipYawPitch is no actuator: it mimics the left one.
   const auto& r = nao.body->joints[static_cast<size_t>(nao.body->jointIndex("RHipYawPitch"))];

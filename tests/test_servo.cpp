@@ -11,15 +11,24 @@
 
 using namespace simsoccer;
 
-TEST(JointServoBatch, TorqueEnvelope) {
-  // A huge inertia bound: the predicted speed is the current one (explicit envelope).
-  engine::JointServoBatch batch;
+namespace {
+
+// A 2 N m, 5 rad/s motor with a stiff P gain.
+engine::Motor testMotor(double kp) {
   engine::Motor m;
   m.stall_torque = 2.0;
   m.no_load_speed = 5.0;
-  m.kp = 100.0;
+  m.kp = kp;
   m.kd = 0.0;
-  batch.add(m, 0.0, -1.0, 1.0, 1e12);
+  return m;
+}
+
+}  // namespace
+
+TEST(JointServoBatch, TorqueEnvelope) {
+  // A huge inertia bound: the predicted speed is the current one (explicit envelope).
+  engine::JointServoBatch batch;
+  batch.add(testMotor(100.0), 0.0, -1.0, 1.0, 1e12);
   std::vector<double> tau(1);
   const double dt = 0.005;
   auto torque = [&](double q, double qd) {
@@ -28,16 +37,16 @@ TEST(JointServoBatch, TorqueEnvelope) {
     return tau[0];
   };
   batch.setTarget(0, 0.5, 1.0);
-  EXPECT_NEAR(torque(0.0, 0.0), 2.0, 1e-9);  // saturates at stall torque
-  EXPECT_NEAR(torque(0.0, 2.5), 1.0, 1e-9);  // half the no-load speed: half the torque left
-  EXPECT_NEAR(torque(0.0, 5.0), 0.0, 1e-9);  // no torque at no-load speed
-  EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9); // unsaturated: plain P
+  EXPECT_NEAR(torque(0.0, 0.0), 2.0, 1e-9);   // saturates at stall torque
+  EXPECT_NEAR(torque(0.0, 2.5), 1.0, 1e-9);   // half the no-load speed: half the torque left
+  EXPECT_NEAR(torque(0.0, 5.0), 0.0, 1e-9);   // no torque at no-load speed
+  EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9);  // unsaturated: plain P
   batch.setTarget(0, 0.5, 0.25);
   EXPECT_NEAR(torque(0.0, 0.0), 0.5, 1e-9);  // stiffness scales the available torque
   batch.setTarget(0, 0.5, 0.0);
-  EXPECT_EQ(torque(0.0, 0.0), 0.0);          // limp
+  EXPECT_EQ(torque(0.0, 0.0), 0.0);  // limp
   batch.setTarget(0, 3.0, 1.0);
-  EXPECT_DOUBLE_EQ(batch.target(0), 1.0);    // targets clamp to the limits
+  EXPECT_DOUBLE_EQ(batch.target(0), 1.0);  // targets clamp to the limits
 }
 
 TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
@@ -45,12 +54,8 @@ TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
   // the batch returns, the speed approaches but never passes the no-load speed,
   // even though one step of stall torque alone would overshoot it.
   engine::JointServoBatch batch;
-  engine::Motor m;
-  m.stall_torque = 2.0;
-  m.no_load_speed = 5.0;
-  m.kp = 1000.0;
   const double inertia = 1e-3, dt = 0.005;  // stall * dt / I = 10 rad/s > 5 rad/s
-  batch.add(m, 0.0, -10.0, 10.0, inertia);
+  batch.add(testMotor(1000.0), 0.0, -10.0, 10.0, inertia);
   batch.setTarget(0, 9.0, 1.0);
   std::vector<double> q{0.0}, qd{0.0}, tau(1);
   double peak = 0.0;
@@ -67,11 +72,7 @@ TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
 TEST(JointServoBatch, LoadedJointGetsFullStallTorque) {
   // Held against a constant load at rest, the torque converges to stall.
   engine::JointServoBatch batch;
-  engine::Motor m;
-  m.stall_torque = 2.0;
-  m.no_load_speed = 5.0;
-  m.kp = 1000.0;
-  batch.add(m, 0.0, -1.0, 1.0, 1e-3);
+  batch.add(testMotor(1000.0), 0.0, -1.0, 1.0, 1e-3);
   batch.setTarget(0, 0.5, 1.0);
   std::vector<double> tau(1);
   for (int i = 0; i < 400; ++i)
@@ -97,7 +98,8 @@ HeadStep stepHeadYaw(world::World& w, double target, double seconds) {
   for (int i = 0; i < static_cast<int>(std::lround(seconds / w.scenario().physics.dt)); ++i) {
     w.step();
     const double q = w.jointPosition(0, head_yaw);
-    r.max_speed = std::max(r.max_speed, std::abs(w.physics().jointVelocity(w.robot(0).body, head_yaw)));
+    r.max_speed =
+        std::max(r.max_speed, std::abs(w.physics().jointVelocity(w.robot(0).body, head_yaw)));
     if (std::abs(q - target) > band) r.settle_time = w.time() - t0;
   }
   r.final_angle = w.jointPosition(0, head_yaw);
@@ -110,10 +112,12 @@ TEST(Servo, HeadYawStepSettlesWithinSpeedLimit) {
   world::World w(test::scenario(1));
   for (int i = 0; i < 100; ++i) w.step();
   const HeadStep r = stepHeadYaw(w, 0.5, 1.0);
-  const auto& motor = w.robot(0).model->body->motors[static_cast<size_t>(
-      w.robot(0).model->body->joints[0].motor)];
-  std::printf("HeadYaw 0.5 rad step: settled (2%%) after %.3f s, peak speed %.3f rad/s "
-              "(no-load %.2f)\n", r.settle_time, r.max_speed, motor.no_load_speed);
+  const auto& motor =
+      w.robot(0).model->body->motors[static_cast<size_t>(w.robot(0).model->body->joints[0].motor)];
+  std::printf(
+      "HeadYaw 0.5 rad step: settled (2%%) after %.3f s, peak speed %.3f rad/s "
+      "(no-load %.2f)\n",
+      r.settle_time, r.max_speed, motor.no_load_speed);
   EXPECT_LT(r.settle_time, 0.3);
   EXPECT_NEAR(r.final_angle, 0.5, 0.01);
   EXPECT_LE(r.max_speed, motor.no_load_speed);

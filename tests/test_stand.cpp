@@ -11,12 +11,18 @@ using namespace simsoccer;
 
 namespace {
 
-double tiltOf(const engine::Pose& torso) { return std::acos(std::clamp(torso.linear()(2, 2), -1.0, 1.0)); }
+double tiltOf(const engine::Pose& torso) {
+  return std::acos(std::clamp(torso.linear()(2, 2), -1.0, 1.0));
+}
 
 }  // namespace
 
-TEST(Stand, StiffStandPoseStaysUprightFor30Seconds) {
-  world::World w(test::scenario(1));
+class StandModels : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(StandModels, StiffStandPoseStaysUprightFor30Seconds) {
+  world::Scenario s = test::scenario(1);
+  s.robot_model_file = test::sourceDir() / "robots" / GetParam();
+  world::World w(s);
   for (int i = 0; i < 200; ++i) w.step();  // 1 s to settle onto the feet
   const engine::Pose start = w.torsoPose(0);
   double max_dz = 0.0, max_tilt = 0.0;
@@ -30,12 +36,15 @@ TEST(Stand, StiffStandPoseStaysUprightFor30Seconds) {
     }
   }
   const engine::Pose end = w.torsoPose(0);
-  std::printf("torso height start %.4f end %.4f, max |dz| %.4f m, max tilt %.2f deg\n",
-              start.translation().z(), end.translation().z(), max_dz, max_tilt * 180 / M_PI);
+  std::printf("%s: torso height start %.4f end %.4f, max |dz| %.4f m, max tilt %.2f deg\n",
+              GetParam(), start.translation().z(), end.translation().z(), max_dz,
+              max_tilt * 180 / M_PI);
   EXPECT_LT(max_dz, 0.01);
   EXPECT_LT(max_tilt, 3.0 * M_PI / 180.0);
   EXPECT_TRUE(w.isStanding(0));
 }
+
+INSTANTIATE_TEST_SUITE_P(Nao, StandModels, ::testing::Values("nao_v6_h25.yaml", "nao_h21.yaml"));
 
 TEST(Stand, ZeroStiffnessCollapses) {
   world::World w(test::scenario(1));

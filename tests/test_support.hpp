@@ -9,11 +9,21 @@
 
 namespace simsoccer::test {
 
-inline std::filesystem::path sourceDir() { return SIMSOCCER_SOURCE_DIR; }
-inline std::filesystem::path dataDir() { return sourceDir() / "tests" / "data"; }
-inline std::filesystem::path naoH25() { return sourceDir() / "robots" / "nao_v6_h25.yaml"; }
-inline std::filesystem::path naoH21() { return sourceDir() / "robots" / "nao_h21.yaml"; }
-inline std::filesystem::path splField() { return sourceDir() / "fields" / "spl.yaml"; }
+inline std::filesystem::path sourceDir() {
+  return SIMSOCCER_SOURCE_DIR;
+}
+inline std::filesystem::path dataDir() {
+  return sourceDir() / "tests" / "data";
+}
+inline std::filesystem::path naoH25() {
+  return sourceDir() / "robots" / "nao_v6_h25.yaml";
+}
+inline std::filesystem::path naoH21() {
+  return sourceDir() / "robots" / "nao_h21.yaml";
+}
+inline std::filesystem::path splField() {
+  return sourceDir() / "fields" / "spl.yaml";
+}
 
 // An SPL field scenario with the given robots (team 0, numbers 1..n, in a row).
 inline world::Scenario scenario(int robots, uint64_t seed = 1) {

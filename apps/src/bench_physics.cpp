@@ -97,7 +97,8 @@ int benchPhysics(int argc, char** argv, int first) {
     std::fputs(kHelp, stdout);
     return 0;
   }
-  if (!opt.positional().empty()) throw UsageError("unexpected argument '" + opt.positional()[0] + "'");
+  if (!opt.positional().empty())
+    throw UsageError("unexpected argument '" + opt.positional()[0] + "'");
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
@@ -111,17 +112,20 @@ int benchPhysics(int argc, char** argv, int first) {
 
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
   const double dt = cfg.base.physics.dt;
-  std::printf("simsoccer bench physics: %s, field %s, dt %.1f ms, control %.1f ms, %d solver "
-              "iterations, %.1f s settling + %.1f s timed per row, one thread\n",
-              config_file.string().c_str(), field.name.c_str(), dt * 1e3,
-              cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations,
-              cfg.settle, cfg.seconds);
+  std::printf(
+      "simsoccer bench physics: %s, field %s, dt %.1f ms, control %.1f ms, %d solver "
+      "iterations, %.1f s settling + %.1f s timed per row, one thread\n",
+      config_file.string().c_str(), field.name.c_str(), dt * 1e3,
+      cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, cfg.settle,
+      cfg.seconds);
   std::fflush(stdout);
 
   Table table;
-  table.header = {"robots",       "steps_per_s", "real_time_factor", "ms_per_step",
-                  "contacts_per_step", "robot_contacts_per_step", "standing", "collision_pct", "dynamics_pct",
-                  "solver_pct",   "integrate_pct", "servo_pct", "other_pct"};
+  table.header = {"robots",      "steps_per_s",       "real_time_factor",
+                  "ms_per_step", "contacts_per_step", "robot_contacts_per_step",
+                  "standing",    "collision_pct",     "dynamics_pct",
+                  "solver_pct",  "integrate_pct",     "servo_pct",
+                  "other_pct"};
   // One timed run with n robots: (steps/s, table row).
   auto measure = [&](int n) {
     world::World w(placeRobots(cfg, n, field.halfLength(), field.halfWidth()));
@@ -147,7 +151,8 @@ int benchPhysics(int argc, char** argv, int first) {
         const double phase = 2.0 * std::numbers::pi * r / static_cast<double>(w.robotCount());
         const double s = ramp * std::sin(2.0 * std::numbers::pi * cfg.frequency * t + phase);
         for (const JointWave& jw : waves)
-          w.setJointTarget(r, jw.joint, stand[static_cast<size_t>(jw.joint)] + jw.amplitude * s, 1.0);
+          w.setJointTarget(r, jw.joint, stand[static_cast<size_t>(jw.joint)] + jw.amplitude * s,
+                           1.0);
       }
     };
     const auto settle_steps = static_cast<long>(std::lround(cfg.settle / dt));
@@ -167,22 +172,24 @@ int benchPhysics(int argc, char** argv, int first) {
       contacts += cc.total;
       robot_contacts += cc.between_articulations;
     }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     w.physics().enableStageTimers(false);
     int standing = 0;
     for (world::RobotId r = 0; r < w.robotCount(); ++r) standing += w.isStanding(r) ? 1 : 0;
     const auto& st = w.physics().stageTimes();
     const double steps_per_s = static_cast<double>(timed_steps) / wall;
     auto pct = [&](double x) { return fmt(100.0 * x / wall, 1); };
-    const double other = wall - st.collision_s - st.dynamics_s - st.solver_s - st.integrate_s -
-                         st.servo_s;
-    return std::pair<double, std::vector<std::string>>{steps_per_s, {std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
-                          fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
-                          fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
-                          fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
-                          std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
-                          pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s),
-                          pct(st.servo_s), pct(other)}};
+    const double other =
+        wall - st.collision_s - st.dynamics_s - st.solver_s - st.integrate_s - st.servo_s;
+    return std::pair<double, std::vector<std::string>>{
+        steps_per_s,
+        {std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
+         fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
+         fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
+         fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
+         std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
+         pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s), pct(st.servo_s), pct(other)}};
   };
   for (const int n : counts) {
     std::vector<std::pair<double, std::vector<std::string>>> runs;
@@ -191,14 +198,16 @@ int benchPhysics(int argc, char** argv, int first) {
               [](const auto& a, const auto& b) { return a.first < b.first; });
     const auto& median = runs[runs.size() / 2];
     table.rows.push_back(median.second);
-    std::fprintf(stderr, "  %d robots done: %.0f steps/s (median of %d)\n", n, median.first, repeat);
+    std::fprintf(stderr, "  %d robots done: %.0f steps/s (median of %d)\n", n, median.first,
+                 repeat);
   }
   std::printf("\n");
   table.print(stdout);
-  std::printf("\nStages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
-              "dynamics; solver = contact and joint-limit constraints; integrate = positions; "
-              "servo = joint PD torques; other = everything else in the step and the loop "
-              "(commands, contact counting).\n");
+  std::printf(
+      "\nStages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
+      "dynamics; solver = contact and joint-limit constraints; integrate = positions; "
+      "servo = joint PD torques; other = everything else in the step and the loop "
+      "(commands, contact counting).\n");
   if (!csv.empty()) {
     table.writeCsv(csv);
     std::printf("wrote %s\n", csv.c_str());

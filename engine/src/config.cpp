@@ -20,9 +20,9 @@ ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
     return ConfigNode(root, name, "");
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(name, "", "YAML syntax error at line " + std::to_string(e.mark.line + 1) +
-                                    ", column " + std::to_string(e.mark.column + 1) + ": " +
-                                    e.msg);
+    throw ConfigError(name, "",
+                      "YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
+                          std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
 }
 
@@ -33,7 +33,9 @@ std::string ConfigNode::childPath(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
 }
 
-void ConfigNode::fail(const std::string& reason) const { throw ConfigError(file_, path_, reason); }
+void ConfigNode::fail(const std::string& reason) const {
+  throw ConfigError(file_, path_, reason);
+}
 void ConfigNode::failKey(const std::string& key, const std::string& reason) const {
   throw ConfigError(file_, childPath(key), reason);
 }
@@ -179,10 +181,10 @@ Pose readPose(const ConfigNode& node) {
   if (has_rpy && has_axis) node.fail("give either 'rpy' or 'axis', not both");
   if (has_rpy) {
     const Vec3 rpy = node["rpy"].vec3();
-    pose.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) *
-                     Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                     Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
-                        .toRotationMatrix();
+    pose.linear() =
+        (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+         Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+            .toRotationMatrix();
   } else if (has_axis) {
     const Vec3 axis = node["axis"].vec3();
     if (axis.norm() < 1e-9) node.failKey("axis", "must not be the zero vector");

@@ -1,12 +1,12 @@
 #include "simsoccer/engine/physics_world.hpp"
 
-#include <btBulletDynamicsCommon.h>
-
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+#include <btBulletDynamicsCommon.h>
+
 #include <Eigen/Eigenvalues>
 #include <chrono>
 #include <stdexcept>
@@ -21,12 +21,16 @@ btVector3 toBt(const Vec3& v) {
   return btVector3(static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()),
                    static_cast<btScalar>(v.z()));
 }
-Vec3 fromBt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+Vec3 fromBt(const btVector3& v) {
+  return Vec3(v.x(), v.y(), v.z());
+}
 btQuaternion toBt(const Quat& q) {
   return btQuaternion(static_cast<btScalar>(q.x()), static_cast<btScalar>(q.y()),
                       static_cast<btScalar>(q.z()), static_cast<btScalar>(q.w()));
 }
-Quat fromBt(const btQuaternion& q) { return Quat(q.w(), q.x(), q.y(), q.z()); }
+Quat fromBt(const btQuaternion& q) {
+  return Quat(q.w(), q.x(), q.y(), q.z());
+}
 btTransform toBt(const Pose& p) {
   return btTransform(toBt(Quat(p.linear()).normalized()), toBt(Vec3(p.translation())));
 }
@@ -95,7 +99,8 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   StageTimes* times = nullptr;  // null: timers off
 
   void performDiscreteCollisionDetection() override {
-    timed(&StageTimes::collision_s, [&] { btMultiBodyDynamicsWorld::performDiscreteCollisionDetection(); });
+    timed(&StageTimes::collision_s,
+          [&] { btMultiBodyDynamicsWorld::performDiscreteCollisionDetection(); });
   }
   void solveExternalForces(btContactSolverInfo& info) override {
     timed(&StageTimes::dynamics_s, [&] { btMultiBodyDynamicsWorld::solveExternalForces(info); });
@@ -262,8 +267,7 @@ void PhysicsWorld::addStaticShape(const Shape& shape, const Material& material) 
 }
 
 BodyId PhysicsWorld::addRigidBody(const Shape& shape, double mass, const Material& material,
-                                  double linear_damping, double angular_damping,
-                                  const Pose& pose) {
+                                  double linear_damping, double angular_damping, const Pose& pose) {
   if (!(mass > 0.0)) throw std::invalid_argument("rigid body mass must be > 0");
   Impl& m = *impl_;
   Shape centred = shape;
@@ -384,8 +388,9 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       const Link& link = model.links[static_cast<size_t>(joint.child_link)];
       const Motor& motor = model.motors[static_cast<size_t>(joint.motor)];
       const Vec3 a = joint.axis.normalized();
-      const Mat3 about_joint = link.inertia + link.mass * (link.com.squaredNorm() * Mat3::Identity() -
-                                                           link.com * link.com.transpose());
+      const Mat3 about_joint =
+          link.inertia +
+          link.mass * (link.com.squaredNorm() * Mat3::Identity() - link.com * link.com.transpose());
       const double min_inertia = motor.armature + a.dot(about_joint * a);
       art.servo[static_cast<size_t>(j)] = static_cast<int>(
           m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia));
@@ -402,7 +407,9 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   const auto id = static_cast<ArticulationId>(m.articulations.size() - 1);
   resetArticulation(id, root_pose, joint_positions);
   for (int j = 0; j < num_links; ++j) {
-    const double q0 = j < static_cast<int>(joint_positions.size()) ? joint_positions[static_cast<size_t>(j)] : 0.0;
+    const double q0 = j < static_cast<int>(joint_positions.size())
+                          ? joint_positions[static_cast<size_t>(j)]
+                          : 0.0;
     const int s = m.articulations[id].servo[static_cast<size_t>(j)];
     if (s >= 0) m.servos.setTarget(static_cast<size_t>(s), q0, 0.0);
   }
@@ -418,8 +425,8 @@ void PhysicsWorld::setJointTarget(ArticulationId a, int joint, double target_rad
   const auto& joints = art.model->joints;
   for (size_t j = 0; j < joints.size(); ++j) {
     if (joints[j].mimic_of == joint && art.servo[j] >= 0)
-      m.servos.setTarget(static_cast<size_t>(art.servo[j]),
-                         joints[j].mimic_multiplier * target_rad, stiffness);
+      m.servos.setTarget(static_cast<size_t>(art.servo[j]), joints[j].mimic_multiplier * target_rad,
+                         stiffness);
   }
 }
 
@@ -485,11 +492,19 @@ void PhysicsWorld::step() {
   }
 }
 
-const StageTimes& PhysicsWorld::stageTimes() const { return impl_->times; }
-void PhysicsWorld::resetStageTimes() { impl_->times = StageTimes{}; }
+const StageTimes& PhysicsWorld::stageTimes() const {
+  return impl_->times;
+}
+void PhysicsWorld::resetStageTimes() {
+  impl_->times = StageTimes{};
+}
 
-size_t PhysicsWorld::articulationCount() const { return impl_->articulations.size(); }
-size_t PhysicsWorld::rigidBodyCount() const { return impl_->bodies.size(); }
+size_t PhysicsWorld::articulationCount() const {
+  return impl_->articulations.size();
+}
+size_t PhysicsWorld::rigidBodyCount() const {
+  return impl_->bodies.size();
+}
 
 const ArticulatedModel& PhysicsWorld::model(ArticulationId a) const {
   return *impl_->articulations.at(a).model;

@@ -18,11 +18,11 @@ void buildMarkings(FieldModel& f) {
   auto line = [&](double x0, double y0, double x1, double y1) {
     f.lines.push_back({Vec2(x0, y0), Vec2(x1, y1)});
   };
-  line(-hx, -hy, hx, -hy);   // touchlines
+  line(-hx, -hy, hx, -hy);  // touchlines
   line(-hx, hy, hx, hy);
-  line(-hx, -hy, -hx, hy);   // goal lines
+  line(-hx, -hy, -hx, hy);  // goal lines
   line(hx, -hy, hx, hy);
-  line(0, -hy, 0, hy);       // halfway line
+  line(0, -hy, 0, hy);  // halfway line
   for (int side : {-1, 1}) {
     for (const auto& area : {f.penalty_area, f.goal_area}) {
       if (!area) continue;
@@ -47,7 +47,7 @@ bool FieldModel::onCarpet(double x, double y) const {
 std::vector<Shape> FieldModel::goalShapes(int side) const {
   const double s = side >= 0 ? 1.0 : -1.0;
   const double r = 0.5 * goal.post_diameter;
-  const double post_y = 0.5 * goal.inner_width + r;  // post centres
+  const double post_y = 0.5 * goal.inner_width + r;           // post centres
   const double top = goal.clear_height + goal.post_diameter;  // top of the crossbar
   const double x_line = s * halfLength();
   const double t = goal.net_thickness;
@@ -74,8 +74,8 @@ std::vector<Shape> FieldModel::goalShapes(int side) const {
   // Net: back wall, two side walls and the roof, behind the goal line.
   const double x_back = x_line + s * (goal.depth + 0.5 * t);
   const double x_mid = x_line + s * 0.5 * goal.depth;
-  add(ShapeType::Box, Vec3(x_back, 0, 0.5 * goal.clear_height), Vec3(t, 2 * post_y, goal.clear_height),
-      0, 0, I);
+  add(ShapeType::Box, Vec3(x_back, 0, 0.5 * goal.clear_height),
+      Vec3(t, 2 * post_y, goal.clear_height), 0, 0, I);
   for (double y : {-post_y, post_y})
     add(ShapeType::Box, Vec3(x_mid, y, 0.5 * goal.clear_height),
         Vec3(goal.depth, t, goal.clear_height), 0, 0, I);
@@ -100,7 +100,8 @@ FieldModel loadFieldModel(const std::filesystem::path& file) {
     pm->allowOnly({"distance", "size"});
     f.penalty_mark_distance = (*pm)["distance"].positive();
     f.penalty_mark_size = (*pm)["size"].positive();
-    if (*f.penalty_mark_distance >= f.halfLength()) pm->failKey("distance", "beyond the halfway line");
+    if (*f.penalty_mark_distance >= f.halfLength())
+      pm->failKey("distance", "beyond the halfway line");
   }
   for (const char* key : {"penalty_area", "goal_area"}) {
     if (auto a = root.optional(key)) {
@@ -112,7 +113,8 @@ FieldModel loadFieldModel(const std::filesystem::path& file) {
     }
   }
   const ConfigNode g = root["goal"];
-  g.allowOnly({"inner_width", "clear_height", "depth", "post_diameter", "net_thickness", "material"});
+  g.allowOnly(
+      {"inner_width", "clear_height", "depth", "post_diameter", "net_thickness", "material"});
   f.goal.inner_width = g["inner_width"].positive();
   f.goal.clear_height = g["clear_height"].positive();
   f.goal.depth = g["depth"].positive();

@@ -96,8 +96,8 @@ double RobotModel::soleDepth(const std::vector<double>& q) const {
 
 RobotModel loadRobotModel(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
-  root.allowOnly({"robot", "material", "motors", "links", "joints", "actuators",
-                  "absent_actuators", "hands", "sensors", "poses"});
+  root.allowOnly({"robot", "material", "motors", "links", "joints", "actuators", "absent_actuators",
+                  "hands", "sensors", "poses"});
   RobotModel robot;
   robot.name = root["robot"].string();
   robot.source_file = file.string();
@@ -151,8 +151,12 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   for (const ConfigNode& n : root["joints"].items()) {
     n.allowOnly({"name", "type", "parent", "child", "origin", "axis", "limits", "motor", "mimic",
                  "damping"});
-    RawJoint j{n, n["name"].string(), n.has("type") ? n["type"].string() : "revolute",
-               n["parent"].string(), n["child"].string(), n["origin"].vec3()};
+    RawJoint j{n,
+               n["name"].string(),
+               n.has("type") ? n["type"].string() : "revolute",
+               n["parent"].string(),
+               n["child"].string(),
+               n["origin"].vec3()};
     if (!joint_names.insert(j.name).second) n["name"].fail("duplicate joint name '" + j.name + "'");
     if (j.type != "revolute" && j.type != "fixed")
       n["type"].fail("unknown joint type '" + j.type + "' (revolute or fixed)");
@@ -196,7 +200,8 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     joint.name = j.name;
     joint.parent_link = body->linkIndex(parent);
     if (joint.parent_link < 0)
-      j.node["parent"].fail("link '" + j.parent + "' must be attached by an earlier joint (tree order)");
+      j.node["parent"].fail("link '" + j.parent +
+                            "' must be attached by an earlier joint (tree order)");
     joint.child_link = static_cast<int>(body->links.size());
     joint.origin = off + j.origin;
     joint.axis = j.node["axis"].vec3();
@@ -306,7 +311,8 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
         if (joint.mimic_of >= 0)
           q[j] = joint.mimic_multiplier * q[static_cast<size_t>(joint.mimic_of)];
         if (q[j] < joint.lower - 1e-9 || q[j] > joint.upper + 1e-9)
-          n.failKey(joint.name, "angle " + engine::formatNumber(q[j]) + " is outside the joint limits");
+          n.failKey(joint.name,
+                    "angle " + engine::formatNumber(q[j]) + " is outside the joint limits");
       }
       robot.poses[pose_name] = q;
     }

@@ -53,7 +53,8 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   Pose ball_pose = Pose::Identity();
   Vec3 bp = scenario_.ball_position;
   if (bp.z() < 0.0) bp.z() = bm.radius;
-  if (!field_->onCarpet(bp.x(), bp.y())) scenarioError(scenario_, "ball.position", "outside the carpet");
+  if (!field_->onCarpet(bp.x(), bp.y()))
+    scenarioError(scenario_, "ball.position", "outside the carpet");
   ball_pose.translation() = bp;
   ball_ = physics_->addRigidBody(ball_shape, bm.mass, bm.material, bm.linear_damping,
                                  bm.angular_damping, ball_pose);
@@ -149,20 +150,26 @@ void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffn
       physics_->setJointTarget(info.body, static_cast<int>(j), q[j], stiffness);
 }
 
-void World::step() { physics_->step(); }
+void World::step() {
+  physics_->step();
+}
 
 void World::stepControlPeriod() {
   for (int i = 0; i < steps_per_control_; ++i) physics_->step();
 }
 
-Pose World::torsoPose(RobotId r) const { return physics_->linkPose(robots_.at(r).body, 0); }
+Pose World::torsoPose(RobotId r) const {
+  return physics_->linkPose(robots_.at(r).body, 0);
+}
 Pose World::linkPose(RobotId r, int link) const {
   return physics_->linkPose(robots_.at(r).body, link);
 }
 double World::jointPosition(RobotId r, int joint) const {
   return physics_->jointPosition(robots_.at(r).body, joint);
 }
-engine::RigidBodyState World::ballState() const { return physics_->rigidBodyState(ball_); }
+engine::RigidBodyState World::ballState() const {
+  return physics_->rigidBodyState(ball_);
+}
 void World::setBallState(const engine::RigidBodyState& state) {
   physics_->setRigidBodyState(ball_, state);
 }

@@ -44,8 +44,8 @@ class ConfigNode {
 
   bool isMap() const { return node_.IsMap(); }
   bool isSequence() const { return node_.IsSequence(); }
-  std::vector<ConfigNode> items() const;                              // sequence
-  std::vector<std::pair<std::string, ConfigNode>> entries() const;    // map, file order
+  std::vector<ConfigNode> items() const;                            // sequence
+  std::vector<std::pair<std::string, ConfigNode>> entries() const;  // map, file order
 
   double number() const;
   double positive() const;     // > 0
@@ -53,7 +53,7 @@ class ConfigNode {
   int integer() const;
   bool boolean() const;
   std::string string() const;
-  std::vector<double> numbers() const;             // sequence of numbers
+  std::vector<double> numbers() const;              // sequence of numbers
   std::vector<double> numbers(size_t count) const;  // exactly `count`
   Vec3 vec3() const;
 

@@ -44,8 +44,8 @@ class JointServoBatch {
                       std::span<double> tau, double dt);
 
  private:
-  std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_,
-      upper_, min_inertia_, prev_qdot_, prev_tau_, load_;
+  std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_, upper_,
+      min_inertia_, prev_qdot_, prev_tau_, load_;
   std::vector<unsigned char> has_history_;
 };
 

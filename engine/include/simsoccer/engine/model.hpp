@@ -25,10 +25,10 @@ enum class ShapeType { Sphere, Box, Capsule, Cylinder };
 // axis; `length` is the full end-to-end length (a capsule's includes its caps).
 struct Shape {
   ShapeType type = ShapeType::Sphere;
-  double radius = 0.0;              // sphere, capsule, cylinder
-  double length = 0.0;              // capsule, cylinder
-  Vec3 extents = Vec3::Zero();      // box: full size along x, y, z
-  Pose pose = Pose::Identity();     // in the owner's frame (link joint frame or world)
+  double radius = 0.0;           // sphere, capsule, cylinder
+  double length = 0.0;           // capsule, cylinder
+  Vec3 extents = Vec3::Zero();   // box: full size along x, y, z
+  Pose pose = Pose::Identity();  // in the owner's frame (link joint frame or world)
 };
 
 // Contact material. Bullet combines two materials by multiplying frictions
@@ -43,9 +43,9 @@ struct Material {
 struct Link {
   std::string name;
   double mass = 0.0;
-  Vec3 com = Vec3::Zero();          // in the link's joint frame
-  Mat3 inertia = Mat3::Zero();      // about the CoM, joint-frame axes
-  std::vector<Shape> shapes;        // in the link's joint frame
+  Vec3 com = Vec3::Zero();      // in the link's joint frame
+  Mat3 inertia = Mat3::Zero();  // about the CoM, joint-frame axes
+  std::vector<Shape> shapes;    // in the link's joint frame
 };
 
 // A position-controlled DC motor with gearbox, as seen at the joint.
@@ -64,20 +64,20 @@ struct Joint {
   std::string name;
   int parent_link = 0;
   int child_link = 1;
-  Vec3 axis = Vec3::UnitZ();    // unit, in the parent's joint frame at zero pose
-  Vec3 origin = Vec3::Zero();   // joint position in the parent's joint frame
-  double lower = 0.0;           // rad
-  double upper = 0.0;           // rad
-  int motor = -1;               // index into ArticulatedModel::motors, -1 = passive
-  int mimic_of = -1;            // index of the joint whose command drives this one
+  Vec3 axis = Vec3::UnitZ();   // unit, in the parent's joint frame at zero pose
+  Vec3 origin = Vec3::Zero();  // joint position in the parent's joint frame
+  double lower = 0.0;          // rad
+  double upper = 0.0;          // rad
+  int motor = -1;              // index into ArticulatedModel::motors, -1 = passive
+  int mimic_of = -1;           // index of the joint whose command drives this one
   double mimic_multiplier = 1.0;
-  double damping = 0.0;         // passive viscous damping, N m s/rad
+  double damping = 0.0;  // passive viscous damping, N m s/rad
 };
 
 struct ArticulatedModel {
   std::string name;
-  std::vector<Link> links;      // links[0] is the root (floating base)
-  std::vector<Joint> joints;    // joints[i].child_link == i + 1
+  std::vector<Link> links;    // links[0] is the root (floating base)
+  std::vector<Joint> joints;  // joints[i].child_link == i + 1
   std::vector<Motor> motors;
   Material material;
 

@@ -33,12 +33,12 @@ struct PhysicsSettings {
 
 // Wall time spent per stage, accumulated over steps (only when enabled).
 struct StageTimes {
-  double servo_s = 0.0;       // joint servo torques
-  double collision_s = 0.0;   // broadphase + narrowphase
-  double dynamics_s = 0.0;    // articulated-body forward dynamics
-  double solver_s = 0.0;      // contact/limit constraint solve
-  double integrate_s = 0.0;   // position integration
-  double total_s = 0.0;       // the whole step
+  double servo_s = 0.0;      // joint servo torques
+  double collision_s = 0.0;  // broadphase + narrowphase
+  double dynamics_s = 0.0;   // articulated-body forward dynamics
+  double solver_s = 0.0;     // contact/limit constraint solve
+  double integrate_s = 0.0;  // position integration
+  double total_s = 0.0;      // the whole step
   uint64_t steps = 0;
 };
 

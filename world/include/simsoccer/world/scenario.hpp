@@ -12,20 +12,20 @@
 namespace simsoccer::world {
 
 struct RobotPlacement {
-  int team = 0;             // 0 or 1
-  int number = 1;           // player number, unique within a team
-  double x = 0.0, y = 0.0;  // m, field frame
-  double yaw = 0.0;         // rad, heading in the field frame
-  std::string posture = "stand";   // named pose of the robot model
-  std::string model_file;          // empty: the scenario's robot_model
+  int team = 0;                   // 0 or 1
+  int number = 1;                 // player number, unique within a team
+  double x = 0.0, y = 0.0;        // m, field frame
+  double yaw = 0.0;               // rad, heading in the field frame
+  std::string posture = "stand";  // named pose of the robot model
+  std::string model_file;         // empty: the scenario's robot_model
 };
 
 struct PhysicsConfig {
   double dt = 0.005;              // s
   double control_period = 0.010;  // s, a whole multiple of dt
   int solver_iterations = 10;
-  int friction_directions = 1;    // per contact: 1 (along the slip) or 2 (a pyramid)
-  double gravity = -9.81;         // m/s^2 along z
+  int friction_directions = 1;  // per contact: 1 (along the slip) or 2 (a pyramid)
+  double gravity = -9.81;       // m/s^2 along z
 };
 
 // Standard deviations of the seeded random perturbations applied when the
@@ -38,7 +38,7 @@ struct PlacementNoise {
 
 struct Scenario {
   std::string name;
-  std::string source_file;        // for error messages; empty when built in code
+  std::string source_file;  // for error messages; empty when built in code
   std::filesystem::path field_file;
   std::filesystem::path robot_model_file;
   PhysicsConfig physics;

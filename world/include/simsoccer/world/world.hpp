@@ -33,8 +33,8 @@ struct RobotInfo {
 };
 
 struct RobotState {
-  Pose torso = Pose::Identity();     // torso frame in the field frame
-  Vec3 linear_velocity = Vec3::Zero();   // torso origin... root, world frame
+  Pose torso = Pose::Identity();        // torso frame in the field frame
+  Vec3 linear_velocity = Vec3::Zero();  // torso origin... root, world frame
   Vec3 angular_velocity = Vec3::Zero();
   std::vector<double> joint_positions;   // per body joint, rad
   std::vector<double> joint_velocities;  // rad/s
@@ -68,8 +68,8 @@ class World {
   void setPoseTarget(RobotId r, const std::string& pose_name, double stiffness);
 
   // --- time -----------------------------------------------------------------------
-  void step();                // one physics step (dt)
-  void stepControlPeriod();   // control_period / dt physics steps
+  void step();               // one physics step (dt)
+  void stepControlPeriod();  // control_period / dt physics steps
   uint64_t stepCount() const { return physics_->stepCount(); }
   double time() const { return static_cast<double>(stepCount()) * scenario_.physics.dt; }
 
