@@ -164,3 +164,30 @@ TEST_F(ConfigErrors, BadFieldValue) {
     EXPECT_NE(std::string(e.what()).find("field.yaml"), std::string::npos);
   }
 }
+
+TEST_F(ConfigErrors, MimicJointWithItsOwnMotor) {
+  replace(robot_, "mimic: {joint: LHipYawPitch, multiplier: 1.0}}",
+          "mimic: {joint: LHipYawPitch, multiplier: 1.0}, motor: leg_yaw_roll}");
+  expectError("robot.yaml", "joints[18].motor", "driven by its master's motor");
+}
+
+TEST_F(ConfigErrors, LinkAttachedTwice) {
+  replace(robot_, "parent: LThigh, child: LTibia", "parent: LThigh, child: LHip");
+  expectError("robot.yaml", "joints[15].child", "already attached by joint 'LHipRoll'");
+}
+
+TEST_F(ConfigErrors, OverlappingRobots) {
+  replace(scenario_, "pose: [-3.0, -1.0, 0.0]", "pose: [-3.0, 0.95, 0.0]");
+  expectError("scenario.yaml", "robots[2].pose", "overlaps robots[1]");
+}
+
+TEST_F(ConfigErrors, BallBelowTheCarpet) {
+  replace(scenario_, "ball: {position: [0.0, 0.0]}", "ball: {position: [0.0, 0.0, 0.01]}");
+  expectError("scenario.yaml", "ball.position", "at least its radius");
+}
+
+TEST_F(ConfigErrors, DirectoryInsteadOfFile) {
+  replace(scenario_, test::splField().string(), test::sourceDir().string());
+  const engine::ConfigError e = load();
+  EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+}

@@ -139,11 +139,57 @@ TEST(RobotModel, SensorFramesFromReference) {
   EXPECT_EQ(fsr, 8);
 }
 
-TEST(RobotModel, StandPoseHasFlatFeetAndUprightTorso) {
+TEST(RobotModel, StandPoseHasFlatFeetUnderTheHips) {
   const auto nao = robots::loadRobotModel(test::naoH25());
   const auto frames = nao.body->linkFramesAt(nao.pose("stand"));
-  for (const char* foot : {"LFoot", "RFoot"}) {
-    const auto& f = frames[static_cast<size_t>(nao.body->linkIndex(foot))];
-    EXPECT_NEAR(f.linear()(2, 2), 1.0, 1e-9) << foot;  // sole parallel to the torso's xy plane
+  for (const char* side : {"L", "R"}) {
+    const auto& foot = frames[static_cast<size_t>(nao.body->linkIndex(std::string(side) + "Foot"))];
+    const auto& hip = frames[static_cast<size_t>(nao.body->linkIndex(std::string(side) + "Hip"))];
+    EXPECT_NEAR(foot.linear()(2, 2), 1.0, 1e-9) << side;  // sole parallel to the torso's xy plane
+    EXPECT_NEAR(foot.translation().x(), hip.translation().x(), 0.005) << side;  // ankle under hip
   }
+}
+
+// Independent numbers typed from ../shared/reference/nao.md section 2.2 (not
+// read from our YAML): right-side signs and the mirrored hip axes.
+TEST(RobotModel, RightSideMatchesReferenceTable) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  struct Row {
+    const char* name;
+    double lower, upper;
+    Vec3 origin, axis;
+  };
+  const double s = std::sqrt(0.5);
+  const Row rows[] = {
+      {"RShoulderPitch", -2.08567, 2.08567, {0, -0.098, 0.100}, {0, 1, 0}},
+      {"RShoulderRoll", -1.32645, 0.314159, {0, 0, 0}, {0, 0, 1}},
+      {"RElbowYaw", -2.08567, 2.08567, {0.105, -0.015, 0}, {1, 0, 0}},
+      {"RElbowRoll", 0.0349066, 1.54462, {0, 0, 0}, {0, 0, 1}},
+      {"RWristYaw", -1.82387, 1.82387, {0.05595, 0, 0}, {1, 0, 0}},
+      {"RHipYawPitch", -1.14529, 0.740718, {0, -0.050, -0.085}, {0, s, s}},
+      {"RHipRoll", -0.79046, 0.379435, {0, 0, 0}, {1, 0, 0}},
+      {"RHipPitch", -1.53589, 0.48398, {0, 0, 0}, {0, 1, 0}},
+      {"RKneePitch", -0.0923279, 2.11255, {0, 0, -0.100}, {0, 1, 0}},
+      {"RAnklePitch", -1.1863, 0.932006, {0, 0, -0.1029}, {0, 1, 0}},
+      {"RAnkleRoll", -0.768992, 0.397761, {0, 0, 0}, {1, 0, 0}},
+      {"LHipRoll", -0.379435, 0.79046, {0, 0, 0}, {1, 0, 0}},
+      {"LAnkleRoll", -0.397761, 0.768992, {0, 0, 0}, {1, 0, 0}},
+      {"HeadPitch", -0.671952, 0.514872, {0, 0, 0}, {0, 1, 0}},
+  };
+  for (const Row& r : rows) {
+    const int j = nao.body->jointIndex(r.name);
+    ASSERT_GE(j, 0) << r.name;
+    const auto& joint = nao.body->joints[static_cast<size_t>(j)];
+    EXPECT_NEAR(joint.lower, r.lower, 1e-6) << r.name;
+    EXPECT_NEAR(joint.upper, r.upper, 1e-6) << r.name;
+    EXPECT_LT((joint.origin - r.origin).norm(), 1e-9) << r.name;
+    EXPECT_LT((joint.axis - r.axis.normalized()).norm(), 1e-6) << r.name;
+  }
+  // Masses (nao.md 4.1): right thigh and foot, head.
+  EXPECT_NEAR(nao.body->links[static_cast<size_t>(nao.body->linkIndex("RThigh"))].mass, 0.38968,
+              1e-9);
+  EXPECT_NEAR(nao.body->links[static_cast<size_t>(nao.body->linkIndex("RFoot"))].com.y(), -0.0033,
+              1e-9);
+  EXPECT_NEAR(nao.body->links[static_cast<size_t>(nao.body->linkIndex("Head"))].mass, 0.65973,
+              1e-9);
 }

@@ -124,6 +124,8 @@ TEST(Servo, HeadYawStepSettlesWithinSpeedLimit) {
   EXPECT_GT(r.max_speed, 0.5 * motor.no_load_speed);  // it does use the motor's speed
 }
 
+// Targets are clamped to the limits; the Bullet limit constraints that hold
+// a joint against external forces are exercised by the collapse test below.
 TEST(Servo, TargetBeyondLimitStopsAtLimit) {
   world::World w(test::scenario(1));
   const auto& joints = w.robot(0).model->body->joints;
@@ -138,18 +140,35 @@ TEST(Servo, LimpRobotCollapsesWithinJointLimits) {
   // drives them: a limp robot folds onto its limits but not beyond.
   world::World w(test::scenario(1));
   const auto& joints = w.robot(0).model->body->joints;
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) w.setJointTarget(0, j, 0.0, 0.0);
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(0, j, 0.0, 0.0);
   double worst = 0.0;
+  std::string worst_joint;
   for (int i = 0; i < 800; ++i) {
     w.step();
     for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
       const double q = w.jointPosition(0, j);
       const auto& jt = joints[static_cast<size_t>(j)];
-      worst = std::max({worst, jt.lower - q, q - jt.upper});
+      const double beyond = std::max(jt.lower - q, q - jt.upper);
+      if (beyond > worst) {
+        worst = beyond;
+        worst_joint = jt.name;
+      }
     }
   }
-  std::printf("largest excursion beyond a limit while collapsing: %.4f rad\n", worst);
-  EXPECT_LT(worst, 0.05);
+  std::printf("largest excursion beyond a limit while collapsing: %.4f rad (%s)\n", worst,
+              worst_joint.c_str());
+  // On impact a joint may pass its stop for a moment (Bullet adds limit rows
+  // once a joint is past the limit and corrects at the solver's ERP) ...
+  EXPECT_LT(worst, 0.15);
+  // ... and at rest every joint is back within its limits.
+  for (int i = 0; i < 200; ++i) w.step();
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
+    const auto& jt = joints[static_cast<size_t>(j)];
+    const double q = w.jointPosition(0, j);
+    EXPECT_GT(q, jt.lower - 0.01) << jt.name;
+    EXPECT_LT(q, jt.upper + 0.01) << jt.name;
+  }
 }
 
 TEST(Servo, TorqueNeverExceedsStiffnessTimesStall) {
@@ -203,4 +222,28 @@ TEST(Servo, SharedHipMotorMovesBothHipsMirrored) {
   EXPECT_NEAR(l.y(), -r.y(), 0.005);
   EXPECT_NEAR(l.z(), r.z(), 0.005);
   EXPECT_GT(std::abs(l.x() - 0.0), 0.01);  // and they did move (yawed legs swing the feet)
+  // The right hinge has no motor of its own: it cannot be commanded.
+  EXPECT_THROW(w.setJointTarget(0, right, 0.1, 1.0), std::invalid_argument);
+}
+
+TEST(Servo, LinkPosesAreCurrentAfterEachStep) {
+  // Every link's pose agrees with forward kinematics from the current root
+  // pose and joint angles, step after step, while the robot moves.
+  world::World w(test::scenario(1));
+  const auto& body = *w.robot(0).model->body;
+  const int knee = body.jointIndex("LKneePitch");
+  for (int i = 0; i < 60; ++i) {
+    w.setJointTarget(0, knee, 0.9 + 0.5 * std::sin(0.3 * i), 1.0);
+    w.step();
+    std::vector<double> q(body.joints.size());
+    for (size_t j = 0; j < q.size(); ++j) q[j] = w.jointPosition(0, static_cast<int>(j));
+    const auto frames = body.linkFramesAt(q);
+    const engine::Pose torso = w.torsoPose(0);
+    for (const char* link : {"LFoot", "RFoot", "Head", "LWrist"}) {
+      const int l = body.linkIndex(link);
+      const engine::Pose expected = torso * frames[static_cast<size_t>(l)];
+      ASSERT_LT((expected.translation() - w.linkPose(0, l).translation()).norm(), 1e-4)
+          << link << " at step " << i;
+    }
+  }
 }

@@ -50,7 +50,8 @@ TEST(Stand, ZeroStiffnessCollapses) {
   world::World w(test::scenario(1));
   const double start = w.torsoPose(0).translation().z();
   const auto& joints = w.robot(0).model->body->joints;
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) w.setJointTarget(0, j, 0.0, 0.0);
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(0, j, 0.0, 0.0);
   for (int i = 0; i < 600; ++i) w.step();  // 3 s
   const double end = w.torsoPose(0).translation().z();
   std::printf("limp: torso height %.3f -> %.3f m\n", start, end);

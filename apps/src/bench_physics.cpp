@@ -106,8 +106,8 @@ int benchPhysics(int argc, char** argv, int first) {
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
   const std::string csv = opt.get("csv", "");
   const double repeat_value = opt.number("repeat", 1);
-  if (repeat_value < 1 || repeat_value != std::floor(repeat_value))
-    throw UsageError("--repeat must be a whole number >= 1");
+  if (repeat_value < 1 || repeat_value > 1000 || repeat_value != std::floor(repeat_value))
+    throw UsageError("--repeat must be a whole number from 1 to 1000");
   const int repeat = static_cast<int>(repeat_value);
 
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);

@@ -15,10 +15,13 @@ ConfigError::ConfigError(std::string file, std::string key, std::string reason)
 ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   const std::string name = file.string();
   if (!std::filesystem::exists(file)) throw ConfigError(name, "", "file not found");
+  if (!std::filesystem::is_regular_file(file)) throw ConfigError(name, "", "not a regular file");
   try {
     YAML::Node root = YAML::LoadFile(name);
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
     return ConfigNode(root, name, "");
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(name, "", "cannot be read");
   } catch (const YAML::ParserException& e) {
     throw ConfigError(name, "",
                       "YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +

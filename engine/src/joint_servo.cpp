@@ -27,12 +27,19 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
   prev_tau_.push_back(0.0);
   has_history_.push_back(0);
   load_.push_back(0.0);
+  motor_tau_.push_back(0.0);
   return target_.size() - 1;
 }
 
 void JointServoBatch::setTarget(size_t i, double target_rad, double stiffness) {
   target_[i] = std::clamp(target_rad, lower_[i], upper_[i]);
   stiffness_[i] = std::clamp(stiffness, 0.0, 1.0);
+}
+
+void JointServoBatch::appendState(std::vector<double>& out) const {
+  for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &prev_tau_, &load_})
+    out.insert(out.end(), v->begin(), v->end());
+  for (unsigned char h : has_history_) out.push_back(h);
 }
 
 void JointServoBatch::resetHistory(size_t i) {
@@ -63,6 +70,7 @@ void JointServoBatch::computeTorques(std::span<const double> q, std::span<const 
       const double lo = (-drive * (1.0 + w * inv_no_load_[i]) - k * load) * inv;
       motor = std::min(std::max(pd, lo), hi);
     }
+    motor_tau_[i] = motor;
     tau[i] = motor - damping_[i] * w;
     prev_qdot_[i] = w;
     prev_tau_[i] = tau[i];

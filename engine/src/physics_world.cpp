@@ -1,14 +1,17 @@
 #include "simsoccer/engine/physics_world.hpp"
 
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -137,7 +140,41 @@ struct Articulation {
   std::vector<Pose> bullet_in_joint;
   // Per joint: index into the servo batch, or -1 for a passive joint.
   std::vector<int> servo;
+  // Bullet refreshes the links' cached world transforms only inside its
+  // step, before integration; they are recomputed on the first read after.
+  bool kinematics_stale = false;
 };
+
+// Checks a model before any Bullet object is made from it.
+void validateModel(const ArticulatedModel& model) {
+  auto fail = [&](const std::string& what) {
+    throw std::invalid_argument("articulated model '" + model.name + "': " + what);
+  };
+  if (model.links.empty() || model.joints.size() + 1 != model.links.size())
+    fail("needs one joint per non-root link");
+  for (const Link& l : model.links)
+    if (!(l.mass > 0.0)) fail("link '" + l.name + "' needs a mass > 0");
+  for (const Motor& m : model.motors)
+    if (!(m.no_load_speed > 0.0) || !(m.stall_torque > 0.0))
+      fail("motor '" + m.name + "' needs stall torque and no-load speed > 0");
+  for (size_t j = 0; j < model.joints.size(); ++j) {
+    const Joint& joint = model.joints[j];
+    if (joint.child_link != static_cast<int>(j) + 1 || joint.parent_link < 0 ||
+        joint.parent_link > static_cast<int>(j))
+      fail("joint '" + joint.name + "' is not in tree order");
+    if (!(joint.lower < joint.upper)) fail("joint '" + joint.name + "' has lower >= upper limit");
+    if (joint.motor >= static_cast<int>(model.motors.size()))
+      fail("joint '" + joint.name + "' names a motor that does not exist");
+    if (joint.mimic_of >= 0) {
+      if (joint.mimic_of >= static_cast<int>(model.joints.size()) ||
+          joint.mimic_of == static_cast<int>(j) ||
+          model.joints[static_cast<size_t>(joint.mimic_of)].mimic_of >= 0)
+        fail("joint '" + joint.name + "' mimics an invalid joint");
+      if (joint.motor >= 0) fail("mimic joint '" + joint.name + "' must not have its own motor");
+      if (joint.mimic_multiplier == 0.0) fail("joint '" + joint.name + "' has mimic multiplier 0");
+    }
+  }
+}
 
 }  // namespace
 
@@ -181,6 +218,14 @@ struct PhysicsWorld::Impl {
       compound->addChildShape(toBt(Pose(joint_in_bullet * s.pose)), child);
     }
     return keep(std::move(compound));
+  }
+
+  void refresh(Articulation& art) {
+    if (!art.kinematics_stale) return;
+    btAlignedObjectArray<btQuaternion> world_to_local;
+    btAlignedObjectArray<btVector3> local_origin;
+    art.body->forwardKinematics(world_to_local, local_origin);
+    art.kinematics_stale = false;
   }
 
   void updateKinematics(btMultiBody* mb) {
@@ -298,9 +343,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
                                              int collision_group) {
   Impl& m = *impl_;
   const ArticulatedModel& model = *model_ptr;
-  if (model.links.empty() || model.joints.size() + 1 != model.links.size())
-    throw std::invalid_argument("articulated model '" + model.name +
-                                "': needs one joint per non-root link");
+  validateModel(model);
   const int num_links = static_cast<int>(model.joints.size());
 
   Articulation art;
@@ -334,9 +377,6 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     const Joint& joint = model.joints[static_cast<size_t>(j)];
     const size_t child = static_cast<size_t>(joint.child_link);
     const size_t parent = static_cast<size_t>(joint.parent_link);
-    if (static_cast<int>(child) != j + 1 || joint.parent_link > j)
-      throw std::invalid_argument("articulated model '" + model.name + "': joint '" + joint.name +
-                                  "' is not in tree order");
     const Mat3 rot_parent_to_this = axes[child].transpose() * axes[parent];
     const Vec3 axis_in_this = axes[child].transpose() * joint.axis.normalized();
     const Vec3 parent_com_to_pivot =
@@ -355,6 +395,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
 
   btMultiBody* raw = mb.get();
   art.body = raw;
+  m.multibodies.push_back(std::move(mb));  // owned before the world points to it
   m.world->addMultiBody(raw);
 
   // Colliders, one per link that has shapes; the user index is the group.
@@ -364,6 +405,8 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     auto col = std::make_unique<btMultiBodyLinkCollider>(raw, static_cast<int>(i) - 1);
     col->setCollisionShape(m.linkShape(link, art.bullet_in_joint[i]));
     col->setUserIndex(collision_group);
+    col->setUserIndex2(static_cast<int>(i));                       // link index in the model
+    col->setUserIndex3(static_cast<int>(m.articulations.size()));  // articulation id
     applyMaterial(col.get(), model.material);
     m.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter,
                                 btBroadphaseProxy::AllFilter);
@@ -382,6 +425,19 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
         raw, j, static_cast<btScalar>(joint.lower), static_cast<btScalar>(joint.upper));
     m.world->addMultiBodyConstraint(limit.get());
     m.constraints.push_back(std::move(limit));
+    if (joint.mimic_of >= 0) {
+      // One motor drives both hinges through a rigid linkage: a gear
+      // constraint q_mimic = multiplier * q_master (Bullet's rows enforce
+      // qdot_A + ratio * qdot_B = 0), with position drift corrected.
+      auto gear = std::make_unique<btMultiBodyGearConstraint>(
+          raw, joint.mimic_of, raw, j, btVector3(0, 0, 0), btVector3(0, 0, 0),
+          btMatrix3x3::getIdentity(), btMatrix3x3::getIdentity());
+      gear->setGearRatio(static_cast<btScalar>(-1.0 / joint.mimic_multiplier));
+      gear->setErp(0.2f);
+      gear->setMaxAppliedImpulse(static_cast<btScalar>(1e3 * settings_.dt));
+      m.world->addMultiBodyConstraint(gear.get());
+      m.constraints.push_back(std::move(gear));
+    }
     if (joint.motor >= 0) {
       // Lower bound of the inertia this joint moves: the armature plus its own
       // link about the joint axis (the rest of the chain only adds to it).
@@ -402,7 +458,6 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   m.qdot.resize(m.servos.size());
   m.tau.resize(m.servos.size());
 
-  m.multibodies.push_back(std::move(mb));
   m.articulations.push_back(std::move(art));
   const auto id = static_cast<ArticulationId>(m.articulations.size() - 1);
   resetArticulation(id, root_pose, joint_positions);
@@ -420,14 +475,13 @@ void PhysicsWorld::setJointTarget(ArticulationId a, int joint, double target_rad
                                   double stiffness) {
   Impl& m = *impl_;
   const Articulation& art = m.articulations.at(a);
-  const int s = art.servo.at(static_cast<size_t>(joint));
+  const Joint& j = art.model->joints.at(static_cast<size_t>(joint));
+  if (j.mimic_of >= 0)
+    throw std::invalid_argument("joint '" + j.name + "' follows '" +
+                                art.model->joints[static_cast<size_t>(j.mimic_of)].name +
+                                "' (one motor): command that joint");
+  const int s = art.servo[static_cast<size_t>(joint)];
   if (s >= 0) m.servos.setTarget(static_cast<size_t>(s), target_rad, stiffness);
-  const auto& joints = art.model->joints;
-  for (size_t j = 0; j < joints.size(); ++j) {
-    if (joints[j].mimic_of == joint && art.servo[j] >= 0)
-      m.servos.setTarget(static_cast<size_t>(art.servo[j]), joints[j].mimic_multiplier * target_rad,
-                         stiffness);
-  }
 }
 
 void PhysicsWorld::resetArticulation(ArticulationId a, const Pose& root_pose,
@@ -485,6 +539,7 @@ void PhysicsWorld::step() {
   // Stage 2: Bullet (collision, dynamics, solve, integrate); exactly one dt.
   const auto dt = static_cast<btScalar>(settings_.dt);
   m.world->stepSimulation(dt, 0, dt);
+  for (Articulation& art : m.articulations) art.kinematics_stale = true;
   ++step_count_;
   if (timers_on_) {
     m.times.total_s += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -511,7 +566,10 @@ const ArticulatedModel& PhysicsWorld::model(ArticulationId a) const {
 }
 
 Pose PhysicsWorld::linkPose(ArticulationId a, int link) const {
-  const Articulation& art = impl_->articulations.at(a);
+  Articulation& art = impl_->articulations.at(a);
+  if (link < 0 || link >= static_cast<int>(art.model->links.size()))
+    throw std::out_of_range("link index " + std::to_string(link) + " out of range");
+  impl_->refresh(art);
   const btTransform t = link == 0 ? art.body->getBaseWorldTransform()
                                   : art.body->getLink(link - 1).m_cachedWorldTransform;
   return fromBt(t) * art.bullet_in_joint.at(static_cast<size_t>(link)).inverse();
@@ -523,15 +581,34 @@ Vec3 PhysicsWorld::rootLinearVelocity(ArticulationId a) const {
 Vec3 PhysicsWorld::rootAngularVelocity(ArticulationId a) const {
   return fromBt(impl_->articulations.at(a).body->getBaseOmega());
 }
+namespace {
+void checkJoint(const Articulation& art, int joint) {
+  if (joint < 0 || joint >= static_cast<int>(art.model->joints.size()))
+    throw std::out_of_range("joint index " + std::to_string(joint) + " out of range");
+}
+}  // namespace
+
 double PhysicsWorld::jointPosition(ArticulationId a, int joint) const {
-  return impl_->articulations.at(a).body->getJointPos(joint);
+  const Articulation& art = impl_->articulations.at(a);
+  checkJoint(art, joint);
+  return art.body->getJointPos(joint);
 }
 double PhysicsWorld::jointVelocity(ArticulationId a, int joint) const {
-  return impl_->articulations.at(a).body->getJointVel(joint);
+  const Articulation& art = impl_->articulations.at(a);
+  checkJoint(art, joint);
+  return art.body->getJointVel(joint);
 }
 double PhysicsWorld::jointTorque(ArticulationId a, int joint) const {
   const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));
   return s >= 0 ? impl_->tau[static_cast<size_t>(s)] : 0.0;
+}
+double PhysicsWorld::jointMotorTorque(ArticulationId a, int joint) const {
+  const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));
+  return s >= 0 ? impl_->servos.motorTorque(static_cast<size_t>(s)) : 0.0;
+}
+double PhysicsWorld::jointStiffness(ArticulationId a, int joint) const {
+  const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));
+  return s >= 0 ? impl_->servos.stiffness(static_cast<size_t>(s)) : 0.0;
 }
 double PhysicsWorld::jointTarget(ArticulationId a, int joint) const {
   const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));
@@ -556,6 +633,60 @@ ContactCount PhysicsWorld::contactCount() const {
   return c;
 }
 
+void PhysicsWorld::linkContacts(std::vector<LinkContact>& out) const {
+  out.clear();
+  btDispatcher* d = impl_->dispatcher.get();
+  for (int i = 0; i < d->getNumManifolds(); ++i) {
+    const btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+    const btCollisionObject* bodies[2] = {m->getBody0(), m->getBody1()};
+    const bool is_link[2] = {bodies[0]->getUserIndex() >= 0, bodies[1]->getUserIndex() >= 0};
+    if (!is_link[0] && !is_link[1]) continue;
+    for (int c = 0; c < m->getNumContacts(); ++c) {
+      const btManifoldPoint& pt = m->getContactPoint(c);
+      // m_normalWorldOnB points from B to A: the impulse pushes A along it.
+      for (int side = 0; side < 2; ++side) {
+        if (!is_link[side]) continue;
+        LinkContact lc;
+        lc.articulation = static_cast<ArticulationId>(bodies[side]->getUserIndex3());
+        lc.link = bodies[side]->getUserIndex2();
+        lc.position = fromBt(side == 0 ? pt.getPositionWorldOnA() : pt.getPositionWorldOnB());
+        lc.normal = fromBt(side == 0 ? pt.m_normalWorldOnB : -pt.m_normalWorldOnB);
+        lc.impulse = pt.getAppliedImpulse();
+        lc.with_articulation = is_link[1 - side];
+        out.push_back(lc);
+      }
+    }
+  }
+}
+
+Vec3 PhysicsWorld::rootPointVelocity(ArticulationId a, const Vec3& world_point) const {
+  const btMultiBody* mb = impl_->articulations.at(a).body;
+  // The root's Bullet frame sits at its centre of mass.
+  const Vec3 com = fromBt(mb->getBaseWorldTransform().getOrigin());
+  return fromBt(mb->getBaseVel()) + fromBt(mb->getBaseOmega()).cross(world_point - com);
+}
+
+double PhysicsWorld::rayTestClosest(const Vec3& origin, const Vec3& direction, double max_distance,
+                                    int exclude_group) const {
+  struct Callback : btCollisionWorld::ClosestRayResultCallback {
+    int exclude;
+    Callback(const btVector3& from, const btVector3& to, int ex)
+        : ClosestRayResultCallback(from, to), exclude(ex) {}
+    bool needsCollision(btBroadphaseProxy* proxy) const override {
+      const auto* o = static_cast<const btCollisionObject*>(proxy->m_clientObject);
+      if (exclude >= 0 && o->getUserIndex() == exclude) return false;
+      return ClosestRayResultCallback::needsCollision(proxy);
+    }
+  };
+  const btVector3 from = toBt(origin);
+  const btVector3 to = toBt(Vec3(origin + max_distance * direction.normalized()));
+  Callback cb(from, to, exclude_group);
+  cb.m_flags |= btTriangleRaycastCallback::kF_UseGjkConvexCastRaytest;  // the accurate caster
+  impl_->world->rayTest(from, to, cb);
+  return cb.hasHit() ? cb.m_closestHitFraction * max_distance
+                     : std::numeric_limits<double>::infinity();
+}
+
 void PhysicsWorld::appendState(std::vector<double>& out) const {
   auto push3 = [&](const btVector3& v) { out.insert(out.end(), {v.x(), v.y(), v.z()}); };
   auto pushT = [&](const btTransform& t) {
@@ -578,6 +709,7 @@ void PhysicsWorld::appendState(std::vector<double>& out) const {
     push3(body->getLinearVelocity());
     push3(body->getAngularVelocity());
   }
+  impl_->servos.appendState(out);  // targets, stiffnesses and the motors' memory
 }
 
 }  // namespace simsoccer::engine

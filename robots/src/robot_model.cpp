@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -81,16 +82,36 @@ double RobotModel::soleDepth(const std::vector<double>& q) const {
   double lowest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < body->links.size(); ++i) {
     for (const engine::Shape& s : body->links[i].shapes) {
-      if (s.type != engine::ShapeType::Box) continue;
       const Pose p = frames[i] * s.pose;
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 corner(((c & 1) ? 0.5 : -0.5) * s.extents.x(),
-                          ((c & 2) ? 0.5 : -0.5) * s.extents.y(),
-                          ((c & 4) ? 0.5 : -0.5) * s.extents.z());
-        lowest = std::min(lowest, (p * corner).z());
+      const Vec3 c = p.translation();
+      const Vec3 axis = p.linear().col(2);  // capsules and cylinders run along z
+      switch (s.type) {
+        case engine::ShapeType::Box:
+          for (int k = 0; k < 8; ++k) {
+            const Vec3 corner(((k & 1) ? 0.5 : -0.5) * s.extents.x(),
+                              ((k & 2) ? 0.5 : -0.5) * s.extents.y(),
+                              ((k & 4) ? 0.5 : -0.5) * s.extents.z());
+            lowest = std::min(lowest, (p * corner).z());
+          }
+          break;
+        case engine::ShapeType::Sphere:
+          lowest = std::min(lowest, c.z() - s.radius);
+          break;
+        case engine::ShapeType::Capsule: {
+          const double half = 0.5 * s.length - s.radius;
+          lowest = std::min(lowest, c.z() - std::abs(axis.z()) * half - s.radius);
+          break;
+        }
+        case engine::ShapeType::Cylinder: {
+          const double rim = s.radius * std::sqrt(std::max(0.0, 1.0 - axis.z() * axis.z()));
+          lowest = std::min(lowest, c.z() - std::abs(axis.z()) * 0.5 * s.length - rim);
+          break;
+        }
       }
     }
   }
+  if (!std::isfinite(lowest))
+    throw std::invalid_argument("robot '" + name + "' has no collision shapes to stand on");
   return -lowest;
 }
 
@@ -162,6 +183,18 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
       n["type"].fail("unknown joint type '" + j.type + "' (revolute or fixed)");
     if (!links.count(j.parent)) n["parent"].fail("unknown link '" + j.parent + "'");
     if (!links.count(j.child)) n["child"].fail("unknown link '" + j.child + "'");
+    if (j.child == j.parent) n["child"].fail("a joint cannot attach a link to itself");
+    for (const RawJoint& other : raw)
+      if (other.child == j.child)
+        n["child"].fail("link '" + j.child + "' is already attached by joint '" + other.name + "'");
+    if (j.type == "fixed") {
+      for (const char* key : {"axis", "limits", "motor", "mimic", "damping"})
+        if (n.has(key)) n.failKey(key, "a fixed joint has no '" + std::string(key) + "'");
+    } else if (n.has("mimic") && n.has("motor")) {
+      n.failKey("motor", "a mimic joint is driven by its master's motor: remove 'motor'");
+    } else if (n.has("damping") && !n.has("motor")) {
+      n.failKey("damping", "passive damping is applied by a joint's motor: this joint has none");
+    }
     raw.push_back(j);
   }
   std::map<std::string, std::string> merged_into;  // fixed child -> parent it joined
@@ -229,6 +262,12 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     const int master = body->jointIndex((*mimic)["joint"].string());
     if (master < 0) (*mimic)["joint"].fail("unknown joint '" + (*mimic)["joint"].string() + "'");
     if (master == self) (*mimic)["joint"].fail("a joint cannot mimic itself");
+    if (body->joints[static_cast<size_t>(master)].motor < 0)
+      (*mimic)["joint"].fail("the master joint '" + (*mimic)["joint"].string() + "' has no motor");
+    for (const RawJoint& other : raw)
+      if (other.name == (*mimic)["joint"].string() && other.node.has("mimic"))
+        (*mimic)["joint"].fail("the master joint mimics another joint itself");
+    if (mimic->number("multiplier", 1.0) == 0.0) mimic->failKey("multiplier", "must not be 0");
     body->joints[static_cast<size_t>(self)].mimic_of = master;
     body->joints[static_cast<size_t>(self)].mimic_multiplier = mimic->number("multiplier", 1.0);
   }

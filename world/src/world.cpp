@@ -22,6 +22,33 @@ std::string robotKey(size_t i, const char* field) {
   return "robots[" + std::to_string(i) + "]." + field;
 }
 
+// Standard normal samples from a seeded engine by Box-Muller: unlike
+// std::normal_distribution, the same on every standard library.
+class NormalSampler {
+ public:
+  explicit NormalSampler(uint64_t seed) : rng_(seed) {}
+  double operator()() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    const double u1 = (static_cast<double>(rng_() >> 11) + 1.0) * 0x1.0p-53;  // (0, 1]
+    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;          // [0, 1)
+    const double r = std::sqrt(-2.0 * std::log(u1));
+    spare_ = r * std::sin(2.0 * M_PI * u2);
+    has_spare_ = true;
+    return r * std::cos(2.0 * M_PI * u2);
+  }
+
+ private:
+  std::mt19937_64 rng_;
+  double spare_ = 0.0;
+  bool has_spare_ = false;
+};
+
+// Robots whose torsos start closer than this overlap.
+constexpr double kMinRobotSpacing = 0.2;  // m
+
 }  // namespace
 
 World World::fromFile(const std::filesystem::path& scenario_file) {
@@ -32,8 +59,12 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   const PhysicsConfig& pc = scenario_.physics;
   if (!(pc.dt > 0.0)) scenarioError(scenario_, "physics.dt", "must be > 0");
   const double ratio = pc.control_period / pc.dt;
-  if (!(ratio >= 1.0) || std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
+  if (!(ratio >= 1.0) || ratio > 1e6 || std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
     scenarioError(scenario_, "physics.control_period", "must be a whole multiple of dt");
+  if (pc.solver_iterations < 1)
+    scenarioError(scenario_, "physics.solver_iterations", "must be >= 1");
+  if (pc.friction_directions != 1 && pc.friction_directions != 2)
+    scenarioError(scenario_, "physics.friction_directions", "must be 1 or 2");
   steps_per_control_ = static_cast<int>(std::lround(ratio));
 
   field_ = std::make_shared<const fields::FieldModel>(fields::loadFieldModel(scenario_.field_file));
@@ -52,7 +83,12 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   ball_shape.radius = bm.radius;
   Pose ball_pose = Pose::Identity();
   Vec3 bp = scenario_.ball_position;
-  if (bp.z() < 0.0) bp.z() = bm.radius;
+  if (bp.z() < 0.0)
+    bp.z() = bm.radius;  // not given: resting on the carpet
+  else if (bp.z() < bm.radius)
+    scenarioError(scenario_, "ball.position",
+                  "the ball's centre must be at least its radius (" +
+                      engine::formatNumber(bm.radius) + " m) above the carpet");
   if (!field_->onCarpet(bp.x(), bp.y()))
     scenarioError(scenario_, "ball.position", "outside the carpet");
   ball_pose.translation() = bp;
@@ -63,8 +99,8 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   // Robots, in scenario order; each model file is loaded once and shared.
   std::map<std::string, std::shared_ptr<const robots::RobotModel>> models;
   std::map<std::pair<int, int>, size_t> numbers;
-  std::mt19937_64 rng(scenario_.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+  NormalSampler normal(scenario_.seed);
+  std::vector<Vec3> placed;
   for (size_t i = 0; i < scenario_.robots.size(); ++i) {
     const RobotPlacement& p = scenario_.robots[i];
     if (auto [it, fresh] = numbers.emplace(std::pair{p.team, p.number}, i); !fresh)
@@ -91,19 +127,29 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     const auto& joints = model->body->joints;
     double x = p.x, y = p.y, yaw = p.yaw;
     if (scenario_.noise.position > 0) {
-      x += scenario_.noise.position * normal(rng);
-      y += scenario_.noise.position * normal(rng);
+      x += scenario_.noise.position * normal();
+      y += scenario_.noise.position * normal();
     }
-    if (scenario_.noise.yaw > 0) yaw += scenario_.noise.yaw * normal(rng);
+    if (scenario_.noise.yaw > 0) yaw += scenario_.noise.yaw * normal();
     if (scenario_.noise.joints > 0) {
       for (size_t j = 0; j < q.size(); ++j)
         if (joints[j].mimic_of < 0)
-          q[j] = std::clamp(q[j] + scenario_.noise.joints * normal(rng), joints[j].lower,
+          q[j] = std::clamp(q[j] + scenario_.noise.joints * normal(), joints[j].lower,
                             joints[j].upper);
       for (size_t j = 0; j < q.size(); ++j)
         if (joints[j].mimic_of >= 0)
           q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
     }
+    if (!field_->onCarpet(x, y))
+      scenarioError(
+          scenario_, robotKey(i, "pose"),
+          "placement noise moved the robot off the carpet: lower placement_noise.position");
+    for (size_t k = 0; k < placed.size(); ++k)
+      if ((placed[k].head<2>() - Vec3(x, y, 0).head<2>()).norm() < kMinRobotSpacing)
+        scenarioError(scenario_, robotKey(i, "pose"),
+                      "overlaps robots[" + std::to_string(k) + "] (torsos closer than " +
+                          engine::formatNumber(kMinRobotSpacing) + " m)");
+    placed.emplace_back(x, y, 0.0);
     // Upright, soles 1 mm above the carpet.
     Pose torso = Pose::Identity();
     torso.translation() = Vec3(x, y, model->soleDepth(q) + 0.001);
@@ -116,8 +162,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     robots_.push_back(info);
     // Hold the posture at full stiffness until commanded otherwise.
     for (size_t j = 0; j < joints.size(); ++j)
-      if (joints[j].motor >= 0 && joints[j].mimic_of < 0)
-        physics_->setJointTarget(info.body, static_cast<int>(j), q[j], 1.0);
+      if (joints[j].motor >= 0) physics_->setJointTarget(info.body, static_cast<int>(j), q[j], 1.0);
   }
 }
 
@@ -146,7 +191,7 @@ void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffn
   const auto& q = info.model->pose(pose_name);
   const auto& joints = info.model->body->joints;
   for (size_t j = 0; j < joints.size(); ++j)
-    if (joints[j].motor >= 0 && joints[j].mimic_of < 0)
+    if (joints[j].motor >= 0)
       physics_->setJointTarget(info.body, static_cast<int>(j), q[j], stiffness);
 }
 

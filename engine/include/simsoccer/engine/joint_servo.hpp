@@ -35,6 +35,11 @@ class JointServoBatch {
   void setTarget(size_t i, double target_rad, double stiffness);
   double target(size_t i) const { return target_[i]; }
   double stiffness(size_t i) const { return stiffness_[i]; }
+  // Motor part of the last computed torque (without passive damping), N m.
+  double motorTorque(size_t i) const { return motor_tau_[i]; }
+  // Appends every servo's target, stiffness and the state it carries between
+  // steps (for state hashes).
+  void appendState(std::vector<double>& out) const;
   // Forget the load history of one servo (after a teleport).
   void resetHistory(size_t i);
 
@@ -45,7 +50,7 @@ class JointServoBatch {
 
  private:
   std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_, upper_,
-      min_inertia_, prev_qdot_, prev_tau_, load_;
+      min_inertia_, prev_qdot_, prev_tau_, load_, motor_tau_;
   std::vector<unsigned char> has_history_;
 };
 

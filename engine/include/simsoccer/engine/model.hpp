@@ -56,6 +56,13 @@ struct Motor {
   double armature = 0.0;       // reflected rotor inertia, kg m^2
   double kp = 0.0;             // N m/rad, servo proportional gain
   double kd = 0.0;             // N m s/rad, servo derivative gain
+  // Electrical and thermal model (sensors: current, temperature).
+  double gear_ratio = 1.0;
+  double torque_constant = 0.0;        // N m/A at the motor shaft
+  double resistance = 0.0;             // winding resistance, ohm
+  double no_load_current = 0.0;        // A drawn while moving freely
+  double thermal_resistance = 0.0;     // K/W, winding to ambient
+  double thermal_time_constant = 0.0;  // s
 };
 
 // A revolute joint. Joint i moves link i + 1 (link 0 is the root), so the

@@ -47,6 +47,16 @@ struct ContactCount {
   int between_articulations = 0;  // of which robot against robot
 };
 
+// One contact point as it acts on one link of an articulation.
+struct LinkContact {
+  ArticulationId articulation = 0;
+  int link = 0;                    // link index in the articulation's model
+  Vec3 position = Vec3::Zero();    // contact point on the link, world frame
+  Vec3 normal = Vec3::Zero();      // unit direction of the normal impulse on the link
+  double impulse = 0.0;            // N s applied along `normal` in the last step
+  bool with_articulation = false;  // the other body is a link of another articulation
+};
+
 struct RigidBodyState {
   Pose pose = Pose::Identity();
   Vec3 linear_velocity = Vec3::Zero();
@@ -78,8 +88,8 @@ class PhysicsWorld {
                                  int collision_group);
 
   // --- commands ----------------------------------------------------------------
-  // Servo target and stiffness of one joint. Mimic joints follow their master:
-  // commanding the master also commands them.
+  // Servo target and stiffness of one joint. A mimic joint has no motor of
+  // its own (a gear constraint ties it to its master): commanding it throws.
   void setJointTarget(ArticulationId a, int joint, double target_rad, double stiffness);
   // Teleports an articulation (zero velocities); for placement and tests.
   void resetArticulation(ArticulationId a, const Pose& root_pose,
@@ -107,13 +117,28 @@ class PhysicsWorld {
   double jointVelocity(ArticulationId a, int joint) const;
   // Torque the servo applied in the last step (motor + passive damping).
   double jointTorque(ArticulationId a, int joint) const;
+  // The motor's part of it (what the motor current follows).
+  double jointMotorTorque(ArticulationId a, int joint) const;
+  double jointStiffness(ArticulationId a, int joint) const;
   double jointTarget(ArticulationId a, int joint) const;
   RigidBodyState rigidBodyState(BodyId b) const;
   // Contact points in the contact manifolds after the last step.
   ContactCount contactCount() const;
+  // Every contact point touching a link of an articulation after the last
+  // step, one entry per link side. Refills `out` (its capacity is reused).
+  void linkContacts(std::vector<LinkContact>& out) const;
+  // Velocity of a world point rigidly attached to an articulation's root.
+  Vec3 rootPointVelocity(ArticulationId a, const Vec3& world_point) const;
+
+  // Reference ray cast through Bullet (btCollisionWorld::rayTest), one ray:
+  // distance to the nearest collider within max_distance, ignoring the links
+  // of articulations in `exclude_group`; infinity if nothing.
+  double rayTestClosest(const Vec3& origin, const Vec3& direction, double max_distance,
+                        int exclude_group) const;
 
   // Appends the full dynamic state (every root pose and velocity, joint
-  // positions and velocities, rigid bodies) as raw values in creation order:
+  // positions and velocities, rigid bodies, servo targets and memory) as raw
+  // values in creation order:
   // the canonical byte image that state hashes are computed over.
   void appendState(std::vector<double>& out) const;
 

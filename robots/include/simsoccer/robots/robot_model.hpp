@@ -53,8 +53,8 @@ struct RobotModel {
   const std::vector<double>& pose(const std::string& pose_name) const;
   int actuatorIndex(const std::string& actuator_name) const;  // -1 if absent
   const SensorFrame* sensor(const std::string& sensor_name) const;
-  // Height of the sole (lowest point of the feet's collision boxes) below
-  // the torso origin at the given joint angles, torso upright.
+  // Depth of the lowest point of any collision shape (the soles, standing)
+  // below the torso origin at the given joint angles, torso upright.
   double soleDepth(const std::vector<double>& joint_positions) const;
 };
 
