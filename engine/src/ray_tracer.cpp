@@ -42,10 +42,18 @@ inline float raySphere(float ox, float oy, float oz, float dx, float dy, float d
 }  // namespace
 
 void RayScene::clear() {
-  spheres_ = {};
-  capsules_ = {};
-  boxes_ = {};
-  cylinders_ = {};
+  // Keeps the arrays' capacity: rebuilding the scene every sonar update
+  // allocates nothing once the first one has sized them.
+  for (auto* v : {&spheres_.cx, &spheres_.cy, &spheres_.cz, &spheres_.r, &capsules_.ax,
+                  &capsules_.ay, &capsules_.az, &capsules_.bx, &capsules_.by, &capsules_.bz,
+                  &capsules_.r, &boxes_.cx, &boxes_.cy, &boxes_.cz, &boxes_.hx, &boxes_.hy,
+                  &boxes_.hz, &cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux,
+                  &cylinders_.uy, &cylinders_.uz, &cylinders_.h, &cylinders_.r})
+    v->clear();
+  for (auto& v : boxes_.r) v.clear();
+  for (auto* v : {&spheres_.object, &spheres_.owner, &capsules_.object, &capsules_.owner,
+                  &boxes_.object, &boxes_.owner, &cylinders_.object, &cylinders_.owner})
+    v->clear();
   groups_.clear();
   has_ground_ = false;
   ground_object_ = kNoObject;
@@ -111,13 +119,15 @@ size_t RayScene::primitiveCount() const {
 }
 
 void RayScene::finalize() {
-  {
+  // Group the primitives by owner (callers that add them owner by owner, as
+  // the sensor system does, skip the reordering and its allocations).
+  if (!std::is_sorted(spheres_.owner.begin(), spheres_.owner.end())) {
     const auto o = ownerOrder(spheres_.owner);
     for (auto* v : {&spheres_.cx, &spheres_.cy, &spheres_.cz, &spheres_.r}) permute(*v, o);
     permute(spheres_.object, o);
     permute(spheres_.owner, o);
   }
-  {
+  if (!std::is_sorted(capsules_.owner.begin(), capsules_.owner.end())) {
     const auto o = ownerOrder(capsules_.owner);
     for (auto* v : {&capsules_.ax, &capsules_.ay, &capsules_.az, &capsules_.bx, &capsules_.by,
                     &capsules_.bz, &capsules_.r})
@@ -125,7 +135,7 @@ void RayScene::finalize() {
     permute(capsules_.object, o);
     permute(capsules_.owner, o);
   }
-  {
+  if (!std::is_sorted(boxes_.owner.begin(), boxes_.owner.end())) {
     const auto o = ownerOrder(boxes_.owner);
     for (auto* v : {&boxes_.cx, &boxes_.cy, &boxes_.cz, &boxes_.hx, &boxes_.hy, &boxes_.hz})
       permute(*v, o);
@@ -133,55 +143,73 @@ void RayScene::finalize() {
     permute(boxes_.object, o);
     permute(boxes_.owner, o);
   }
-  {
+  if (!std::is_sorted(cylinders_.owner.begin(), cylinders_.owner.end())) {
     const auto o = ownerOrder(cylinders_.owner);
-    for (auto* v : {&cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux, &cylinders_.uy,
-                    &cylinders_.uz, &cylinders_.h, &cylinders_.r})
+    for (auto* v : {&cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux,
+                    &cylinders_.uy, &cylinders_.uz, &cylinders_.h, &cylinders_.r})
       permute(*v, o);
     permute(cylinders_.object, o);
     permute(cylinders_.owner, o);
   }
 
-  // One group per distinct owner, in ascending owner order (no owner first).
-  std::vector<int32_t> owners;
-  for (const auto* v : {&spheres_.owner, &capsules_.owner, &boxes_.owner, &cylinders_.owner})
-    owners.insert(owners.end(), v->begin(), v->end());
-  std::sort(owners.begin(), owners.end());
-  owners.erase(std::unique(owners.begin(), owners.end()), owners.end());
-  groups_.assign(owners.size(), Group{});
-  auto range = [](const std::vector<int32_t>& v, int32_t owner, uint32_t& b, uint32_t& e) {
-    b = static_cast<uint32_t>(std::lower_bound(v.begin(), v.end(), owner) - v.begin());
-    e = static_cast<uint32_t>(std::upper_bound(v.begin(), v.end(), owner) - v.begin());
-  };
-  for (size_t g = 0; g < owners.size(); ++g) {
-    Group& grp = groups_[g];
-    grp.owner = owners[g];
-    range(spheres_.owner, grp.owner, grp.sphere_begin, grp.sphere_end);
-    range(capsules_.owner, grp.owner, grp.capsule_begin, grp.capsule_end);
-    range(boxes_.owner, grp.owner, grp.box_begin, grp.box_end);
-    range(cylinders_.owner, grp.owner, grp.cylinder_begin, grp.cylinder_end);
-    // Bounding sphere around the primitives' own bounding spheres.
-    std::vector<std::pair<Vec3f, float>> bounds;
-    for (uint32_t i = grp.sphere_begin; i < grp.sphere_end; ++i)
-      bounds.push_back({{spheres_.cx[i], spheres_.cy[i], spheres_.cz[i]}, spheres_.r[i]});
-    for (uint32_t i = grp.capsule_begin; i < grp.capsule_end; ++i) {
-      const Vec3f a(capsules_.ax[i], capsules_.ay[i], capsules_.az[i]);
-      const Vec3f b(capsules_.bx[i], capsules_.by[i], capsules_.bz[i]);
-      bounds.push_back({0.5f * (a + b), 0.5f * (b - a).norm() + capsules_.r[i]});
-    }
-    for (uint32_t i = grp.box_begin; i < grp.box_end; ++i)
-      bounds.push_back({{boxes_.cx[i], boxes_.cy[i], boxes_.cz[i]},
-                        Vec3f(boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]).norm()});
-    for (uint32_t i = grp.cylinder_begin; i < grp.cylinder_end; ++i)
-      bounds.push_back({{cylinders_.cx[i], cylinders_.cy[i], cylinders_.cz[i]},
-                        std::hypot(cylinders_.h[i], cylinders_.r[i])});
+  // One group per distinct owner, ascending (no owner first): walk the four
+  // sorted owner arrays together.
+  groups_.clear();
+  uint32_t si = 0, ci = 0, bi = 0, yi = 0;
+  const auto ns = static_cast<uint32_t>(spheres_.owner.size());
+  const auto nc = static_cast<uint32_t>(capsules_.owner.size());
+  const auto nb = static_cast<uint32_t>(boxes_.owner.size());
+  const auto ny = static_cast<uint32_t>(cylinders_.owner.size());
+  constexpr int32_t kEnd = std::numeric_limits<int32_t>::max();
+  while (si < ns || ci < nc || bi < nb || yi < ny) {
+    const int32_t owner = std::min({si < ns ? spheres_.owner[si] : kEnd,
+                                    ci < nc ? capsules_.owner[ci] : kEnd,
+                                    bi < nb ? boxes_.owner[bi] : kEnd,
+                                    yi < ny ? cylinders_.owner[yi] : kEnd});
+    Group g;
+    g.owner = owner;
+    g.sphere_begin = si;
+    while (si < ns && spheres_.owner[si] == owner) ++si;
+    g.sphere_end = si;
+    g.capsule_begin = ci;
+    while (ci < nc && capsules_.owner[ci] == owner) ++ci;
+    g.capsule_end = ci;
+    g.box_begin = bi;
+    while (bi < nb && boxes_.owner[bi] == owner) ++bi;
+    g.box_end = bi;
+    g.cylinder_begin = yi;
+    while (yi < ny && cylinders_.owner[yi] == owner) ++yi;
+    g.cylinder_end = yi;
+
+    // Bounding sphere around the primitives' own bounding spheres: centre at
+    // their mean, radius to the farthest.
+    auto each = [&](auto&& f) {
+      for (uint32_t i = g.sphere_begin; i < g.sphere_end; ++i)
+        f(Vec3f(spheres_.cx[i], spheres_.cy[i], spheres_.cz[i]), spheres_.r[i]);
+      for (uint32_t i = g.capsule_begin; i < g.capsule_end; ++i) {
+        const Vec3f a(capsules_.ax[i], capsules_.ay[i], capsules_.az[i]);
+        const Vec3f b(capsules_.bx[i], capsules_.by[i], capsules_.bz[i]);
+        f(0.5f * (a + b), 0.5f * (b - a).norm() + capsules_.r[i]);
+      }
+      for (uint32_t i = g.box_begin; i < g.box_end; ++i)
+        f(Vec3f(boxes_.cx[i], boxes_.cy[i], boxes_.cz[i]),
+          Vec3f(boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]).norm());
+      for (uint32_t i = g.cylinder_begin; i < g.cylinder_end; ++i)
+        f(Vec3f(cylinders_.cx[i], cylinders_.cy[i], cylinders_.cz[i]),
+          std::hypot(cylinders_.h[i], cylinders_.r[i]));
+    };
     Vec3f centre = Vec3f::Zero();
-    for (const auto& b : bounds) centre += b.first;
-    if (!bounds.empty()) centre /= static_cast<float>(bounds.size());
+    int count = 0;
+    each([&](const Vec3f& c, float) {
+      centre += c;
+      ++count;
+    });
+    centre /= static_cast<float>(std::max(count, 1));
     float radius = 0.0f;
-    for (const auto& b : bounds) radius = std::max(radius, (b.first - centre).norm() + b.second);
-    grp.centre = centre;
-    grp.radius = radius * 1.0001f + 1e-5f;
+    each([&](const Vec3f& c, float r) { radius = std::max(radius, (c - centre).norm() + r); });
+    g.centre = centre;
+    g.radius = radius * 1.0001f + 1e-5f;
+    groups_.push_back(g);
   }
 }
 

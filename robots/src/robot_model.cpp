@@ -117,8 +117,8 @@ double RobotModel::soleDepth(const std::vector<double>& q) const {
 
 RobotModel loadRobotModel(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
-  root.allowOnly({"robot", "material", "motors", "links", "joints", "actuators", "absent_actuators",
-                  "hands", "sensors", "poses"});
+  root.allowOnly({"robot", "material", "encoder", "imu", "sonar", "thermal", "motors", "links",
+                  "joints", "actuators", "absent_actuators", "hands", "sensors", "poses"});
   RobotModel robot;
   robot.name = root["robot"].string();
   robot.source_file = file.string();
@@ -126,11 +126,48 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   body->name = robot.name;
   if (auto m = root.optional("material")) body->material = engine::readMaterial(*m, {});
 
+  // Sensor hardware.
+  SensorSpec& spec = robot.sensor_spec;
+  if (auto n = root.optional("encoder")) {
+    n->allowOnly({"bits"});
+    spec.encoder_bits = (*n)["bits"].integer();
+    if (spec.encoder_bits < 4 || spec.encoder_bits > 24) n->failKey("bits", "must be 4..24");
+  }
+  if (auto n = root.optional("imu")) {
+    n->allowOnly({"gyro_range", "accel_range"});
+    spec.gyro_range = (*n)["gyro_range"].positive();
+    spec.accel_range = (*n)["accel_range"].positive();
+  }
+  if (auto n = root.optional("sonar")) {
+    n->allowOnly({"min_range", "max_range", "cone_angle", "no_echo_value", "max_echoes"});
+    spec.sonar_min_range = (*n)["min_range"].nonNegative();
+    spec.sonar_max_range = (*n)["max_range"].positive();
+    if (spec.sonar_max_range <= spec.sonar_min_range) n->failKey("max_range", "must exceed min_range");
+    spec.sonar_cone_angle = (*n)["cone_angle"].positive();
+    if (spec.sonar_cone_angle >= M_PI) n->failKey("cone_angle", "must be below pi");
+    spec.sonar_no_echo_value = (*n)["no_echo_value"].positive();
+    spec.sonar_max_echoes = (*n)["max_echoes"].integer();
+    if (spec.sonar_max_echoes < 1 || spec.sonar_max_echoes > 10)
+      n->failKey("max_echoes", "must be 1..10 (the Nao reports up to 10)");
+  }
+  if (auto n = root.optional("thermal")) {
+    n->allowOnly({"ambient", "hot", "very_hot", "critical"});
+    spec.ambient_temperature = (*n)["ambient"].number();
+    spec.temperature_hot = (*n)["hot"].number();
+    spec.temperature_very_hot = (*n)["very_hot"].number();
+    spec.temperature_critical = (*n)["critical"].number();
+    if (!(spec.ambient_temperature < spec.temperature_hot &&
+          spec.temperature_hot < spec.temperature_very_hot &&
+          spec.temperature_very_hot < spec.temperature_critical))
+      n->fail("expected ambient < hot < very_hot < critical");
+  }
+
   // Motors.
   std::map<std::string, double> motor_damping;
   for (const auto& [name, n] : root["motors"].entries()) {
     n.allowOnly({"motor_type", "gear_ratio", "stall_torque", "no_load_speed", "armature", "kp",
-                 "kd", "damping"});
+                 "kd", "damping", "torque_constant", "resistance", "no_load_current",
+                 "thermal_resistance", "thermal_time_constant"});
     engine::Motor m;
     m.name = name;
     m.stall_torque = n["stall_torque"].positive();
@@ -138,7 +175,12 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     m.armature = n["armature"].nonNegative();
     m.kp = n["kp"].nonNegative();
     m.kd = n["kd"].nonNegative();
-    if (auto g = n.optional("gear_ratio")) g->positive();
+    m.gear_ratio = n["gear_ratio"].positive();
+    m.torque_constant = n["torque_constant"].positive();
+    m.resistance = n["resistance"].positive();
+    m.no_load_current = n["no_load_current"].nonNegative();
+    m.thermal_resistance = n["thermal_resistance"].positive();
+    m.thermal_time_constant = n["thermal_time_constant"].positive();
     motor_damping[name] = n.has("damping") ? n["damping"].nonNegative() : 0.0;
     body->motors.push_back(m);
   }

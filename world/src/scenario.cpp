@@ -11,7 +11,7 @@ using engine::ConfigNode;
 Scenario loadScenario(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"scenario", "field", "robot_model", "physics", "seed", "placement_noise", "ball",
-                  "robots", "bench"});
+                  "robots", "sensors", "bench"});
   Scenario s;
   s.source_file = file.string();
   s.name = root["scenario"].string();
@@ -45,6 +45,33 @@ Scenario loadScenario(const std::filesystem::path& file) {
     s.noise.position = n->has("position") ? (*n)["position"].nonNegative() : 0.0;
     s.noise.yaw = n->has("yaw") ? (*n)["yaw"].nonNegative() : 0.0;
     s.noise.joints = n->has("joints") ? (*n)["joints"].nonNegative() : 0.0;
+  }
+  if (auto n = root.optional("sensors")) {
+    n->allowOnly({"sonar", "imu"});
+    if (auto sonar = n->optional("sonar")) {
+      sonar->allowOnly({"rays", "update_period"});
+      s.sensors.sonar_rays = sonar->integer("rays", s.sensors.sonar_rays);
+      if (s.sensors.sonar_rays < 1 || s.sensors.sonar_rays > 256)
+        sonar->failKey("rays", "must be 1..256");
+      if (sonar->has("update_period")) s.sensors.sonar_period = (*sonar)["update_period"].positive();
+      const double k = s.sensors.sonar_period / s.physics.control_period;
+      if (std::abs(k - std::round(k)) > 1e-9 * k || std::round(k) < 1.0)
+        sonar->failKey("update_period", "must be a whole multiple of the control period (" +
+                                            engine::formatNumber(s.physics.control_period) + " s)");
+    }
+    if (auto imu = n->optional("imu")) {
+      imu->allowOnly({"gyro_noise", "gyro_bias", "accel_noise", "accel_bias", "angle_noise"});
+      auto vec = [&](const char* key, engine::Vec3& out, bool non_negative) {
+        if (!imu->has(key)) return;
+        out = (*imu)[key].vec3();
+        if (non_negative && out.minCoeff() < 0.0) imu->failKey(key, "standard deviations must be >= 0");
+      };
+      vec("gyro_noise", s.sensors.gyro_noise, true);
+      vec("gyro_bias", s.sensors.gyro_bias, false);
+      vec("accel_noise", s.sensors.accel_noise, true);
+      vec("accel_bias", s.sensors.accel_bias, false);
+      vec("angle_noise", s.sensors.angle_noise, true);
+    }
   }
   if (auto b = root.optional("ball")) {
     b->allowOnly({"position", "velocity"});

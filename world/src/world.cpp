@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "simsoccer/engine/config.hpp"
+#include "simsoccer/engine/random.hpp"
 #include "simsoccer/engine/state_hash.hpp"
 
 namespace simsoccer::world {
@@ -21,30 +22,6 @@ namespace {
 std::string robotKey(size_t i, const char* field) {
   return "robots[" + std::to_string(i) + "]." + field;
 }
-
-// Standard normal samples from a seeded engine by Box-Muller: unlike
-// std::normal_distribution, the same on every standard library.
-class NormalSampler {
- public:
-  explicit NormalSampler(uint64_t seed) : rng_(seed) {}
-  double operator()() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    const double u1 = (static_cast<double>(rng_() >> 11) + 1.0) * 0x1.0p-53;  // (0, 1]
-    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;          // [0, 1)
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    spare_ = r * std::sin(2.0 * M_PI * u2);
-    has_spare_ = true;
-    return r * std::cos(2.0 * M_PI * u2);
-  }
-
- private:
-  std::mt19937_64 rng_;
-  double spare_ = 0.0;
-  bool has_spare_ = false;
-};
 
 // Robots whose torsos start closer than this overlap.
 constexpr double kMinRobotSpacing = 0.2;  // m
@@ -99,7 +76,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   // Robots, in scenario order; each model file is loaded once and shared.
   std::map<std::string, std::shared_ptr<const robots::RobotModel>> models;
   std::map<std::pair<int, int>, size_t> numbers;
-  NormalSampler normal(scenario_.seed);
+  engine::NormalSampler normal(scenario_.seed);
   std::vector<Vec3> placed;
   for (size_t i = 0; i < scenario_.robots.size(); ++i) {
     const RobotPlacement& p = scenario_.robots[i];
@@ -164,6 +141,16 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     for (size_t j = 0; j < joints.size(); ++j)
       if (joints[j].motor >= 0) physics_->setJointTarget(info.body, static_cast<int>(j), q[j], 1.0);
   }
+  initSensors();
+}
+
+void World::initSensors() {
+  std::vector<SensorSystem::RobotRef> refs;
+  for (size_t i = 0; i < robots_.size(); ++i)
+    refs.push_back({robots_[i].body, static_cast<int>(i), robots_[i].model.get()});
+  sensors_ = std::make_unique<SensorSystem>(scenario_.sensors, *field_, std::move(refs), *physics_,
+                                            ball_, scenario_.seed, scenario_.physics.control_period,
+                                            scenario_.physics.dt);
 }
 
 void World::setCommand(RobotId r, std::span<const double> positions,
@@ -177,9 +164,12 @@ void World::setCommand(RobotId r, std::span<const double> positions,
     if (!std::isfinite(positions[i]) || !std::isfinite(stiffness[i]))
       throw std::invalid_argument("command for robot " + std::to_string(r) +
                                   ": non-finite value for " + actuators[i].name);
-  for (size_t i = 0; i < actuators.size(); ++i)
+  for (size_t i = 0; i < actuators.size(); ++i) {
     if (actuators[i].kind == robots::Actuator::Kind::Joint)
       physics_->setJointTarget(info.body, actuators[i].index, positions[i], stiffness[i]);
+    else if (actuators[i].kind == robots::Actuator::Kind::Hand)
+      sensors_->commandHand(r, static_cast<size_t>(actuators[i].index), positions[i], stiffness[i]);
+  }
 }
 
 void World::setJointTarget(RobotId r, int joint, double target_rad, double stiffness) {
@@ -197,10 +187,14 @@ void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffn
 
 void World::step() {
   physics_->step();
+  sensors_->afterStep(*physics_);
+  const uint64_t steps = physics_->stepCount();
+  if (steps % static_cast<uint64_t>(steps_per_control_) == 0)
+    sensors_->finishPeriod(*physics_, steps / static_cast<uint64_t>(steps_per_control_), time());
 }
 
 void World::stepControlPeriod() {
-  for (int i = 0; i < steps_per_control_; ++i) physics_->step();
+  for (int i = 0; i < steps_per_control_; ++i) step();
 }
 
 Pose World::torsoPose(RobotId r) const {

@@ -40,6 +40,19 @@ struct SensorFrame {
   Pose pose = Pose::Identity();  // in the link's joint frame
 };
 
+// Sensor hardware characteristics (not placement: that is SensorFrame).
+struct SensorSpec {
+  int encoder_bits = 12;
+  double gyro_range = 8.727;    // rad/s, +-
+  double accel_range = 19.62;   // m/s^2, +-
+  double sonar_min_range = 0.20, sonar_max_range = 0.80;  // m
+  double sonar_cone_angle = 1.0472;                        // rad, full cone
+  double sonar_no_echo_value = 5.0;                        // m
+  int sonar_max_echoes = 10;
+  double ambient_temperature = 25.0;                       // deg C
+  double temperature_hot = 70.0, temperature_very_hot = 80.0, temperature_critical = 90.0;
+};
+
 struct RobotModel {
   std::string name;
   std::string source_file;
@@ -47,6 +60,7 @@ struct RobotModel {
   std::vector<Actuator> actuators;  // the robot's command order
   std::vector<Hand> hands;
   std::vector<SensorFrame> sensors;
+  SensorSpec sensor_spec;
   std::map<std::string, std::vector<double>> poses;  // per body joint, rad
 
   // Joint angles (one per body joint) of a named pose; throws if unknown.

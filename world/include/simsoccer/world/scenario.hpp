@@ -36,6 +36,18 @@ struct PlacementNoise {
   double joints = 0.0;    // rad
 };
 
+// Sensor simulation settings (the hardware's own numbers are in the robot
+// model). Noise is white, per axis, from the scenario seed; off by default.
+struct SensorSettings {
+  int sonar_rays = 9;              // rays per sonar cone
+  double sonar_period = 0.060;     // s between sonar updates, a multiple of the control period
+  engine::Vec3 gyro_noise = engine::Vec3::Zero();    // rad/s std dev
+  engine::Vec3 gyro_bias = engine::Vec3::Zero();     // rad/s
+  engine::Vec3 accel_noise = engine::Vec3::Zero();   // m/s^2 std dev
+  engine::Vec3 accel_bias = engine::Vec3::Zero();    // m/s^2
+  engine::Vec3 angle_noise = engine::Vec3::Zero();   // rad std dev (roll, pitch, yaw)
+};
+
 struct Scenario {
   std::string name;
   std::string source_file;  // for error messages; empty when built in code
@@ -44,6 +56,7 @@ struct Scenario {
   PhysicsConfig physics;
   uint64_t seed = 1;
   PlacementNoise noise;
+  SensorSettings sensors;
   engine::Vec3 ball_position{0.0, 0.0, -1.0};  // z < 0: resting on the ground
   engine::Vec3 ball_velocity = engine::Vec3::Zero();
   std::vector<RobotPlacement> robots;

@@ -18,6 +18,8 @@
 #include "simsoccer/fields/field_model.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 #include "simsoccer/world/scenario.hpp"
+#include "simsoccer/world/sensor_frame.hpp"
+#include "simsoccer/world/sensor_system.hpp"
 
 namespace simsoccer::world {
 
@@ -62,13 +64,15 @@ class World {
   // Targets (rad) and stiffnesses (0..1) in actuator order; sizes must match
   // the robot's actuator count. Non-finite values are rejected (throws).
   void setCommand(RobotId r, std::span<const double> positions, std::span<const double> stiffness);
-  // One body joint by index (mimic joints follow their master).
+  // One body joint by index (a mimic joint cannot be commanded: its master is).
   void setJointTarget(RobotId r, int joint, double target_rad, double stiffness);
   // A named pose of the robot model at one stiffness for every joint.
   void setPoseTarget(RobotId r, const std::string& pose_name, double stiffness);
 
   // --- time -----------------------------------------------------------------------
-  void step();               // one physics step (dt)
+  // One physics step (dt); completes the sensor frames when a control
+  // period ends.
+  void step();
   void stepControlPeriod();  // control_period / dt physics steps
   uint64_t stepCount() const { return physics_->stepCount(); }
   double time() const { return static_cast<double>(stepCount()) * scenario_.physics.dt; }
@@ -81,6 +85,13 @@ class World {
   void setBallState(const engine::RigidBodyState& state);
   // Upright: torso origin above `min_height` and tilted less than `max_tilt`.
   bool isStanding(RobotId r, double min_height = 0.22, double max_tilt = 0.785) const;
+
+  // The sensor frame of the last completed control period.
+  const SensorFrame& sensorFrame(RobotId r) const { return sensors_->frame(r); }
+  // Chest button, head and hand touch sensors are inputs (set by a scenario
+  // or a test); the foot bumpers come from contacts.
+  void setTouch(RobotId r, Touch sensor, bool pressed) { sensors_->setTouch(r, sensor, pressed); }
+  SensorSystem& sensors() { return *sensors_; }
 
   WorldSnapshot snapshot() const;
   // 64-bit hash over the full dynamic state and the step count.
@@ -96,6 +107,8 @@ class World {
   std::vector<RobotInfo> robots_;
   engine::BodyId ball_ = 0;
   int steps_per_control_ = 1;
+  std::unique_ptr<SensorSystem> sensors_;
+  void initSensors();
 };
 
 }  // namespace simsoccer::world

@@ -1,0 +1,436 @@
+#include "simsoccer/world/sensor_system.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "simsoccer/engine/config.hpp"
+
+namespace simsoccer::world {
+
+using engine::Pose;
+using engine::Vec3;
+using engine::Vec3f;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kStandardGravity = 9.81;  // m/s^2, LoLA's kg = N / g
+constexpr int32_t kGroundObject = 0;
+constexpr int32_t kBallObject = 1;
+constexpr int32_t kGoalObjectBase = 10;
+constexpr int32_t kRobotObjectBase = 1000;
+
+const robots::SensorFrame& needSensor(const robots::RobotModel& model, const std::string& name) {
+  const robots::SensorFrame* s = model.sensor(name);
+  if (!s)
+    throw engine::ConfigError(model.source_file, "sensors",
+                              "missing sensor frame '" + name + "' (needed for the sensor frame)");
+  return *s;
+}
+
+float clampAbs(double v, double range) {
+  return static_cast<float>(std::clamp(v, -range, range));
+}
+
+void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world, int32_t object,
+              int32_t owner) {
+  const Pose p = world * s.pose;
+  const Vec3f c = p.translation().cast<float>();
+  const Vec3f axis = p.linear().col(2).cast<float>();
+  switch (s.type) {
+    case engine::ShapeType::Sphere:
+      scene.addSphere(c, static_cast<float>(s.radius), object, owner);
+      break;
+    case engine::ShapeType::Capsule: {
+      const float half = static_cast<float>(0.5 * s.length - s.radius);
+      scene.addCapsule(c - half * axis, c + half * axis, static_cast<float>(s.radius), object,
+                       owner);
+      break;
+    }
+    case engine::ShapeType::Box:
+      scene.addBox(c, p.linear().cast<float>(), (0.5 * s.extents).cast<float>(), object, owner);
+      break;
+    case engine::ShapeType::Cylinder:
+      scene.addCylinder(c, axis, static_cast<float>(0.5 * s.length),
+                        static_cast<float>(s.radius), object, owner);
+      break;
+  }
+}
+
+}  // namespace
+
+SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldModel& field,
+                           std::vector<RobotRef> robots, const engine::PhysicsWorld& physics,
+                           engine::BodyId ball, uint64_t seed, double control_period, double dt)
+    : settings_(settings), field_(field), control_period_(control_period), dt_(dt), ball_(ball) {
+  sonar_every_ = std::max(1, static_cast<int>(std::lround(settings.sonar_period / control_period)));
+  // Cone directions: a Vogel spiral over the cone's solid angle, with the
+  // first ray on the axis; the outermost ray lies just inside the cone.
+  const int k = std::max(1, settings.sonar_rays);
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (const RobotRef& ref : robots) {
+    const robots::RobotModel& model = *ref.model;
+    if (model.actuators.size() != kActuators)
+      throw engine::ConfigError(model.source_file, "actuators",
+                                "the sensor frame needs exactly " + std::to_string(kActuators) +
+                                    " actuators (LoLA order)");
+    Robot r;
+    r.body = ref.body;
+    r.group = ref.collision_group;
+    r.model = ref.model;
+    const char* feet[2] = {"L", "R"};
+    for (int f = 0; f < 2; ++f) {
+      Foot& foot = r.feet[static_cast<size_t>(f)];
+      const char* corners[4] = {"FL", "FR", "RL", "RR"};
+      for (int c = 0; c < 4; ++c) {
+        const auto& s = needSensor(model, std::string(feet[f]) + "Fsr" + corners[c]);
+        foot.link = s.link;
+        foot.fsr[static_cast<size_t>(c)] = s.pose.translation();
+      }
+      foot.x_front = 0.5 * (foot.fsr[0].x() + foot.fsr[1].x());
+      foot.x_rear = 0.5 * (foot.fsr[2].x() + foot.fsr[3].x());
+      foot.y_left = 0.5 * (foot.fsr[0].y() + foot.fsr[2].y());
+      foot.y_right = 0.5 * (foot.fsr[1].y() + foot.fsr[3].y());
+      foot.sole_z = foot.fsr[0].z();
+      foot.bumper[0] = needSensor(model, std::string(feet[f]) + "FootBumperLeft").pose.translation();
+      foot.bumper[1] = needSensor(model, std::string(feet[f]) + "FootBumperRight").pose.translation();
+    }
+    r.accel_point = needSensor(model, "Accelerometer").pose.translation();
+    if (needSensor(model, "Accelerometer").link != 0)
+      throw engine::ConfigError(model.source_file, "sensors", "the accelerometer must be on the root link");
+    for (int s = 0; s < 2; ++s) {
+      const auto& sonar = needSensor(model, s == 0 ? "SonarLeft" : "SonarRight");
+      r.sonar_link[static_cast<size_t>(s)] = sonar.link;
+      r.sonar_pose[static_cast<size_t>(s)] = sonar.pose;
+    }
+    const char* touch_names[kTouchSensors] = {
+        "ChestButton",      "HeadTouchFront",  "HeadTouchMiddle",  "HeadTouchRear",
+        "LFootBumperLeft",  "LFootBumperRight", "LHandTouchBack",  "LHandTouchLeft",
+        "LHandTouchRight",  "RFootBumperLeft", "RFootBumperRight", "RHandTouchBack",
+        "RHandTouchLeft",   "RHandTouchRight"};
+    for (size_t t = 0; t < kTouchSensors; ++t) {
+      const std::string name = touch_names[t];
+      if (name.find("FootBumper") != std::string::npos)
+        r.touch_source[t] = (name[0] == 'L' ? 0 : 2) + (name.find("Right") != std::string::npos);
+      else
+        r.touch_source[t] = model.sensor(name) ? -1 : -2;
+    }
+    r.temperature.fill(model.sensor_spec.ambient_temperature);
+    for (size_t a = 0; a < kActuators; ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind == robots::Actuator::Kind::Joint)
+        r.last_position[a] = physics.jointPosition(r.body, act.index);
+    }
+    const Pose torso = physics.linkPose(r.body, 0);
+    r.last_accel_point_velocity = physics.rootPointVelocity(r.body, torso * r.accel_point);
+    r.noise = engine::NormalSampler(seed ^ (0x9E3779B97F4A7C15ull * (robots_.size() + 1)));
+    robots_.push_back(r);
+  }
+  double cone_half = 0.5;
+  if (!robots_.empty()) cone_half = 0.5 * robots_[0].model->sensor_spec.sonar_cone_angle;
+  for (int i = 0; i < k; ++i) {
+    const double theta = k == 1 ? 0.0 : cone_half * std::sqrt(i / (k - 0.5));
+    const double phi = i * golden;
+    ray_dirs_.emplace_back(std::cos(theta), std::sin(theta) * std::cos(phi),
+                           std::sin(theta) * std::sin(phi));
+  }
+  for (int side : {-1, 1})
+    for (const engine::Shape& s : field.goalShapes(side)) static_shapes_.push_back(s);
+  for (size_t i = 0; i < robots_.size(); ++i) {
+    const auto a = robots_[i].body;
+    if (articulation_robot_.size() <= a) articulation_robot_.resize(a + 1, -1);
+    articulation_robot_[a] = static_cast<int>(i);
+  }
+  frames_.resize(robots_.size());
+  rays_.reserve(robots_.size() * 2 * ray_dirs_.size());
+  hits_.resize(robots_.size() * 2 * ray_dirs_.size());
+  echo_scratch_.reserve(ray_dirs_.size());
+  contacts_.reserve(64 * robots_.size() + 16);
+  updateSonar(physics);
+}
+
+void SensorSystem::setTouch(size_t robot, Touch sensor, bool pressed) {
+  Robot& r = robots_.at(robot);
+  const auto t = static_cast<size_t>(sensor);
+  if (r.touch_source[t] != -1)
+    throw std::invalid_argument("touch sensor " + std::to_string(t) +
+                                " is not an input on this robot (a bumper, or absent)");
+  r.touch_input[t] = pressed;
+}
+
+void SensorSystem::commandHand(size_t robot, size_t hand, double target, double stiffness) {
+  Robot& r = robots_.at(robot);
+  const auto& h = r.model->hands.at(hand);
+  r.hand_target.at(hand) = std::clamp(target, h.lower, h.upper);
+  r.hand_stiffness.at(hand) = std::clamp(stiffness, 0.0, 1.0);
+}
+
+void SensorSystem::afterStep(const engine::PhysicsWorld& physics) {
+  const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
+  ++steps_in_period_;
+
+  // Feet: contact impulses on the soles (FSRs) and on the toes (bumpers).
+  physics.linkContacts(contacts_);
+  for (Robot& r : robots_) r.feet_posed = false;
+  for (const engine::LinkContact& c : contacts_) {
+    if (c.articulation >= articulation_robot_.size()) continue;
+    const int ri = articulation_robot_[c.articulation];
+    if (ri < 0) continue;
+    Robot& r = robots_[static_cast<size_t>(ri)];
+    const int f = c.link == r.feet[0].link ? 0 : c.link == r.feet[1].link ? 1 : -1;
+    if (f < 0) continue;
+    if (!r.feet_posed) {
+      for (int k = 0; k < 2; ++k)
+        r.foot_pose[static_cast<size_t>(k)] = physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link);
+      r.feet_posed = true;
+    }
+    const Foot& foot = r.feet[static_cast<size_t>(f)];
+    const Pose& pose = r.foot_pose[static_cast<size_t>(f)];
+    const Vec3 p = pose.inverse() * c.position;
+    const Vec3 n = pose.linear().transpose() * c.normal;
+    const double force = c.impulse / dt_;
+    const double up = force * n.z();  // pressing on the sole
+    if (up > 0.0 && p.z() < foot.sole_z + 0.01) {
+      // Bilinear weights over the four sensors (FL, FR, RL, RR).
+      const double u = std::clamp((p.x() - foot.x_rear) / (foot.x_front - foot.x_rear), 0.0, 1.0);
+      const double v = std::clamp((p.y() - foot.y_right) / (foot.y_left - foot.y_right), 0.0, 1.0);
+      const double w[4] = {u * v, u * (1 - v), (1 - u) * v, (1 - u) * (1 - v)};
+      for (int k = 0; k < 4; ++k) r.fsr_sum[static_cast<size_t>(4 * f + k)] += up * w[k];
+      r.weight_sum[static_cast<size_t>(f)] += up;
+      r.cop_sum[static_cast<size_t>(f)] += up * p;
+    }
+    // A toe pushed against something: contact at the front, normal mostly horizontal.
+    if (force > 0.0 && std::hypot(n.x(), n.y()) > 0.5 && p.x() >= foot.bumper[0].x() - 0.005) {
+      const double mid = 0.5 * (foot.bumper[0].y() + foot.bumper[1].y());
+      r.bumper_hit[static_cast<size_t>(2 * f + (p.y() >= mid ? 0 : 1))] = true;
+    }
+  }
+
+  for (Robot& r : robots_) {
+    const Pose torso = physics.linkPose(r.body, 0);
+    r.gyro_sum += torso.linear().transpose() * physics.rootAngularVelocity(r.body);
+    const auto& model = *r.model;
+    for (size_t a = 0; a < kActuators; ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind != robots::Actuator::Kind::Joint) continue;
+      const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+      const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
+      const double qd = std::abs(physics.jointVelocity(r.body, act.index));
+      const double current =
+          std::abs(physics.jointMotorTorque(r.body, act.index)) /
+              (motor.torque_constant * motor.gear_ratio) +
+          motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
+      r.current_sum[a] += current;
+      r.current_sq_sum[a] += current * current;
+    }
+  }
+  if (timers_on_) times_.other_s += std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t tick, double time) {
+  const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
+  const int n = std::max(1, steps_in_period_);
+  const double period = n * dt_;
+  const Vec3 gravity = physics.settings().gravity;
+  for (size_t ri = 0; ri < robots_.size(); ++ri) {
+    Robot& r = robots_[ri];
+    const auto& model = *r.model;
+    const auto& spec = model.sensor_spec;
+    SensorFrame& f = frames_[ri];
+    f.tick = tick;
+    f.time = time;
+
+    // Joints and hands.
+    const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+    for (size_t a = 0; a < kActuators; ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind == robots::Actuator::Kind::Joint) {
+        const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+        const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
+        const double q = physics.jointPosition(r.body, act.index);
+        f.position[a] = static_cast<float>(std::round(q / resolution) * resolution);
+        f.velocity[a] = static_cast<float>((q - r.last_position[a]) / period);
+        r.last_position[a] = q;
+        f.target[a] = static_cast<float>(physics.jointTarget(r.body, act.index));
+        f.stiffness[a] = static_cast<float>(physics.jointStiffness(r.body, act.index));
+        f.current[a] = static_cast<float>(r.current_sum[a] / n);
+        // Winding temperature: copper losses heat it, the housing cools it.
+        const double power = motor.resistance * r.current_sq_sum[a] / n;
+        const double capacity = motor.thermal_time_constant / motor.thermal_resistance;  // J/K
+        double& temp = r.temperature[a];
+        temp += period * (power - (temp - spec.ambient_temperature) / motor.thermal_resistance) /
+                capacity;
+        f.temperature[a] = static_cast<float>(temp);
+        f.status[a] = temp >= spec.temperature_critical   ? 3
+                      : temp >= spec.temperature_very_hot ? 2
+                      : temp >= spec.temperature_hot      ? 1
+                                                          : 0;
+      } else if (act.kind == robots::Actuator::Kind::Hand) {
+        const auto h = static_cast<size_t>(act.index);
+        const auto& motor = model.body->motors[static_cast<size_t>(model.hands[h].motor)];
+        const double before = r.hand_position[h];
+        const double reach = r.hand_stiffness[h] > 0.0 ? motor.no_load_speed * period : 0.0;
+        r.hand_position[h] += std::clamp(r.hand_target[h] - before, -reach, reach);
+        f.position[a] = static_cast<float>(r.hand_position[h]);
+        f.velocity[a] = static_cast<float>((r.hand_position[h] - before) / period);
+        f.target[a] = static_cast<float>(r.hand_target[h]);
+        f.stiffness[a] = static_cast<float>(r.hand_stiffness[h]);
+        f.temperature[a] = static_cast<float>(spec.ambient_temperature);
+      }
+      r.current_sum[a] = r.current_sq_sum[a] = 0.0;
+    }
+
+    // Inertial unit: specific force at the accelerometer from the change of
+    // its velocity over the period; gyro averaged over the period.
+    const Pose torso = physics.linkPose(r.body, 0);
+    const engine::Mat3 rt = torso.linear().transpose();
+    const Vec3 v = physics.rootPointVelocity(r.body, torso * r.accel_point);
+    const Vec3 specific = (v - r.last_accel_point_velocity) / period - gravity;
+    r.last_accel_point_velocity = v;
+    const Vec3 accel = rt * specific;
+    const Vec3 gyro = r.gyro_sum / n;
+    r.gyro_sum.setZero();
+    const engine::Mat3& R = torso.linear();
+    const double angles[3] = {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
+                              std::atan2(R(1, 0), R(0, 0))};
+    for (int k = 0; k < 3; ++k) {
+      f.accelerometer[static_cast<size_t>(k)] =
+          clampAbs(accel[k] + settings_.accel_bias[k] + settings_.accel_noise[k] * r.noise(),
+                   spec.accel_range);
+      f.gyroscope[static_cast<size_t>(k)] = clampAbs(
+          gyro[k] + settings_.gyro_bias[k] + settings_.gyro_noise[k] * r.noise(), spec.gyro_range);
+      f.angles[static_cast<size_t>(k)] =
+          static_cast<float>(angles[k] + settings_.angle_noise[k] * r.noise());
+    }
+
+    // Feet.
+    for (size_t k = 0; k < kFsrs; ++k) {
+      f.fsr[k] = static_cast<float>(r.fsr_sum[k] / n);
+      f.fsr_kg[k] = static_cast<float>(r.fsr_sum[k] / n / kStandardGravity);
+      r.fsr_sum[k] = 0.0;
+    }
+    for (size_t foot = 0; foot < 2; ++foot) {
+      const double w = r.weight_sum[foot];
+      f.foot_weight[foot] = static_cast<float>(w / n);
+      f.centre_of_pressure[foot][0] = w > 1e-9 ? static_cast<float>(r.cop_sum[foot].x() / w) : 0.0f;
+      f.centre_of_pressure[foot][1] = w > 1e-9 ? static_cast<float>(r.cop_sum[foot].y() / w) : 0.0f;
+      r.weight_sum[foot] = 0.0;
+      r.cop_sum[foot].setZero();
+    }
+    for (size_t t = 0; t < kTouchSensors; ++t) {
+      const int src = r.touch_source[t];
+      f.touch[t] = src >= 0 ? r.bumper_hit[static_cast<size_t>(src)]
+                   : src == -1 ? r.touch_input[t]
+                               : 0;
+    }
+    r.bumper_hit.fill(false);
+  }
+  steps_in_period_ = 0;
+  ++times_.periods;
+  if (timers_on_) times_.other_s += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (tick % static_cast<uint64_t>(sonar_every_) == 0) updateSonar(physics);
+}
+
+const std::vector<engine::Ray>& SensorSystem::buildSonarRays(const engine::PhysicsWorld& physics) {
+  rays_.clear();
+  for (size_t ri = 0; ri < robots_.size(); ++ri) {
+    const Robot& r = robots_[ri];
+    const float range = static_cast<float>(r.model->sensor_spec.sonar_max_range);
+    for (size_t s = 0; s < 2; ++s) {
+      const Pose sonar = physics.linkPose(r.body, r.sonar_link[s]) * r.sonar_pose[s];
+      const Vec3f origin = sonar.translation().cast<float>();
+      const engine::Mat3f rot = sonar.linear().cast<float>();
+      for (const Vec3& d : ray_dirs_) {
+        engine::Ray ray;
+        ray.origin = origin;
+        ray.direction = (rot * d.cast<float>()).normalized();
+        ray.max_distance = range;
+        ray.exclude_owner = r.group;
+        rays_.push_back(ray);
+      }
+    }
+  }
+  return rays_;
+}
+
+void SensorSystem::buildScene(const engine::PhysicsWorld& physics) {
+  scene_.clear();
+  scene_.setGround(kGroundObject);
+  for (size_t i = 0; i < static_shapes_.size(); ++i)
+    addShape(scene_, static_shapes_[i], Pose::Identity(), kGoalObjectBase + static_cast<int32_t>(i),
+             engine::kNoOwner);
+  const engine::RigidBodyState ball = physics.rigidBodyState(ball_);
+  scene_.addSphere(ball.pose.translation().cast<float>(), static_cast<float>(field_.ball.radius),
+                   kBallObject, engine::kNoOwner);
+  for (const Robot& r : robots_) {
+    const auto& links = r.model->body->links;
+    for (size_t l = 0; l < links.size(); ++l) {
+      if (links[l].shapes.empty()) continue;
+      const Pose pose = physics.linkPose(r.body, static_cast<int>(l));
+      const int32_t object = kRobotObjectBase + r.group * 64 + static_cast<int32_t>(l);
+      for (const engine::Shape& s : links[l].shapes) addShape(scene_, s, pose, object, r.group);
+    }
+  }
+  scene_.finalize();
+}
+
+void SensorSystem::traceBatched(const engine::PhysicsWorld& physics,
+                                std::vector<engine::RayHit>& hits) {
+  buildSonarRays(physics);
+  buildScene(physics);
+  hits.resize(rays_.size());
+  scene_.trace(rays_, hits);
+}
+
+void SensorSystem::traceReference(const engine::PhysicsWorld& physics,
+                                  std::vector<engine::RayHit>& hits) {
+  buildSonarRays(physics);
+  hits.resize(rays_.size());
+  for (size_t i = 0; i < rays_.size(); ++i) {
+    const engine::Ray& ray = rays_[i];
+    const double d = physics.rayTestClosest(ray.origin.cast<double>(), ray.direction.cast<double>(),
+                                            ray.max_distance, ray.exclude_owner);
+    hits[i].distance = static_cast<float>(d);
+    hits[i].object = std::isfinite(d) ? 0 : engine::kNoObject;
+  }
+}
+
+void SensorSystem::updateSonar(const engine::PhysicsWorld& physics) {
+  const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
+  traceBatched(physics, hits_);
+  const size_t k = ray_dirs_.size();
+  for (size_t ri = 0; ri < robots_.size(); ++ri) {
+    const auto& spec = robots_[ri].model->sensor_spec;
+    SensorFrame& f = frames_[ri];
+    for (size_t s = 0; s < 2; ++s) {
+      // One echo per object: the nearest ray hit on it; sorted by distance.
+      echo_scratch_.clear();
+      for (size_t i = 0; i < k; ++i) {
+        const engine::RayHit& h = hits_[(2 * ri + s) * k + i];
+        if (h.object != engine::kNoObject) echo_scratch_.emplace_back(h.distance, h.object);
+      }
+      std::sort(echo_scratch_.begin(), echo_scratch_.end());
+      size_t count = 0;
+      auto& echoes = f.sonar_echoes[s];
+      for (size_t i = 0; i < echo_scratch_.size() && count < static_cast<size_t>(spec.sonar_max_echoes); ++i) {
+        bool seen = false;
+        for (size_t j = 0; j < i; ++j) seen = seen || echo_scratch_[j].second == echo_scratch_[i].second;
+        if (seen) continue;
+        // Closer than the minimum range: the robot only knows something is there.
+        echoes[count++] = std::max(echo_scratch_[i].first, static_cast<float>(spec.sonar_min_range));
+      }
+      for (size_t i = count; i < kSonarEchoes; ++i) echoes[i] = static_cast<float>(spec.sonar_no_echo_value);
+      f.sonar_echo_count[s] = static_cast<uint8_t>(count);
+      f.sonar[s] = echoes[0];
+    }
+  }
+  ++times_.sonar_updates;
+  if (timers_on_) times_.sonar_s += std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+}  // namespace simsoccer::world
