@@ -681,7 +681,8 @@ double PhysicsWorld::rayTestClosest(const Vec3& origin, const Vec3& direction, d
   const btVector3 from = toBt(origin);
   const btVector3 to = toBt(Vec3(origin + max_distance * direction.normalized()));
   Callback cb(from, to, exclude_group);
-  cb.m_flags |= btTriangleRaycastCallback::kF_UseGjkConvexCastRaytest;  // the accurate caster
+  // GJK cast: stops within 1 mm of the surface (the subsimplex cast is coarser).
+  cb.m_flags |= btTriangleRaycastCallback::kF_UseGjkConvexCastRaytest;
   impl_->world->rayTest(from, to, cb);
   return cb.hasHit() ? cb.m_closestHitFraction * max_distance
                      : std::numeric_limits<double>::infinity();

@@ -44,11 +44,11 @@ inline float raySphere(float ox, float oy, float oz, float dx, float dy, float d
 void RayScene::clear() {
   // Keeps the arrays' capacity: rebuilding the scene every sonar update
   // allocates nothing once the first one has sized them.
-  for (auto* v : {&spheres_.cx, &spheres_.cy, &spheres_.cz, &spheres_.r, &capsules_.ax,
-                  &capsules_.ay, &capsules_.az, &capsules_.bx, &capsules_.by, &capsules_.bz,
-                  &capsules_.r, &boxes_.cx, &boxes_.cy, &boxes_.cz, &boxes_.hx, &boxes_.hy,
-                  &boxes_.hz, &cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux,
-                  &cylinders_.uy, &cylinders_.uz, &cylinders_.h, &cylinders_.r})
+  for (auto* v : {&spheres_.cx,   &spheres_.cy,   &spheres_.cz,   &spheres_.r,    &capsules_.ax,
+                  &capsules_.ay,  &capsules_.az,  &capsules_.bx,  &capsules_.by,  &capsules_.bz,
+                  &capsules_.r,   &boxes_.cx,     &boxes_.cy,     &boxes_.cz,     &boxes_.hx,
+                  &boxes_.hy,     &boxes_.hz,     &cylinders_.cx, &cylinders_.cy, &cylinders_.cz,
+                  &cylinders_.ux, &cylinders_.uy, &cylinders_.uz, &cylinders_.h,  &cylinders_.r})
     v->clear();
   for (auto& v : boxes_.r) v.clear();
   for (auto* v : {&spheres_.object, &spheres_.owner, &capsules_.object, &capsules_.owner,
@@ -145,8 +145,8 @@ void RayScene::finalize() {
   }
   if (!std::is_sorted(cylinders_.owner.begin(), cylinders_.owner.end())) {
     const auto o = ownerOrder(cylinders_.owner);
-    for (auto* v : {&cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux,
-                    &cylinders_.uy, &cylinders_.uz, &cylinders_.h, &cylinders_.r})
+    for (auto* v : {&cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux, &cylinders_.uy,
+                    &cylinders_.uz, &cylinders_.h, &cylinders_.r})
       permute(*v, o);
     permute(cylinders_.object, o);
     permute(cylinders_.owner, o);
@@ -162,10 +162,9 @@ void RayScene::finalize() {
   const auto ny = static_cast<uint32_t>(cylinders_.owner.size());
   constexpr int32_t kEnd = std::numeric_limits<int32_t>::max();
   while (si < ns || ci < nc || bi < nb || yi < ny) {
-    const int32_t owner = std::min({si < ns ? spheres_.owner[si] : kEnd,
-                                    ci < nc ? capsules_.owner[ci] : kEnd,
-                                    bi < nb ? boxes_.owner[bi] : kEnd,
-                                    yi < ny ? cylinders_.owner[yi] : kEnd});
+    const int32_t owner =
+        std::min({si < ns ? spheres_.owner[si] : kEnd, ci < nc ? capsules_.owner[ci] : kEnd,
+                  bi < nb ? boxes_.owner[bi] : kEnd, yi < ny ? cylinders_.owner[yi] : kEnd});
     Group g;
     g.owner = owner;
     g.sphere_begin = si;
@@ -213,21 +212,25 @@ void RayScene::finalize() {
   }
 }
 
-void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit) const {
+void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& best) const {
   const float ox = ray.origin.x(), oy = ray.origin.y(), oz = ray.origin.z();
   const float dx = ray.direction.x(), dy = ray.direction.y(), dz = ray.direction.z();
-  auto take = [&](float t, int32_t object) {
+  Kind kind = Kind::None;
+  auto take = [&](float t, int32_t object, uint32_t index) {
     if (t < hit.distance) {
       hit.distance = t;
       hit.object = object;
+      best = {kind, index};
     }
   };
 
+  kind = Kind::Sphere;
   for (uint32_t i = g.sphere_begin; i < g.sphere_end; ++i)
     take(raySphere(ox, oy, oz, dx, dy, dz, spheres_.cx[i], spheres_.cy[i], spheres_.cz[i],
                    spheres_.r[i]),
-         spheres_.object[i]);
+         spheres_.object[i], i);
 
+  kind = Kind::Capsule;
   for (uint32_t i = g.capsule_begin; i < g.capsule_end; ++i) {
     const float ax = capsules_.ax[i], ay = capsules_.ay[i], az = capsules_.az[i];
     const float bx = capsules_.bx[i], by = capsules_.by[i], bz = capsules_.bz[i];
@@ -254,9 +257,10 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit) const {
     }
     t = std::min({t, raySphere(ox, oy, oz, dx, dy, dz, ax, ay, az, r),
                   raySphere(ox, oy, oz, dx, dy, dz, bx, by, bz, r)});
-    take(t, capsules_.object[i]);
+    take(t, capsules_.object[i], i);
   }
 
+  kind = Kind::Box;
   for (uint32_t i = g.box_begin; i < g.box_end; ++i) {
     // Ray in box coordinates: local = R^T (o - c), R^T d.
     const float px = ox - boxes_.cx[i], py = oy - boxes_.cy[i], pz = oz - boxes_.cz[i];
@@ -279,9 +283,10 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit) const {
         tmax = std::min(tmax, std::max(t1, t2));
       }
     }
-    if (!miss && tmax >= std::max(tmin, 0.0f)) take(std::max(tmin, 0.0f), boxes_.object[i]);
+    if (!miss && tmax >= std::max(tmin, 0.0f)) take(std::max(tmin, 0.0f), boxes_.object[i], i);
   }
 
+  kind = Kind::Cylinder;
   for (uint32_t i = g.cylinder_begin; i < g.cylinder_end; ++i) {
     const float ux = cylinders_.ux[i], uy = cylinders_.uy[i], uz = cylinders_.uz[i];
     const float hh = cylinders_.h[i], r = cylinders_.r[i];
@@ -309,20 +314,57 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit) const {
         if (cx * cx + cy * cy + cz * cz <= r * r) t = tc;
       }
     }
-    take(t, cylinders_.object[i]);
+    take(t, cylinders_.object[i], i);
   }
+}
+
+Vec3f RayScene::normalAt(const Best& b, const Vec3f& p) const {
+  const uint32_t i = b.index;
+  switch (b.kind) {
+    case Kind::None:
+      return Vec3f::Zero();
+    case Kind::Ground:
+      return Vec3f::UnitZ();
+    case Kind::Sphere:
+      return (p - Vec3f(spheres_.cx[i], spheres_.cy[i], spheres_.cz[i])).normalized();
+    case Kind::Capsule: {
+      const Vec3f a(capsules_.ax[i], capsules_.ay[i], capsules_.az[i]);
+      const Vec3f u = Vec3f(capsules_.bx[i], capsules_.by[i], capsules_.bz[i]) - a;
+      const float s = std::clamp((p - a).dot(u) / u.squaredNorm(), 0.0f, 1.0f);
+      return (p - (a + s * u)).normalized();
+    }
+    case Kind::Box: {
+      Mat3f r;
+      for (int k = 0; k < 9; ++k) r(k / 3, k % 3) = boxes_.r[k][i];
+      const Vec3f local = r.transpose() * (p - Vec3f(boxes_.cx[i], boxes_.cy[i], boxes_.cz[i]));
+      const Vec3f h(boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]);
+      int axis = 0;
+      (local.array().abs() / h.array()).maxCoeff(&axis);
+      return r.col(axis) * (local[axis] < 0.0f ? -1.0f : 1.0f);
+    }
+    case Kind::Cylinder: {
+      const Vec3f c(cylinders_.cx[i], cylinders_.cy[i], cylinders_.cz[i]);
+      const Vec3f u(cylinders_.ux[i], cylinders_.uy[i], cylinders_.uz[i]);
+      const float along = (p - c).dot(u);
+      if (std::abs(along) >= cylinders_.h[i] - 1e-5f) return u * (along < 0.0f ? -1.0f : 1.0f);
+      return (p - c - along * u).normalized();
+    }
+  }
+  return Vec3f::Zero();
 }
 
 void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) const {
   for (size_t k = 0; k < rays.size(); ++k) {
     const Ray& ray = rays[k];
     RayHit hit;
+    Best best;
     hit.distance = ray.max_distance;  // only hits within range count
     if (has_ground_ && ray.direction.z() < 0.0f && ray.origin.z() > 0.0f) {
       const float t = -ray.origin.z() / ray.direction.z();
       if (t < hit.distance) {
         hit.distance = t;
         hit.object = ground_object_;
+        best = {Kind::Ground, 0};
       }
     }
     for (const Group& g : groups_) {
@@ -332,9 +374,12 @@ void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) const {
       const Vec3f oc = g.centre - ray.origin;
       const float along = std::clamp(oc.dot(ray.direction), 0.0f, hit.distance);
       if ((oc - along * ray.direction).squaredNorm() > g.radius * g.radius) continue;
-      traceGroup(g, ray, hit);
+      traceGroup(g, ray, hit, best);
     }
-    if (hit.object == kNoObject) hit.distance = kInf;
+    if (hit.object == kNoObject)
+      hit.distance = kInf;
+    else
+      hit.normal = normalAt(best, ray.origin + hit.distance * ray.direction);
     hits[k] = hit;
   }
 }

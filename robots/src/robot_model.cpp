@@ -142,7 +142,8 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     n->allowOnly({"min_range", "max_range", "cone_angle", "no_echo_value", "max_echoes"});
     spec.sonar_min_range = (*n)["min_range"].nonNegative();
     spec.sonar_max_range = (*n)["max_range"].positive();
-    if (spec.sonar_max_range <= spec.sonar_min_range) n->failKey("max_range", "must exceed min_range");
+    if (spec.sonar_max_range <= spec.sonar_min_range)
+      n->failKey("max_range", "must exceed min_range");
     spec.sonar_cone_angle = (*n)["cone_angle"].positive();
     if (spec.sonar_cone_angle >= M_PI) n->failKey("cone_angle", "must be below pi");
     spec.sonar_no_echo_value = (*n)["no_echo_value"].positive();

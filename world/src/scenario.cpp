@@ -53,7 +53,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
       s.sensors.sonar_rays = sonar->integer("rays", s.sensors.sonar_rays);
       if (s.sensors.sonar_rays < 1 || s.sensors.sonar_rays > 256)
         sonar->failKey("rays", "must be 1..256");
-      if (sonar->has("update_period")) s.sensors.sonar_period = (*sonar)["update_period"].positive();
+      if (sonar->has("update_period"))
+        s.sensors.sonar_period = (*sonar)["update_period"].positive();
       const double k = s.sensors.sonar_period / s.physics.control_period;
       if (std::abs(k - std::round(k)) > 1e-9 * k || std::round(k) < 1.0)
         sonar->failKey("update_period", "must be a whole multiple of the control period (" +
@@ -64,7 +65,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
       auto vec = [&](const char* key, engine::Vec3& out, bool non_negative) {
         if (!imu->has(key)) return;
         out = (*imu)[key].vec3();
-        if (non_negative && out.minCoeff() < 0.0) imu->failKey(key, "standard deviations must be >= 0");
+        if (non_negative && out.minCoeff() < 0.0)
+          imu->failKey(key, "standard deviations must be >= 0");
       };
       vec("gyro_noise", s.sensors.gyro_noise, true);
       vec("gyro_bias", s.sensors.gyro_bias, false);

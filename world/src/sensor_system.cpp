@@ -56,8 +56,8 @@ void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world
       scene.addBox(c, p.linear().cast<float>(), (0.5 * s.extents).cast<float>(), object, owner);
       break;
     case engine::ShapeType::Cylinder:
-      scene.addCylinder(c, axis, static_cast<float>(0.5 * s.length),
-                        static_cast<float>(s.radius), object, owner);
+      scene.addCylinder(c, axis, static_cast<float>(0.5 * s.length), static_cast<float>(s.radius),
+                        object, owner);
       break;
   }
 }
@@ -97,22 +97,25 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
       foot.y_left = 0.5 * (foot.fsr[0].y() + foot.fsr[2].y());
       foot.y_right = 0.5 * (foot.fsr[1].y() + foot.fsr[3].y());
       foot.sole_z = foot.fsr[0].z();
-      foot.bumper[0] = needSensor(model, std::string(feet[f]) + "FootBumperLeft").pose.translation();
-      foot.bumper[1] = needSensor(model, std::string(feet[f]) + "FootBumperRight").pose.translation();
+      foot.bumper[0] =
+          needSensor(model, std::string(feet[f]) + "FootBumperLeft").pose.translation();
+      foot.bumper[1] =
+          needSensor(model, std::string(feet[f]) + "FootBumperRight").pose.translation();
     }
     r.accel_point = needSensor(model, "Accelerometer").pose.translation();
     if (needSensor(model, "Accelerometer").link != 0)
-      throw engine::ConfigError(model.source_file, "sensors", "the accelerometer must be on the root link");
+      throw engine::ConfigError(model.source_file, "sensors",
+                                "the accelerometer must be on the root link");
     for (int s = 0; s < 2; ++s) {
       const auto& sonar = needSensor(model, s == 0 ? "SonarLeft" : "SonarRight");
       r.sonar_link[static_cast<size_t>(s)] = sonar.link;
       r.sonar_pose[static_cast<size_t>(s)] = sonar.pose;
     }
     const char* touch_names[kTouchSensors] = {
-        "ChestButton",      "HeadTouchFront",  "HeadTouchMiddle",  "HeadTouchRear",
-        "LFootBumperLeft",  "LFootBumperRight", "LHandTouchBack",  "LHandTouchLeft",
-        "LHandTouchRight",  "RFootBumperLeft", "RFootBumperRight", "RHandTouchBack",
-        "RHandTouchLeft",   "RHandTouchRight"};
+        "ChestButton",     "HeadTouchFront",   "HeadTouchMiddle",  "HeadTouchRear",
+        "LFootBumperLeft", "LFootBumperRight", "LHandTouchBack",   "LHandTouchLeft",
+        "LHandTouchRight", "RFootBumperLeft",  "RFootBumperRight", "RHandTouchBack",
+        "RHandTouchLeft",  "RHandTouchRight"};
     for (size_t t = 0; t < kTouchSensors; ++t) {
       const std::string name = touch_names[t];
       if (name.find("FootBumper") != std::string::npos)
@@ -186,7 +189,8 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics) {
     if (f < 0) continue;
     if (!r.feet_posed) {
       for (int k = 0; k < 2; ++k)
-        r.foot_pose[static_cast<size_t>(k)] = physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link);
+        r.foot_pose[static_cast<size_t>(k)] =
+            physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link);
       r.feet_posed = true;
     }
     const Foot& foot = r.feet[static_cast<size_t>(f)];
@@ -221,10 +225,9 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics) {
       const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
       const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
       const double qd = std::abs(physics.jointVelocity(r.body, act.index));
-      const double current =
-          std::abs(physics.jointMotorTorque(r.body, act.index)) /
-              (motor.torque_constant * motor.gear_ratio) +
-          motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
+      const double current = std::abs(physics.jointMotorTorque(r.body, act.index)) /
+                                 (motor.torque_constant * motor.gear_ratio) +
+                             motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
       r.current_sum[a] += current;
       r.current_sq_sum[a] += current * current;
     }
@@ -296,7 +299,8 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     const Vec3 gyro = r.gyro_sum / n;
     r.gyro_sum.setZero();
     const engine::Mat3& R = torso.linear();
-    const double angles[3] = {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
+    const double angles[3] = {std::atan2(R(2, 1), R(2, 2)),
+                              std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
                               std::atan2(R(1, 0), R(0, 0))};
     for (int k = 0; k < 3; ++k) {
       f.accelerometer[static_cast<size_t>(k)] =
@@ -324,7 +328,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     }
     for (size_t t = 0; t < kTouchSensors; ++t) {
       const int src = r.touch_source[t];
-      f.touch[t] = src >= 0 ? r.bumper_hit[static_cast<size_t>(src)]
+      f.touch[t] = src >= 0    ? r.bumper_hit[static_cast<size_t>(src)]
                    : src == -1 ? r.touch_input[t]
                                : 0;
     }
@@ -417,14 +421,18 @@ void SensorSystem::updateSonar(const engine::PhysicsWorld& physics) {
       std::sort(echo_scratch_.begin(), echo_scratch_.end());
       size_t count = 0;
       auto& echoes = f.sonar_echoes[s];
-      for (size_t i = 0; i < echo_scratch_.size() && count < static_cast<size_t>(spec.sonar_max_echoes); ++i) {
+      for (size_t i = 0;
+           i < echo_scratch_.size() && count < static_cast<size_t>(spec.sonar_max_echoes); ++i) {
         bool seen = false;
-        for (size_t j = 0; j < i; ++j) seen = seen || echo_scratch_[j].second == echo_scratch_[i].second;
+        for (size_t j = 0; j < i; ++j)
+          seen = seen || echo_scratch_[j].second == echo_scratch_[i].second;
         if (seen) continue;
         // Closer than the minimum range: the robot only knows something is there.
-        echoes[count++] = std::max(echo_scratch_[i].first, static_cast<float>(spec.sonar_min_range));
+        echoes[count++] =
+            std::max(echo_scratch_[i].first, static_cast<float>(spec.sonar_min_range));
       }
-      for (size_t i = count; i < kSonarEchoes; ++i) echoes[i] = static_cast<float>(spec.sonar_no_echo_value);
+      for (size_t i = count; i < kSonarEchoes; ++i)
+        echoes[i] = static_cast<float>(spec.sonar_no_echo_value);
       f.sonar_echo_count[s] = static_cast<uint8_t>(count);
       f.sonar[s] = echoes[0];
     }

@@ -32,6 +32,7 @@ struct Ray {
 struct RayHit {
   float distance = std::numeric_limits<float>::infinity();  // inf: nothing within range
   int32_t object = kNoObject;
+  Vec3f normal = Vec3f::Zero();  // outward surface normal at the hit, world frame
 };
 
 class RayScene {
@@ -89,7 +90,14 @@ class RayScene {
   };
   std::vector<Group> groups_;
 
-  void traceGroup(const Group& g, const Ray& ray, RayHit& hit) const;
+  // The primitive a ray stopped on (to compute its normal once, at the end).
+  enum class Kind : uint8_t { None, Ground, Sphere, Capsule, Box, Cylinder };
+  struct Best {
+    Kind kind = Kind::None;
+    uint32_t index = 0;
+  };
+  void traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& best) const;
+  Vec3f normalAt(const Best& best, const Vec3f& point) const;
 };
 
 }  // namespace simsoccer::engine

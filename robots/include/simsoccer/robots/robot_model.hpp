@@ -43,13 +43,13 @@ struct SensorFrame {
 // Sensor hardware characteristics (not placement: that is SensorFrame).
 struct SensorSpec {
   int encoder_bits = 12;
-  double gyro_range = 8.727;    // rad/s, +-
-  double accel_range = 19.62;   // m/s^2, +-
+  double gyro_range = 8.727;                              // rad/s, +-
+  double accel_range = 19.62;                             // m/s^2, +-
   double sonar_min_range = 0.20, sonar_max_range = 0.80;  // m
-  double sonar_cone_angle = 1.0472;                        // rad, full cone
-  double sonar_no_echo_value = 5.0;                        // m
+  double sonar_cone_angle = 1.0472;                       // rad, full cone
+  double sonar_no_echo_value = 5.0;                       // m
   int sonar_max_echoes = 10;
-  double ambient_temperature = 25.0;                       // deg C
+  double ambient_temperature = 25.0;  // deg C
   double temperature_hot = 70.0, temperature_very_hot = 80.0, temperature_critical = 90.0;
 };
 

@@ -39,13 +39,13 @@ struct PlacementNoise {
 // Sensor simulation settings (the hardware's own numbers are in the robot
 // model). Noise is white, per axis, from the scenario seed; off by default.
 struct SensorSettings {
-  int sonar_rays = 9;              // rays per sonar cone
-  double sonar_period = 0.060;     // s between sonar updates, a multiple of the control period
-  engine::Vec3 gyro_noise = engine::Vec3::Zero();    // rad/s std dev
-  engine::Vec3 gyro_bias = engine::Vec3::Zero();     // rad/s
-  engine::Vec3 accel_noise = engine::Vec3::Zero();   // m/s^2 std dev
-  engine::Vec3 accel_bias = engine::Vec3::Zero();    // m/s^2
-  engine::Vec3 angle_noise = engine::Vec3::Zero();   // rad std dev (roll, pitch, yaw)
+  int sonar_rays = 9;           // rays per sonar cone
+  double sonar_period = 0.060;  // s between sonar updates, a multiple of the control period
+  engine::Vec3 gyro_noise = engine::Vec3::Zero();   // rad/s std dev
+  engine::Vec3 gyro_bias = engine::Vec3::Zero();    // rad/s
+  engine::Vec3 accel_noise = engine::Vec3::Zero();  // m/s^2 std dev
+  engine::Vec3 accel_bias = engine::Vec3::Zero();   // m/s^2
+  engine::Vec3 angle_noise = engine::Vec3::Zero();  // rad std dev (roll, pitch, yaw)
 };
 
 struct Scenario {

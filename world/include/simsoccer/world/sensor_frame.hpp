@@ -14,7 +14,7 @@
 namespace simsoccer::world {
 
 constexpr std::size_t kActuators = 25;
-constexpr std::size_t kFsrs = 8;         // L FL, FR, RL, RR, R FL, FR, RL, RR
+constexpr std::size_t kFsrs = 8;  // L FL, FR, RL, RR, R FL, FR, RL, RR
 constexpr std::size_t kTouchSensors = 14;
 constexpr std::size_t kSonarEchoes = 10;
 
@@ -37,8 +37,8 @@ enum class Touch : uint8_t {
 };
 
 struct SensorFrame {
-  uint64_t tick = 0;   // control period index (1 = the first period's end)
-  double time = 0.0;   // s of simulation at the end of the period
+  uint64_t tick = 0;  // control period index (1 = the first period's end)
+  double time = 0.0;  // s of simulation at the end of the period
 
   // Joints, per actuator (absent actuators stay 0).
   std::array<float, kActuators> position{};     // rad, quantised to the encoder
@@ -55,9 +55,9 @@ struct SensorFrame {
   std::array<float, 3> angles{};         // roll, pitch, yaw of the torso, rad
 
   // Feet, averaged over the period.
-  std::array<float, kFsrs> fsr{};        // N
-  std::array<float, kFsrs> fsr_kg{};     // kg (LoLA's unit): N / 9.81
-  std::array<float, 2> foot_weight{};    // N per foot (left, right)
+  std::array<float, kFsrs> fsr{};                            // N
+  std::array<float, kFsrs> fsr_kg{};                         // kg (LoLA's unit): N / 9.81
+  std::array<float, 2> foot_weight{};                        // N per foot (left, right)
   std::array<std::array<float, 2>, 2> centre_of_pressure{};  // per foot, x y in m
 
   // Sonars (left, right): nearest echo and up to 10 echoes, sorted.

@@ -77,8 +77,8 @@ class SensorSystem {
     std::array<Foot, 2> feet;
     engine::Vec3 accel_point = engine::Vec3::Zero();  // torso frame
     std::array<int, 2> sonar_link{};
-    std::array<engine::Pose, 2> sonar_pose;           // in the link frame
-    std::array<int, kTouchSensors> touch_source{};    // -1: input, -2: absent, else bumper idx
+    std::array<engine::Pose, 2> sonar_pose;         // in the link frame
+    std::array<int, kTouchSensors> touch_source{};  // -1: input, -2: absent, else bumper idx
     // Per-period accumulators.
     std::array<double, kFsrs> fsr_sum{};
     std::array<double, 2> weight_sum{};
@@ -104,8 +104,8 @@ class SensorSystem {
   int sonar_every_ = 6;  // control periods per sonar update
   engine::BodyId ball_;
   std::vector<Robot> robots_;
-  std::vector<int> articulation_robot_;        // articulation id -> robot index (-1 none)
-  std::vector<engine::Shape> static_shapes_;   // goals, field frame
+  std::vector<int> articulation_robot_;       // articulation id -> robot index (-1 none)
+  std::vector<engine::Shape> static_shapes_;  // goals, field frame
   std::vector<SensorFrame> frames_;
   std::vector<engine::Vec3> ray_dirs_;  // cone directions in the sonar frame (x = axis)
   int steps_in_period_ = 0;
