@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_scene.hpp"
 #include "cli.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/world/world.hpp"
@@ -31,63 +32,6 @@ const char* kHelp =
     "  --repeat N      time each robot count N times (fresh world each) and report the run\n"
     "                  with the median steps/s (default 1)\n"
     "  --csv FILE      also write the table as CSV (one row per robot count)\n";
-
-struct JointWave {
-  int joint;
-  double amplitude;
-};
-
-struct BenchConfig {
-  world::Scenario base;
-  std::vector<int> robots;
-  double settle = 1.0;
-  double seconds = 10.0;
-  double pair_gap = 0.3;
-  double frequency = 0.5;
-  std::vector<std::pair<std::string, double>> motion;  // joint name, amplitude
-};
-
-BenchConfig loadBenchConfig(const std::filesystem::path& file) {
-  BenchConfig c;
-  c.base = world::loadScenario(file);
-  const auto root = engine::ConfigNode::loadFile(file);
-  const auto b = root["bench"];
-  b.allowOnly({"robots", "settle", "seconds", "pair_gap", "motion"});
-  for (const auto& n : b["robots"].items()) {
-    const int v = n.integer();
-    if (v < 1) n.fail("robot counts must be >= 1");
-    c.robots.push_back(v);
-  }
-  c.settle = b["settle"].nonNegative();
-  c.seconds = b["seconds"].positive();
-  c.pair_gap = b["pair_gap"].positive();
-  const auto m = b["motion"];
-  m.allowOnly({"frequency", "joints"});
-  c.frequency = m["frequency"].positive();
-  for (const auto& [name, amp] : m["joints"].entries()) c.motion.emplace_back(name, amp.number());
-  return c;
-}
-
-// Pairs of robots side by side on a 4 x 3 grid over the field, alternating teams.
-world::Scenario placeRobots(const BenchConfig& c, int n, double half_length, double half_width) {
-  world::Scenario s = c.base;
-  s.robots.clear();
-  const int columns = 4, rows = 3;
-  int numbers[2] = {0, 0};
-  for (int i = 0; i < n; ++i) {
-    const int pair = i / 2;
-    const int col = pair % columns, row = (pair / columns) % rows;
-    const int layer = pair / (columns * rows);  // beyond 24 robots: shift the grid
-    world::RobotPlacement p;
-    p.team = i % 2;
-    p.number = ++numbers[p.team];
-    p.x = -half_length + (col + 0.5) * (2 * half_length / columns) + 0.4 * layer;
-    p.y = -half_width + (row + 0.5) * (2 * half_width / rows) + (i % 2 ? 0.5 : -0.5) * c.pair_gap;
-    p.yaw = 0.0;
-    s.robots.push_back(p);
-  }
-  return s;
-}
 
 }  // namespace
 
@@ -129,36 +73,12 @@ int benchPhysics(int argc, char** argv, int first) {
   // One timed run with n robots: (steps/s, table row).
   auto measure = [&](int n) {
     world::World w(placeRobots(cfg, n, field.halfLength(), field.halfWidth()));
-    const auto& model = *w.robot(0).model;
-    std::vector<JointWave> waves;
-    for (const auto& [name, amp] : cfg.motion) {
-      const int j = model.body->jointIndex(name);
-      if (j < 0) {
-        // H21 has no wrists: skip joints the model lacks, but never a typo of a real name.
-        if (model.actuatorIndex(name) >= 0) continue;
-        throw engine::ConfigError(config_file.string(), "bench.motion.joints." + name,
-                                  "unknown joint for robot model '" + model.name + "'");
-      }
-      waves.push_back({j, amp});
-    }
-    const auto& stand = model.pose("stand");
+    const BenchMotion motion(cfg, w);
     const int per_control = w.stepsPerControlPeriod();
-    // Each robot has its own phase; the amplitude ramps in over the settling time so no
-    // target jumps at the start.
-    auto command = [&](double t) {
-      const double ramp = cfg.settle > 0 ? std::min(1.0, t / cfg.settle) : 1.0;
-      for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-        const double phase = 2.0 * std::numbers::pi * r / static_cast<double>(w.robotCount());
-        const double s = ramp * std::sin(2.0 * std::numbers::pi * cfg.frequency * t + phase);
-        for (const JointWave& jw : waves)
-          w.setJointTarget(r, jw.joint, stand[static_cast<size_t>(jw.joint)] + jw.amplitude * s,
-                           1.0);
-      }
-    };
     const auto settle_steps = static_cast<long>(std::lround(cfg.settle / dt));
     const auto timed_steps = static_cast<long>(std::lround(cfg.seconds / dt));
     for (long i = 0; i < settle_steps; ++i) {
-      if (i % per_control == 0) command(w.time());
+      if (i % per_control == 0) motion.command(w);
       w.step();
     }
     w.physics().resetStageTimes();
@@ -166,7 +86,7 @@ int benchPhysics(int argc, char** argv, int first) {
     long contacts = 0, robot_contacts = 0;
     const auto t0 = std::chrono::steady_clock::now();
     for (long i = 0; i < timed_steps; ++i) {
-      if (i % per_control == 0) command(w.time());
+      if (i % per_control == 0) motion.command(w);
       w.step();
       const engine::ContactCount cc = w.physics().contactCount();
       contacts += cc.total;

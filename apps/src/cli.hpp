@@ -47,6 +47,7 @@ struct Table {
 std::string fmt(double value, int decimals);
 
 int benchPhysics(int argc, char** argv, int first);
+int benchSensors(int argc, char** argv, int first);
 int check(int argc, char** argv, int first);
 
 }  // namespace simsoccer::apps

@@ -124,6 +124,7 @@ const char* kUsage =
     "commands:\n"
     "  check SCENARIO  load and validate a scenario file, print what it contains\n"
     "  bench physics   physics scaling benchmark (steps/s against robot count)\n"
+    "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
 
@@ -141,7 +142,9 @@ int main(int argc, char** argv) {
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);
-      std::fprintf(stderr, "simsoccer bench: unknown benchmark '%s' (available: physics)\n",
+      if (sub == "sensors") return benchSensors(argc, argv, 3);
+      std::fprintf(stderr,
+                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors)\n",
                    sub.c_str());
       return 2;
     }

@@ -10,20 +10,12 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kEps = 1e-12f;
 
-// Reorders every array of a primitive set by a permutation.
-template <class T>
-void permute(std::vector<T>& v, const std::vector<uint32_t>& order) {
-  std::vector<T> out(v.size());
-  for (size_t i = 0; i < order.size(); ++i) out[i] = v[order[i]];
-  v.swap(out);
+inline int64_t groupKey(int32_t owner, uint8_t cluster) {
+  return static_cast<int64_t>(owner) * 256 + cluster;
 }
-
-std::vector<uint32_t> ownerOrder(const std::vector<int32_t>& owner) {
-  std::vector<uint32_t> order(owner.size());
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t a, uint32_t b) { return owner[a] < owner[b]; });
-  return order;
+// The owner part of a key (floor division, negative owners included).
+inline int32_t keyOwner(int64_t key) {
+  return static_cast<int32_t>(key >= 0 ? key / 256 : -((-key + 255) / 256));
 }
 
 // First entry distance of a ray into a sphere, or inf. A ray starting inside
@@ -41,20 +33,41 @@ inline float raySphere(float ox, float oy, float oz, float dx, float dy, float d
 
 }  // namespace
 
+void RayScene::Columns::clear() {
+  for (auto& c : values) c.clear();
+  object.clear();
+  key.clear();
+}
+
+void RayScene::Columns::push(std::initializer_list<float> row, int32_t obj, int64_t k) {
+  size_t i = 0;
+  for (float v : row) values[i++].push_back(v);
+  object.push_back(obj);
+  key.push_back(k);
+}
+
+void RayScene::Columns::sortByKey() {
+  if (std::is_sorted(key.begin(), key.end())) return;  // the usual case: added in order
+  std::vector<uint32_t> order(key.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return key[a] < key[b]; });
+  auto permute = [&](auto& v) {
+    std::remove_reference_t<decltype(v)> out(v.size());
+    for (size_t i = 0; i < order.size(); ++i) out[i] = v[order[i]];
+    v.swap(out);
+  };
+  for (auto& c : values) permute(c);
+  permute(object);
+  permute(key);
+}
+
 void RayScene::clear() {
   // Keeps the arrays' capacity: rebuilding the scene every sonar update
   // allocates nothing once the first one has sized them.
-  for (auto* v : {&spheres_.cx,   &spheres_.cy,   &spheres_.cz,   &spheres_.r,    &capsules_.ax,
-                  &capsules_.ay,  &capsules_.az,  &capsules_.bx,  &capsules_.by,  &capsules_.bz,
-                  &capsules_.r,   &boxes_.cx,     &boxes_.cy,     &boxes_.cz,     &boxes_.hx,
-                  &boxes_.hy,     &boxes_.hz,     &cylinders_.cx, &cylinders_.cy, &cylinders_.cz,
-                  &cylinders_.ux, &cylinders_.uy, &cylinders_.uz, &cylinders_.h,  &cylinders_.r})
-    v->clear();
-  for (auto& v : boxes_.r) v.clear();
-  for (auto* v : {&spheres_.object, &spheres_.owner, &capsules_.object, &capsules_.owner,
-                  &boxes_.object, &boxes_.owner, &cylinders_.object, &cylinders_.owner})
-    v->clear();
+  for (Columns* c : {&spheres_, &capsules_, &boxes_, &cylinders_}) c->clear();
   groups_.clear();
+  blocks_.clear();
   has_ground_ = false;
   ground_object_ = kNoObject;
 }
@@ -64,138 +77,82 @@ void RayScene::setGround(int32_t object) {
   ground_object_ = object;
 }
 
-void RayScene::addSphere(const Vec3f& c, float radius, int32_t object, int32_t owner) {
-  spheres_.cx.push_back(c.x());
-  spheres_.cy.push_back(c.y());
-  spheres_.cz.push_back(c.z());
-  spheres_.r.push_back(radius);
-  spheres_.object.push_back(object);
-  spheres_.owner.push_back(owner);
+void RayScene::addSphere(const Vec3f& c, float radius, int32_t object, int32_t owner,
+                         uint8_t cluster) {
+  spheres_.push({c.x(), c.y(), c.z(), radius}, object, groupKey(owner, cluster));
 }
 
 void RayScene::addCapsule(const Vec3f& p0, const Vec3f& p1, float radius, int32_t object,
-                          int32_t owner) {
-  capsules_.ax.push_back(p0.x());
-  capsules_.ay.push_back(p0.y());
-  capsules_.az.push_back(p0.z());
-  capsules_.bx.push_back(p1.x());
-  capsules_.by.push_back(p1.y());
-  capsules_.bz.push_back(p1.z());
-  capsules_.r.push_back(radius);
-  capsules_.object.push_back(object);
-  capsules_.owner.push_back(owner);
+                          int32_t owner, uint8_t cluster) {
+  capsules_.push({p0.x(), p0.y(), p0.z(), p1.x(), p1.y(), p1.z(), radius}, object,
+                 groupKey(owner, cluster));
 }
 
-void RayScene::addBox(const Vec3f& c, const Mat3f& rotation, const Vec3f& half, int32_t object,
-                      int32_t owner) {
-  boxes_.cx.push_back(c.x());
-  boxes_.cy.push_back(c.y());
-  boxes_.cz.push_back(c.z());
-  boxes_.hx.push_back(half.x());
-  boxes_.hy.push_back(half.y());
-  boxes_.hz.push_back(half.z());
-  for (int k = 0; k < 9; ++k) boxes_.r[k].push_back(rotation(k / 3, k % 3));
-  boxes_.object.push_back(object);
-  boxes_.owner.push_back(owner);
+void RayScene::addBox(const Vec3f& c, const Mat3f& r, const Vec3f& half, int32_t object,
+                      int32_t owner, uint8_t cluster) {
+  boxes_.push({c.x(), c.y(), c.z(), half.x(), half.y(), half.z(), r(0, 0), r(0, 1), r(0, 2),
+               r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)},
+              object, groupKey(owner, cluster));
 }
 
 void RayScene::addCylinder(const Vec3f& c, const Vec3f& axis, float half_length, float radius,
-                           int32_t object, int32_t owner) {
+                           int32_t object, int32_t owner, uint8_t cluster) {
   const Vec3f u = axis.normalized();
-  cylinders_.cx.push_back(c.x());
-  cylinders_.cy.push_back(c.y());
-  cylinders_.cz.push_back(c.z());
-  cylinders_.ux.push_back(u.x());
-  cylinders_.uy.push_back(u.y());
-  cylinders_.uz.push_back(u.z());
-  cylinders_.h.push_back(half_length);
-  cylinders_.r.push_back(radius);
-  cylinders_.object.push_back(object);
-  cylinders_.owner.push_back(owner);
+  cylinders_.push({c.x(), c.y(), c.z(), u.x(), u.y(), u.z(), half_length, radius}, object,
+                  groupKey(owner, cluster));
 }
 
 size_t RayScene::primitiveCount() const {
-  return spheres_.r.size() + capsules_.r.size() + boxes_.hx.size() + cylinders_.r.size();
+  return spheres_.size() + capsules_.size() + boxes_.size() + cylinders_.size();
 }
 
 void RayScene::finalize() {
-  // Group the primitives by owner (callers that add them owner by owner, as
-  // the sensor system does, skip the reordering and its allocations).
-  if (!std::is_sorted(spheres_.owner.begin(), spheres_.owner.end())) {
-    const auto o = ownerOrder(spheres_.owner);
-    for (auto* v : {&spheres_.cx, &spheres_.cy, &spheres_.cz, &spheres_.r}) permute(*v, o);
-    permute(spheres_.object, o);
-    permute(spheres_.owner, o);
-  }
-  if (!std::is_sorted(capsules_.owner.begin(), capsules_.owner.end())) {
-    const auto o = ownerOrder(capsules_.owner);
-    for (auto* v : {&capsules_.ax, &capsules_.ay, &capsules_.az, &capsules_.bx, &capsules_.by,
-                    &capsules_.bz, &capsules_.r})
-      permute(*v, o);
-    permute(capsules_.object, o);
-    permute(capsules_.owner, o);
-  }
-  if (!std::is_sorted(boxes_.owner.begin(), boxes_.owner.end())) {
-    const auto o = ownerOrder(boxes_.owner);
-    for (auto* v : {&boxes_.cx, &boxes_.cy, &boxes_.cz, &boxes_.hx, &boxes_.hy, &boxes_.hz})
-      permute(*v, o);
-    for (auto& v : boxes_.r) permute(v, o);
-    permute(boxes_.object, o);
-    permute(boxes_.owner, o);
-  }
-  if (!std::is_sorted(cylinders_.owner.begin(), cylinders_.owner.end())) {
-    const auto o = ownerOrder(cylinders_.owner);
-    for (auto* v : {&cylinders_.cx, &cylinders_.cy, &cylinders_.cz, &cylinders_.ux, &cylinders_.uy,
-                    &cylinders_.uz, &cylinders_.h, &cylinders_.r})
-      permute(*v, o);
-    permute(cylinders_.object, o);
-    permute(cylinders_.owner, o);
-  }
-
-  // One group per distinct owner, ascending (no owner first): walk the four
-  // sorted owner arrays together.
+  for (Columns* c : {&spheres_, &capsules_, &boxes_, &cylinders_}) c->sortByKey();
+  // One group per distinct key, ascending: walk the four sorted key arrays
+  // together.
   groups_.clear();
   uint32_t si = 0, ci = 0, bi = 0, yi = 0;
-  const auto ns = static_cast<uint32_t>(spheres_.owner.size());
-  const auto nc = static_cast<uint32_t>(capsules_.owner.size());
-  const auto nb = static_cast<uint32_t>(boxes_.owner.size());
-  const auto ny = static_cast<uint32_t>(cylinders_.owner.size());
-  constexpr int32_t kEnd = std::numeric_limits<int32_t>::max();
+  const auto ns = static_cast<uint32_t>(spheres_.size());
+  const auto nc = static_cast<uint32_t>(capsules_.size());
+  const auto nb = static_cast<uint32_t>(boxes_.size());
+  const auto ny = static_cast<uint32_t>(cylinders_.size());
+  constexpr int64_t kEnd = std::numeric_limits<int64_t>::max();
   while (si < ns || ci < nc || bi < nb || yi < ny) {
-    const int32_t owner =
-        std::min({si < ns ? spheres_.owner[si] : kEnd, ci < nc ? capsules_.owner[ci] : kEnd,
-                  bi < nb ? boxes_.owner[bi] : kEnd, yi < ny ? cylinders_.owner[yi] : kEnd});
+    const int64_t key =
+        std::min({si < ns ? spheres_.key[si] : kEnd, ci < nc ? capsules_.key[ci] : kEnd,
+                  bi < nb ? boxes_.key[bi] : kEnd, yi < ny ? cylinders_.key[yi] : kEnd});
     Group g;
-    g.owner = owner;
+    g.owner = keyOwner(key);
     g.sphere_begin = si;
-    while (si < ns && spheres_.owner[si] == owner) ++si;
+    while (si < ns && spheres_.key[si] == key) ++si;
     g.sphere_end = si;
     g.capsule_begin = ci;
-    while (ci < nc && capsules_.owner[ci] == owner) ++ci;
+    while (ci < nc && capsules_.key[ci] == key) ++ci;
     g.capsule_end = ci;
     g.box_begin = bi;
-    while (bi < nb && boxes_.owner[bi] == owner) ++bi;
+    while (bi < nb && boxes_.key[bi] == key) ++bi;
     g.box_end = bi;
     g.cylinder_begin = yi;
-    while (yi < ny && cylinders_.owner[yi] == owner) ++yi;
+    while (yi < ny && cylinders_.key[yi] == key) ++yi;
     g.cylinder_end = yi;
 
     // Bounding sphere around the primitives' own bounding spheres: centre at
     // their mean, radius to the farthest.
+    const auto& S = spheres_.values;
+    const auto& C = capsules_.values;
+    const auto& B = boxes_.values;
+    const auto& Y = cylinders_.values;
     auto each = [&](auto&& f) {
       for (uint32_t i = g.sphere_begin; i < g.sphere_end; ++i)
-        f(Vec3f(spheres_.cx[i], spheres_.cy[i], spheres_.cz[i]), spheres_.r[i]);
+        f(Vec3f(S[0][i], S[1][i], S[2][i]), S[3][i]);
       for (uint32_t i = g.capsule_begin; i < g.capsule_end; ++i) {
-        const Vec3f a(capsules_.ax[i], capsules_.ay[i], capsules_.az[i]);
-        const Vec3f b(capsules_.bx[i], capsules_.by[i], capsules_.bz[i]);
-        f(0.5f * (a + b), 0.5f * (b - a).norm() + capsules_.r[i]);
+        const Vec3f a(C[0][i], C[1][i], C[2][i]), b(C[3][i], C[4][i], C[5][i]);
+        f(0.5f * (a + b), 0.5f * (b - a).norm() + C[6][i]);
       }
       for (uint32_t i = g.box_begin; i < g.box_end; ++i)
-        f(Vec3f(boxes_.cx[i], boxes_.cy[i], boxes_.cz[i]),
-          Vec3f(boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]).norm());
+        f(Vec3f(B[0][i], B[1][i], B[2][i]), Vec3f(B[3][i], B[4][i], B[5][i]).norm());
       for (uint32_t i = g.cylinder_begin; i < g.cylinder_end; ++i)
-        f(Vec3f(cylinders_.cx[i], cylinders_.cy[i], cylinders_.cz[i]),
-          std::hypot(cylinders_.h[i], cylinders_.r[i]));
+        f(Vec3f(Y[0][i], Y[1][i], Y[2][i]), std::hypot(Y[6][i], Y[7][i]));
     };
     Vec3f centre = Vec3f::Zero();
     int count = 0;
@@ -210,9 +167,31 @@ void RayScene::finalize() {
     g.radius = radius * 1.0001f + 1e-5f;
     groups_.push_back(g);
   }
+
+  blocks_.clear();
+  for (uint32_t g = 0; g < groups_.size();) {
+    Block b;
+    b.owner = groups_[g].owner;
+    b.group_begin = g;
+    while (g < groups_.size() && groups_[g].owner == b.owner) ++g;
+    b.group_end = g;
+    Vec3f centre = Vec3f::Zero();
+    for (uint32_t k = b.group_begin; k < b.group_end; ++k) centre += groups_[k].centre;
+    centre /= static_cast<float>(b.group_end - b.group_begin);
+    float radius = 0.0f;
+    for (uint32_t k = b.group_begin; k < b.group_end; ++k)
+      radius = std::max(radius, (groups_[k].centre - centre).norm() + groups_[k].radius);
+    b.centre = centre;
+    b.radius = radius * 1.0001f + 1e-5f;
+    blocks_.push_back(b);
+  }
 }
 
 void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& best) const {
+  const auto& S = spheres_.values;
+  const auto& C = capsules_.values;
+  const auto& B = boxes_.values;
+  const auto& Y = cylinders_.values;
   const float ox = ray.origin.x(), oy = ray.origin.y(), oz = ray.origin.z();
   const float dx = ray.direction.x(), dy = ray.direction.y(), dz = ray.direction.z();
   Kind kind = Kind::None;
@@ -226,15 +205,14 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
 
   kind = Kind::Sphere;
   for (uint32_t i = g.sphere_begin; i < g.sphere_end; ++i)
-    take(raySphere(ox, oy, oz, dx, dy, dz, spheres_.cx[i], spheres_.cy[i], spheres_.cz[i],
-                   spheres_.r[i]),
-         spheres_.object[i], i);
+    take(raySphere(ox, oy, oz, dx, dy, dz, S[0][i], S[1][i], S[2][i], S[3][i]), spheres_.object[i],
+         i);
 
   kind = Kind::Capsule;
   for (uint32_t i = g.capsule_begin; i < g.capsule_end; ++i) {
-    const float ax = capsules_.ax[i], ay = capsules_.ay[i], az = capsules_.az[i];
-    const float bx = capsules_.bx[i], by = capsules_.by[i], bz = capsules_.bz[i];
-    const float r = capsules_.r[i];
+    const float ax = C[0][i], ay = C[1][i], az = C[2][i];
+    const float bx = C[3][i], by = C[4][i], bz = C[5][i];
+    const float r = C[6][i];
     // Cylindrical body between the end caps.
     const float ux = bx - ax, uy = by - ay, uz = bz - az;
     const float px = ox - ax, py = oy - ay, pz = oz - az;
@@ -263,14 +241,14 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
   kind = Kind::Box;
   for (uint32_t i = g.box_begin; i < g.box_end; ++i) {
     // Ray in box coordinates: local = R^T (o - c), R^T d.
-    const float px = ox - boxes_.cx[i], py = oy - boxes_.cy[i], pz = oz - boxes_.cz[i];
+    const float px = ox - B[0][i], py = oy - B[1][i], pz = oz - B[2][i];
     const float* R[9];
-    for (int k = 0; k < 9; ++k) R[k] = &boxes_.r[k][i];
+    for (int k = 0; k < 9; ++k) R[k] = &B[6 + k][i];
     const float lo[3] = {*R[0] * px + *R[3] * py + *R[6] * pz, *R[1] * px + *R[4] * py + *R[7] * pz,
                          *R[2] * px + *R[5] * py + *R[8] * pz};
     const float ld[3] = {*R[0] * dx + *R[3] * dy + *R[6] * dz, *R[1] * dx + *R[4] * dy + *R[7] * dz,
                          *R[2] * dx + *R[5] * dy + *R[8] * dz};
-    const float h[3] = {boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]};
+    const float h[3] = {B[3][i], B[4][i], B[5][i]};
     float tmin = -kInf, tmax = kInf;
     bool miss = false;
     for (int k = 0; k < 3; ++k) {
@@ -288,9 +266,9 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
 
   kind = Kind::Cylinder;
   for (uint32_t i = g.cylinder_begin; i < g.cylinder_end; ++i) {
-    const float ux = cylinders_.ux[i], uy = cylinders_.uy[i], uz = cylinders_.uz[i];
-    const float hh = cylinders_.h[i], r = cylinders_.r[i];
-    const float px = ox - cylinders_.cx[i], py = oy - cylinders_.cy[i], pz = oz - cylinders_.cz[i];
+    const float ux = Y[3][i], uy = Y[4][i], uz = Y[5][i];
+    const float hh = Y[6][i], r = Y[7][i];
+    const float px = ox - Y[0][i], py = oy - Y[1][i], pz = oz - Y[2][i];
     const float oa = px * ux + py * uy + pz * uz;  // along the axis
     const float da = dx * ux + dy * uy + dz * uz;
     const float qx = px - oa * ux, qy = py - oa * uy, qz = pz - oa * uz;  // across
@@ -319,6 +297,10 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
 }
 
 Vec3f RayScene::normalAt(const Best& b, const Vec3f& p) const {
+  const auto& S = spheres_.values;
+  const auto& C = capsules_.values;
+  const auto& B = boxes_.values;
+  const auto& Y = cylinders_.values;
   const uint32_t i = b.index;
   switch (b.kind) {
     case Kind::None:
@@ -326,27 +308,27 @@ Vec3f RayScene::normalAt(const Best& b, const Vec3f& p) const {
     case Kind::Ground:
       return Vec3f::UnitZ();
     case Kind::Sphere:
-      return (p - Vec3f(spheres_.cx[i], spheres_.cy[i], spheres_.cz[i])).normalized();
+      return (p - Vec3f(S[0][i], S[1][i], S[2][i])).normalized();
     case Kind::Capsule: {
-      const Vec3f a(capsules_.ax[i], capsules_.ay[i], capsules_.az[i]);
-      const Vec3f u = Vec3f(capsules_.bx[i], capsules_.by[i], capsules_.bz[i]) - a;
+      const Vec3f a(C[0][i], C[1][i], C[2][i]);
+      const Vec3f u = Vec3f(C[3][i], C[4][i], C[5][i]) - a;
       const float s = std::clamp((p - a).dot(u) / u.squaredNorm(), 0.0f, 1.0f);
       return (p - (a + s * u)).normalized();
     }
     case Kind::Box: {
       Mat3f r;
-      for (int k = 0; k < 9; ++k) r(k / 3, k % 3) = boxes_.r[k][i];
-      const Vec3f local = r.transpose() * (p - Vec3f(boxes_.cx[i], boxes_.cy[i], boxes_.cz[i]));
-      const Vec3f h(boxes_.hx[i], boxes_.hy[i], boxes_.hz[i]);
+      for (int k = 0; k < 9; ++k) r(k / 3, k % 3) = B[6 + k][i];
+      const Vec3f local = r.transpose() * (p - Vec3f(B[0][i], B[1][i], B[2][i]));
+      const Vec3f h(B[3][i], B[4][i], B[5][i]);
       int axis = 0;
       (local.array().abs() / h.array()).maxCoeff(&axis);
       return r.col(axis) * (local[axis] < 0.0f ? -1.0f : 1.0f);
     }
     case Kind::Cylinder: {
-      const Vec3f c(cylinders_.cx[i], cylinders_.cy[i], cylinders_.cz[i]);
-      const Vec3f u(cylinders_.ux[i], cylinders_.uy[i], cylinders_.uz[i]);
+      const Vec3f c(Y[0][i], Y[1][i], Y[2][i]);
+      const Vec3f u(Y[3][i], Y[4][i], Y[5][i]);
       const float along = (p - c).dot(u);
-      if (std::abs(along) >= cylinders_.h[i] - 1e-5f) return u * (along < 0.0f ? -1.0f : 1.0f);
+      if (std::abs(along) >= Y[6][i] - 1e-5f) return u * (along < 0.0f ? -1.0f : 1.0f);
       return (p - c - along * u).normalized();
     }
   }
@@ -367,14 +349,17 @@ void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) const {
         best = {Kind::Ground, 0};
       }
     }
-    for (const Group& g : groups_) {
-      if (g.owner != kNoOwner && g.owner == ray.exclude_owner) continue;
-      // Broadphase: skip the group unless the ray passes within its bounding
-      // sphere before the best hit so far.
-      const Vec3f oc = g.centre - ray.origin;
+    // Does the ray pass within a sphere before the best hit so far?
+    auto passes = [&](const Vec3f& centre, float radius) {
+      const Vec3f oc = centre - ray.origin;
       const float along = std::clamp(oc.dot(ray.direction), 0.0f, hit.distance);
-      if ((oc - along * ray.direction).squaredNorm() > g.radius * g.radius) continue;
-      traceGroup(g, ray, hit, best);
+      return (oc - along * ray.direction).squaredNorm() <= radius * radius;
+    };
+    for (const Block& b : blocks_) {
+      if (b.owner != kNoOwner && b.owner == ray.exclude_owner) continue;
+      if (!passes(b.centre, b.radius)) continue;
+      for (uint32_t k = b.group_begin; k < b.group_end; ++k)
+        if (passes(groups_[k].centre, groups_[k].radius)) traceGroup(groups_[k], ray, hit, best);
     }
     if (hit.object == kNoObject)
       hit.distance = kInf;

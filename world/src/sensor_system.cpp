@@ -24,6 +24,7 @@ constexpr int32_t kGroundObject = 0;
 constexpr int32_t kBallObject = 1;
 constexpr int32_t kGoalObjectBase = 10;
 constexpr int32_t kRobotObjectBase = 1000;
+constexpr int32_t kBallOwner = -4, kGoalMinusOwner = -3, kGoalPlusOwner = -2;
 
 const robots::SensorFrame& needSensor(const robots::RobotModel& model, const std::string& name) {
   const robots::SensorFrame* s = model.sensor(name);
@@ -38,26 +39,27 @@ float clampAbs(double v, double range) {
 }
 
 void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world, int32_t object,
-              int32_t owner) {
+              int32_t owner, uint8_t cluster = 0) {
   const Pose p = world * s.pose;
   const Vec3f c = p.translation().cast<float>();
   const Vec3f axis = p.linear().col(2).cast<float>();
   switch (s.type) {
     case engine::ShapeType::Sphere:
-      scene.addSphere(c, static_cast<float>(s.radius), object, owner);
+      scene.addSphere(c, static_cast<float>(s.radius), object, owner, cluster);
       break;
     case engine::ShapeType::Capsule: {
       const float half = static_cast<float>(0.5 * s.length - s.radius);
       scene.addCapsule(c - half * axis, c + half * axis, static_cast<float>(s.radius), object,
-                       owner);
+                       owner, cluster);
       break;
     }
     case engine::ShapeType::Box:
-      scene.addBox(c, p.linear().cast<float>(), (0.5 * s.extents).cast<float>(), object, owner);
+      scene.addBox(c, p.linear().cast<float>(), (0.5 * s.extents).cast<float>(), object, owner,
+                   cluster);
       break;
     case engine::ShapeType::Cylinder:
       scene.addCylinder(c, axis, static_cast<float>(0.5 * s.length), static_cast<float>(s.radius),
-                        object, owner);
+                        object, owner, cluster);
       break;
   }
 }
@@ -123,6 +125,17 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
       else
         r.touch_source[t] = model.sensor(name) ? -1 : -2;
     }
+    // Clusters for the ray broadphase: the root, and one per subtree hanging
+    // off it (head, each arm, each leg).
+    const auto& links = model.body->links;
+    r.link_cluster.assign(links.size(), 0);
+    uint8_t next_cluster = 1;
+    for (const auto& joint : model.body->joints) {
+      const auto child = static_cast<size_t>(joint.child_link);
+      r.link_cluster[child] = joint.parent_link == 0
+                                  ? next_cluster++
+                                  : r.link_cluster[static_cast<size_t>(joint.parent_link)];
+    }
     r.temperature.fill(model.sensor_spec.ambient_temperature);
     for (size_t a = 0; a < kActuators; ++a) {
       const auto& act = model.actuators[a];
@@ -143,7 +156,10 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
                            std::sin(theta) * std::sin(phi));
   }
   for (int side : {-1, 1})
-    for (const engine::Shape& s : field.goalShapes(side)) static_shapes_.push_back(s);
+    for (const engine::Shape& s : field.goalShapes(side)) {
+      static_shapes_.push_back(s);
+      static_owner_.push_back(side < 0 ? kGoalMinusOwner : kGoalPlusOwner);
+    }
   for (size_t i = 0; i < robots_.size(); ++i) {
     const auto a = robots_[i].body;
     if (articulation_robot_.size() <= a) articulation_robot_.resize(a + 1, -1);
@@ -365,19 +381,22 @@ const std::vector<engine::Ray>& SensorSystem::buildSonarRays(const engine::Physi
 void SensorSystem::buildScene(const engine::PhysicsWorld& physics) {
   scene_.clear();
   scene_.setGround(kGroundObject);
-  for (size_t i = 0; i < static_shapes_.size(); ++i)
-    addShape(scene_, static_shapes_[i], Pose::Identity(), kGoalObjectBase + static_cast<int32_t>(i),
-             engine::kNoOwner);
+  // Each goal and the ball is a broadphase group of its own (negative
+  // owners: never excluded), so rays far from them skip them.
   const engine::RigidBodyState ball = physics.rigidBodyState(ball_);
   scene_.addSphere(ball.pose.translation().cast<float>(), static_cast<float>(field_.ball.radius),
-                   kBallObject, engine::kNoOwner);
+                   kBallObject, kBallOwner);
+  for (size_t i = 0; i < static_shapes_.size(); ++i)
+    addShape(scene_, static_shapes_[i], Pose::Identity(), kGoalObjectBase + static_cast<int32_t>(i),
+             static_owner_[i]);
   for (const Robot& r : robots_) {
     const auto& links = r.model->body->links;
     for (size_t l = 0; l < links.size(); ++l) {
       if (links[l].shapes.empty()) continue;
       const Pose pose = physics.linkPose(r.body, static_cast<int>(l));
       const int32_t object = kRobotObjectBase + r.group * 64 + static_cast<int32_t>(l);
-      for (const engine::Shape& s : links[l].shapes) addShape(scene_, s, pose, object, r.group);
+      for (const engine::Shape& s : links[l].shapes)
+        addShape(scene_, s, pose, object, r.group, r.link_cluster[l]);
     }
   }
   scene_.finalize();

@@ -72,6 +72,7 @@ class SensorSystem {
     engine::ArticulationId body;
     int group = 0;
     const robots::RobotModel* model;
+    std::vector<uint8_t> link_cluster;      // broadphase cluster: torso 0, each limb its own
     std::array<engine::Pose, 2> foot_pose;  // this step's, computed on first use
     bool feet_posed = false;
     std::array<Foot, 2> feet;
@@ -106,6 +107,7 @@ class SensorSystem {
   std::vector<Robot> robots_;
   std::vector<int> articulation_robot_;       // articulation id -> robot index (-1 none)
   std::vector<engine::Shape> static_shapes_;  // goals, field frame
+  std::vector<int32_t> static_owner_;         // their broadphase group
   std::vector<SensorFrame> frames_;
   std::vector<engine::Vec3> ray_dirs_;  // cone directions in the sonar frame (x = axis)
   int steps_in_period_ = 0;
