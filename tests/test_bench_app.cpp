@@ -77,3 +77,27 @@ TEST(CheckApp, ValidScenarioAndConfigError) {
       << err;
   std::filesystem::remove(bad);
 }
+
+TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
+  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_sensors_test.csv";
+  std::filesystem::remove(csv);
+  int status = -1;
+  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
+                                         " bench sensors --robots 1,2 --rays 9,32 --seconds 0.2 "
+                                         "--csv " + csv.string(),
+                                     status);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  std::ifstream f(csv);
+  std::string header, row1, row2;
+  std::getline(f, header);
+  std::getline(f, row1);
+  std::getline(f, row2);
+  EXPECT_EQ(header.rfind("robots,batched_us_rays9,reference_us_rays9,speedup_rays9", 0), 0u)
+      << header;
+  EXPECT_NE(header.find("speedup_rays32"), std::string::npos);
+  EXPECT_NE(header.find("sensor_share_pct"), std::string::npos);
+  EXPECT_EQ(row1.rfind("1,", 0), 0u) << row1;
+  EXPECT_EQ(row2.rfind("2,", 0), 0u) << row2;
+  std::filesystem::remove(csv);
+}

@@ -49,6 +49,7 @@ double medianMicros(int repeats, F&& f) {
 // Builds the scene with n robots and lets it settle with the motion running.
 world::World settledWorld(const BenchConfig& cfg, int n, int rays, const fields::FieldModel& f) {
   world::Scenario s = placeRobots(cfg, n, f.halfLength(), f.halfWidth());
+  s.sensors.enabled = true;
   s.sensors.sonar_rays = rays;
   world::World w(s);
   const BenchMotion motion(cfg, w);

@@ -47,7 +47,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
     s.noise.joints = n->has("joints") ? (*n)["joints"].nonNegative() : 0.0;
   }
   if (auto n = root.optional("sensors")) {
-    n->allowOnly({"sonar", "imu"});
+    n->allowOnly({"enabled", "sonar", "imu"});
+    s.sensors.enabled = n->boolean("enabled", true);
     if (auto sonar = n->optional("sonar")) {
       sonar->allowOnly({"rays", "update_period"});
       s.sensors.sonar_rays = sonar->integer("rays", s.sensors.sonar_rays);

@@ -187,6 +187,7 @@ void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffn
 
 void World::step() {
   physics_->step();
+  if (!scenario_.sensors.enabled) return;
   sensors_->afterStep(*physics_);
   const uint64_t steps = physics_->stepCount();
   if (steps % static_cast<uint64_t>(steps_per_control_) == 0)

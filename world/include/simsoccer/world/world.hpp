@@ -86,7 +86,8 @@ class World {
   // Upright: torso origin above `min_height` and tilted less than `max_tilt`.
   bool isStanding(RobotId r, double min_height = 0.22, double max_tilt = 0.785) const;
 
-  // The sensor frame of the last completed control period.
+  // The sensor frame of the last completed control period (stays the
+  // initial one when the scenario turns sensors off).
   const SensorFrame& sensorFrame(RobotId r) const { return sensors_->frame(r); }
   // Chest button, head and hand touch sensors are inputs (set by a scenario
   // or a test); the foot bumpers come from contacts.
