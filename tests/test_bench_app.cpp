@@ -84,7 +84,8 @@ TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
   int status = -1;
   const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
                                          " bench sensors --robots 1,2 --rays 9,32 --seconds 0.2 "
-                                         "--csv " + csv.string(),
+                                         "--csv " +
+                                         csv.string(),
                                      status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;

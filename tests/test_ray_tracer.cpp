@@ -84,3 +84,47 @@ TEST(RayScene, OwnerExclusionAndBroadphase) {
   mixed.finalize();
   EXPECT_EQ(traceOne(mixed, {0, 0, 0}, {1, 0, 0}, 10.0f, 1).object, 9);
 }
+
+TEST(RayScene, CapsCornersAndTiltedShapes) {
+  RayScene scene;
+  // Capsule along z from (0,0,0) to (0,0,1), radius 0.2: hit its top cap.
+  scene.addCapsule({0, 0, 0}, {0, 0, 1}, 0.2f, 1, kNoOwner);
+  // Box rotated 30 deg about x, half extents 0.5 x 0.3 x 0.1, at (5, 0, 0).
+  const Mat3f tilt =
+      Eigen::AngleAxisf(static_cast<float>(M_PI / 6), Vec3f::UnitX()).toRotationMatrix();
+  scene.addBox({5, 0, 0}, tilt, {0.5f, 0.3f, 0.1f}, 2, kNoOwner);
+  // Cylinder tilted 45 deg in the x-z plane at (0, 5, 0), radius 0.1, half length 0.5.
+  scene.addCylinder({0, 5, 0}, Vec3f(1, 0, 1).normalized(), 0.5f, 0.1f, 3, kNoOwner);
+  scene.finalize();
+
+  RayHit h = traceOne(scene, {0, 0, 3}, {0, 0, -1});  // straight down onto the cap
+  EXPECT_EQ(h.object, 1);
+  EXPECT_NEAR(h.distance, 3.0f - 1.2f, 1e-5f);
+  EXPECT_TRUE(h.normal.isApprox(Vec3f(0, 0, 1), 1e-5f));
+  h = traceOne(scene, {0.15f, 0, 3}, {0, 0, -1});  // off-centre on the cap's sphere
+  EXPECT_NEAR(h.distance, 3.0f - (1.0f + std::sqrt(0.04f - 0.0225f)), 1e-5f);
+  h = traceOne(scene, {-2, 0, 0.5f}, {1, 0, 0});  // the body, side on
+  EXPECT_NEAR(h.distance, 1.8f, 1e-5f);
+  EXPECT_TRUE(h.normal.isApprox(Vec3f(-1, 0, 0), 1e-5f));
+  h = traceOne(scene, {0, 0, 0.5f}, {1, 0, 0});  // from inside: 0, as spheres and boxes
+  EXPECT_EQ(h.object, 1);
+  EXPECT_FLOAT_EQ(h.distance, 0.0f);
+
+  // The tilted box from above: its top face's plane through the centre.
+  h = traceOne(scene, {5, 0, 2}, {0, 0, -1});
+  EXPECT_EQ(h.object, 2);
+  EXPECT_NEAR(h.distance, 2.0f - 0.1f / std::cos(static_cast<float>(M_PI / 6)), 1e-5f);
+  EXPECT_TRUE(h.normal.isApprox(tilt.col(2), 1e-5f));
+
+  // The tilted cylinder, along its axis from below-left: hits the bottom cap.
+  const Vec3f axis = Vec3f(1, 0, 1).normalized();
+  h = traceOne(scene, Vec3f(0, 5, 0) - 2.0f * axis, axis);
+  EXPECT_EQ(h.object, 3);
+  EXPECT_NEAR(h.distance, 1.5f, 1e-5f);
+  EXPECT_TRUE(h.normal.isApprox(-axis, 1e-5f));
+  // Across its side at the centre: radius 0.1 along the perpendicular.
+  const Vec3f across = Vec3f(1, 0, -1).normalized();
+  h = traceOne(scene, Vec3f(0, 5, 0) - 1.0f * across, across);
+  EXPECT_NEAR(h.distance, 0.9f, 1e-5f);
+  EXPECT_TRUE(h.normal.isApprox(-across, 1e-4f));
+}

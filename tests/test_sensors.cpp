@@ -36,14 +36,40 @@ Pose sensorPose(const world::World& w, world::RobotId r, const char* name) {
 }  // namespace
 
 TEST(Sonar, NothingInFrontReportsNoEcho) {
-  world::World w(single(0.0, 0.0, 0.0));
-  w.stepControlPeriod();
-  const auto& f = w.sensorFrame(0);
-  const double no_echo = w.robot(0).model->sensor_spec.sonar_no_echo_value;
-  for (int s = 0; s < 2; ++s) {
-    EXPECT_EQ(f.sonar_echo_count[s], 0);
-    EXPECT_FLOAT_EQ(f.sonar[s], no_echo);
+  // Whatever the number of rays: the carpet under the cone does not echo
+  // back (met too obliquely), nothing else is within range.
+  for (const int rays : {9, 32, 128}) {
+    world::Scenario sc = single(0.0, 0.0, 0.0);
+    sc.sensors.sonar_rays = rays;
+    world::World w(sc);
+    for (int i = 0; i < 12; ++i) w.stepControlPeriod();
+    const auto& f = w.sensorFrame(0);
+    const double no_echo = w.robot(0).model->sensor_spec.sonar_no_echo_value;
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_EQ(f.sonar_echo_count[s], 0) << rays << " rays";
+      EXPECT_FLOAT_EQ(f.sonar[s], no_echo);
+    }
   }
+}
+
+TEST(Sonar, CarpetEchoesWhenTheRobotLeansForward) {
+  // Bent 25 deg forward at the hips, the lower rays meet the carpet steeply
+  // enough to return: the floor is in the traced scene.
+  world::Scenario sc = single(0.0, 0.0, 0.0);
+  sc.sensors.sonar_rays = 32;
+  world::World w(sc);
+  const auto& body = *w.robot(0).model->body;
+  for (const char* j : {"LHipPitch", "RHipPitch"})
+    w.setJointTarget(0, body.jointIndex(j), -0.9, 1.0);
+  for (const char* j : {"LAnklePitch", "RAnklePitch"})
+    w.setJointTarget(0, body.jointIndex(j), -0.2, 1.0);
+  for (int i = 0; i < 100; ++i) w.stepControlPeriod();
+  ASSERT_TRUE(w.isStanding(0));
+  const auto& f = w.sensorFrame(0);
+  std::printf("leaning: torso pitch %.1f deg, sonar %.3f / %.3f\n", f.angles[1] * 180 / kPi,
+              f.sonar[0], f.sonar[1]);
+  EXPECT_GT(f.sonar_echo_count[0] + f.sonar_echo_count[1], 0);
+  EXPECT_LT(std::min(f.sonar[0], f.sonar[1]), 0.8f);
 }
 
 TEST(Sonar, GoalPostAtKnownDistance) {
@@ -211,8 +237,13 @@ TEST(Sonar, BatchedAndReferenceTracersAgreeOnRandomScene) {
     // Bullet's convex cast stops once its point is within 1 mm of the shape,
     // so its error is that far from the surface, measured along the surface
     // normal; along the ray it grows as 1 / cos(incidence) on grazing hits.
+    // The incidence is taken from Bullet's own hit normal.
+    Vec3 normal;
+    w.physics().rayTestClosest(rays[i].origin.cast<double>(), rays[i].direction.cast<double>(),
+                               rays[i].max_distance, rays[i].exclude_owner, &normal);
     const double along = std::abs(batched[i].distance - reference[i].distance);
-    const double incidence_cos = std::abs(batched[i].normal.dot(rays[i].direction));
+    const double incidence_cos = std::abs(normal.dot(rays[i].direction.cast<double>()));
+    EXPECT_GT(batched[i].normal.cast<double>().dot(normal), 0.9) << "normals disagree, ray " << i;
     worst = std::max(worst, along * incidence_cos);
     worst_along = std::max(worst_along, along);
     if (incidence_cos > 0.5) worst_frontal = std::max(worst_frontal, along);
@@ -222,7 +253,8 @@ TEST(Sonar, BatchedAndReferenceTracersAgreeOnRandomScene) {
       "along the ray %.5f m (%.5f m within 60 deg of the normal)\n",
       batched.size(), hits, robot_hits, worst, worst_along, worst_frontal);
   EXPECT_GT(robot_hits, 100);
-  EXPECT_LT(worst, 0.001);
+  // Bullet's GJK cast terminates 1 mm from the shape (plus float error).
+  EXPECT_LT(worst, 0.0015);
   EXPECT_LT(worst_frontal, 0.002);
 }
 
@@ -251,9 +283,13 @@ TEST(Imu, GyroMatchesKnownRotationRate) {
   world::Scenario s = single(0.0, 0.0, 0.0);
   s.physics.gravity = 0.0;
   world::World w(s);
-  // Lift it off the carpet and spin it about the world z and x axes.
+  // Lift it off the carpet, tilt and turn it, and spin it about the world
+  // z and x axes: torso and world frames differ a lot.
   Pose lifted = w.torsoPose(0);
   lifted.translation().z() += 1.0;
+  lifted.linear() = (Eigen::AngleAxisd(1.0, Vec3::UnitZ()) * Eigen::AngleAxisd(0.6, Vec3::UnitY()) *
+                     Eigen::AngleAxisd(-0.4, Vec3::UnitX()))
+                        .toRotationMatrix();
   std::vector<double> q = w.robot(0).model->pose("stand");
   w.physics().resetArticulation(w.robot(0).body, lifted, q);
   const Vec3 rate(0.4, 0.0, 1.5);
@@ -262,10 +298,25 @@ TEST(Imu, GyroMatchesKnownRotationRate) {
   w.stepControlPeriod();
   const auto& f = w.sensorFrame(0);
   const Vec3 expected = w.torsoPose(0).linear().transpose() * rate;  // in the torso frame
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(f.gyroscope[k], expected[k], 0.05) << k;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(f.gyroscope[k], expected[k], 0.02) << k;
+  EXPECT_GT((expected - rate).norm(), 0.5);  // the frames really differ
   // Free fall / weightless: the accelerometer reads (almost) no specific force
   // beyond the centripetal term at its offset from the centre of mass.
   EXPECT_LT(Vec3(f.accelerometer[0], f.accelerometer[1], f.accelerometer[2]).norm(), 0.5);
+}
+
+TEST(Imu, FreeFallReadsNoSpecificForce) {
+  // With gravity on, lifted 3 m above the carpet and let go (limp): the
+  // accelerometer reads ~0 while falling, then gravity's reaction at rest.
+  world::World w(single(0.0, 0.0, 0.0));
+  Pose lifted = w.torsoPose(0);
+  lifted.translation().z() += 3.0;
+  w.physics().resetArticulation(w.robot(0).body, lifted, w.robot(0).model->pose("stand"));
+  for (int i = 0; i < 10; ++i) w.stepControlPeriod();  // 0.1 s of falling
+  const auto& f = w.sensorFrame(0);
+  const Vec3 falling(f.accelerometer[0], f.accelerometer[1], f.accelerometer[2]);
+  std::printf("free fall: accelerometer |%.4f| m/s^2\n", falling.norm());
+  EXPECT_LT(falling.norm(), 0.1);
 }
 
 TEST(Imu, TiltedPlacementAngles) {
@@ -317,6 +368,70 @@ TEST(Fsr, LeaningForwardMovesCentreOfPressureForward) {
   EXPECT_GT(f.centre_of_pressure[0][0], before + 0.01);
   EXPECT_GT(f.centre_of_pressure[1][0], before + 0.01);
   EXPECT_TRUE(w.isStanding(0));
+}
+
+TEST(Fsr, FrontSensorsCarryALeanForward) {
+  world::World w(single(0.0, 0.0, 0.0));
+  const auto& body = *w.robot(0).model->body;
+  for (const char* j : {"LHipPitch", "RHipPitch"})
+    w.setJointTarget(0, body.jointIndex(j), -0.65, 1.0);
+  for (int i = 0; i < 150; ++i) w.stepControlPeriod();
+  ASSERT_TRUE(w.isStanding(0));
+  const auto& f = w.sensorFrame(0);
+  for (int foot = 0; foot < 2; ++foot) {
+    const size_t b = static_cast<size_t>(4 * foot);
+    EXPECT_GT(f.fsr[b + 0] + f.fsr[b + 1], f.fsr[b + 2] + f.fsr[b + 3]) << foot;  // FL+FR > RL+RR
+  }
+}
+
+TEST(Fsr, BilinearWeightsOrderAndEdges) {
+  const engine::FsrRectangle r{0.07, -0.03, 0.03, -0.02};  // front, rear, left, right
+  auto w = engine::fsrWeights(r, 0.07, 0.03);              // on the front-left sensor
+  EXPECT_DOUBLE_EQ(w[0], 1.0);
+  w = engine::fsrWeights(r, 0.07, -0.02);  // front-right
+  EXPECT_DOUBLE_EQ(w[1], 1.0);
+  w = engine::fsrWeights(r, -0.03, 0.03);  // rear-left
+  EXPECT_DOUBLE_EQ(w[2], 1.0);
+  w = engine::fsrWeights(r, -0.03, -0.02);  // rear-right
+  EXPECT_DOUBLE_EQ(w[3], 1.0);
+  w = engine::fsrWeights(r, 0.02, 0.005);  // the middle
+  for (double x : w) EXPECT_NEAR(x, 0.25, 1e-12);
+  w = engine::fsrWeights(r, 0.02, 0.2);  // beyond the left edge: the left pair, halved
+  EXPECT_NEAR(w[0], 0.5, 1e-12);
+  EXPECT_NEAR(w[2], 0.5, 1e-12);
+  w = engine::fsrWeights(r, 0.045, -0.0075);  // 3/4 front, 1/4 left
+  EXPECT_NEAR(w[0], 0.75 * 0.25, 1e-12);
+  EXPECT_NEAR(w[1], 0.75 * 0.75, 1e-12);
+  EXPECT_NEAR(w[0] + w[1] + w[2] + w[3], 1.0, 1e-12);
+}
+
+TEST(Fsr, SwayRightLoadsTheRightFootAndTheRightSensors) {
+  // Both hip rolls +, ankle rolls -: the feet move left relative to the
+  // hips, so the torso moves right over the right foot. Compared with
+  // standing, the right foot carries more, and within it the right-hand
+  // sensors (FR, RR) take a larger share.
+  auto frame = [](double roll) {
+    world::World w(single(0.0, 0.0, 0.0));
+    const auto& body = *w.robot(0).model->body;
+    for (const char* j : {"LHipRoll", "RHipRoll"})
+      w.setJointTarget(0, body.jointIndex(j), roll, 1.0);
+    for (const char* j : {"LAnkleRoll", "RAnkleRoll"})
+      w.setJointTarget(0, body.jointIndex(j), -roll, 1.0);
+    for (int i = 0; i < 150; ++i) w.stepControlPeriod();
+    EXPECT_TRUE(w.isStanding(0));
+    return w.sensorFrame(0);
+  };
+  const auto stand = frame(0.0), sway = frame(0.08);
+  auto right_share = [](const world::SensorFrame& f, size_t foot) {
+    return (f.fsr[4 * foot + 1] + f.fsr[4 * foot + 3]) / f.foot_weight[foot];
+  };
+  std::printf(
+      "right foot weight %.1f -> %.1f N; right-sensor share L %.2f -> %.2f, R %.2f -> %.2f\n",
+      stand.foot_weight[1], sway.foot_weight[1], right_share(stand, 0), right_share(sway, 0),
+      right_share(stand, 1), right_share(sway, 1));
+  EXPECT_GT(sway.foot_weight[1], stand.foot_weight[1] + 3.0);
+  EXPECT_GT(right_share(sway, 1), right_share(stand, 1));
+  EXPECT_LT(sway.centre_of_pressure[1][1], stand.centre_of_pressure[1][1]);
 }
 
 TEST(Joints, EncoderQuantisation) {

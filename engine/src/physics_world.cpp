@@ -143,6 +143,10 @@ struct Articulation {
   // Bullet refreshes the links' cached world transforms only inside its
   // step, before integration; they are recomputed on the first read after.
   bool kinematics_stale = false;
+  // Bullet's scratch arrays for forward kinematics, kept so that refreshing
+  // allocates nothing after the first time.
+  btAlignedObjectArray<btQuaternion> scratch_world_to_local;
+  btAlignedObjectArray<btVector3> scratch_local_origin;
 };
 
 // Checks a model before any Bullet object is made from it.
@@ -222,9 +226,7 @@ struct PhysicsWorld::Impl {
 
   void refresh(Articulation& art) {
     if (!art.kinematics_stale) return;
-    btAlignedObjectArray<btQuaternion> world_to_local;
-    btAlignedObjectArray<btVector3> local_origin;
-    art.body->forwardKinematics(world_to_local, local_origin);
+    art.body->forwardKinematics(art.scratch_world_to_local, art.scratch_local_origin);
     art.kinematics_stale = false;
   }
 
@@ -569,7 +571,7 @@ Pose PhysicsWorld::linkPose(ArticulationId a, int link) const {
   Articulation& art = impl_->articulations.at(a);
   if (link < 0 || link >= static_cast<int>(art.model->links.size()))
     throw std::out_of_range("link index " + std::to_string(link) + " out of range");
-  impl_->refresh(art);
+  if (link != 0) impl_->refresh(art);  // the root's transform is always current
   const btTransform t = link == 0 ? art.body->getBaseWorldTransform()
                                   : art.body->getLink(link - 1).m_cachedWorldTransform;
   return fromBt(t) * art.bullet_in_joint.at(static_cast<size_t>(link)).inverse();
@@ -667,7 +669,7 @@ Vec3 PhysicsWorld::rootPointVelocity(ArticulationId a, const Vec3& world_point) 
 }
 
 double PhysicsWorld::rayTestClosest(const Vec3& origin, const Vec3& direction, double max_distance,
-                                    int exclude_group) const {
+                                    int exclude_group, Vec3* normal) const {
   struct Callback : btCollisionWorld::ClosestRayResultCallback {
     int exclude;
     Callback(const btVector3& from, const btVector3& to, int ex)
@@ -684,8 +686,9 @@ double PhysicsWorld::rayTestClosest(const Vec3& origin, const Vec3& direction, d
   // GJK cast: stops within 1 mm of the surface (the subsimplex cast is coarser).
   cb.m_flags |= btTriangleRaycastCallback::kF_UseGjkConvexCastRaytest;
   impl_->world->rayTest(from, to, cb);
-  return cb.hasHit() ? cb.m_closestHitFraction * max_distance
-                     : std::numeric_limits<double>::infinity();
+  if (!cb.hasHit()) return std::numeric_limits<double>::infinity();
+  if (normal) *normal = fromBt(cb.m_hitNormalWorld).normalized();
+  return cb.m_closestHitFraction * max_distance;
 }
 
 void PhysicsWorld::appendState(std::vector<double>& out) const {

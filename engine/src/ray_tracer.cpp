@@ -222,6 +222,10 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
     const float dp = dx * px + dy * py + dz * pz;
     const float pp = px * px + py * py + pz * pz;
     float t = kInf;
+    // A ray starting inside reports 0, as for spheres and boxes.
+    const float s0 = std::clamp(up / uu, 0.0f, 1.0f);
+    const float ix = px - s0 * ux, iy = py - s0 * uy, iz = pz - s0 * uz;
+    if (ix * ix + iy * iy + iz * iz <= r * r) t = 0.0f;
     const float A = uu - ud * ud;
     if (A > kEps) {
       const float B = uu * dp - up * ud;
@@ -230,7 +234,7 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
       if (h >= 0.0f) {
         const float tb = (-B - std::sqrt(h)) / A;
         const float y = up + tb * ud;
-        if (tb >= 0.0f && y > 0.0f && y < uu) t = tb;
+        if (tb >= 0.0f && y > 0.0f && y < uu) t = std::min(t, tb);
       }
     }
     t = std::min({t, raySphere(ox, oy, oz, dx, dy, dz, ax, ay, az, r),
@@ -274,6 +278,7 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
     const float qx = px - oa * ux, qy = py - oa * uy, qz = pz - oa * uz;  // across
     const float ex = dx - da * ux, ey = dy - da * uy, ez = dz - da * uz;
     float t = kInf;
+    if (std::abs(oa) <= hh && qx * qx + qy * qy + qz * qz <= r * r) t = 0.0f;  // starts inside
     const float a = ex * ex + ey * ey + ez * ez;
     const float b = qx * ex + qy * ey + qz * ez;
     const float c = qx * qx + qy * qy + qz * qz - r * r;
@@ -281,7 +286,7 @@ void RayScene::traceGroup(const Group& g, const Ray& ray, RayHit& hit, Best& bes
       const float disc = b * b - a * c;
       if (disc >= 0.0f) {
         const float ts = (-b - std::sqrt(disc)) / a;
-        if (ts >= 0.0f && std::abs(oa + ts * da) <= hh) t = ts;
+        if (ts >= 0.0f && std::abs(oa + ts * da) <= hh) t = std::min(t, ts);
       }
     }
     if (std::abs(da) > 1e-9f) {

@@ -139,7 +139,8 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     spec.accel_range = (*n)["accel_range"].positive();
   }
   if (auto n = root.optional("sonar")) {
-    n->allowOnly({"min_range", "max_range", "cone_angle", "no_echo_value", "max_echoes"});
+    n->allowOnly(
+        {"min_range", "max_range", "cone_angle", "no_echo_value", "max_echoes", "max_incidence"});
     spec.sonar_min_range = (*n)["min_range"].nonNegative();
     spec.sonar_max_range = (*n)["max_range"].positive();
     if (spec.sonar_max_range <= spec.sonar_min_range)
@@ -150,6 +151,8 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     spec.sonar_max_echoes = (*n)["max_echoes"].integer();
     if (spec.sonar_max_echoes < 1 || spec.sonar_max_echoes > 10)
       n->failKey("max_echoes", "must be 1..10 (the Nao reports up to 10)");
+    spec.sonar_max_incidence = (*n)["max_incidence"].positive();
+    if (spec.sonar_max_incidence > M_PI / 2) n->failKey("max_incidence", "must be at most pi/2");
   }
   if (auto n = root.optional("thermal")) {
     n->allowOnly({"ambient", "hot", "very_hot", "critical"});
@@ -318,7 +321,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   // Hands.
   if (auto hands = root.optional("hands")) {
     for (const ConfigNode& n : hands->items()) {
-      n.allowOnly({"name", "link", "limits", "motor"});
+      n.allowOnly({"name", "link", "limits", "motor", "speed"});
       Hand h;
       h.name = n["name"].string();
       Vec3 off;
@@ -329,6 +332,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
       h.lower = lim[0];
       h.upper = lim[1];
       h.motor = motorIndex(n["motor"]);
+      h.speed = n["speed"].positive();
       robot.hands.push_back(h);
     }
   }

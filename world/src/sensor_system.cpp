@@ -8,6 +8,7 @@
 #include <string>
 
 #include "simsoccer/engine/config.hpp"
+#include "simsoccer/engine/fsr.hpp"
 
 namespace simsoccer::world {
 
@@ -94,10 +95,10 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
         foot.link = s.link;
         foot.fsr[static_cast<size_t>(c)] = s.pose.translation();
       }
-      foot.x_front = 0.5 * (foot.fsr[0].x() + foot.fsr[1].x());
-      foot.x_rear = 0.5 * (foot.fsr[2].x() + foot.fsr[3].x());
-      foot.y_left = 0.5 * (foot.fsr[0].y() + foot.fsr[2].y());
-      foot.y_right = 0.5 * (foot.fsr[1].y() + foot.fsr[3].y());
+      foot.rect.x_front = 0.5 * (foot.fsr[0].x() + foot.fsr[1].x());
+      foot.rect.x_rear = 0.5 * (foot.fsr[2].x() + foot.fsr[3].x());
+      foot.rect.y_left = 0.5 * (foot.fsr[0].y() + foot.fsr[2].y());
+      foot.rect.y_right = 0.5 * (foot.fsr[1].y() + foot.fsr[3].y());
       foot.sole_z = foot.fsr[0].z();
       foot.bumper[0] =
           needSensor(model, std::string(feet[f]) + "FootBumperLeft").pose.translation();
@@ -145,16 +146,17 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
     const Pose torso = physics.linkPose(r.body, 0);
     r.last_accel_point_velocity = physics.rootPointVelocity(r.body, torso * r.accel_point);
     r.noise = engine::NormalSampler(seed ^ (0x9E3779B97F4A7C15ull * (robots_.size() + 1)));
+    // This robot's sonar cone (its model's angle) in the sonar frame.
+    const double cone_half = 0.5 * model.sensor_spec.sonar_cone_angle;
+    for (int i = 0; i < k; ++i) {
+      const double theta = k == 1 ? 0.0 : cone_half * std::sqrt(i / (k - 0.5));
+      const double phi = i * golden;
+      r.ray_dirs.emplace_back(std::cos(theta), std::sin(theta) * std::cos(phi),
+                              std::sin(theta) * std::sin(phi));
+    }
     robots_.push_back(r);
   }
-  double cone_half = 0.5;
-  if (!robots_.empty()) cone_half = 0.5 * robots_[0].model->sensor_spec.sonar_cone_angle;
-  for (int i = 0; i < k; ++i) {
-    const double theta = k == 1 ? 0.0 : cone_half * std::sqrt(i / (k - 0.5));
-    const double phi = i * golden;
-    ray_dirs_.emplace_back(std::cos(theta), std::sin(theta) * std::cos(phi),
-                           std::sin(theta) * std::sin(phi));
-  }
+  rays_per_sonar_ = static_cast<size_t>(k);
   for (int side : {-1, 1})
     for (const engine::Shape& s : field.goalShapes(side)) {
       static_shapes_.push_back(s);
@@ -166,9 +168,9 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
     articulation_robot_[a] = static_cast<int>(i);
   }
   frames_.resize(robots_.size());
-  rays_.reserve(robots_.size() * 2 * ray_dirs_.size());
-  hits_.resize(robots_.size() * 2 * ray_dirs_.size());
-  echo_scratch_.reserve(ray_dirs_.size());
+  rays_.reserve(robots_.size() * 2 * rays_per_sonar_);
+  hits_.resize(robots_.size() * 2 * rays_per_sonar_);
+  echo_scratch_.reserve(rays_per_sonar_);
   contacts_.reserve(64 * robots_.size() + 16);
   updateSonar(physics);
 }
@@ -216,16 +218,14 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics) {
     const double force = c.impulse / dt_;
     const double up = force * n.z();  // pressing on the sole
     if (up > 0.0 && p.z() < foot.sole_z + 0.01) {
-      // Bilinear weights over the four sensors (FL, FR, RL, RR).
-      const double u = std::clamp((p.x() - foot.x_rear) / (foot.x_front - foot.x_rear), 0.0, 1.0);
-      const double v = std::clamp((p.y() - foot.y_right) / (foot.y_left - foot.y_right), 0.0, 1.0);
-      const double w[4] = {u * v, u * (1 - v), (1 - u) * v, (1 - u) * (1 - v)};
-      for (int k = 0; k < 4; ++k) r.fsr_sum[static_cast<size_t>(4 * f + k)] += up * w[k];
+      const auto w = engine::fsrWeights(foot.rect, p.x(), p.y());
+      for (size_t k = 0; k < 4; ++k) r.fsr_sum[4 * static_cast<size_t>(f) + k] += up * w[k];
       r.weight_sum[static_cast<size_t>(f)] += up;
       r.cop_sum[static_cast<size_t>(f)] += up * p;
     }
     // A toe pushed against something: contact at the front, normal mostly horizontal.
-    if (force > 0.0 && std::hypot(n.x(), n.y()) > 0.5 && p.x() >= foot.bumper[0].x() - 0.005) {
+    // (pushed backwards: the impulse on the foot points mostly along -x).
+    if (force > 0.0 && -n.x() > 0.5 && p.x() >= foot.bumper[0].x() - 0.005) {
       const double mid = 0.5 * (foot.bumper[0].y() + foot.bumper[1].y());
       r.bumper_hit[static_cast<size_t>(2 * f + (p.y() >= mid ? 0 : 1))] = true;
     }
@@ -291,9 +291,8 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
                                                           : 0;
       } else if (act.kind == robots::Actuator::Kind::Hand) {
         const auto h = static_cast<size_t>(act.index);
-        const auto& motor = model.body->motors[static_cast<size_t>(model.hands[h].motor)];
         const double before = r.hand_position[h];
-        const double reach = r.hand_stiffness[h] > 0.0 ? motor.no_load_speed * period : 0.0;
+        const double reach = r.hand_stiffness[h] > 0.0 ? model.hands[h].speed * period : 0.0;
         r.hand_position[h] += std::clamp(r.hand_target[h] - before, -reach, reach);
         f.position[a] = static_cast<float>(r.hand_position[h]);
         f.velocity[a] = static_cast<float>((r.hand_position[h] - before) / period);
@@ -365,7 +364,7 @@ const std::vector<engine::Ray>& SensorSystem::buildSonarRays(const engine::Physi
       const Pose sonar = physics.linkPose(r.body, r.sonar_link[s]) * r.sonar_pose[s];
       const Vec3f origin = sonar.translation().cast<float>();
       const engine::Mat3f rot = sonar.linear().cast<float>();
-      for (const Vec3& d : ray_dirs_) {
+      for (const Vec3& d : r.ray_dirs) {
         engine::Ray ray;
         ray.origin = origin;
         ray.direction = (rot * d.cast<float>()).normalized();
@@ -426,16 +425,25 @@ void SensorSystem::traceReference(const engine::PhysicsWorld& physics,
 void SensorSystem::updateSonar(const engine::PhysicsWorld& physics) {
   const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
   traceBatched(physics, hits_);
-  const size_t k = ray_dirs_.size();
+  const size_t k = rays_per_sonar_;
   for (size_t ri = 0; ri < robots_.size(); ++ri) {
     const auto& spec = robots_[ri].model->sensor_spec;
+    const float min_cos = static_cast<float>(std::cos(spec.sonar_max_incidence));
     SensorFrame& f = frames_[ri];
     for (size_t s = 0; s < 2; ++s) {
-      // One echo per object: the nearest ray hit on it; sorted by distance.
+      // One echo per object (a robot counts as one), the nearest ray that
+      // returns from it; a ray returns only if it meets the surface within
+      // the maximum incidence (smooth surfaces reflect ultrasound away).
       echo_scratch_.clear();
       for (size_t i = 0; i < k; ++i) {
-        const engine::RayHit& h = hits_[(2 * ri + s) * k + i];
-        if (h.object != engine::kNoObject) echo_scratch_.emplace_back(h.distance, h.object);
+        const size_t index = (2 * ri + s) * k + i;
+        const engine::RayHit& h = hits_[index];
+        if (h.object == engine::kNoObject) continue;
+        if (-h.normal.dot(rays_[index].direction) < min_cos) continue;
+        const int32_t echo_object = h.object >= kRobotObjectBase
+                                        ? kRobotObjectBase + (h.object - kRobotObjectBase) / 64 * 64
+                                        : h.object;
+        echo_scratch_.emplace_back(h.distance, echo_object);
       }
       std::sort(echo_scratch_.begin(), echo_scratch_.end());
       size_t count = 0;

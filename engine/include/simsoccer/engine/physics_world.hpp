@@ -132,9 +132,10 @@ class PhysicsWorld {
 
   // Reference ray cast through Bullet (btCollisionWorld::rayTest), one ray:
   // distance to the nearest collider within max_distance, ignoring the links
-  // of articulations in `exclude_group`; infinity if nothing.
+  // of articulations in `exclude_group`; infinity if nothing. `normal`, if
+  // given, receives Bullet's surface normal at the hit.
   double rayTestClosest(const Vec3& origin, const Vec3& direction, double max_distance,
-                        int exclude_group) const;
+                        int exclude_group, Vec3* normal = nullptr) const;
 
   // Appends the full dynamic state (every root pose and velocity, joint
   // positions and velocities, rigid bodies, servo targets and memory) as raw

@@ -31,6 +31,7 @@ struct Hand {
   int link = -1;
   double lower = 0.0, upper = 1.0;
   int motor = -1;
+  double speed = 2.0;  // range units per second (0..1 in 0.5 s)
 };
 
 struct SensorFrame {
@@ -49,6 +50,7 @@ struct SensorSpec {
   double sonar_cone_angle = 1.0472;                       // rad, full cone
   double sonar_no_echo_value = 5.0;                       // m
   int sonar_max_echoes = 10;
+  double sonar_max_incidence = 0.96;  // rad from the surface normal
   double ambient_temperature = 25.0;  // deg C
   double temperature_hot = 70.0, temperature_very_hot = 80.0, temperature_critical = 90.0;
 };

@@ -39,7 +39,7 @@ struct PlacementNoise {
 // Sensor simulation settings (the hardware's own numbers are in the robot
 // model). Noise is white, per axis, from the scenario seed; off by default.
 struct SensorSettings {
-  bool enabled = true;             // false: no sensor frames (pure physics runs)
+  bool enabled = true;          // false: no sensor frames (pure physics runs)
   int sonar_rays = 9;           // rays per sonar cone
   double sonar_period = 0.060;  // s between sonar updates, a multiple of the control period
   engine::Vec3 gyro_noise = engine::Vec3::Zero();   // rad/s std dev

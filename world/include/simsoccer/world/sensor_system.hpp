@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "simsoccer/engine/fsr.hpp"
 #include "simsoccer/engine/physics_world.hpp"
 #include "simsoccer/engine/random.hpp"
 #include "simsoccer/engine/ray_tracer.hpp"
@@ -55,7 +56,7 @@ class SensorSystem {
   void traceBatched(const engine::PhysicsWorld& physics, std::vector<engine::RayHit>& hits);
   // The same rays one at a time through Bullet's rayTest (reference path).
   void traceReference(const engine::PhysicsWorld& physics, std::vector<engine::RayHit>& hits);
-  int raysPerSonar() const { return settings_.sonar_rays; }
+  int raysPerSonar() const { return static_cast<int>(rays_per_sonar_); }
 
   void enableTimers(bool on) { timers_on_ = on; }
   const SensorTimes& times() const { return times_; }
@@ -65,7 +66,8 @@ class SensorSystem {
   struct Foot {
     int link = -1;
     std::array<engine::Vec3, 4> fsr;  // FL, FR, RL, RR in the foot's joint frame
-    double x_front = 0, x_rear = 0, y_left = 0, y_right = 0, sole_z = 0;
+    engine::FsrRectangle rect;
+    double sole_z = 0;
     std::array<engine::Vec3, 2> bumper;  // left, right
   };
   struct Robot {
@@ -73,6 +75,7 @@ class SensorSystem {
     int group = 0;
     const robots::RobotModel* model;
     std::vector<uint8_t> link_cluster;      // broadphase cluster: torso 0, each limb its own
+    std::vector<engine::Vec3> ray_dirs;     // sonar cone directions, sonar frame (x = axis)
     std::array<engine::Pose, 2> foot_pose;  // this step's, computed on first use
     bool feet_posed = false;
     std::array<Foot, 2> feet;
@@ -109,7 +112,7 @@ class SensorSystem {
   std::vector<engine::Shape> static_shapes_;  // goals, field frame
   std::vector<int32_t> static_owner_;         // their broadphase group
   std::vector<SensorFrame> frames_;
-  std::vector<engine::Vec3> ray_dirs_;  // cone directions in the sonar frame (x = axis)
+  size_t rays_per_sonar_ = 0;
   int steps_in_period_ = 0;
 
   std::vector<engine::LinkContact> contacts_;
