@@ -37,12 +37,8 @@ const char* kHelp =
 
 int benchPhysics(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"}, {"config", "robots", "seconds", "repeat", "csv"});
-  if (opt.flag("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (!opt.positional().empty())
-    throw UsageError("unexpected argument '" + opt.positional()[0] + "'");
+  if (opt.help(kHelp)) return 0;
+  opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);

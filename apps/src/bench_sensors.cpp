@@ -65,12 +65,8 @@ world::World settledWorld(const BenchConfig& cfg, int n, int rays, const fields:
 
 int benchSensors(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"}, {"config", "robots", "rays", "seconds", "csv"});
-  if (opt.flag("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
-  if (!opt.positional().empty())
-    throw UsageError("unexpected argument '" + opt.positional()[0] + "'");
+  if (opt.help(kHelp)) return 0;
+  opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   const BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);

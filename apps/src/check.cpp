@@ -19,10 +19,7 @@ const char* kHelp =
 
 int check(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"}, {});
-  if (opt.flag("help")) {
-    std::fputs(kHelp, stdout);
-    return 0;
-  }
+  if (opt.help(kHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario file");
   const world::World w = world::World::fromFile(opt.positional()[0]);
   const auto& s = w.scenario();

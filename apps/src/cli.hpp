@@ -25,6 +25,10 @@ class Options {
   double number(const std::string& name, double fallback) const;
   std::vector<int> intList(const std::string& name, const std::vector<int>& fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
+  // --help given: prints `text` and returns true.
+  bool help(const char* text) const;
+  // Throws a UsageError if there are arguments that are not options.
+  void noPositional() const;
 
  private:
   std::map<std::string, bool> flags_;

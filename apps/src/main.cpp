@@ -36,6 +36,16 @@ Options::Options(int argc, char** argv, int first, const std::vector<std::string
   }
 }
 
+bool Options::help(const char* text) const {
+  if (!flag("help")) return false;
+  std::fputs(text, stdout);
+  return true;
+}
+
+void Options::noPositional() const {
+  if (!positional_.empty()) throw UsageError("unexpected argument '" + positional_[0] + "'");
+}
+
 std::string Options::get(const std::string& name, const std::string& fallback) const {
   auto it = values_.find(name);
   return it == values_.end() ? fallback : it->second;
