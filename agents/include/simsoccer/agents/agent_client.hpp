@@ -1,0 +1,62 @@
+// The client library every agent links: connect to a simulator over DDS,
+// claim a robot, then loop: receive its SensorFrame -> compute -> send a
+// JointCommand for that tick. Also the GameState, team messages and the
+// simulated clock.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "simsoccer/net/dds.hpp"
+#include "simsoccer_msgs.h"
+
+namespace simsoccer::agents {
+
+struct TeamMessageIn {
+  int from_player = 0;
+  uint64_t tick = 0;
+  std::vector<uint8_t> data;
+};
+
+class AgentClient {
+ public:
+  AgentClient(const net::DomainConfig& dds, int team, int player);
+  ~AgentClient();
+
+  int team() const { return team_; }
+  int player() const { return player_; }
+
+  // Sends a join request and waits until the simulator says who owns the
+  // robot: true if this agent does, false if another agent does or no
+  // answer came in time.
+  bool claim(double timeout_seconds);
+  // The latest RobotStatus seen for this robot (owner, counters).
+  const simsoccer_msg_RobotStatus& status() const { return status_; }
+  bool ownsRobot() const;
+
+  // Waits for this robot's next SensorFrame; false on timeout.
+  bool receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds);
+  // Answers the frame of `tick`: 25 positions (rad) and stiffnesses, actuator order.
+  void send(uint64_t tick, std::span<const float> position, std::span<const float> stiffness);
+  // Raw command, for tests that send malformed ones (wrong sizes, NaN, ...).
+  void sendRaw(const simsoccer_msg_JointCommand& command);
+
+  // The latest GameState (false until one arrived).
+  bool gameState(simsoccer_msg_GameState& out);
+  // Team communication: at most 128 bytes, delivered by the simulator to
+  // this robot's teammates.
+  void sendTeamMessage(std::span<const uint8_t> data);
+  std::vector<TeamMessageIn> receiveTeamMessages();
+
+ private:
+  struct Impl;
+  int team_, player_;
+  std::unique_ptr<Impl> impl_;
+  simsoccer_msg_RobotStatus status_{};
+  uint32_t serial_ = 0;
+  void readStatus();
+};
+
+}  // namespace simsoccer::agents

@@ -1,0 +1,154 @@
+#include "simsoccer/agents/agent_client.hpp"
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace simsoccer::agents {
+
+using net::QosSpec;
+using Clock = std::chrono::steady_clock;
+
+struct AgentClient::Impl {
+  net::Participant participant;
+  net::Writer<simsoccer_msg_JoinRequest> join;
+  net::Writer<simsoccer_msg_JointCommand> command;
+  net::Writer<simsoccer_msg_TeamMessage> team_send;
+  net::Reader<simsoccer_msg_SensorFrame> frames;
+  net::Reader<simsoccer_msg_RobotStatus> status;
+  net::Reader<simsoccer_msg_GameState> game;
+  net::Reader<simsoccer_msg_TeamMessage> team_deliver;
+  net::Entity waitset, frame_condition;
+  bool have_game = false;
+  simsoccer_msg_GameState game_state{};
+
+  Impl(const net::DomainConfig& dds, int team, int player)
+      : participant(dds),
+        join(participant, simsoccer_msg_JoinRequest_desc, "simsoccer_JoinRequest",
+             {true, 4, true, ""}),
+        command(participant, simsoccer_msg_JointCommand_desc, "simsoccer_JointCommand",
+                {true, 16, false, ""}),
+        team_send(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageSend",
+                  {true, 16, false, ""}),
+        frames(participant, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
+               {true, 1, false, net::robotPartitionName(team, player)}),
+        status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
+               {true, 1, true, ""}),
+        game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 1, true, ""}),
+        team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
+                     {true, 16, false, ""}) {
+    waitset = net::Entity(net::check(dds_create_waitset(participant.get()), "create waitset"));
+    frame_condition = net::Entity(
+        net::check(dds_create_readcondition(frames.get(), DDS_ANY_STATE), "read condition"));
+    net::check(dds_waitset_attach(waitset.get(), frame_condition.get(), 0), "attach");
+  }
+};
+
+AgentClient::AgentClient(const net::DomainConfig& dds, int team, int player)
+    : team_(team), player_(player), impl_(std::make_unique<Impl>(dds, team, player)) {
+  if (team < 0 || team > 1 || player < 1 || player > 255)
+    throw std::invalid_argument("team must be 0 or 1 and player 1..255");
+}
+
+AgentClient::~AgentClient() = default;
+
+void AgentClient::readStatus() {
+  impl_->status.take([&](const simsoccer_msg_RobotStatus& s, const dds_sample_info_t&) {
+    if (s.team == team_ && s.player == player_) status_ = s;
+  });
+}
+
+bool AgentClient::ownsRobot() const {
+  const dds_guid_t me = impl_->participant.guid();
+  return status_.owned && std::memcmp(status_.owner_guid, me.v, 16) == 0;
+}
+
+bool AgentClient::claim(double timeout_seconds) {
+  simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
+  impl_->join.write(j);
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(timeout_seconds));
+  while (Clock::now() < end) {
+    readStatus();
+    if (status_.owned) {
+      if (ownsRobot()) return true;
+      // Owned by someone else: the simulator's refusal counter says it saw us.
+      if (status_.refused > 0) return false;
+    }
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  return false;
+}
+
+bool AgentClient::receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds) {
+  bool got = false;
+  auto grab = [&] {
+    impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t&) {
+      if (f.team == team_ && f.player == player_ && (!got || f.tick > frame.tick)) {
+        frame = f;
+        got = true;
+      }
+    });
+  };
+  grab();
+  if (!got) {
+    dds_waitset_wait(impl_->waitset.get(), nullptr, 0,
+                     static_cast<dds_duration_t>(timeout_seconds * 1e9));
+    grab();
+  }
+  readStatus();
+  return got;
+}
+
+void AgentClient::send(uint64_t tick, std::span<const float> position,
+                       std::span<const float> stiffness) {
+  if (position.size() != 25 || stiffness.size() != 25)
+    throw std::invalid_argument("a joint command has 25 positions and 25 stiffnesses");
+  simsoccer_msg_JointCommand c{};
+  c.team = static_cast<uint8_t>(team_);
+  c.player = static_cast<uint8_t>(player_);
+  c.tick = tick;
+  c.serial = ++serial_;
+  c.position._buffer = const_cast<float*>(position.data());
+  c.position._length = c.position._maximum = 25;
+  c.stiffness._buffer = const_cast<float*>(stiffness.data());
+  c.stiffness._length = c.stiffness._maximum = 25;
+  impl_->command.write(c);
+}
+
+void AgentClient::sendRaw(const simsoccer_msg_JointCommand& command) {
+  impl_->command.write(command);
+}
+
+bool AgentClient::gameState(simsoccer_msg_GameState& out) {
+  impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t&) {
+    impl_->game_state = g;
+    impl_->have_game = true;
+  });
+  if (impl_->have_game) out = impl_->game_state;
+  return impl_->have_game;
+}
+
+void AgentClient::sendTeamMessage(std::span<const uint8_t> data) {
+  if (data.size() > 128) throw std::invalid_argument("team messages are at most 128 bytes");
+  simsoccer_msg_TeamMessage m{};
+  m.team = static_cast<uint8_t>(team_);
+  m.to_player = 0;
+  m.from_player = static_cast<uint8_t>(player_);
+  m.data._buffer = const_cast<uint8_t*>(data.data());
+  m.data._length = m.data._maximum = static_cast<uint32_t>(data.size());
+  impl_->team_send.write(m);
+}
+
+std::vector<TeamMessageIn> AgentClient::receiveTeamMessages() {
+  std::vector<TeamMessageIn> out;
+  impl_->team_deliver.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t&) {
+    if (m.team != team_ || m.to_player != player_) return;
+    out.push_back({m.from_player, m.tick,
+                   std::vector<uint8_t>(m.data._buffer, m.data._buffer + m.data._length)});
+  });
+  return out;
+}
+
+}  // namespace simsoccer::agents

@@ -1,0 +1,122 @@
+// simsoccer-agent: a minimal agent. It claims a robot, then answers every
+// SensorFrame with the stand pose and a nodding head, to prove the loop.
+// Test modes send malformed commands or stop answering.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/robots/robot_model.hpp"
+
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE]\n"
+    "                       [--robot FILE] [--mode nod|garbage|stall] [--stall-after N]\n"
+    "                       [--ticks N] [--claim-timeout S]\n"
+    "\n"
+    "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame with\n"
+    "the stand pose of the robot model and a nodding head (0.2 rad at 0.5 Hz).\n"
+    "  --mode garbage   also sends an invalid command before each valid one (NaN, wrong\n"
+    "                   sizes, stale and future ticks, stiffness out of range)\n"
+    "  --mode stall     answers --stall-after ticks, then keeps running without answering\n"
+    "  --ticks N        exit after answering N frames (default: run until the simulator is gone)\n"
+    "Exit status: 0 done, 3 the claim was refused or not answered, 4 the simulator went away.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace simsoccer;
+  try {
+    const apps::Options opt(argc, argv, 1, {"help"},
+                            {"team", "player", "domain", "dds-config", "robot", "mode",
+                             "stall-after", "ticks", "claim-timeout"});
+    if (opt.help(kHelp)) return 0;
+    opt.noPositional();
+    if (!opt.has("team") || !opt.has("player"))
+      throw apps::UsageError("--team and --player are required");
+    const int team = static_cast<int>(opt.number("team", 0));
+    const int player = static_cast<int>(opt.number("player", 1));
+    net::DomainConfig dds;
+    dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
+    dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
+    const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
+    const std::string mode = opt.get("mode", "nod");
+    if (mode != "nod" && mode != "garbage" && mode != "stall")
+      throw apps::UsageError("--mode must be nod, garbage or stall");
+    const long stall_after = static_cast<long>(opt.number("stall-after", 50));
+    const long max_ticks = static_cast<long>(opt.number("ticks", -1));
+
+    const robots::RobotModel model = robots::loadRobotModel(robot_file);
+    const auto& stand = model.pose("stand");
+    std::vector<float> position(25, 0.0f), stiffness(25, 1.0f);
+    int head_pitch = -1;
+    for (size_t a = 0; a < model.actuators.size() && a < 25; ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind == robots::Actuator::Kind::Joint)
+        position[a] = static_cast<float>(stand[static_cast<size_t>(act.index)]);
+      if (act.name == "HeadPitch") head_pitch = static_cast<int>(a);
+    }
+
+    agents::AgentClient client(dds, team, player);
+    if (!client.claim(opt.number("claim-timeout", 10.0))) {
+      std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
+      return 3;
+    }
+    simsoccer_msg_SensorFrame frame{};
+    long answered = 0, garbage = 0;
+    for (;;) {
+      if (!client.receive(frame, 5.0)) {
+        std::fprintf(stderr, "simsoccer-agent: no frame for 5 s, the simulator is gone\n");
+        return 4;
+      }
+      if (mode == "stall" && answered >= stall_after) continue;
+      if (head_pitch >= 0)
+        position[static_cast<size_t>(head_pitch)] =
+            static_cast<float>(0.2 * std::sin(2.0 * std::numbers::pi * 0.5 * frame.sim_time));
+      if (mode == "garbage") {
+        // One invalid command of each kind in turn, then the valid answer.
+        simsoccer_msg_JointCommand bad{};
+        bad.team = static_cast<uint8_t>(team);
+        bad.player = static_cast<uint8_t>(player);
+        bad.tick = frame.tick;
+        std::vector<float> p = position, k = stiffness;
+        bad.position._buffer = p.data();
+        bad.position._length = bad.position._maximum = 25;
+        bad.stiffness._buffer = k.data();
+        bad.stiffness._length = bad.stiffness._maximum = 25;
+        switch (garbage++ % 5) {
+          case 0:
+            p[3] = std::nanf("");
+            break;  // NaN
+          case 1:
+            bad.position._length = 24;
+            break;  // wrong count
+          case 2:
+            bad.tick = frame.tick > 0 ? frame.tick - 1 : frame.tick + 7;
+            break;  // stale
+          case 3:
+            bad.tick = frame.tick + 5;
+            break;  // future
+          case 4:
+            k[10] = 3.0f;
+            break;  // stiffness out of range
+        }
+        client.sendRaw(bad);
+      }
+      client.send(frame.tick, position, stiffness);
+      ++answered;
+      if (max_ticks >= 0 && answered >= max_ticks) return 0;
+    }
+  } catch (const apps::UsageError& e) {
+    std::fprintf(stderr, "simsoccer-agent: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "simsoccer-agent: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,125 @@
+// Option parsing and tables for the command-line programs.
+#include "cli.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace simsoccer::apps {
+
+Options::Options(int argc, char** argv, int first, const std::vector<std::string>& flags,
+                 const std::vector<std::string>& valued) {
+  auto in = [](const std::vector<std::string>& v, const std::string& s) {
+    for (const auto& x : v)
+      if (x == s) return true;
+    return false;
+  };
+  for (int i = first; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--", 0) == 0) {
+      const std::string name = a.substr(2);
+      if (in(flags, name)) {
+        flags_[name] = true;
+      } else if (in(valued, name)) {
+        if (i + 1 >= argc) throw UsageError("option --" + name + " needs a value");
+        values_[name] = argv[++i];
+      } else {
+        throw UsageError("unknown option " + a);
+      }
+    } else {
+      positional_.push_back(a);
+    }
+  }
+}
+
+bool Options::help(const char* text) const {
+  if (!flag("help")) return false;
+  std::fputs(text, stdout);
+  return true;
+}
+
+void Options::noPositional() const {
+  if (!positional_.empty()) throw UsageError("unexpected argument '" + positional_[0] + "'");
+}
+
+std::string Options::get(const std::string& name, const std::string& fallback) const {
+  auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+double Options::number(const std::string& name, double fallback) const {
+  if (!has(name)) return fallback;
+  const std::string v = values_.at(name);
+  try {
+    size_t used = 0;
+    const double d = std::stod(v, &used);
+    if (used != v.size() || !std::isfinite(d)) throw std::invalid_argument(v);
+    return d;
+  } catch (const std::exception&) {
+    throw UsageError("--" + name + ": expected a number, got '" + v + "'");
+  }
+}
+
+std::vector<int> Options::intList(const std::string& name, const std::vector<int>& fallback) const {
+  if (!has(name)) return fallback;
+  std::vector<int> out;
+  std::stringstream ss(values_.at(name));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      const int v = std::stoi(item, &used);
+      if (used != item.size() || v < 1) throw std::invalid_argument(item);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw UsageError("--" + name + ": expected positive integers separated by commas, got '" +
+                       values_.at(name) + "'");
+    }
+  }
+  if (out.empty()) throw UsageError("--" + name + ": empty list");
+  return out;
+}
+
+std::filesystem::path findConfig(const std::string& given, const std::string& default_relative) {
+  if (!given.empty()) return given;
+  if (std::filesystem::exists(default_relative)) return default_relative;
+  return std::filesystem::path(SIMSOCCER_SOURCE_DIR) / default_relative;
+}
+
+std::string fmt(double value, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  return buf;
+}
+
+void Table::print(FILE* out) const {
+  std::vector<size_t> width(header.size());
+  for (size_t c = 0; c < header.size(); ++c) {
+    width[c] = header[c].size();
+    for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
+  }
+  auto line = [&](const std::vector<std::string>& cells) {
+    for (size_t c = 0; c < cells.size(); ++c)
+      std::fprintf(out, "%s%*s", c ? "  " : "", static_cast<int>(width[c]), cells[c].c_str());
+    std::fprintf(out, "\n");
+  };
+  line(header);
+  for (const auto& r : rows) line(r);
+  std::fflush(out);
+}
+
+void Table::writeCsv(const std::filesystem::path& file) const {
+  std::ofstream f(file);
+  if (!f) throw std::runtime_error(file.string() + ": cannot open for writing");
+  auto line = [&](const std::vector<std::string>& cells) {
+    for (size_t c = 0; c < cells.size(); ++c) f << (c ? "," : "") << cells[c];
+    f << "\n";
+  };
+  line(header);
+  for (const auto& r : rows) line(r);
+  if (!f) throw std::runtime_error(file.string() + ": write failed");
+}
+
+}  // namespace simsoccer::apps

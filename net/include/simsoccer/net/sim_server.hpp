@@ -1,0 +1,103 @@
+// The simulator's side of the agent protocol: publishes every robot's
+// SensorFrame, takes JointCommands, keeps robot ownership, relays team
+// messages on simulated time, and advances the World, in lockstep (wait for
+// every owned robot's command for tick t, then step) or in real time.
+//
+// Topics (names, QoS, rates and sizes: README "Agents over DDS"):
+//   simsoccer_SensorFrame   sim -> agent, partition robot_<team>_<player>
+//   simsoccer_JointCommand  agent -> sim
+//   simsoccer_JoinRequest   agent -> sim
+//   simsoccer_RobotStatus   sim -> agents
+//   simsoccer_SimClock      sim -> agents
+//   simsoccer_GameState     sim -> agents
+//   simsoccer_TeamMessageSend / simsoccer_TeamMessageDeliver
+//   simsoccer_WorldTruth    sim -> monitors (optional)
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "simsoccer/net/dds.hpp"
+#include "simsoccer/world/world.hpp"
+#include "simsoccer_msgs.h"
+
+namespace simsoccer::net {
+
+struct ServerConfig {
+  DomainConfig dds;
+  bool lockstep = true;
+  double command_timeout = 0.5;     // s of wall time to wait per lockstep period
+  bool hold_on_release = true;      // a released robot holds its pose (false: goes limp)
+  double team_message_delay = 0.0;  // s of simulated time
+  double team_message_loss = 0.0;   // probability a copy is lost
+  bool world_truth = false;
+  double position_margin = 0.5;  // rad beyond a joint's limits before a target is rejected
+};
+
+struct RobotNetStats {
+  bool owned = false;
+  uint64_t accepted = 0, rejected = 0, refused = 0, missed = 0;
+};
+
+struct ServerTimes {
+  double publish_s = 0.0;  // building and writing frames, clock, status
+  double wait_s = 0.0;     // waiting for and taking commands (lockstep)
+  double physics_s = 0.0;  // World steps (physics and sensors)
+  uint64_t periods = 0;
+};
+
+class SimServer {
+ public:
+  SimServer(world::World& world, const ServerConfig& config);
+  ~SimServer();
+
+  // One control period: publish the frames for the current tick, collect
+  // commands (lockstep: wait for every owned robot, up to the timeout),
+  // apply the valid ones, step the world.
+  void runPeriod();
+  // Handle claims and commands for up to `seconds` of wall time without
+  // stepping (while agents connect).
+  void poll(double seconds);
+  // Polls until `count` robots are owned or the timeout passes.
+  bool waitForOwners(size_t count, double timeout_seconds);
+
+  size_t ownedCount() const;
+  const RobotNetStats& stats(world::RobotId r) const { return robots_.at(r).stats; }
+  const ServerTimes& times() const { return times_; }
+  // The GameState published at every change and every 0.5 s (2 Hz).
+  void setGameState(const simsoccer_msg_GameState& state);
+
+ private:
+  struct Impl;
+  struct RobotSlot {
+    int team = 0, player = 0;
+    RobotNetStats stats;
+    dds_guid_t owner{};
+    dds_instance_handle_t owner_join = 0;  // the owner's JoinRequest writer (liveness)
+    bool has_command = false;              // a valid command waits to be applied
+    uint64_t last_tick = 0;                // tick of the last accepted command
+    std::array<double, world::kActuators> position{}, stiffness{};
+  };
+
+  void handleJoins();
+  void handleCommands(bool lockstep, uint64_t tick);
+  void checkOwners();
+  void relayTeamMessages(uint64_t tick);
+  void publishStatus(world::RobotId r);
+  void release(world::RobotId r);
+  int robotIndex(int team, int player) const;
+  bool validCommand(const world::RobotInfo& info, const simsoccer_msg_JointCommand& c) const;
+
+  world::World& world_;
+  ServerConfig config_;
+  std::unique_ptr<Impl> impl_;
+  std::vector<RobotSlot> robots_;
+  ServerTimes times_;
+};
+
+// Copies a world sensor frame into the wire message.
+void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_SensorFrame& m);
+
+}  // namespace simsoccer::net

@@ -1,0 +1,418 @@
+#include "simsoccer/net/sim_server.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <random>
+
+namespace simsoccer::net {
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// Reliable, latest sample per instance: frames, clock, status.
+QosSpec latest() {
+  return {true, 1, false, ""};
+}
+QosSpec latestDurable() {
+  return {true, 1, true, ""};
+}
+
+}  // namespace
+
+void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_SensorFrame& m) {
+  m.team = static_cast<uint8_t>(team);
+  m.player = static_cast<uint8_t>(player);
+  m.tick = f.tick;
+  m.sim_time = f.time;
+  std::memcpy(m.position, f.position.data(), sizeof m.position);
+  std::memcpy(m.velocity, f.velocity.data(), sizeof m.velocity);
+  std::memcpy(m.target, f.target.data(), sizeof m.target);
+  std::memcpy(m.stiffness, f.stiffness.data(), sizeof m.stiffness);
+  std::memcpy(m.current, f.current.data(), sizeof m.current);
+  std::memcpy(m.temperature, f.temperature.data(), sizeof m.temperature);
+  std::memcpy(m.status, f.status.data(), sizeof m.status);
+  std::memcpy(m.accelerometer, f.accelerometer.data(), sizeof m.accelerometer);
+  std::memcpy(m.gyroscope, f.gyroscope.data(), sizeof m.gyroscope);
+  std::memcpy(m.angles, f.angles.data(), sizeof m.angles);
+  std::memcpy(m.fsr, f.fsr.data(), sizeof m.fsr);
+  std::memcpy(m.foot_weight, f.foot_weight.data(), sizeof m.foot_weight);
+  for (int foot = 0; foot < 2; ++foot)
+    for (int k = 0; k < 2; ++k) m.centre_of_pressure[2 * foot + k] = f.centre_of_pressure[foot][k];
+  std::memcpy(m.sonar, f.sonar.data(), sizeof m.sonar);
+  for (int s = 0; s < 2; ++s)
+    for (int e = 0; e < 10; ++e) m.sonar_echoes[10 * s + e] = f.sonar_echoes[s][e];
+  std::memcpy(m.sonar_echo_count, f.sonar_echo_count.data(), sizeof m.sonar_echo_count);
+  std::memcpy(m.touch, f.touch.data(), sizeof m.touch);
+}
+
+struct SimServer::Impl {
+  Participant participant;
+  std::vector<std::unique_ptr<Writer<simsoccer_msg_SensorFrame>>>
+      frames;  // one per robot partition
+  Writer<simsoccer_msg_RobotStatus> status;
+  Writer<simsoccer_msg_SimClock> clock;
+  Writer<simsoccer_msg_GameState> game;
+  Writer<simsoccer_msg_TeamMessage> team_deliver;
+  std::unique_ptr<Writer<simsoccer_msg_WorldTruth>> truth;
+  Reader<simsoccer_msg_JointCommand> commands;
+  Reader<simsoccer_msg_JoinRequest> joins;
+  Reader<simsoccer_msg_TeamMessage> team_send;
+  Entity waitset;
+  Entity command_condition;
+  Entity join_condition;
+  // Publication handle -> participant GUID of writers seen on the command
+  // and team-message readers (cached: looked up once per writer).
+  std::vector<std::pair<dds_instance_handle_t, dds_guid_t>> publishers;
+  // Team messages waiting for their delivery tick.
+  struct Pending {
+    uint64_t due;
+    simsoccer_msg_TeamMessage msg;
+    std::array<uint8_t, 128> data;
+  };
+  std::deque<Pending> pending;
+  std::mt19937_64 loss_rng;
+  simsoccer_msg_GameState game_state{};
+  double game_state_published_at = -1e9;
+  simsoccer_msg_SensorFrame frame_msg{};
+
+  explicit Impl(const ServerConfig& c, uint64_t seed)
+      : participant(c.dds),
+        status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
+               latestDurable()),
+        clock(participant, simsoccer_msg_SimClock_desc, "simsoccer_SimClock", latest()),
+        game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", latestDurable()),
+        team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
+                     {true, 16, false, ""}),
+        commands(participant, simsoccer_msg_JointCommand_desc, "simsoccer_JointCommand",
+                 {true, 16, false, ""}),
+        joins(participant, simsoccer_msg_JoinRequest_desc, "simsoccer_JoinRequest",
+              {true, 4, true, ""}),
+        team_send(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageSend",
+                  {true, 16, false, ""}),
+        loss_rng(seed) {
+    waitset = Entity(check(dds_create_waitset(participant.get()), "create waitset"));
+    command_condition =
+        Entity(check(dds_create_readcondition(commands.get(), DDS_ANY_STATE), "read condition"));
+    join_condition =
+        Entity(check(dds_create_readcondition(joins.get(), DDS_ANY_STATE), "read condition"));
+    check(dds_waitset_attach(waitset.get(), command_condition.get(), 0), "attach");
+    check(dds_waitset_attach(waitset.get(), join_condition.get(), 1), "attach");
+  }
+
+  bool participantOf(dds_entity_t reader, dds_instance_handle_t h, dds_guid_t& guid) {
+    for (const auto& [handle, g] : publishers)
+      if (handle == h) {
+        guid = g;
+        return true;
+      }
+    if (!publisherParticipant(reader, h, guid)) return false;
+    publishers.emplace_back(h, guid);
+    return true;
+  }
+};
+
+SimServer::SimServer(world::World& world, const ServerConfig& config)
+    : world_(world), config_(config) {
+  impl_ = std::make_unique<Impl>(config, world.scenario().seed ^ 0x7EA3u);
+  if (config.world_truth)
+    impl_->truth = std::make_unique<Writer<simsoccer_msg_WorldTruth>>(
+        impl_->participant, simsoccer_msg_WorldTruth_desc, "simsoccer_WorldTruth", latest());
+  for (world::RobotId r = 0; r < world.robotCount(); ++r) {
+    const auto& info = world.robot(r);
+    RobotSlot slot;
+    slot.team = info.team;
+    slot.player = info.number;
+    robots_.push_back(slot);
+    impl_->frames.push_back(std::make_unique<Writer<simsoccer_msg_SensorFrame>>(
+        impl_->participant, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
+        QosSpec{true, 1, false, robotPartitionName(info.team, info.number)}));
+    publishStatus(r);
+  }
+  impl_->game_state.kicking_team = 255;
+  impl_->game_state.first_half = 1;
+  setGameState(impl_->game_state);
+}
+
+SimServer::~SimServer() = default;
+
+int SimServer::robotIndex(int team, int player) const {
+  for (size_t i = 0; i < robots_.size(); ++i)
+    if (robots_[i].team == team && robots_[i].player == player) return static_cast<int>(i);
+  return -1;
+}
+
+size_t SimServer::ownedCount() const {
+  size_t n = 0;
+  for (const RobotSlot& s : robots_) n += s.stats.owned;
+  return n;
+}
+
+void SimServer::setGameState(const simsoccer_msg_GameState& state) {
+  impl_->game_state = state;
+  impl_->game_state.tick =
+      world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
+  impl_->game.write(impl_->game_state);
+  impl_->game_state_published_at = world_.time();
+}
+
+void SimServer::publishStatus(world::RobotId r) {
+  const RobotSlot& s = robots_[r];
+  simsoccer_msg_RobotStatus m{};
+  m.team = static_cast<uint8_t>(s.team);
+  m.player = static_cast<uint8_t>(s.player);
+  m.owned = s.stats.owned;
+  std::memcpy(m.owner_guid, s.owner.v, sizeof m.owner_guid);
+  m.accepted = static_cast<uint32_t>(s.stats.accepted);
+  m.rejected = static_cast<uint32_t>(s.stats.rejected);
+  m.refused = static_cast<uint32_t>(s.stats.refused);
+  m.missed = static_cast<uint32_t>(s.stats.missed);
+  impl_->status.write(m);
+}
+
+void SimServer::release(world::RobotId r) {
+  RobotSlot& s = robots_[r];
+  s.stats.owned = false;
+  s.owner = {};
+  s.owner_join = 0;
+  s.has_command = false;
+  const auto& info = world_.robot(r);
+  const auto& joints = info.model->body->joints;
+  for (size_t j = 0; j < joints.size(); ++j) {
+    if (joints[j].motor < 0) continue;
+    const int ji = static_cast<int>(j);
+    // Hold: keep today's angles as targets; limp: no drive at all.
+    world_.setJointTarget(r, ji, world_.jointPosition(r, ji), config_.hold_on_release ? 1.0 : 0.0);
+  }
+  publishStatus(r);
+}
+
+void SimServer::handleJoins() {
+  impl_->joins.take([&](const simsoccer_msg_JoinRequest& j, const dds_sample_info_t& info) {
+    const int ri = robotIndex(j.team, j.player);
+    if (ri < 0) return;
+    RobotSlot& s = robots_[static_cast<size_t>(ri)];
+    dds_guid_t guid;
+    if (!publisherParticipant(impl_->joins.get(), info.publication_handle, guid)) return;
+    if (!s.stats.owned) {
+      s.stats.owned = true;
+      s.owner = guid;
+      s.owner_join = info.publication_handle;
+      s.last_tick = 0;
+    } else if (!sameGuid(s.owner, guid)) {
+      ++s.stats.refused;  // owned by another agent
+    }
+    publishStatus(static_cast<world::RobotId>(ri));
+  });
+}
+
+void SimServer::checkOwners() {
+  dds_subscription_matched_status_t st;
+  if (dds_get_subscription_matched_status(impl_->joins.get(), &st) < 0) return;
+  if (st.current_count_change == 0 && st.total_count_change == 0) return;
+  for (size_t r = 0; r < robots_.size(); ++r)
+    if (robots_[r].stats.owned && !publicationMatched(impl_->joins.get(), robots_[r].owner_join))
+      release(static_cast<world::RobotId>(r));
+}
+
+bool SimServer::validCommand(const world::RobotInfo& info,
+                             const simsoccer_msg_JointCommand& c) const {
+  if (c.position._length != world::kActuators || c.stiffness._length != world::kActuators)
+    return false;
+  const auto& actuators = info.model->actuators;
+  const auto& joints = info.model->body->joints;
+  for (size_t a = 0; a < world::kActuators; ++a) {
+    const double p = c.position._buffer[a], k = c.stiffness._buffer[a];
+    if (!std::isfinite(p) || !std::isfinite(k) || k < 0.0 || k > 1.0) return false;
+    if (actuators[a].kind == robots::Actuator::Kind::Joint) {
+      const auto& jt = joints[static_cast<size_t>(actuators[a].index)];
+      if (p < jt.lower - config_.position_margin || p > jt.upper + config_.position_margin)
+        return false;
+    } else if (std::abs(p) > 10.0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void SimServer::handleCommands(bool lockstep, uint64_t tick) {
+  impl_->commands.take([&](const simsoccer_msg_JointCommand& c, const dds_sample_info_t& info) {
+    const int ri = robotIndex(c.team, c.player);
+    if (ri < 0) return;
+    RobotSlot& s = robots_[static_cast<size_t>(ri)];
+    dds_guid_t guid;
+    if (!s.stats.owned ||
+        !impl_->participantOf(impl_->commands.get(), info.publication_handle, guid) ||
+        !sameGuid(guid, s.owner)) {
+      ++s.stats.refused;
+      return;
+    }
+    // Lockstep: exactly the tick just published. Real time: not newer than
+    // it, not older than the last accepted one, at most 1 s old.
+    const uint64_t window =
+        static_cast<uint64_t>(std::lround(1.0 / world_.scenario().physics.control_period));
+    const bool tick_ok = lockstep
+                             ? c.tick == tick
+                             : (c.tick <= tick && c.tick >= s.last_tick && c.tick + window >= tick);
+    if (!tick_ok || !validCommand(world_.robot(static_cast<world::RobotId>(ri)), c)) {
+      ++s.stats.rejected;
+      return;
+    }
+    for (size_t a = 0; a < world::kActuators; ++a) {
+      s.position[a] = c.position._buffer[a];
+      s.stiffness[a] = c.stiffness._buffer[a];
+    }
+    s.has_command = true;
+    s.last_tick = c.tick;
+  });
+}
+
+void SimServer::relayTeamMessages(uint64_t tick) {
+  const double period = world_.scenario().physics.control_period;
+  const auto delay = static_cast<uint64_t>(std::lround(config_.team_message_delay / period));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  impl_->team_send.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t& info) {
+    const int ri = robotIndex(m.team, m.from_player);
+    if (ri < 0) return;
+    RobotSlot& sender = robots_[static_cast<size_t>(ri)];
+    dds_guid_t guid;
+    if (!sender.stats.owned ||
+        !impl_->participantOf(impl_->team_send.get(), info.publication_handle, guid) ||
+        !sameGuid(guid, sender.owner) || m.data._length > 128) {
+      ++sender.stats.refused;
+      return;
+    }
+    for (const RobotSlot& to : robots_) {
+      if (to.team != m.team || to.player == m.from_player) continue;
+      if (config_.team_message_loss > 0.0 && unit(impl_->loss_rng) < config_.team_message_loss)
+        continue;
+      Impl::Pending p{tick + delay, m, {}};
+      std::memcpy(p.data.data(), m.data._buffer, m.data._length);
+      p.msg.to_player = static_cast<uint8_t>(to.player);
+      p.msg.tick = tick;
+      impl_->pending.push_back(p);
+    }
+  });
+  while (!impl_->pending.empty() && impl_->pending.front().due <= tick) {
+    Impl::Pending& p = impl_->pending.front();
+    p.msg.data._buffer = p.data.data();
+    p.msg.data._release = false;
+    impl_->team_deliver.write(p.msg);
+    impl_->pending.pop_front();
+  }
+}
+
+void SimServer::poll(double wait_seconds) {
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(wait_seconds));
+  do {
+    handleJoins();
+    checkOwners();
+    handleCommands(false, 0);  // commands before any frame: refused or rejected
+    const auto left = std::max(0.0, seconds(Clock::now(), end));
+    dds_waitset_wait(impl_->waitset.get(), nullptr, 0, static_cast<dds_duration_t>(left * 1e9));
+  } while (Clock::now() < end);
+}
+
+bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(timeout_seconds));
+  while (ownedCount() < count && Clock::now() < end) poll(0.02);
+  return ownedCount() >= count;
+}
+
+void SimServer::runPeriod() {
+  const auto t0 = Clock::now();
+  const uint64_t tick = world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
+  handleJoins();
+  checkOwners();
+
+  // Frames for this tick (the state the commands will answer).
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+    world::SensorFrame f = world_.sensorFrame(r);
+    f.tick = tick;
+    f.time = world_.time();
+    toMessage(f, robots_[r].team, robots_[r].player, impl_->frame_msg);
+    impl_->frames[r]->write(impl_->frame_msg);
+  }
+  simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
+  impl_->clock.write(clock);
+  if (world_.time() - impl_->game_state_published_at >= 0.5 - 1e-9) setGameState(impl_->game_state);
+  if (impl_->truth) {
+    simsoccer_msg_WorldTruth t{};
+    t.tick = tick;
+    t.sim_time = world_.time();
+    const auto ball = world_.ballState();
+    for (int k = 0; k < 3; ++k) {
+      t.ball_position[k] = static_cast<float>(ball.pose.translation()[k]);
+      t.ball_velocity[k] = static_cast<float>(ball.linear_velocity[k]);
+    }
+    std::vector<simsoccer_msg_RobotTruth> rt(world_.robotCount());
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+      const auto pose = world_.torsoPose(r);
+      const Eigen::Quaterniond q(pose.linear());
+      rt[r].team = static_cast<uint8_t>(robots_[r].team);
+      rt[r].player = static_cast<uint8_t>(robots_[r].player);
+      for (int k = 0; k < 3; ++k) rt[r].position[k] = static_cast<float>(pose.translation()[k]);
+      rt[r].orientation[0] = static_cast<float>(q.x());
+      rt[r].orientation[1] = static_cast<float>(q.y());
+      rt[r].orientation[2] = static_cast<float>(q.z());
+      rt[r].orientation[3] = static_cast<float>(q.w());
+    }
+    t.robots._buffer = rt.data();
+    t.robots._length = static_cast<uint32_t>(rt.size());
+    t.robots._maximum = static_cast<uint32_t>(rt.size());
+    t.robots._release = false;
+    impl_->truth->write(t);
+  }
+  const auto t1 = Clock::now();
+
+  // Commands.
+  for (RobotSlot& s : robots_) s.has_command = false;
+  if (config_.lockstep) {
+    const auto deadline = t1 + std::chrono::duration_cast<Clock::duration>(
+                                   std::chrono::duration<double>(config_.command_timeout));
+    for (;;) {
+      handleCommands(true, tick);
+      bool all = true;
+      for (const RobotSlot& s : robots_) all = all && (!s.stats.owned || s.has_command);
+      const auto now = Clock::now();
+      if (all || now >= deadline) break;
+      dds_waitset_wait(impl_->waitset.get(), nullptr, 0,
+                       static_cast<dds_duration_t>(seconds(now, deadline) * 1e9));
+      handleJoins();
+    }
+    for (RobotSlot& s : robots_)
+      if (s.stats.owned && !s.has_command) ++s.stats.missed;  // keeps its last command
+  } else {
+    handleCommands(false, tick);
+  }
+  relayTeamMessages(tick);
+  const auto t2 = Clock::now();
+
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+    RobotSlot& s = robots_[r];
+    if (!s.has_command) continue;
+    world_.setCommand(r, s.position, s.stiffness);
+    ++s.stats.accepted;
+  }
+  world_.stepControlPeriod();
+  const auto t3 = Clock::now();
+  times_.publish_s += seconds(t0, t1);
+  times_.wait_s += seconds(t1, t2);
+  times_.physics_s += seconds(t2, t3);
+  ++times_.periods;
+  // Status at 1 Hz of simulated time (and at every ownership change).
+  if (tick % static_cast<uint64_t>(std::lround(1.0 / world_.scenario().physics.control_period)) ==
+      0)
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r) publishStatus(r);
+}
+
+}  // namespace simsoccer::net

@@ -1,0 +1,276 @@
+// Agents over DDS, end to end: the simulator's server in this process, real
+// simsoccer-agent processes, real Cyclone DDS on loopback.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/net/sim_server.hpp"
+#include "test_support.hpp"
+
+extern char** environ;
+
+using namespace simsoccer;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+net::DomainConfig dds(uint32_t domain) {
+  net::DomainConfig c;
+  c.domain = domain;
+  c.config_file = test::sourceDir() / "configs" / "dds" / "loopback.xml";
+  return c;
+}
+
+// A simsoccer-agent process, killed (SIGKILL) when this goes.
+class AgentProcess {
+ public:
+  AgentProcess(uint32_t domain, int team, int player, std::vector<std::string> extra = {}) {
+    std::vector<std::string> args = {SIMSOCCER_AGENT_BIN,
+                                     "--team",
+                                     std::to_string(team),
+                                     "--player",
+                                     std::to_string(player),
+                                     "--domain",
+                                     std::to_string(domain),
+                                     "--dds-config",
+                                     dds(domain).config_file.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~AgentProcess() { kill(); }
+  void kill() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+      pid_ = -1;
+    }
+  }
+  // Exit status once it ended by itself (waits up to `seconds`), or -1.
+  int exitStatus(double seconds) {
+    const auto end = Clock::now() + std::chrono::milliseconds(static_cast<int>(seconds * 1000));
+    while (Clock::now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      usleep(10000);
+    }
+    return -1;
+  }
+  bool running() const { return pid_ > 0; }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+world::Scenario teams(int n) {
+  world::Scenario s = test::scenario(n);
+  return s;
+}
+
+double seconds(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
+
+}  // namespace
+
+TEST(Net, RoundTripAgentDrivesItsRobot) {
+  const uint32_t domain = 101;
+  world::World w(teams(1));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  net::SimServer server(w, cfg);
+  AgentProcess agent(domain, 0, 1);
+  ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
+  const int head = w.robot(0).model->body->jointIndex("HeadPitch");
+  double lo = 1e9, hi = -1e9;
+  for (int i = 0; i < 200; ++i) {  // 2 s: a whole nod
+    server.runPeriod();
+    const double q = w.jointPosition(0, head);
+    lo = std::min(lo, q);
+    hi = std::max(hi, q);
+  }
+  const auto& st = server.stats(0);
+  std::printf("accepted %llu, missed %llu, rejected %llu; head pitch %.3f..%.3f\n",
+              (unsigned long long)st.accepted, (unsigned long long)st.missed,
+              (unsigned long long)st.rejected, lo, hi);
+  EXPECT_GE(st.accepted, 195u);
+  EXPECT_EQ(st.rejected, 0u);
+  EXPECT_GT(hi - lo, 0.3);  // the nod commanded over DDS moved the head
+  EXPECT_TRUE(w.isStanding(0));
+}
+
+TEST(Net, LockstepIsDeterministicWithAgentProcesses) {
+  auto run = [](uint32_t domain) {
+    world::World w(teams(5));
+    net::ServerConfig cfg;
+    cfg.dds = dds(domain);
+    cfg.command_timeout = 5.0;  // a slow machine must not change the result
+    net::SimServer server(w, cfg);
+    std::vector<std::unique_ptr<AgentProcess>> agents;
+    for (world::RobotId r = 0; r < w.robotCount(); ++r)
+      agents.push_back(std::make_unique<AgentProcess>(domain, w.robot(r).team, w.robot(r).number));
+    EXPECT_TRUE(server.waitForOwners(5, 30.0));
+    for (int i = 0; i < 500; ++i) server.runPeriod();
+    uint64_t missed = 0;
+    for (world::RobotId r = 0; r < w.robotCount(); ++r) missed += server.stats(r).missed;
+    EXPECT_EQ(missed, 0u);
+    return w.stateHash();
+  };
+  const uint64_t a = run(102), b = run(103);
+  std::printf("final state hashes %016llx %016llx\n", (unsigned long long)a, (unsigned long long)b);
+  EXPECT_EQ(a, b);
+}
+
+TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
+  const uint32_t domain = 104;
+  world::World w(teams(1));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.command_timeout = 2.0;
+  net::SimServer server(w, cfg);
+  AgentProcess owner(domain, 0, 1);
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  // An intruder in this process (its own participant) claims the same robot.
+  agents::AgentClient intruder(dds(domain), 0, 1);
+  bool granted = true;
+  std::thread([&] { granted = intruder.claim(5.0); }).detach();
+  for (int i = 0; i < 100 && granted; ++i) server.poll(0.02);
+  server.poll(0.2);
+  EXPECT_FALSE(intruder.ownsRobot());
+  // It sends head-yaw commands for the coming ticks; the owner keeps HeadYaw at 0.
+  std::vector<float> pos(25, 0.0f), stiff(25, 1.0f);
+  pos[0] = 1.5f;  // HeadYaw
+  const uint64_t refused_before = server.stats(0).refused;
+  for (int i = 0; i < 100; ++i) {
+    const uint64_t tick = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+    intruder.send(tick, pos, stiff);
+    server.runPeriod();
+  }
+  std::printf("refused %llu commands, head yaw %.3f\n",
+              (unsigned long long)(server.stats(0).refused - refused_before),
+              w.jointPosition(0, 0));
+  EXPECT_GT(server.stats(0).refused, refused_before + 50);
+  EXPECT_NEAR(w.jointPosition(0, 0), 0.0, 0.05);
+}
+
+TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
+  const uint32_t domain = 105;
+  world::World w(teams(2));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.command_timeout = 0.05;
+  net::SimServer server(w, cfg);
+  auto a = std::make_unique<AgentProcess>(domain, 0, 1);
+  AgentProcess b(domain, 1, 1);
+  ASSERT_TRUE(server.waitForOwners(2, 20.0));
+  for (int i = 0; i < 50; ++i) server.runPeriod();
+  a->kill();  // SIGKILL: no goodbye on DDS, the lease has to expire
+  const auto t0 = Clock::now();
+  while (server.stats(0).owned && seconds(t0) < 10.0) server.runPeriod();
+  const double released_after = seconds(t0);
+  EXPECT_FALSE(server.stats(0).owned);
+  const uint64_t b_accepted = server.stats(1).accepted;
+  for (int i = 0; i < 50; ++i) server.runPeriod();
+  EXPECT_GE(server.stats(1).accepted, b_accepted + 45);  // the other robot kept going
+  EXPECT_TRUE(w.isStanding(0));                          // released: holds its pose
+  // Restarted, it claims the robot again and drives it.
+  AgentProcess again(domain, 0, 1);
+  ASSERT_TRUE(server.waitForOwners(2, 20.0));
+  const uint64_t before = server.stats(0).accepted;
+  for (int i = 0; i < 100; ++i) server.runPeriod();
+  std::printf("released %.2f s after SIGKILL; after restart accepted %llu commands\n",
+              released_after, (unsigned long long)(server.stats(0).accepted - before));
+  EXPECT_GE(server.stats(0).accepted, before + 90);
+}
+
+TEST(Net, GarbageCommandsAreRejectedAndCounted) {
+  const uint32_t domain = 106;
+  world::World w(teams(2));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.command_timeout = 2.0;
+  net::SimServer server(w, cfg);
+  AgentProcess garbage(domain, 0, 1, {"--mode", "garbage"});
+  AgentProcess good(domain, 1, 1);
+  ASSERT_TRUE(server.waitForOwners(2, 20.0));
+  for (int i = 0; i < 150; ++i) server.runPeriod();
+  const auto& g = server.stats(0);
+  std::printf(
+      "garbage agent: accepted %llu, rejected %llu; good agent: accepted %llu rejected %llu\n",
+      (unsigned long long)g.accepted, (unsigned long long)g.rejected,
+      (unsigned long long)server.stats(1).accepted, (unsigned long long)server.stats(1).rejected);
+  EXPECT_GE(g.rejected, 140u);  // one bad command per tick, of every kind in turn
+  EXPECT_GE(g.accepted, 145u);  // its valid commands still count
+  EXPECT_EQ(server.stats(1).rejected, 0u);
+  EXPECT_GE(server.stats(1).accepted, 145u);
+  EXPECT_TRUE(w.isStanding(0));
+  EXPECT_TRUE(w.isStanding(1));
+  for (int j = 0; j < static_cast<int>(w.robot(0).model->body->joints.size()); ++j)
+    EXPECT_TRUE(std::isfinite(w.jointPosition(0, j)));
+}
+
+TEST(Net, LockstepTimeoutBoundsAStalledAgent) {
+  const uint32_t domain = 107;
+  world::World w(teams(1));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.command_timeout = 0.05;
+  net::SimServer server(w, cfg);
+  AgentProcess stall(domain, 0, 1, {"--mode", "stall", "--stall-after", "20"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const auto t0 = Clock::now();
+  for (int i = 0; i < 80; ++i) server.runPeriod();
+  const double elapsed = seconds(t0);
+  std::printf("80 periods in %.2f s; missed %llu\n", elapsed,
+              (unsigned long long)server.stats(0).missed);
+  EXPECT_GE(server.stats(0).missed, 55u);
+  EXPECT_LT(elapsed, 60 * 0.05 * 1.5 + 2.0);  // each miss costs the timeout, no more
+  EXPECT_TRUE(w.isStanding(0));               // it keeps its last command
+}
+
+TEST(Net, TeamMessagesReachTeammatesOnly) {
+  const uint32_t domain = 108;
+  world::World w(teams(3));  // team 0: numbers 1, 2; team 1: number 1
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.lockstep = false;
+  cfg.team_message_delay = 0.05;
+  net::SimServer server(w, cfg);
+  agents::AgentClient a(dds(domain), 0, 1), b(dds(domain), 0, 2), c(dds(domain), 1, 1);
+  bool ok_a = false, ok_b = false, ok_c = false;
+  std::thread ta([&] { ok_a = a.claim(10.0); }), tb([&] { ok_b = b.claim(10.0); }),
+      tc([&] { ok_c = c.claim(10.0); });
+  server.waitForOwners(3, 15.0);
+  ta.join();
+  tb.join();
+  tc.join();
+  ASSERT_TRUE(ok_a && ok_b && ok_c);
+  const std::vector<uint8_t> hello = {'h', 'i', 0, 255};
+  a.sendTeamMessage(hello);
+  server.poll(0.2);
+  std::vector<agents::TeamMessageIn> got_b, got_c;
+  for (int i = 0; i < 40; ++i) {
+    server.runPeriod();
+    dds_sleepfor(DDS_MSECS(2));
+    for (auto& m : b.receiveTeamMessages()) got_b.push_back(m);
+    for (auto& m : c.receiveTeamMessages()) got_c.push_back(m);
+  }
+  ASSERT_EQ(got_b.size(), 1u);
+  EXPECT_EQ(got_b[0].from_player, 1);
+  EXPECT_EQ(got_b[0].data, hello);
+  EXPECT_TRUE(got_c.empty());  // the other team hears nothing
+}
