@@ -51,7 +51,31 @@ AgentClient::AgentClient(const net::DomainConfig& dds, int team, int player)
     throw std::invalid_argument("team must be 0 or 1 and player 1..255");
 }
 
-AgentClient::~AgentClient() = default;
+AgentClient::~AgentClient() {
+  if (handler_) dds_set_listener(impl_->frames.get(), nullptr);
+}
+
+void AgentClient::onFrameData(dds_entity_t, void* self) {
+  auto* client = static_cast<AgentClient*>(self);
+  client->impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t&) {
+    if (f.team == client->team_ && f.player == client->player_ && client->handler_)
+      client->handler_(f);
+  });
+}
+
+void AgentClient::onFrame(FrameHandler handler) {
+  if (!handler) {
+    dds_set_listener(impl_->frames.get(), nullptr);
+    handler_ = nullptr;
+    return;
+  }
+  handler_ = std::move(handler);
+  dds_listener_t* l = dds_create_listener(this);
+  dds_lset_data_available_arg(l, &AgentClient::onFrameData, this, true);
+  net::check(dds_set_listener(impl_->frames.get(), l), "set frame listener");
+  dds_delete_listener(l);
+  onFrameData(impl_->frames.get(), this);  // frames that came before the listener
+}
 
 void AgentClient::readStatus() {
   impl_->status.take([&](const simsoccer_msg_RobotStatus& s, const dds_sample_info_t&) {

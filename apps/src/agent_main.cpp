@@ -1,11 +1,14 @@
 // simsoccer-agent: a minimal agent. It claims a robot, then answers every
 // SensorFrame with the stand pose and a nodding head, to prove the loop.
 // Test modes send malformed commands or stop answering.
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli.hpp"
@@ -67,14 +70,21 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
       return 3;
     }
-    simsoccer_msg_SensorFrame frame{};
-    long answered = 0, garbage = 0;
-    for (;;) {
-      if (!client.receive(frame, 5.0)) {
-        std::fprintf(stderr, "simsoccer-agent: no frame for 5 s, the simulator is gone\n");
-        return 4;
-      }
-      if (mode == "stall" && answered >= stall_after) continue;
+    // Answers run in the DDS receive thread (AgentClient::onFrame): no
+    // thread hop between a frame arriving and its command leaving.
+    std::atomic<long> answered{0};
+    std::atomic<int64_t> last_frame_ns{0};
+    long garbage = 0;
+    auto now_ns = [] {
+      return std::chrono::duration_cast<std::chrono::nanoseconds>(
+                 std::chrono::steady_clock::now().time_since_epoch())
+          .count();
+    };
+    last_frame_ns = now_ns();
+    client.onFrame([&](const simsoccer_msg_SensorFrame& frame) {
+      last_frame_ns = now_ns();
+      if (mode == "stall" && answered >= stall_after) return;
+      if (max_ticks >= 0 && answered >= max_ticks) return;
       if (head_pitch >= 0)
         position[static_cast<size_t>(head_pitch)] =
             static_cast<float>(0.2 * std::sin(2.0 * std::numbers::pi * 0.5 * frame.sim_time));
@@ -110,7 +120,18 @@ int main(int argc, char** argv) {
       }
       client.send(frame.tick, position, stiffness);
       ++answered;
-      if (max_ticks >= 0 && answered >= max_ticks) return 0;
+    });
+    for (;;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (max_ticks >= 0 && answered >= max_ticks) {
+        client.onFrame(nullptr);
+        return 0;
+      }
+      if (now_ns() - last_frame_ns > 5'000'000'000LL) {
+        client.onFrame(nullptr);
+        std::fprintf(stderr, "simsoccer-agent: no frame for 5 s, the simulator is gone\n");
+        return 4;
+      }
     }
   } catch (const apps::UsageError& e) {
     std::fprintf(stderr, "simsoccer-agent: %s\n", e.what());

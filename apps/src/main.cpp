@@ -18,6 +18,8 @@ const char* kUsage =
     "  check SCENARIO  load and validate a scenario file, print what it contains\n"
     "  bench physics   physics scaling benchmark (steps/s against robot count)\n"
     "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
+    "  bench net       lockstep with real agent processes over DDS: overhead and bytes per tick\n"
+    "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
 
@@ -32,12 +34,14 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd == "check") return check(argc, argv, 2);
+    if (cmd == "serve") return serve(argc, argv, 2);
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);
       if (sub == "sensors") return benchSensors(argc, argv, 3);
+      if (sub == "net") return benchNet(argc, argv, 3);
       std::fprintf(stderr,
-                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors)\n",
+                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net)\n",
                    sub.c_str());
       return 2;
     }

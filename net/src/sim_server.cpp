@@ -66,7 +66,6 @@ struct SimServer::Impl {
   Reader<simsoccer_msg_JoinRequest> joins;
   Reader<simsoccer_msg_TeamMessage> team_send;
   Entity waitset;
-  Entity command_condition;
   Entity join_condition;
   // Publication handle -> participant GUID of writers seen on the command
   // and team-message readers (cached: looked up once per writer).
@@ -99,11 +98,8 @@ struct SimServer::Impl {
                   {true, 16, false, ""}),
         loss_rng(seed) {
     waitset = Entity(check(dds_create_waitset(participant.get()), "create waitset"));
-    command_condition =
-        Entity(check(dds_create_readcondition(commands.get(), DDS_ANY_STATE), "read condition"));
     join_condition =
         Entity(check(dds_create_readcondition(joins.get(), DDS_ANY_STATE), "read condition"));
-    check(dds_waitset_attach(waitset.get(), command_condition.get(), 0), "attach");
     check(dds_waitset_attach(waitset.get(), join_condition.get(), 1), "attach");
   }
 
@@ -139,9 +135,36 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
   impl_->game_state.kicking_team = 255;
   impl_->game_state.first_half = 1;
   setGameState(impl_->game_state);
+  // Commands are taken as they arrive, in the DDS receive thread: the main
+  // thread wakes once, when the last owned robot has answered.
+  dds_listener_t* l = dds_create_listener(this);
+  dds_lset_data_available_arg(l, &SimServer::onCommands, this, true);
+  check(dds_set_listener(impl_->commands.get(), l), "set command listener");
+  dds_delete_listener(l);
 }
 
-SimServer::~SimServer() = default;
+void SimServer::onCommands(dds_entity_t, void* self) {
+  auto* server = static_cast<SimServer*>(self);
+  std::lock_guard lock(server->mutex_);
+  server->handleCommands();
+  if (server->expected_tick_ != UINT64_MAX && server->allOwnedAnswered())
+    server->answered_.notify_one();
+}
+
+bool SimServer::allOwnedAnswered() const {
+  for (const RobotSlot& s : robots_)
+    if (s.stats.owned && !s.has_command) return false;
+  return true;
+}
+
+RobotNetStats SimServer::stats(world::RobotId r) const {
+  std::lock_guard lock(mutex_);
+  return robots_.at(r).stats;
+}
+
+SimServer::~SimServer() {
+  dds_set_listener(impl_->commands.get(), nullptr);
+}
 
 int SimServer::robotIndex(int team, int player) const {
   for (size_t i = 0; i < robots_.size(); ++i)
@@ -150,6 +173,7 @@ int SimServer::robotIndex(int team, int player) const {
 }
 
 size_t SimServer::ownedCount() const {
+  std::lock_guard lock(mutex_);
   size_t n = 0;
   for (const RobotSlot& s : robots_) n += s.stats.owned;
   return n;
@@ -242,7 +266,10 @@ bool SimServer::validCommand(const world::RobotInfo& info,
   return true;
 }
 
-void SimServer::handleCommands(bool lockstep, uint64_t tick) {
+void SimServer::handleCommands() {
+  const bool lockstep = config_.lockstep;
+  // Lockstep: the tick just published; real time: the newest published.
+  const uint64_t tick = lockstep ? expected_tick_ : published_tick_;
   impl_->commands.take([&](const simsoccer_msg_JointCommand& c, const dds_sample_info_t& info) {
     const int ri = robotIndex(c.team, c.player);
     if (ri < 0) return;
@@ -313,9 +340,12 @@ void SimServer::poll(double wait_seconds) {
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(wait_seconds));
   do {
-    handleJoins();
-    checkOwners();
-    handleCommands(false, 0);  // commands before any frame: refused or rejected
+    {
+      std::lock_guard lock(mutex_);
+      handleJoins();
+      checkOwners();
+      handleCommands();  // commands before any frame: refused or rejected
+    }
     const auto left = std::max(0.0, seconds(Clock::now(), end));
     dds_waitset_wait(impl_->waitset.get(), nullptr, 0, static_cast<dds_duration_t>(left * 1e9));
   } while (Clock::now() < end);
@@ -331,8 +361,14 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
 void SimServer::runPeriod() {
   const auto t0 = Clock::now();
   const uint64_t tick = world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
-  handleJoins();
-  checkOwners();
+  {
+    std::lock_guard lock(mutex_);
+    handleJoins();
+    checkOwners();
+    for (RobotSlot& s : robots_) s.has_command = false;
+    if (config_.lockstep) expected_tick_ = tick;  // from now on commands for `tick` count
+    published_tick_ = tick;
+  }
 
   // Frames for this tick (the state the commands will answer).
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
@@ -375,33 +411,33 @@ void SimServer::runPeriod() {
   const auto t1 = Clock::now();
 
   // Commands.
-  for (RobotSlot& s : robots_) s.has_command = false;
-  if (config_.lockstep) {
-    const auto deadline = t1 + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(config_.command_timeout));
-    for (;;) {
-      handleCommands(true, tick);
-      bool all = true;
-      for (const RobotSlot& s : robots_) all = all && (!s.stats.owned || s.has_command);
-      const auto now = Clock::now();
-      if (all || now >= deadline) break;
-      dds_waitset_wait(impl_->waitset.get(), nullptr, 0,
-                       static_cast<dds_duration_t>(seconds(now, deadline) * 1e9));
-      handleJoins();
+  {
+    std::unique_lock lock(mutex_);
+    if (config_.lockstep) {
+      const auto deadline = t1 + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(config_.command_timeout));
+      handleCommands();  // anything the listener has not taken yet
+      answered_.wait_until(lock, deadline, [&] { return allOwnedAnswered(); });
+      expected_tick_ = UINT64_MAX;  // late answers are stale from here on
+      for (RobotSlot& s : robots_)
+        if (s.stats.owned && !s.has_command) ++s.stats.missed;  // keeps its last command
+    } else {
+      handleCommands();
     }
-    for (RobotSlot& s : robots_)
-      if (s.stats.owned && !s.has_command) ++s.stats.missed;  // keeps its last command
-  } else {
-    handleCommands(false, tick);
+    relayTeamMessages(tick);
   }
-  relayTeamMessages(tick);
+
   const auto t2 = Clock::now();
 
-  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-    RobotSlot& s = robots_[r];
-    if (!s.has_command) continue;
-    world_.setCommand(r, s.position, s.stiffness);
-    ++s.stats.accepted;
+  {
+    std::lock_guard lock(mutex_);
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+      RobotSlot& s = robots_[r];
+      if (!s.has_command) continue;
+      world_.setCommand(r, s.position, s.stiffness);
+      ++s.stats.accepted;
+      if (!config_.lockstep) s.has_command = false;  // applied once
+    }
   }
   world_.stepControlPeriod();
   const auto t3 = Clock::now();
@@ -411,8 +447,10 @@ void SimServer::runPeriod() {
   ++times_.periods;
   // Status at 1 Hz of simulated time (and at every ownership change).
   if (tick % static_cast<uint64_t>(std::lround(1.0 / world_.scenario().physics.control_period)) ==
-      0)
+      0) {
+    std::lock_guard lock(mutex_);
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) publishStatus(r);
+  }
 }
 
 }  // namespace simsoccer::net

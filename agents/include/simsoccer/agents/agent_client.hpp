@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -38,6 +39,12 @@ class AgentClient {
 
   // Waits for this robot's next SensorFrame; false on timeout.
   bool receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds);
+  // Alternative to receive(): `handler` is called for every new frame of
+  // this robot right in the DDS receive thread (no thread hop: the fastest
+  // lockstep round trip). It answers with send(); the caller's thread must
+  // not call send() or receive() meanwhile. Pass an empty handler to stop.
+  using FrameHandler = std::function<void(const simsoccer_msg_SensorFrame&)>;
+  void onFrame(FrameHandler handler);
   // Answers the frame of `tick`: 25 positions (rad) and stiffnesses, actuator order.
   void send(uint64_t tick, std::span<const float> position, std::span<const float> stiffness);
   // Raw command, for tests that send malformed ones (wrong sizes, NaN, ...).
@@ -56,7 +63,9 @@ class AgentClient {
   std::unique_ptr<Impl> impl_;
   simsoccer_msg_RobotStatus status_{};
   uint32_t serial_ = 0;
+  FrameHandler handler_;
   void readStatus();
+  static void onFrameData(dds_entity_t reader, void* self);
 };
 
 }  // namespace simsoccer::agents

@@ -15,8 +15,10 @@
 #pragma once
 
 #include <array>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
@@ -64,7 +66,7 @@ class SimServer {
   bool waitForOwners(size_t count, double timeout_seconds);
 
   size_t ownedCount() const;
-  const RobotNetStats& stats(world::RobotId r) const { return robots_.at(r).stats; }
+  RobotNetStats stats(world::RobotId r) const;
   const ServerTimes& times() const { return times_; }
   // The GameState published at every change and every 0.5 s (2 Hz).
   void setGameState(const simsoccer_msg_GameState& state);
@@ -82,7 +84,11 @@ class SimServer {
   };
 
   void handleJoins();
-  void handleCommands(bool lockstep, uint64_t tick);
+  // Takes and checks the waiting commands; called from the DDS listener
+  // (the receive thread) and from poll(), always with mutex_ held.
+  void handleCommands();
+  bool allOwnedAnswered() const;
+  static void onCommands(dds_entity_t reader, void* self);
   void checkOwners();
   void relayTeamMessages(uint64_t tick);
   void publishStatus(world::RobotId r);
@@ -92,6 +98,11 @@ class SimServer {
 
   world::World& world_;
   ServerConfig config_;
+  // Guards robots_ between the main thread and the command listener.
+  mutable std::mutex mutex_;
+  std::condition_variable answered_;
+  uint64_t expected_tick_ = UINT64_MAX;  // lockstep: the tick commands must answer
+  uint64_t published_tick_ = 0;          // the newest tick whose frames went out
   std::unique_ptr<Impl> impl_;
   std::vector<RobotSlot> robots_;
   ServerTimes times_;

@@ -1,0 +1,122 @@
+// simsoccer bench net: the lockstep loop with N real agent processes over
+// loopback DDS, against the same world stepped without the network.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_scene.hpp"
+#include "cli.hpp"
+#include "process.hpp"
+#include "simsoccer/net/sim_server.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer bench net [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
+    "                           [--domain D] [--dds-config FILE] [--csv FILE]\n"
+    "\n"
+    "Per N: starts N simsoccer-agent processes (stand and nod), runs the lockstep loop for S\n"
+    "simulated seconds (default 10) over loopback DDS, then the same world for S seconds\n"
+    "without the network. Prints the messaging overhead per control period (total minus the\n"
+    "world's stepping), the bytes per tick on the loopback interface, commands missed, and the\n"
+    "real-time factor with and without the network.\n";
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+int benchNet(int argc, char** argv, int first) {
+  const Options opt(argc, argv, first, {"help"},
+                    {"config", "robots", "seconds", "domain", "dds-config", "csv"});
+  if (opt.help(kHelp)) return 0;
+  opt.noPositional();
+  const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
+  BenchConfig cfg = loadBenchConfig(config_file);
+  const std::vector<int> counts = opt.intList("robots", cfg.robots);
+  const double sim_seconds = opt.number("seconds", 10.0);
+  if (!(sim_seconds > 0)) throw UsageError("--seconds must be > 0");
+  net::DomainConfig dds;
+  dds.domain = static_cast<uint32_t>(opt.number("domain", 42));
+  dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
+  const std::string csv = opt.get("csv", "");
+  const auto agent = agentProgram();
+  const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
+  std::printf("simsoccer bench net: %s, DDS domain %u (%s), %.1f s simulated per row, lockstep\n",
+              config_file.string().c_str(), dds.domain, dds.config_file.string().c_str(),
+              sim_seconds);
+  std::fflush(stdout);
+
+  Table table;
+  table.header = {
+      "robots",       "overhead_ms_per_period", "publish_ms", "wait_ms",      "world_ms_per_period",
+      "overhead_pct", "bytes_per_tick",         "missed",     "rtf_with_net", "rtf_without_net"};
+  for (const int n : counts) {
+    world::Scenario s = placeRobots(cfg, n, field.halfLength(), field.halfWidth());
+    s.sensors.enabled = true;
+    const double period = s.physics.control_period;
+    const auto periods = static_cast<long>(sim_seconds / period);
+
+    // With the network.
+    world::World w(s);
+    net::ServerConfig server_cfg;
+    server_cfg.dds = dds;
+    server_cfg.command_timeout = 1.0;
+    net::SimServer server(w, server_cfg);
+    std::vector<std::unique_ptr<ChildProcess>> agents;
+    for (world::RobotId r = 0; r < w.robotCount(); ++r)
+      agents.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
+          agent.string(), "--team", std::to_string(w.robot(r).team), "--player",
+          std::to_string(w.robot(r).number), "--domain", std::to_string(dds.domain), "--dds-config",
+          dds.config_file.string()}));
+    if (!server.waitForOwners(w.robotCount(), 60.0))
+      throw std::runtime_error("only " + std::to_string(server.ownedCount()) + " of " +
+                               std::to_string(w.robotCount()) + " agents claimed their robots");
+    for (int i = 0; i < 50; ++i) server.runPeriod();  // warm-up
+    const net::ServerTimes before = server.times();
+    const long long bytes0 = loopbackBytes();
+    const auto t0 = Clock::now();
+    for (long i = 0; i < periods; ++i) server.runPeriod();
+    const double wall_net = std::chrono::duration<double>(Clock::now() - t0).count();
+    const long long bytes = loopbackBytes() - bytes0;
+    const auto& after = server.times();
+    const double world_s = after.physics_s - before.physics_s;
+    uint64_t missed = 0;
+    for (world::RobotId r = 0; r < w.robotCount(); ++r) missed += server.stats(r).missed;
+    agents.clear();
+
+    // The same world without the network.
+    world::World alone(s);
+    const auto t1 = Clock::now();
+    for (long i = 0; i < periods + 50; ++i) alone.stepControlPeriod();
+    const double wall_alone =
+        std::chrono::duration<double>(Clock::now() - t1).count() * periods / (periods + 50);
+
+    const double overhead_ms = 1e3 * (wall_net - world_s) / periods;
+    const double world_ms = 1e3 * wall_alone / periods;
+    const double publish_ms = 1e3 * (after.publish_s - before.publish_s) / periods;
+    const double wait_ms = 1e3 * (after.wait_s - before.wait_s) / periods;
+    table.rows.push_back({std::to_string(n), fmt(overhead_ms, 3), fmt(publish_ms, 3),
+                          fmt(wait_ms, 3), fmt(world_ms, 3), fmt(100.0 * overhead_ms / world_ms, 1),
+                          bytes >= 0 ? std::to_string(bytes / periods) : "n/a",
+                          std::to_string(missed), fmt(sim_seconds / wall_net, 2),
+                          fmt(sim_seconds / wall_alone, 2)});
+    std::fprintf(stderr, "  %d robots done\n", n);
+  }
+  std::printf("\n");
+  table.print(stdout);
+  std::printf(
+      "\noverhead = wall time per period minus the world's stepping (publishing frames, "
+      "waiting for and taking commands); world = the same world stepped alone (physics and "
+      "sensors); bytes = loopback interface traffic per tick (all processes, RTPS headers "
+      "and acknowledgements included).\n");
+  if (!csv.empty()) {
+    table.writeCsv(csv);
+    std::printf("wrote %s\n", csv.c_str());
+  }
+  return 0;
+}
+
+}  // namespace simsoccer::apps

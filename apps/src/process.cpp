@@ -1,0 +1,63 @@
+#include "process.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+extern char** environ;
+
+namespace simsoccer::apps {
+
+ChildProcess::ChildProcess(std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+}
+
+ChildProcess::~ChildProcess() {
+  stop();
+}
+
+void ChildProcess::stop() {
+  if (pid_ <= 0) return;
+  ::kill(pid_, SIGTERM);
+  for (int i = 0; i < 50; ++i) {
+    if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
+      pid_ = -1;
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid_, SIGKILL);
+  waitpid(pid_, nullptr, 0);
+  pid_ = -1;
+}
+
+std::filesystem::path agentProgram() {
+  return std::filesystem::read_symlink("/proc/self/exe").parent_path() / "simsoccer-agent";
+}
+
+long long loopbackBytes() {
+  std::ifstream f("/proc/net/dev");
+  std::string line;
+  while (std::getline(f, line)) {
+    const auto colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    std::string name = line.substr(0, colon);
+    name.erase(0, name.find_first_not_of(' '));
+    if (name != "lo") continue;
+    std::istringstream in(line.substr(colon + 1));
+    long long rx_bytes = 0, v = 0, tx_bytes = 0;
+    in >> rx_bytes;
+    for (int i = 0; i < 7; ++i) in >> v;  // rx packets .. rx multicast
+    in >> tx_bytes;
+    return tx_bytes;
+  }
+  return -1;
+}
+
+}  // namespace simsoccer::apps

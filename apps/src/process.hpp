@@ -1,0 +1,35 @@
+// Child processes for the programs that launch agents.
+#pragma once
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace simsoccer::apps {
+
+// A child process, killed (SIGTERM, then SIGKILL) when this goes.
+class ChildProcess {
+ public:
+  explicit ChildProcess(std::vector<std::string> args);
+  ~ChildProcess();
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+  bool started() const { return pid_ > 0; }
+  void stop();
+
+ private:
+  pid_t pid_ = -1;
+};
+
+// The simsoccer-agent program beside the running executable.
+std::filesystem::path agentProgram();
+
+// Bytes sent on the loopback interface so far (/proc/net/dev), or -1.
+long long loopbackBytes();
+
+}  // namespace simsoccer::apps
