@@ -7,6 +7,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <string>
 #include <thread>
@@ -273,4 +276,54 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   EXPECT_EQ(got_b[0].from_player, 1);
   EXPECT_EQ(got_b[0].data, hello);
   EXPECT_TRUE(got_c.empty());  // the other team hears nothing
+}
+
+namespace {
+
+std::string runCommand(const std::string& cmd, int& status) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) out += buf;
+  status = pclose(p);
+  return out;
+}
+
+}  // namespace
+
+TEST(NetApps, BenchNetWritesItsTable) {
+  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_net_test.csv";
+  std::filesystem::remove(csv);
+  int status = -1;
+  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
+                                         " bench net --robots 1,2 --seconds 1 --domain 109 --csv " +
+                                         csv.string(),
+                                     status);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  std::ifstream f(csv);
+  std::string header, row1, row2;
+  std::getline(f, header);
+  std::getline(f, row1);
+  std::getline(f, row2);
+  EXPECT_EQ(header.rfind("robots,overhead_ms_per_period", 0), 0u) << header;
+  EXPECT_NE(header.find("bytes_per_tick"), std::string::npos);
+  EXPECT_EQ(row1.rfind("1,", 0), 0u);
+  EXPECT_EQ(row2.rfind("2,", 0), 0u);
+  std::filesystem::remove(csv);
+}
+
+TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {
+  const uint32_t domain = 110;
+  AgentProcess agent(domain, 0, 1);
+  int status = -1;
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " serve " + SIMSOCCER_SOURCE_DIR +
+                     "/configs/scenarios/lineup_5v5.yaml --agents 1 --seconds 1 --domain " +
+                     std::to_string(domain),
+                 status);
+  std::printf("%s", out.c_str());
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("team 0 player 1: owned, accepted 100"), std::string::npos) << out;
 }
