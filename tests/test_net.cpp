@@ -7,10 +7,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
 #include <string>
 #include <thread>
 #include <vector>
@@ -296,10 +296,10 @@ TEST(NetApps, BenchNetWritesItsTable) {
   const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_net_test.csv";
   std::filesystem::remove(csv);
   int status = -1;
-  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
-                                         " bench net --robots 1,2 --seconds 1 --domain 109 --csv " +
-                                         csv.string(),
-                                     status);
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) +
+                     " bench net --robots 1,2 --seconds 1 --domain 109 --csv " + csv.string(),
+                 status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
   std::ifstream f(csv);

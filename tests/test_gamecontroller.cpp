@@ -1,0 +1,199 @@
+// The GameController wire format, byte by byte, and over real UDP sockets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "simsoccer/referee/gamecontroller.hpp"
+
+using namespace simsoccer::referee;
+
+namespace {
+
+ControlData knownState() {
+  ControlData d;
+  d.packet_number = 42;
+  d.players_per_team = 5;
+  d.competition_phase = 1;
+  d.competition_type = 0;
+  d.game_phase = static_cast<uint8_t>(gc::GamePhase::Normal);
+  d.state = static_cast<uint8_t>(gc::State::Playing);
+  d.set_play = static_cast<uint8_t>(gc::SetPlay::CornerKick);
+  d.first_half = 1;
+  d.kicking_team = 13;
+  d.secs_remaining = 600;  // 0x0258
+  d.secondary_time = -3;   // 0xfffd
+  d.teams[0].team_number = 13;
+  d.teams[0].field_player_colour = 0;  // blue
+  d.teams[0].goalkeeper_colour = 2;
+  d.teams[0].goalkeeper = 1;
+  d.teams[0].score = 2;
+  d.teams[0].single_shots = 0x0105;
+  d.teams[0].message_budget = 1200;  // 0x04b0
+  d.teams[0].players[2] = {static_cast<uint8_t>(gc::Penalty::PlayerPushing), 45};
+  d.teams[1].team_number = 5;
+  d.teams[1].field_player_colour = 1;  // red
+  d.teams[1].score = 1;
+  d.teams[1].message_budget = 0x0102;
+  d.teams[1].players[19] = {static_cast<uint8_t>(gc::Penalty::Substitute), 0};
+  return d;
+}
+
+}  // namespace
+
+TEST(GameControllerPacket, KnownStateAtTheReferenceOffsets) {
+  const auto b = encode(knownState());
+  ASSERT_EQ(b.size(), 118u);
+  EXPECT_EQ(b[0], 'R');
+  EXPECT_EQ(b[1], 'G');
+  EXPECT_EQ(b[2], 'm');
+  EXPECT_EQ(b[3], 'e');
+  EXPECT_EQ(b[4], 18);     // version
+  EXPECT_EQ(b[5], 42);     // packetNumber
+  EXPECT_EQ(b[6], 5);      // playersPerTeam
+  EXPECT_EQ(b[7], 1);      // competitionPhase
+  EXPECT_EQ(b[9], 0);      // gamePhase
+  EXPECT_EQ(b[10], 3);     // state PLAYING
+  EXPECT_EQ(b[11], 3);     // setPlay CORNER_KICK
+  EXPECT_EQ(b[12], 1);     // firstHalf
+  EXPECT_EQ(b[13], 13);    // kickingTeam: a team number
+  EXPECT_EQ(b[14], 0x58);  // secsRemaining 600, little-endian
+  EXPECT_EQ(b[15], 0x02);
+  EXPECT_EQ(b[16], 0xfd);  // secondaryTime -3
+  EXPECT_EQ(b[17], 0xff);
+  EXPECT_EQ(b[18], 13);    // teams[0].teamNumber
+  EXPECT_EQ(b[20], 2);     // goalkeeperColour
+  EXPECT_EQ(b[22], 2);     // teams[0].score (offset 22)
+  EXPECT_EQ(b[24], 0x05);  // singleShots
+  EXPECT_EQ(b[25], 0x01);
+  EXPECT_EQ(b[26], 0xb0);  // messageBudget 1200 at 26-27
+  EXPECT_EQ(b[27], 0x04);
+  EXPECT_EQ(b[28 + 2 * 2], 2);       // player 3 penalty PLAYER_PUSHING
+  EXPECT_EQ(b[28 + 2 * 2 + 1], 45);  // secsTillUnpenalised
+  EXPECT_EQ(b[68], 5);               // teams[1].teamNumber
+  EXPECT_EQ(b[69], 1);               // red
+  EXPECT_EQ(b[72], 1);               // teams[1].score (offset 72)
+  EXPECT_EQ(b[76], 0x02);            // teams[1].messageBudget at 76-77
+  EXPECT_EQ(b[77], 0x01);
+  EXPECT_EQ(b[78 + 2 * 19], 14);  // player 20: SUBSTITUTE
+}
+
+TEST(GameControllerPacket, DecodeOfEncodeIsTheIdentity) {
+  std::mt19937 rng(7);
+  auto byte = [&](int hi) {
+    return static_cast<uint8_t>(std::uniform_int_distribution<int>(0, hi)(rng));
+  };
+  for (int i = 0; i < 500; ++i) {
+    ControlData d;
+    d.true_data = rng() % 2;
+    d.packet_number = byte(255);
+    d.players_per_team = byte(20);
+    d.competition_phase = byte(1);
+    d.competition_type = byte(1);
+    d.game_phase = byte(3);
+    d.state = byte(5);
+    d.set_play = byte(5);
+    d.first_half = byte(1);
+    d.kicking_team = byte(255);
+    d.secs_remaining = static_cast<int16_t>(rng());
+    d.secondary_time = static_cast<int16_t>(rng());
+    for (TeamInfo& t : d.teams) {
+      t.team_number = byte(255);
+      t.field_player_colour = byte(9);
+      t.goalkeeper_colour = byte(9);
+      t.goalkeeper = byte(20);
+      t.score = byte(255);
+      t.penalty_shot = byte(255);
+      t.single_shots = static_cast<uint16_t>(rng());
+      t.message_budget = static_cast<uint16_t>(rng());
+      for (RobotInfo& r : t.players) r = {byte(15), byte(255)};
+    }
+    const auto bytes = encode(d);
+    ASSERT_EQ(decodeControl(bytes), d) << "state " << i;
+  }
+}
+
+TEST(GameControllerPacket, CorruptedPacketsAreRejected) {
+  auto b = encode(knownState());
+  auto expectError = [](std::span<const uint8_t> bytes, const char* what) {
+    try {
+      decodeControl(bytes);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const PacketError& e) {
+      EXPECT_NE(std::string(e.what()).find("control packet"), std::string::npos) << e.what();
+    }
+  };
+  expectError(std::span<const uint8_t>(b.data(), 117), "short");
+  std::vector<uint8_t> longer(b.begin(), b.end());
+  longer.push_back(0);
+  expectError(longer, "long");
+  auto bad = b;
+  bad[2] = 'x';
+  expectError(bad, "header");
+  bad = b;
+  bad[4] = 17;
+  expectError(bad, "version");
+  bad = b;
+  bad[10] = 9;
+  expectError(bad, "state");
+}
+
+TEST(GameControllerPacket, ReturnPacketRoundTripAndGc3Checks) {
+  ReturnData r;
+  r.player_num = 3;
+  r.team_num = 13;
+  r.fallen = 0;
+  r.pose = {1500.0f, -250.5f, 0.75f};
+  r.ball_age = 1.25f;
+  r.ball = {320.0f, -40.0f};
+  const auto b = encode(r);
+  ASSERT_EQ(b.size(), 32u);
+  EXPECT_EQ(std::string(b.begin(), b.begin() + 4), "RGrt");
+  EXPECT_EQ(b[4], 4);
+  EXPECT_EQ(b[5], 3);
+  EXPECT_EQ(b[6], 13);
+  float x;
+  std::memcpy(&x, &b[8], 4);  // little-endian float at offset 8 (x86 is little-endian)
+  EXPECT_EQ(x, 1500.0f);
+  EXPECT_EQ(decodeReturn(b), r);
+  auto bad = b;
+  bad[5] = 21;
+  EXPECT_THROW(decodeReturn(bad), PacketError);  // playerNum 1..20
+  bad = b;
+  bad[7] = 255;
+  EXPECT_THROW(decodeReturn(bad), PacketError);  // fallen 0/1 (the C++ constructor's 255)
+  r.ball_age = std::nanf("");
+  EXPECT_THROW(decodeReturn(encode(r)), PacketError);  // NaN
+  EXPECT_THROW(decodeReturn(std::span<const uint8_t>(b.data(), 31)), PacketError);
+}
+
+TEST(GameControllerUdp, BroadcastToLoopbackIsReceivedAndDecoded) {
+  UdpReceiver receiver(0, "127.0.0.1");  // an ephemeral port: tests run side by side
+  UdpSender sender("127.0.0.1", receiver.port());
+  ControlData d = knownState();
+  for (uint8_t n = 0; n < 3; ++n) {
+    d.packet_number = n;
+    sender.send(encode(d));
+  }
+  // A malformed datagram in between: counted and dropped by a listener.
+  const std::array<uint8_t, 5> junk = {'R', 'G', 'm', 'e', 18};
+  sender.send(junk);
+  std::array<uint8_t, 512> buf{};
+  int good = 0, bad = 0;
+  for (int i = 0; i < 4; ++i) {
+    const size_t n = receiver.receive(buf, 1.0);
+    ASSERT_GT(n, 0u);
+    try {
+      const ControlData got = decodeControl(std::span<const uint8_t>(buf.data(), n));
+      EXPECT_EQ(got.teams[0].message_budget, 1200);
+      ++good;
+    } catch (const PacketError&) {
+      ++bad;
+    }
+  }
+  EXPECT_EQ(good, 3);
+  EXPECT_EQ(bad, 1);
+}
