@@ -1,0 +1,146 @@
+// The game as the SPL GameController runs it: states, halves, set plays,
+// timers, scores and per-robot penalties, on simulated time, with every
+// decision kept as an event. Rule parameters come from a rule book
+// (configs/rules/*.yaml). This is the state machine; automatic refereeing
+// from the world (goals, ball out, fouls) drives it through the commands.
+//
+// Teams are addressed by index: team 0 defends the -x goal in the first
+// half (the goal on the GameController operator's left), team 1 the +x goal;
+// they swap at half-time.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "simsoccer/referee/gamecontroller.hpp"
+
+namespace simsoccer::referee {
+
+struct RuleBook {
+  std::string name;
+  std::string source_file;
+  int players_per_team = 5;
+  int halves = 2;
+  double half_duration = 600, half_time_break = 600, half_time_to_initial = 300;
+  bool clock_in_ready_and_set = true;
+  double ready_duration = 45, ready_penalty_kick_duration = 30;
+  double kick_off_ball_free = 10, set_play_duration = 30, penalty_kick_duration = 30;
+  int mercy_goal_difference = 10;
+  double game_stuck_duration = 30;
+  int goal_area_max_robots = 3;
+  double penalty_base = 45, penalty_increment = 10;
+  double illegal_position_in_set = 15, motion_in_set = 15;
+  bool shootout = true;
+  int shootout_kicks = 3;
+  double shootout_shot_duration = 30;
+  bool sudden_death = true;
+};
+
+// Reads and checks a rule book; throws engine::ConfigError (file, key, reason).
+RuleBook loadRuleBook(const std::filesystem::path& file);
+
+struct TeamSetup {
+  uint8_t number = 0;  // GameController team number
+  uint8_t field_player_colour = 0;
+  uint8_t goalkeeper_colour = 0;
+  uint8_t goalkeeper = 1;  // player number
+};
+
+struct RefereeEvent {
+  double time = 0.0;  // s of simulated time
+  std::string type;   // "state", "goal", "set_play", "penalty", "unpenalise", "half", ...
+  int team = -1;      // team index, -1 none
+  int player = 0;     // player number, 0 none
+  std::string detail;
+};
+
+enum class Half { First, Second, PenaltyShootout };
+
+class Game {
+ public:
+  // `kick_off_team`: the team index that kicks off the first half.
+  Game(const RuleBook& rules, const std::array<TeamSetup, 2>& teams, int kick_off_team);
+
+  // --- time (simulated) -------------------------------------------------------------
+  // Runs the timers for dt seconds and makes the transitions the rules make
+  // on their own (Ready -> Set after its maximum, the end of a kick-off or a
+  // set play, the end of a half, half-time, penalty expiry).
+  void advance(double dt);
+
+  // --- commands (a user, a test or the automatic referee) -----------------------------
+  void standby();       // Initial/Timeout -> Standby
+  void ready();         // Initial/Standby/Timeout -> Ready (kick-off)
+  void set();           // Ready -> Set
+  void playing();       // Set -> Playing
+  void goal(int team);  // `team` scored
+  void ballFree();      // the kick-off or set play is over (the ball moved)
+  void setPlay(gc::SetPlay play,
+               int team);  // a free kick / kick-in / corner / goal kick for `team`
+  void penalise(int team, int player, gc::Penalty penalty);
+  void unpenalise(int team, int player);
+  void timeout(std::optional<int> team);  // a team timeout, or a referee timeout (nullopt)
+  void dropBall();  // restart without a kicking team (after a global game stuck)
+  void substitute(int team, int player_out, int player_in);
+
+  // --- state ----------------------------------------------------------------------------
+  gc::State state() const { return state_; }
+  gc::GamePhase phase() const { return phase_; }
+  gc::SetPlay currentSetPlay() const { return set_play_; }
+  Half half() const { return half_; }
+  int kickingTeam() const { return kicking_team_; }  // -1 none
+  int score(int team) const { return score_[static_cast<size_t>(team)]; }
+  double secondsRemaining() const { return half_clock_; }  // of the half
+  double secondaryTime() const { return secondary_; }      // 0 when none runs
+  bool gameOver() const { return game_over_; }
+  // Remaining penalty seconds (0: not penalised).
+  double penaltyTime(int team, int player) const;
+  gc::Penalty penalty(int team, int player) const;
+  // Which team defends the -x goal now (the operator's left).
+  int leftTeam() const { return sides_swapped_ ? 1 : 0; }
+  const std::vector<RefereeEvent>& events() const { return events_; }
+  double time() const { return time_; }
+  const RuleBook& rules() const { return rules_; }
+
+  // The GameController packet for this state (teams[0]: the left team).
+  ControlData packet(uint8_t packet_number) const;
+
+ private:
+  struct Player {
+    gc::Penalty penalty = gc::Penalty::None;
+    double remaining = 0.0;
+  };
+  void enter(gc::State s, const std::string& why);
+  void startKickOff(int team, const std::string& why);  // -> Ready, kick-off for `team`
+  void endHalf();
+  void log(const std::string& type, int team, int player, const std::string& detail);
+  bool halfClockRuns() const;
+  Player& player(int team, int number);
+  const Player& player(int team, int number) const;
+
+  RuleBook rules_;
+  std::array<TeamSetup, 2> teams_;
+  gc::State state_ = gc::State::Initial;
+  gc::GamePhase phase_ = gc::GamePhase::Normal;
+  gc::SetPlay set_play_ = gc::SetPlay::None;
+  Half half_ = Half::First;
+  int first_half_kick_off_ = 0;
+  int kicking_team_ = -1;
+  bool kick_off_pending_ = true;  // kick-off set play when Playing starts
+  bool half_started_ = false;     // the half's first kick-off has happened (clock runs)
+  bool sides_swapped_ = false;
+  bool game_over_ = false;
+  std::array<int, 2> score_{};
+  std::array<int, 2> incremental_{};  // incremental penalties so far, per team
+  std::array<int, 2> timeouts_left_{1, 1};
+  double half_clock_ = 0.0, secondary_ = 0.0, time_ = 0.0;
+  std::array<std::array<Player, gc::kMaxPlayers>, 2> players_{};
+  std::vector<RefereeEvent> events_;
+};
+
+const char* stateName(gc::State s);
+const char* setPlayName(gc::SetPlay p);
+
+}  // namespace simsoccer::referee

@@ -1,0 +1,421 @@
+#include "simsoccer/referee/game.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "simsoccer/engine/config.hpp"
+
+namespace simsoccer::referee {
+
+using engine::ConfigNode;
+
+RuleBook loadRuleBook(const std::filesystem::path& file) {
+  const ConfigNode root = ConfigNode::loadFile(file);
+  root.allowOnly({"rules", "players_per_team", "halves", "half_duration", "half_time_break",
+                  "half_time_to_initial", "clock_in_ready_and_set", "ready_duration",
+                  "ready_penalty_kick_duration", "kick_off_ball_free", "set_play_duration",
+                  "penalty_kick_duration", "mercy_goal_difference", "game_stuck_duration",
+                  "goal_area_max_robots", "penalties", "shootout"});
+  RuleBook r;
+  r.name = root["rules"].string();
+  r.source_file = file.string();
+  r.players_per_team = root["players_per_team"].integer();
+  if (r.players_per_team < 1 || r.players_per_team > static_cast<int>(gc::kMaxPlayers))
+    root.failKey("players_per_team", "must be 1..20");
+  r.halves = root["halves"].integer();
+  if (r.halves != 1 && r.halves != 2) root.failKey("halves", "must be 1 or 2");
+  r.half_duration = root["half_duration"].positive();
+  r.half_time_break = root["half_time_break"].nonNegative();
+  r.half_time_to_initial = root["half_time_to_initial"].nonNegative();
+  if (r.half_time_to_initial > r.half_time_break)
+    root.failKey("half_time_to_initial", "longer than the half-time break");
+  r.clock_in_ready_and_set = root["clock_in_ready_and_set"].boolean();
+  r.ready_duration = root["ready_duration"].positive();
+  r.ready_penalty_kick_duration = root["ready_penalty_kick_duration"].positive();
+  r.kick_off_ball_free = root["kick_off_ball_free"].positive();
+  r.set_play_duration = root["set_play_duration"].positive();
+  r.penalty_kick_duration = root["penalty_kick_duration"].positive();
+  r.mercy_goal_difference = root["mercy_goal_difference"].integer();
+  if (r.mercy_goal_difference < 0) root.failKey("mercy_goal_difference", "must be >= 0");
+  r.game_stuck_duration = root["game_stuck_duration"].positive();
+  r.goal_area_max_robots = root["goal_area_max_robots"].integer();
+  const ConfigNode p = root["penalties"];
+  p.allowOnly({"base", "increment", "illegal_position_in_set", "motion_in_set"});
+  r.penalty_base = p["base"].positive();
+  r.penalty_increment = p["increment"].nonNegative();
+  r.illegal_position_in_set = p["illegal_position_in_set"].positive();
+  r.motion_in_set = p["motion_in_set"].positive();
+  const ConfigNode s = root["shootout"];
+  s.allowOnly({"enabled", "kicks_per_team", "shot_duration", "sudden_death"});
+  r.shootout = s["enabled"].boolean();
+  r.shootout_kicks = s["kicks_per_team"].integer();
+  if (r.shootout_kicks < 1) s.failKey("kicks_per_team", "must be >= 1");
+  r.shootout_shot_duration = s["shot_duration"].positive();
+  r.sudden_death = s["sudden_death"].boolean();
+  return r;
+}
+
+const char* stateName(gc::State s) {
+  switch (s) {
+    case gc::State::Initial:
+      return "INITIAL";
+    case gc::State::Ready:
+      return "READY";
+    case gc::State::Set:
+      return "SET";
+    case gc::State::Playing:
+      return "PLAYING";
+    case gc::State::Finished:
+      return "FINISHED";
+    case gc::State::Standby:
+      return "STANDBY";
+  }
+  return "?";
+}
+
+const char* setPlayName(gc::SetPlay p) {
+  switch (p) {
+    case gc::SetPlay::None:
+      return "NONE";
+    case gc::SetPlay::GoalKick:
+      return "GOAL_KICK";
+    case gc::SetPlay::PushingFreeKick:
+      return "PUSHING_FREE_KICK";
+    case gc::SetPlay::CornerKick:
+      return "CORNER_KICK";
+    case gc::SetPlay::KickIn:
+      return "KICK_IN";
+    case gc::SetPlay::PenaltyKick:
+      return "PENALTY_KICK";
+  }
+  return "?";
+}
+
+Game::Game(const RuleBook& rules, const std::array<TeamSetup, 2>& teams, int kick_off_team)
+    : rules_(rules), teams_(teams) {
+  if (kick_off_team != 0 && kick_off_team != 1)
+    throw std::invalid_argument("the kick-off team is 0 or 1");
+  first_half_kick_off_ = kick_off_team;
+  kicking_team_ = kick_off_team;
+  half_clock_ = rules.half_duration;
+  for (auto& team : players_)
+    for (size_t n = static_cast<size_t>(rules.players_per_team); n < gc::kMaxPlayers; ++n)
+      team[n].penalty = gc::Penalty::Substitute;  // numbers beyond the team size
+}
+
+void Game::log(const std::string& type, int team, int player, const std::string& detail) {
+  events_.push_back({time_, type, team, player, detail});
+}
+
+void Game::enter(gc::State s, const std::string& why) {
+  state_ = s;
+  log("state", -1, 0, std::string(stateName(s)) + (why.empty() ? "" : ": " + why));
+}
+
+Game::Player& Game::player(int team, int number) {
+  if (team < 0 || team > 1 || number < 1 || number > static_cast<int>(gc::kMaxPlayers))
+    throw std::out_of_range("team 0/1 and player 1..20");
+  return players_[static_cast<size_t>(team)][static_cast<size_t>(number - 1)];
+}
+const Game::Player& Game::player(int team, int number) const {
+  return const_cast<Game*>(this)->player(team, number);
+}
+
+double Game::penaltyTime(int team, int number) const {
+  return player(team, number).remaining;
+}
+gc::Penalty Game::penalty(int team, int number) const {
+  return player(team, number).penalty;
+}
+
+bool Game::halfClockRuns() const {
+  if (state_ == gc::State::Playing) return true;
+  if (state_ == gc::State::Ready || state_ == gc::State::Set)
+    return rules_.clock_in_ready_and_set && half_started_;
+  return false;
+}
+
+void Game::advance(double dt) {
+  if (!(dt > 0.0)) return;
+  time_ += dt;
+  if (game_over_) return;
+
+  // Penalty timers run only in Ready and Playing; an expired penalty is
+  // lifted (the simulator is its own GameController operator).
+  if (state_ == gc::State::Ready || state_ == gc::State::Playing) {
+    for (int t = 0; t < 2; ++t)
+      for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n) {
+        Player& p = player(t, n);
+        if (p.penalty == gc::Penalty::None || p.penalty == gc::Penalty::Substitute) continue;
+        p.remaining = std::max(0.0, p.remaining - dt);
+        if (p.remaining == 0.0) unpenalise(t, n);
+      }
+  }
+
+  switch (state_) {
+    case gc::State::Ready:
+      if (halfClockRuns()) half_clock_ -= dt;
+      secondary_ -= dt;
+      if (secondary_ <= 0.0) {
+        secondary_ = 0.0;
+        set();
+      }
+      break;
+    case gc::State::Set:
+      if (halfClockRuns()) half_clock_ -= dt;
+      break;
+    case gc::State::Playing:
+      half_clock_ -= dt;
+      if (secondary_ > 0.0) {
+        secondary_ -= dt;
+        if (secondary_ <= 0.0) ballFree();  // the kick-off or set play's time is up
+      }
+      break;
+    case gc::State::Finished:
+      if (half_ == Half::First && rules_.halves == 2) {
+        secondary_ -= dt;
+        if (rules_.half_time_break - secondary_ >= rules_.half_time_to_initial - 1e-9) {
+          // Second half: sides swapped, the other team kicks off, penalties lifted.
+          half_ = Half::Second;
+          sides_swapped_ = true;
+          half_clock_ = rules_.half_duration;
+          half_started_ = false;
+          kicking_team_ = 1 - first_half_kick_off_;
+          kick_off_pending_ = true;
+          secondary_ = 0.0;
+          for (int t = 0; t < 2; ++t)
+            for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n)
+              if (player(t, n).penalty != gc::Penalty::Substitute) player(t, n) = Player{};
+          log("half", -1, 0, "second half");
+          enter(gc::State::Initial, "half-time");
+        }
+      }
+      break;
+    case gc::State::Initial:
+    case gc::State::Standby:
+      break;
+  }
+  if (phase_ == gc::GamePhase::Timeout) secondary_ = std::max(0.0, secondary_ - dt);
+  if (half_clock_ <= 0.0 &&
+      (state_ == gc::State::Ready || state_ == gc::State::Set || state_ == gc::State::Playing)) {
+    half_clock_ = 0.0;
+    endHalf();
+  }
+}
+
+void Game::endHalf() {
+  set_play_ = gc::SetPlay::None;
+  secondary_ = 0.0;
+  // Timed penalties end with the half.
+  for (auto& team : players_)
+    for (Player& p : team)
+      if (p.penalty != gc::Penalty::Substitute) p = Player{};
+  log("half", -1, 0, half_ == Half::First ? "end of the first half" : "end of the second half");
+  enter(gc::State::Finished, "end of half");
+  if (half_ == Half::First && rules_.halves == 2) {
+    secondary_ = rules_.half_time_break;
+  } else {
+    game_over_ = true;
+    log("game_over", -1, 0,
+        score_[0] == score_[1] ? "draw" : (score_[0] > score_[1] ? "team 0 wins" : "team 1 wins"));
+  }
+}
+
+void Game::standby() {
+  if (state_ != gc::State::Initial && phase_ != gc::GamePhase::Timeout)
+    throw std::logic_error("Standby comes from Initial or a timeout");
+  phase_ = gc::GamePhase::Normal;
+  enter(gc::State::Standby, "");
+}
+
+void Game::startKickOff(int team, const std::string& why) {
+  kicking_team_ = team;
+  kick_off_pending_ = true;
+  set_play_ = gc::SetPlay::None;
+  secondary_ = rules_.ready_duration;
+  enter(gc::State::Ready, why);
+}
+
+void Game::ready() {
+  if (state_ != gc::State::Initial && state_ != gc::State::Standby &&
+      phase_ != gc::GamePhase::Timeout)
+    throw std::logic_error("Ready comes from Initial, Standby or a timeout");
+  phase_ = gc::GamePhase::Normal;
+  startKickOff(kicking_team_, "kick-off");
+}
+
+void Game::set() {
+  if (state_ != gc::State::Ready) throw std::logic_error("Set comes from Ready");
+  secondary_ = 0.0;
+  enter(gc::State::Set, "");
+}
+
+void Game::playing() {
+  if (state_ != gc::State::Set) throw std::logic_error("Playing comes from Set");
+  half_started_ = true;
+  enter(gc::State::Playing, "");
+  if (set_play_ == gc::SetPlay::PenaltyKick) {
+    secondary_ = rules_.penalty_kick_duration;
+  } else if (kick_off_pending_ && kicking_team_ >= 0) {
+    secondary_ = rules_.kick_off_ball_free;  // the kick-off: ball free after this or a touch
+  } else {
+    secondary_ = 0.0;  // a drop ball is in play at once
+    kicking_team_ = -1;
+  }
+  kick_off_pending_ = false;
+}
+
+void Game::goal(int team) {
+  if (team != 0 && team != 1) throw std::invalid_argument("goal: team 0 or 1");
+  if (state_ != gc::State::Playing) throw std::logic_error("goals count in Playing");
+  ++score_[static_cast<size_t>(team)];
+  log("goal", team, 0, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
+  if (rules_.mercy_goal_difference > 0 &&
+      std::abs(score_[0] - score_[1]) >= rules_.mercy_goal_difference) {
+    secondary_ = 0.0;
+    set_play_ = gc::SetPlay::None;
+    enter(gc::State::Finished, "mercy rule");
+    game_over_ = true;
+    log("game_over", -1, 0, "mercy rule");
+    return;
+  }
+  startKickOff(1 - team, "goal, kick-off for the other team");
+}
+
+void Game::ballFree() {
+  if (state_ != gc::State::Playing) return;
+  if (set_play_ != gc::SetPlay::None || kicking_team_ >= 0)
+    log("set_play", kicking_team_, 0, std::string("over: ") + setPlayName(set_play_));
+  set_play_ = gc::SetPlay::None;
+  kicking_team_ = -1;
+  secondary_ = 0.0;
+}
+
+void Game::setPlay(gc::SetPlay play, int team) {
+  if (team != 0 && team != 1) throw std::invalid_argument("set play: team 0 or 1");
+  if (state_ != gc::State::Playing) throw std::logic_error("set plays start in Playing");
+  if (play == gc::SetPlay::None) return ballFree();
+  kicking_team_ = team;
+  set_play_ = play;
+  log("set_play", team, 0, setPlayName(play));
+  if (play == gc::SetPlay::PenaltyKick) {
+    // Ready (30 s) and Set before the kick, which then has 30 s in Playing.
+    kick_off_pending_ = false;
+    secondary_ = rules_.ready_penalty_kick_duration;
+    enter(gc::State::Ready, "penalty kick");
+  } else {
+    secondary_ = rules_.set_play_duration;
+  }
+}
+
+void Game::penalise(int team, int number, gc::Penalty p) {
+  Player& pl = player(team, number);
+  if (pl.penalty == gc::Penalty::Substitute) throw std::logic_error("substitutes are not in play");
+  double seconds = rules_.penalty_base;
+  switch (p) {
+    case gc::Penalty::IllegalPositionInSet:
+      seconds = rules_.illegal_position_in_set;
+      break;
+    case gc::Penalty::IllegalMotionInSet:
+      seconds = rules_.motion_in_set;
+      break;
+    case gc::Penalty::IllegalBallContact:
+    case gc::Penalty::PlayerPushing:
+    case gc::Penalty::IllegalPosition:
+    case gc::Penalty::PlayerStance:
+    case gc::Penalty::LeavingTheField:
+      // Incremental: +10 s for each earlier incremental penalty of the team.
+      seconds = rules_.penalty_base +
+                rules_.penalty_increment * incremental_[static_cast<size_t>(team)]++;
+      break;
+    case gc::Penalty::Substitute:
+    case gc::Penalty::None:
+      throw std::invalid_argument("penalise: use substitute() / unpenalise()");
+    default:
+      break;
+  }
+  pl.penalty = p;
+  pl.remaining = seconds;
+  log("penalty", team, number,
+      std::to_string(static_cast<int>(p)) + " for " +
+          std::to_string(static_cast<int>(std::ceil(seconds))) + " s");
+}
+
+void Game::unpenalise(int team, int number) {
+  Player& pl = player(team, number);
+  if (pl.penalty == gc::Penalty::None || pl.penalty == gc::Penalty::Substitute) return;
+  pl = Player{};
+  log("unpenalise", team, number, "");
+}
+
+void Game::timeout(std::optional<int> team) {
+  if (state_ == gc::State::Finished) throw std::logic_error("no timeout after the game");
+  if (team) {
+    if (*team != 0 && *team != 1) throw std::invalid_argument("timeout: team 0 or 1");
+    if (state_ == gc::State::Playing) throw std::logic_error("no team timeout while playing");
+    if (timeouts_left_[static_cast<size_t>(*team)] <= 0)
+      throw std::logic_error("the team has no timeout left");
+    --timeouts_left_[static_cast<size_t>(*team)];
+    kicking_team_ = 1 - *team;  // the other team gets the kick-off
+    secondary_ = 300.0;
+  } else {
+    secondary_ = 600.0;  // a referee timeout shows 10 min
+  }
+  phase_ = gc::GamePhase::Timeout;
+  set_play_ = gc::SetPlay::None;
+  log("timeout", team ? *team : -1, 0, team ? "team timeout" : "referee timeout");
+  enter(gc::State::Initial, "timeout");
+}
+
+void Game::dropBall() {
+  if (state_ != gc::State::Playing) throw std::logic_error("a drop ball restarts Playing");
+  log("drop_ball", -1, 0, "");
+  startKickOff(-1, "drop ball");
+}
+
+void Game::substitute(int team, int out, int in) {
+  Player& leaving = player(team, out);
+  Player& coming = player(team, in);
+  if (coming.penalty != gc::Penalty::Substitute)
+    throw std::logic_error("the incoming player is already in play");
+  leaving = Player{gc::Penalty::Substitute, 0.0};
+  coming = Player{};
+  log("substitute", team, in, "for player " + std::to_string(out));
+}
+
+ControlData Game::packet(uint8_t packet_number) const {
+  ControlData d;
+  d.packet_number = packet_number;
+  d.players_per_team = static_cast<uint8_t>(rules_.players_per_team);
+  d.game_phase = static_cast<uint8_t>(phase_);
+  d.state = static_cast<uint8_t>(state_);
+  d.set_play = static_cast<uint8_t>(set_play_);
+  d.first_half = half_ == Half::First ? 1 : 0;
+  d.kicking_team =
+      kicking_team_ >= 0 ? teams_[static_cast<size_t>(kicking_team_)].number : gc::kKickingTeamNone;
+  auto secs = [](double s) {  // rounded up, clamped to the i16 range
+    return static_cast<int16_t>(std::clamp(std::ceil(s - 1e-9), -32768.0, 32767.0));
+  };
+  d.secs_remaining = secs(half_clock_);
+  d.secondary_time = secs(secondary_);
+  for (int side = 0; side < 2; ++side) {
+    const int t = side == 0 ? leftTeam() : 1 - leftTeam();
+    const TeamSetup& setup = teams_[static_cast<size_t>(t)];
+    TeamInfo& info = d.teams[static_cast<size_t>(side)];
+    info.team_number = setup.number;
+    info.field_player_colour = setup.field_player_colour;
+    info.goalkeeper_colour = setup.goalkeeper_colour;
+    info.goalkeeper = setup.goalkeeper;
+    info.score = static_cast<uint8_t>(score_[static_cast<size_t>(t)]);
+    info.message_budget = 1200;
+    for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n) {
+      const Player& p = player(t, n);
+      info.players[static_cast<size_t>(n - 1)] = {
+          static_cast<uint8_t>(p.penalty),
+          static_cast<uint8_t>(std::clamp(std::ceil(p.remaining - 1e-9), 0.0, 255.0))};
+    }
+  }
+  return d;
+}
+
+}  // namespace simsoccer::referee

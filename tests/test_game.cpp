@@ -1,0 +1,239 @@
+// The game-state machine on simulated time, against the rules (spl-rules.md
+// sections 3-5) and the GameController packet it produces.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/referee/game.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using namespace simsoccer::referee;
+
+namespace {
+
+RuleBook spl() {
+  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+}
+
+std::array<TeamSetup, 2> teams() {
+  std::array<TeamSetup, 2> t;
+  t[0].number = 13;
+  t[0].field_player_colour = 0;
+  t[1].number = 5;
+  t[1].field_player_colour = 1;
+  return t;
+}
+
+// Advances in 10 ms steps, as the simulator does.
+void run(Game& g, double seconds) {
+  for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.01)); ++i) g.advance(0.01);
+}
+
+}  // namespace
+
+TEST(Game, KickOffFlowAndTheHalfClockStartsAtTheKickOff) {
+  Game g(spl(), teams(), 0);
+  EXPECT_EQ(g.state(), gc::State::Initial);
+  run(g, 20);  // Initial: nothing runs
+  EXPECT_DOUBLE_EQ(g.secondsRemaining(), 600);
+  g.standby();
+  g.ready();
+  EXPECT_EQ(g.kickingTeam(), 0);
+  run(g, 44.9);
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  run(g, 0.2);  // Ready ends by itself after 45 s
+  EXPECT_EQ(g.state(), gc::State::Set);
+  EXPECT_DOUBLE_EQ(g.secondsRemaining(), 600);  // not before the half's first kick-off
+  g.playing();
+  EXPECT_NEAR(g.secondaryTime(), 10, 1e-9);  // kick-off: ball free after 10 s
+  run(g, 5);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  run(g, 5.1);
+  EXPECT_EQ(g.kickingTeam(), -1);  // ball free
+  EXPECT_NEAR(g.secondsRemaining(), 600 - 10.1, 1e-6);
+}
+
+TEST(Game, GoalGivesTheKickOffToTheOtherTeamAndReadySetCountAfterwards) {
+  Game g(spl(), teams(), 0);
+  g.ready();
+  g.set();
+  g.playing();
+  run(g, 30);
+  g.goal(0);
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  const double before = g.secondsRemaining();
+  run(g, 20);  // round robin: Ready counts as playing time after the first kick-off
+  EXPECT_NEAR(g.secondsRemaining(), before - 20, 1e-6);
+  g.set();
+  g.playing();
+  EXPECT_EQ(g.kickingTeam(), 1);
+}
+
+TEST(Game, SetPlaysEndAfterTheirTimeOrWhenTheBallIsFree) {
+  Game g(spl(), teams(), 0);
+  g.ready();
+  g.set();
+  g.playing();
+  g.ballFree();
+  g.setPlay(gc::SetPlay::KickIn, 1);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  run(g, 29.9);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  run(g, 0.2);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+  g.setPlay(gc::SetPlay::CornerKick, 0);
+  run(g, 3);
+  g.ballFree();  // the kicking team moved the ball
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+  // A penalty kick goes through Ready (30 s) and Set, then 30 s in Playing.
+  g.setPlay(gc::SetPlay::PenaltyKick, 1);
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  run(g, 30.1);
+  EXPECT_EQ(g.state(), gc::State::Set);
+  g.playing();
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::PenaltyKick);
+  run(g, 30.1);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+}
+
+TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
+  Game g(spl(), teams(), 0);
+  g.ready();
+  g.penalise(0, 2, gc::Penalty::PlayerPushing);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 2), 45);
+  g.penalise(0, 3, gc::Penalty::LeavingTheField);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 3), 55);  // 45 + 10 for the team's earlier one
+  g.penalise(0, 4, gc::Penalty::InactivePlayer);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 4), 45);  // not incremental
+  g.penalise(1, 2, gc::Penalty::IllegalBallContact);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(1, 2), 45);  // the other team's count is its own
+  g.penalise(0, 5, gc::Penalty::IllegalPosition);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 5), 65);
+  run(g, 10);  // Ready: timers run
+  EXPECT_NEAR(g.penaltyTime(0, 2), 35, 1e-6);
+  g.set();
+  g.penalise(0, 1, gc::Penalty::IllegalPositionInSet);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 1), 15);
+  run(g, 10);  // Set: frozen
+  EXPECT_NEAR(g.penaltyTime(0, 2), 35, 1e-6);
+  EXPECT_DOUBLE_EQ(g.penaltyTime(0, 1), 15);
+  g.playing();
+  run(g, 15.05);  // lifted when the time is up
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+  run(g, 20);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  int lifted = 0;
+  for (const auto& e : g.events()) lifted += e.type == "unpenalise";
+  EXPECT_GE(lifted, 2);
+  EXPECT_EQ(g.penalty(0, 6), gc::Penalty::Substitute);  // numbers beyond the 5 players
+}
+
+TEST(Game, HalfTimeSwapsSidesAndTheOtherTeamKicksOff) {
+  Game g(spl(), teams(), 0);
+  EXPECT_EQ(g.packet(0).teams[0].team_number, 13);  // team 0 on the operator's left
+  g.ready();
+  g.set();
+  g.playing();
+  g.penalise(1, 1, gc::Penalty::PlayerPushing);
+  run(g, 600.05);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);  // penalties end with the half
+  EXPECT_EQ(g.half(), Half::First);
+  run(g, 299);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  run(g, 1.1);  // 5 min into the break: Initial of the second half
+  EXPECT_EQ(g.state(), gc::State::Initial);
+  EXPECT_EQ(g.half(), Half::Second);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  const ControlData d = g.packet(1);
+  EXPECT_EQ(d.first_half, 0);
+  EXPECT_EQ(d.teams[0].team_number, 5);  // swapped
+  EXPECT_EQ(d.teams[1].team_number, 13);
+  EXPECT_EQ(d.secs_remaining, 600);
+  g.ready();
+  g.set();
+  g.playing();
+  run(g, 600.05);
+  EXPECT_TRUE(g.gameOver());
+}
+
+TEST(Game, MercyRuleEndsTheGame) {
+  Game g(spl(), teams(), 0);
+  g.ready();
+  g.set();
+  g.playing();
+  for (int i = 0; i < 10; ++i) {
+    g.goal(1);
+    if (g.gameOver()) break;
+    g.set();
+    g.playing();
+  }
+  EXPECT_EQ(g.score(1), 10);
+  EXPECT_TRUE(g.gameOver());
+  EXPECT_EQ(g.state(), gc::State::Finished);
+}
+
+TEST(Game, TimeoutsSubstitutesAndDropBall) {
+  Game g(spl(), teams(), 0);
+  g.timeout(1);  // a team timeout: the other team gets the kick-off
+  EXPECT_EQ(g.phase(), gc::GamePhase::Timeout);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  EXPECT_THROW(g.timeout(1), std::logic_error);  // one per game
+  g.ready();
+  EXPECT_EQ(g.phase(), gc::GamePhase::Normal);
+  g.set();
+  g.playing();
+  g.dropBall();
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  EXPECT_EQ(g.kickingTeam(), -1);
+  EXPECT_EQ(g.packet(0).kicking_team, gc::kKickingTeamNone);
+  g.set();
+  g.playing();
+  EXPECT_DOUBLE_EQ(g.secondaryTime(), 0);  // a drop ball is in play at once
+  g.substitute(0, 2, 6);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::Substitute);
+  EXPECT_EQ(g.penalty(0, 6), gc::Penalty::None);
+}
+
+TEST(Game, PacketCarriesTheState) {
+  Game g(spl(), teams(), 1);
+  g.ready();
+  run(g, 12.3);
+  g.penalise(1, 3, gc::Penalty::PlayerPushing);
+  run(g, 0.5);
+  const ControlData d = g.packet(7);
+  EXPECT_EQ(d.packet_number, 7);
+  EXPECT_EQ(d.state, static_cast<uint8_t>(gc::State::Ready));
+  EXPECT_EQ(d.kicking_team, 5);     // team numbers, not indices
+  EXPECT_EQ(d.secondary_time, 33);  // 45 - 12.8 = 32.2, rounded up
+  EXPECT_EQ(d.players_per_team, 5);
+  EXPECT_EQ(d.teams[1].players[2].penalty, static_cast<uint8_t>(gc::Penalty::PlayerPushing));
+  EXPECT_EQ(d.teams[1].players[2].secs_till_unpenalised, 45);  // 44.5 rounded up
+  // Byte-exact on the wire.
+  const auto bytes = encode(d);
+  EXPECT_EQ(decodeControl(bytes), d);
+}
+
+TEST(Game, RuleBookErrorsNameTheKey) {
+  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_rules_test";
+  std::filesystem::create_directories(dir);
+  std::ifstream in(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("half_duration: 600"), 18, "half_duration: -5");
+  std::ofstream(dir / "bad.yaml") << text;
+  try {
+    loadRuleBook(dir / "bad.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "half_duration");
+  }
+  std::filesystem::remove_all(dir);
+  EXPECT_NO_THROW(loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"));
+}
