@@ -327,3 +327,35 @@ TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("team 0 player 1: owned, accepted 100"), std::string::npos) << out;
 }
+
+TEST(NetGameState, RefereePacketReachesAgents) {
+  const uint32_t domain = 111;
+  world::World w(teams(1));
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  net::SimServer server(w, cfg);
+  agents::AgentClient agent(dds(domain), 0, 1);
+  referee::ControlData d;
+  d.state = static_cast<uint8_t>(referee::gc::State::Playing);
+  d.kicking_team = 13;
+  d.secs_remaining = 321;
+  d.teams[0].team_number = 13;
+  d.teams[1].team_number = 5;
+  d.teams[1].score = 2;
+  d.teams[0].players[3] = {2, 40};
+  simsoccer_msg_GameState m{};
+  net::toMessage(d, 7, m);
+  server.setGameState(m);
+  simsoccer_msg_GameState got{};
+  bool have = false;
+  for (int i = 0; i < 200 && !have; ++i) {
+    dds_sleepfor(DDS_MSECS(10));
+    have = agent.gameState(got) && got.secs_remaining == 321;
+  }
+  ASSERT_TRUE(have);
+  EXPECT_EQ(got.state, 3);
+  EXPECT_EQ(got.kicking_team, 13);
+  EXPECT_EQ(got.teams[1].score, 2);
+  EXPECT_EQ(got.teams[0].players[3].penalty, 2);
+  EXPECT_EQ(got.teams[0].players[3].secs_till_unpenalised, 40);
+}

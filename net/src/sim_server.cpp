@@ -27,6 +27,37 @@ QosSpec latestDurable() {
 
 }  // namespace
 
+void toMessage(const referee::ControlData& d, uint64_t tick, simsoccer_msg_GameState& m) {
+  m.packet_number = d.packet_number;
+  m.players_per_team = d.players_per_team;
+  m.competition_phase = d.competition_phase;
+  m.competition_type = d.competition_type;
+  m.game_phase = d.game_phase;
+  m.state = d.state;
+  m.set_play = d.set_play;
+  m.first_half = d.first_half;
+  m.kicking_team = d.kicking_team;
+  m.secs_remaining = d.secs_remaining;
+  m.secondary_time = d.secondary_time;
+  for (size_t t = 0; t < 2; ++t) {
+    const referee::TeamInfo& in = d.teams[t];
+    simsoccer_msg_TeamInfo& out = m.teams[t];
+    out.team_number = in.team_number;
+    out.field_player_colour = in.field_player_colour;
+    out.goalkeeper_colour = in.goalkeeper_colour;
+    out.goalkeeper = in.goalkeeper;
+    out.score = in.score;
+    out.penalty_shot = in.penalty_shot;
+    out.single_shots = in.single_shots;
+    out.message_budget = in.message_budget;
+    for (size_t p = 0; p < referee::gc::kMaxPlayers; ++p) {
+      out.players[p].penalty = in.players[p].penalty;
+      out.players[p].secs_till_unpenalised = in.players[p].secs_till_unpenalised;
+    }
+  }
+  m.tick = tick;
+}
+
 void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_SensorFrame& m) {
   m.team = static_cast<uint8_t>(team);
   m.player = static_cast<uint8_t>(player);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
+#include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/world/world.hpp"
 #include "simsoccer_msgs.h"
 
@@ -107,6 +108,9 @@ class SimServer {
   std::vector<RobotSlot> robots_;
   ServerTimes times_;
 };
+
+// The referee's GameController packet as the DDS GameState message.
+void toMessage(const referee::ControlData& d, uint64_t tick, simsoccer_msg_GameState& m);
 
 // Copies a world sensor frame into the wire message.
 void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_SensorFrame& m);
