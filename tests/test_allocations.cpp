@@ -49,11 +49,13 @@ TEST(Allocations, SensorFramesAllocateNothingAfterWarmUp) {
   s.sensors.enabled = false;
   world::World w(s);
   auto& sensors = w.sensors();
+  std::vector<engine::LinkContact> contacts;
   auto period = [&](uint64_t tick) {
     for (int i = 0; i < w.stepsPerControlPeriod(); ++i) {
       w.step();
       g_counting = true;
-      sensors.afterStep(w.physics());
+      w.physics().linkContacts(contacts);  // what World::step shares with the sensors
+      sensors.afterStep(w.physics(), contacts);
       g_counting = false;
     }
     g_counting = true;

@@ -44,6 +44,9 @@ Pose fromBt(const btTransform& t) {
   return p;
 }
 
+// Marks free rigid bodies (their BodyId is in user index 2).
+constexpr int kRigidBodyTag = -7;
+
 // Small margins: Bullet's default 4 cm would round a 35 mm foot box away.
 constexpr btScalar kBoxMargin = 0.001f;
 constexpr btScalar kCylinderMargin = 0.004f;
@@ -333,6 +336,8 @@ BodyId PhysicsWorld::addRigidBody(const Shape& shape, double mass, const Materia
   body->setCcdMotionThreshold(static_cast<btScalar>(0.5 * r));
   body->setCcdSweptSphereRadius(static_cast<btScalar>(0.9 * r));
   body->setUserIndex(-1);
+  body->setUserIndex2(static_cast<int>(m.bodies.size()));  // BodyId, reported in contacts
+  body->setUserIndex3(kRigidBodyTag);
   applyMaterial(body.get(), material);
   m.world->addRigidBody(body.get());
   m.bodies.push_back(std::move(body));
@@ -655,6 +660,8 @@ void PhysicsWorld::linkContacts(std::vector<LinkContact>& out) const {
         lc.normal = fromBt(side == 0 ? pt.m_normalWorldOnB : -pt.m_normalWorldOnB);
         lc.impulse = pt.getAppliedImpulse();
         lc.with_articulation = is_link[1 - side];
+        const btCollisionObject* other = bodies[1 - side];
+        if (other->getUserIndex3() == kRigidBodyTag) lc.other_body = other->getUserIndex2();
         out.push_back(lc);
       }
     }

@@ -171,7 +171,6 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
   rays_.reserve(robots_.size() * 2 * rays_per_sonar_);
   hits_.resize(robots_.size() * 2 * rays_per_sonar_);
   echo_scratch_.reserve(rays_per_sonar_);
-  contacts_.reserve(64 * robots_.size() + 16);
   updateSonar(physics);
 }
 
@@ -191,14 +190,14 @@ void SensorSystem::commandHand(size_t robot, size_t hand, double target, double 
   r.hand_stiffness.at(hand) = std::clamp(stiffness, 0.0, 1.0);
 }
 
-void SensorSystem::afterStep(const engine::PhysicsWorld& physics) {
+void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
+                             const std::vector<engine::LinkContact>& contacts) {
   const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
   ++steps_in_period_;
 
   // Feet: contact impulses on the soles (FSRs) and on the toes (bumpers).
-  physics.linkContacts(contacts_);
   for (Robot& r : robots_) r.feet_posed = false;
-  for (const engine::LinkContact& c : contacts_) {
+  for (const engine::LinkContact& c : contacts) {
     if (c.articulation >= articulation_robot_.size()) continue;
     const int ri = articulation_robot_[c.articulation];
     if (ri < 0) continue;

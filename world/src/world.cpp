@@ -187,8 +187,12 @@ void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffn
 
 void World::step() {
   physics_->step();
+  physics_->linkContacts(contacts_);
+  for (const engine::LinkContact& c : contacts_)
+    if (c.other_body == static_cast<int>(ball_) && c.articulation < robots_.size())
+      last_touch_ = BallTouch{static_cast<RobotId>(c.articulation), physics_->stepCount()};
   if (!scenario_.sensors.enabled) return;
-  sensors_->afterStep(*physics_);
+  sensors_->afterStep(*physics_, contacts_);
   const uint64_t steps = physics_->stepCount();
   if (steps % static_cast<uint64_t>(steps_per_control_) == 0)
     sensors_->finishPeriod(*physics_, steps / static_cast<uint64_t>(steps_per_control_), time());
@@ -212,6 +216,16 @@ engine::RigidBodyState World::ballState() const {
 }
 void World::setBallState(const engine::RigidBodyState& state) {
   physics_->setRigidBodyState(ball_, state);
+}
+
+void World::placeRobot(RobotId r, double x, double y, double yaw, const std::string& posture) {
+  const RobotInfo& info = robots_.at(r);
+  const std::vector<double>& q = info.model->pose(posture);
+  Pose torso = Pose::Identity();
+  torso.translation() = Vec3(x, y, info.model->soleDepth(q) + 0.001);
+  torso.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+  physics_->resetArticulation(info.body, torso, q);
+  setPoseTarget(r, posture, 1.0);
 }
 
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {

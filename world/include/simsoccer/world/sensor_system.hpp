@@ -40,8 +40,9 @@ class SensorSystem {
                std::vector<RobotRef> robots, const engine::PhysicsWorld& physics,
                engine::BodyId ball, uint64_t seed, double control_period, double dt);
 
-  // After every physics step.
-  void afterStep(const engine::PhysicsWorld& physics);
+  // After every physics step, with that step's link contacts.
+  void afterStep(const engine::PhysicsWorld& physics,
+                 const std::vector<engine::LinkContact>& contacts);
   // At the end of every control period.
   void finishPeriod(const engine::PhysicsWorld& physics, uint64_t tick, double time);
 
@@ -115,7 +116,6 @@ class SensorSystem {
   size_t rays_per_sonar_ = 0;
   int steps_in_period_ = 0;
 
-  std::vector<engine::LinkContact> contacts_;
   engine::RayScene scene_;
   std::vector<engine::Ray> rays_;
   std::vector<engine::RayHit> hits_;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -40,6 +41,12 @@ struct RobotState {
   Vec3 angular_velocity = Vec3::Zero();
   std::vector<double> joint_positions;   // per body joint, rad
   std::vector<double> joint_velocities;  // rad/s
+};
+
+// The last robot that touched the ball.
+struct BallTouch {
+  RobotId robot = 0;
+  uint64_t step = 0;  // physics step of the touch
 };
 
 struct WorldSnapshot {
@@ -85,6 +92,11 @@ class World {
   void setBallState(const engine::RigidBodyState& state);
   // Upright: torso origin above `min_height` and tilted less than `max_tilt`.
   bool isStanding(RobotId r, double min_height = 0.22, double max_tilt = 0.785) const;
+  // The last robot touching the ball (any link), if any has yet.
+  const std::optional<BallTouch>& lastBallTouch() const { return last_touch_; }
+  // Teleports a robot upright onto the carpet at (x, y, yaw) in a named pose,
+  // at rest, holding that pose (a referee placing or removing a robot).
+  void placeRobot(RobotId r, double x, double y, double yaw, const std::string& posture = "stand");
 
   // The sensor frame of the last completed control period (stays the
   // initial one when the scenario turns sensors off).
@@ -109,6 +121,8 @@ class World {
   engine::BodyId ball_ = 0;
   int steps_per_control_ = 1;
   std::unique_ptr<SensorSystem> sensors_;
+  std::vector<engine::LinkContact> contacts_;  // this step's, shared by sensors and ball tracking
+  std::optional<BallTouch> last_touch_;
   void initSensors();
 };
 
