@@ -104,6 +104,11 @@ class Game {
   double time() const { return time_; }
   const RuleBook& rules() const { return rules_; }
 
+  // A referee decision that is not a state change (placement, ...).
+  void recordEvent(const std::string& type, int team, int player, const std::string& detail) {
+    log(type, team, player, detail);
+  }
+
   // The GameController packet for this state (teams[0]: the left team).
   ControlData packet(uint8_t packet_number) const;
 

@@ -1,0 +1,74 @@
+// The automatic referee: watches the world once per control period and
+// drives the Game the way the SPL's human referees and GameController
+// operator do (spl-rules.md sections 4-5): goals, ball out with the right
+// restart and ball placement, the end of kick-offs and set plays, automatic
+// penalties, removal of penalised robots and their re-entry.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "simsoccer/referee/game.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::referee {
+
+struct RefereeConfig {
+  bool auto_placement = false;    // at Set, move illegally placed robots instead of penalising
+  double set_duration = 5.0;      // s in Set before the referee whistles (Playing); <= 0: never
+  double ready_still_time = 1.0;  // Ready ends early when all stand still in legal places this long
+  double still_speed = 0.05;      // m/s: a robot slower than this stands still
+  double inactive_time = 10.0;    // s fallen before Inactive Player
+  double ball_moved = 0.05;       // m: the kicking team moved the ball clearly
+  double stuck_progress = 0.3;    // m the ball must move within the game-stuck time
+  double stuck_radius = 0.5;      // m: a robot this close to a stuck ball is penalised (local)
+};
+
+class Referee {
+ public:
+  Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,
+          int kick_off_team, const RefereeConfig& config = {});
+
+  Game& game() { return game_; }
+  const Game& game() const { return game_; }
+  // Once per control period, after the world stepped.
+  void update();
+
+  // The world's robot for (team, player number), if there is one.
+  std::optional<world::RobotId> robot(int team, int number) const;
+  // Where a penalised robot of `team` waits: 0.5 m outside the touchline,
+  // level with its own half's penalty mark, facing the field.
+  world::Pose penaltySpot(int team, int index) const;
+
+ private:
+  int defenderOfSide(int side) const;  // side -1 / +1: the team defending that goal
+  int teamSign(int team) const;        // -1 if the team defends the -x goal now
+  void checkBall();
+  void checkSetPlayOver();
+  void checkPenalties();
+  void checkGameStuck();
+  void onEnterSet();
+  bool legalKickOffPosition(world::RobotId r) const;
+  bool inOwnGoalArea(world::RobotId r) const;
+  double depthInOwnGoalArea(world::RobotId r) const;  // distance to the area's open border (m)
+  void placeBall(double x, double y);
+  void removePenalised();
+
+  world::World& world_;
+  RefereeConfig config_;
+  Game game_;
+  gc::State last_state_ = gc::State::Initial;
+  double time_in_state_ = 0.0;
+  double still_for_ = 0.0;
+  engine::Vec3 set_play_ball_ = engine::Vec3::Zero();  // where the ball was when the set play began
+  uint64_t set_play_step_ = 0;                         // world step when it began
+  std::vector<double> fallen_for_;
+  std::vector<double> in_goal_area_since_;  // game time of entering the own goal area; <0 outside
+  double clock_ = 0.0;                      // seconds of referee updates, for entry order
+  std::vector<bool> parked_;
+  engine::Vec3 stuck_ball_ = engine::Vec3::Zero();
+  double stuck_for_ = 0.0;
+};
+
+}  // namespace simsoccer::referee

@@ -1,0 +1,336 @@
+#include "simsoccer/referee/referee.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace simsoccer::referee {
+
+using engine::Vec3;
+using world::RobotId;
+
+Referee::Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,
+                 int kick_off_team, const RefereeConfig& config)
+    : world_(world), config_(config), game_(rules, teams, kick_off_team) {
+  fallen_for_.assign(world.robotCount(), 0.0);
+  in_goal_area_since_.assign(world.robotCount(), -1.0);
+  parked_.assign(world.robotCount(), false);
+  stuck_ball_ = world.ballState().pose.translation();
+}
+
+std::optional<RobotId> Referee::robot(int team, int number) const {
+  for (RobotId r = 0; r < world_.robotCount(); ++r)
+    if (world_.robot(r).team == team && world_.robot(r).number == number) return r;
+  return std::nullopt;
+}
+
+int Referee::teamSign(int team) const {
+  return team == game_.leftTeam() ? -1 : 1;
+}
+
+int Referee::defenderOfSide(int side) const {
+  return side < 0 ? game_.leftTeam() : 1 - game_.leftTeam();
+}
+
+world::Pose Referee::penaltySpot(int team, int index) const {
+  const auto& f = world_.field();
+  const double mark = f.penalty_mark_distance.value_or(1.3);
+  const double x = teamSign(team) * (f.halfLength() - mark) + 0.35 * index * -teamSign(team);
+  const double side = index % 2 == 0 ? 1.0 : -1.0;  // alternate touchlines
+  world::Pose p = world::Pose::Identity();
+  p.translation() = Vec3(x, side * (f.halfWidth() + 0.5), 0.0);
+  p.rotate(Eigen::AngleAxisd(side > 0 ? -M_PI / 2 : M_PI / 2, Vec3::UnitZ()));  // facing the field
+  return p;
+}
+
+void Referee::placeBall(double x, double y) {
+  engine::RigidBodyState b;
+  b.pose = engine::Pose::Identity();
+  b.pose.translation() = Vec3(x, y, world_.field().ball.radius);
+  world_.setBallState(b);
+  stuck_ball_ = b.pose.translation();
+  stuck_for_ = 0.0;
+}
+
+bool Referee::inOwnGoalArea(RobotId r) const {
+  const auto& f = world_.field();
+  const auto area = f.goal_area ? f.goal_area : f.penalty_area;
+  if (!area) return false;
+  const Vec3 p = world_.torsoPose(r).translation();
+  const double x = teamSign(world_.robot(r).team) * p.x();  // > 0 towards the own goal
+  return x >= f.halfLength() - area->length && x <= f.halfLength() + f.goal.depth &&
+         std::abs(p.y()) <= 0.5 * area->width;
+}
+
+double Referee::depthInOwnGoalArea(RobotId r) const {
+  const auto& f = world_.field();
+  const auto area = f.goal_area ? f.goal_area : f.penalty_area;
+  const Vec3 p = world_.torsoPose(r).translation();
+  const double x = teamSign(world_.robot(r).team) * p.x();
+  // The goal line side is not a border one leaves by: robots may stand in the goal.
+  return std::min(x - (f.halfLength() - area->length), 0.5 * area->width - std::abs(p.y()));
+}
+
+bool Referee::legalKickOffPosition(RobotId r) const {
+  const auto& f = world_.field();
+  const int team = world_.robot(r).team;
+  const Vec3 p = world_.torsoPose(r).translation();
+  const double own = teamSign(team) * p.x();  // > 0 in the own half
+  const bool on_field =
+      std::abs(p.x()) <= f.halfLength() + f.goal.depth && std::abs(p.y()) <= f.halfWidth();
+  const bool in_circle = std::hypot(p.x(), p.y()) <= f.centre_circle_radius;
+  if (!on_field) return false;
+  if (game_.kickingTeam() == team) return own > 0.0 || in_circle;
+  return own > 0.0 && !in_circle;  // defenders (and drop balls): own half, outside the circle
+}
+
+void Referee::onEnterSet() {
+  // The ball goes to the centre mark for a kick-off (or the penalty mark).
+  const auto& f = world_.field();
+  if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick && f.penalty_mark_distance) {
+    const int defender = 1 - game_.kickingTeam();
+    placeBall(teamSign(defender) * (f.halfLength() - *f.penalty_mark_distance), 0.0);
+    return;
+  }
+  placeBall(0.0, 0.0);
+  // Illegal positions: penalised (15 s), or moved by auto-placement.
+  bool kick_off_player = false;
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+    const Vec3 p = world_.torsoPose(r).translation();
+    bool legal = legalKickOffPosition(r);
+    // At most one robot of the kicking team outside its own half (in the circle).
+    if (legal && game_.kickingTeam() == info.team && teamSign(info.team) * p.x() <= 0.0) {
+      legal = !kick_off_player;
+      kick_off_player = true;
+    }
+    if (legal) continue;
+    if (config_.auto_placement) {
+      const double x = teamSign(info.team) * std::max(f.centre_circle_radius + 0.3, 1.0);
+      const double y = std::clamp(p.y(), -f.halfWidth() + 0.3, f.halfWidth() - 0.3);
+      world_.placeRobot(r, x, y, teamSign(info.team) < 0 ? 0.0 : M_PI);
+      game_.recordEvent("placement", info.team, info.number, "auto-placed to a legal position");
+    } else {
+      game_.penalise(info.team, info.number, gc::Penalty::IllegalPositionInSet);
+    }
+  }
+}
+
+void Referee::checkBall() {
+  const auto& f = world_.field();
+  const engine::RigidBodyState b = world_.ballState();
+  const Vec3 p = b.pose.translation();
+  const double r = f.ball.radius;
+  const double line = 0.5 * f.line_width;
+  const auto touch = world_.lastBallTouch();
+  const int last_team = touch ? world_.robot(touch->robot).team : -1;
+
+  if (std::abs(p.x()) > f.halfLength() + line + r) {
+    const int side = p.x() > 0 ? 1 : -1;
+    const int defender = defenderOfSide(side);
+    const int attacker = 1 - defender;
+    if (std::abs(p.y()) < 0.5 * f.goal.inner_width && p.z() < f.goal.clear_height) {
+      game_.goal(attacker);  // a goal for the team attacking this goal (own goals too)
+      placeBall(0.0, 0.0);
+      return;
+    }
+    const double ys = p.y() >= 0 ? 1.0 : -1.0;
+    if (last_team == attacker || last_team < 0) {
+      // Over the goal line, last touched by the attackers: goal kick.
+      const auto area = f.goal_area ? f.goal_area : f.penalty_area;
+      const double depth = area ? area->length : 0.6, width = area ? area->width : 2.2;
+      game_.setPlay(gc::SetPlay::GoalKick, defender);
+      placeBall(side * (f.halfLength() - depth), ys * 0.5 * width);
+    } else {
+      game_.setPlay(gc::SetPlay::CornerKick, attacker);
+      placeBall(side * f.halfLength(), ys * f.halfWidth());
+    }
+  } else if (std::abs(p.y()) > f.halfWidth() + line + r) {
+    // Over a touchline: kick-in for the team that did not touch it last.
+    const int team =
+        last_team >= 0 ? 1 - last_team : (p.x() < 0 ? game_.leftTeam() : 1 - game_.leftTeam());
+    game_.setPlay(gc::SetPlay::KickIn, team);
+    placeBall(std::clamp(p.x(), -f.halfLength(), f.halfLength()),
+              (p.y() > 0 ? 1.0 : -1.0) * f.halfWidth());
+  } else {
+    return;
+  }
+  set_play_ball_ = world_.ballState().pose.translation();
+  set_play_step_ = world_.stepCount();
+}
+
+void Referee::checkSetPlayOver() {
+  // A kick-off or set play ends when the kicking team touches the ball and moves it clearly.
+  const int kicking = game_.kickingTeam();
+  if (kicking < 0) return;
+  const auto touch = world_.lastBallTouch();
+  if (!touch || touch->step <= set_play_step_ || world_.robot(touch->robot).team != kicking) return;
+  const Vec3 p = world_.ballState().pose.translation();
+  if ((p - set_play_ball_).head<2>().norm() >= config_.ball_moved) game_.ballFree();
+}
+
+void Referee::checkPenalties() {
+  const auto& f = world_.field();
+  const double dt = world_.scenario().physics.control_period;
+  const bool in_game = game_.state() == gc::State::Ready || game_.state() == gc::State::Set ||
+                       game_.state() == gc::State::Playing;
+  std::array<std::vector<RobotId>, 2> in_goal_area;
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+    const Vec3 p = world_.torsoPose(r).translation();
+    if (!in_game) continue;
+    // Leaving the field: off the carpet.
+    if (!f.onCarpet(p.x(), p.y())) {
+      game_.penalise(info.team, info.number, gc::Penalty::LeavingTheField);
+      continue;
+    }
+    // Fallen / inactive: down for longer than the rule's time.
+    fallen_for_[r] = world_.isStanding(r) ? 0.0 : fallen_for_[r] + dt;
+    if (fallen_for_[r] >= config_.inactive_time) {
+      game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
+      fallen_for_[r] = 0.0;
+      continue;
+    }
+    if (inOwnGoalArea(r)) {
+      if (in_goal_area_since_[r] < 0.0) in_goal_area_since_[r] = clock_;
+      in_goal_area[static_cast<size_t>(info.team)].push_back(r);
+    } else {
+      in_goal_area_since_[r] = -1.0;
+    }
+  }
+  // Goal-area limit (Set and Playing): the surplus robots, deepest first.
+  if (game_.state() == gc::State::Set || game_.state() == gc::State::Playing) {
+    const size_t max = static_cast<size_t>(game_.rules().goal_area_max_robots);
+    for (int team = 0; team < 2; ++team) {
+      auto& list = in_goal_area[static_cast<size_t>(team)];
+      if (list.size() <= max) continue;
+      // Who stays: in Set the robots deepest inside (the surplus closest to the
+      // border is penalised); in Playing the ones that were there first.
+      const bool playing = game_.state() == gc::State::Playing;
+      std::sort(list.begin(), list.end(), [&](RobotId a, RobotId b) {
+        if (playing && in_goal_area_since_[a] != in_goal_area_since_[b])
+          return in_goal_area_since_[a] < in_goal_area_since_[b];
+        const double da = depthInOwnGoalArea(a), db = depthInOwnGoalArea(b);
+        return da != db ? da > db : a < b;
+      });
+      for (size_t i = max; i < list.size(); ++i)
+        game_.penalise(team, world_.robot(list[i]).number, gc::Penalty::IllegalPosition);
+    }
+  }
+}
+
+void Referee::checkGameStuck() {
+  const double dt = world_.scenario().physics.control_period;
+  const Vec3 p = world_.ballState().pose.translation();
+  if (game_.kickingTeam() >= 0) {
+    // A kick-off or set play runs on its own timer.
+    stuck_ball_ = p;
+    stuck_for_ = 0.0;
+    return;
+  }
+  if ((p - stuck_ball_).head<2>().norm() > config_.stuck_progress) {
+    stuck_ball_ = p;
+    stuck_for_ = 0.0;
+    return;
+  }
+  stuck_for_ += dt;
+  if (stuck_for_ < game_.rules().game_stuck_duration) return;
+  stuck_for_ = 0.0;
+  stuck_ball_ = p;
+  // Local: the robot closest to the ball, if one is close; otherwise global: drop ball.
+  std::optional<RobotId> closest;
+  double best = config_.stuck_radius;
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+    const double d = (world_.torsoPose(r).translation() - p).head<2>().norm();
+    if (d < best) {
+      best = d;
+      closest = r;
+    }
+  }
+  if (closest)
+    game_.penalise(world_.robot(*closest).team, world_.robot(*closest).number,
+                   gc::Penalty::LocalGameStuck);
+  else
+    game_.dropBall();
+}
+
+void Referee::removePenalised() {
+  std::array<int, 2> waiting{};
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    const gc::Penalty pen = game_.penalty(info.team, info.number);
+    const bool out = pen != gc::Penalty::None;
+    if (out) {
+      const world::Pose spot = penaltySpot(info.team, waiting[static_cast<size_t>(info.team)]++);
+      const double yaw = std::atan2(spot.linear()(1, 0), spot.linear()(0, 0));
+      // Removed at once, and kept there (re-placed if it wanders off).
+      if (!parked_[r] ||
+          (world_.torsoPose(r).translation() - spot.translation()).head<2>().norm() > 0.5) {
+        world_.placeRobot(r, spot.translation().x(), spot.translation().y(), yaw);
+        parked_[r] = true;
+      }
+    } else if (parked_[r]) {
+      // Re-entry: on the touchline beside its waiting spot, facing the field.
+      const world::Pose spot = world_.torsoPose(r);
+      const double side = spot.translation().y() > 0 ? 1.0 : -1.0;
+      world_.placeRobot(r, spot.translation().x(), side * world_.field().halfWidth(),
+                        side > 0 ? -M_PI / 2 : M_PI / 2);
+      parked_[r] = false;
+    }
+  }
+}
+
+void Referee::update() {
+  const double dt = world_.scenario().physics.control_period;
+  game_.advance(dt);
+  clock_ += dt;
+  const gc::State s = game_.state();
+  if (s != last_state_) {
+    time_in_state_ = 0.0;
+    still_for_ = 0.0;
+    if (s == gc::State::Set) onEnterSet();
+    if (s == gc::State::Playing) {
+      set_play_ball_ = world_.ballState().pose.translation();
+      set_play_step_ = world_.stepCount();
+      stuck_ball_ = set_play_ball_;
+      stuck_for_ = 0.0;
+    }
+    last_state_ = s;
+  } else {
+    time_in_state_ += dt;
+  }
+
+  if (!game_.gameOver()) {
+    checkPenalties();
+    if (s == gc::State::Ready) {
+      // Ready ends early when every robot in play stands still in a legal place.
+      bool all = true;
+      for (RobotId r = 0; r < world_.robotCount() && all; ++r) {
+        const auto& info = world_.robot(r);
+        if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+        all = legalKickOffPosition(r) && world_.isStanding(r) &&
+              world_.physics().rootLinearVelocity(world_.robot(r).body).head<2>().norm() <
+                  config_.still_speed;
+      }
+      still_for_ = all ? still_for_ + dt : 0.0;
+      if (all && still_for_ >= config_.ready_still_time) game_.set();
+    } else if (s == gc::State::Set && config_.set_duration > 0 &&
+               time_in_state_ >= config_.set_duration) {
+      game_.playing();
+      set_play_ball_ = world_.ballState().pose.translation();
+      set_play_step_ = world_.stepCount();
+      last_state_ = game_.state();
+      time_in_state_ = 0.0;
+    } else if (s == gc::State::Playing) {
+      checkBall();
+      checkSetPlayOver();
+      if (game_.state() == gc::State::Playing) checkGameStuck();
+    }
+  }
+  removePenalised();
+}
+
+}  // namespace simsoccer::referee

@@ -1,0 +1,283 @@
+// The automatic referee on the real world (real Bullet): scripted ball
+// positions and robot placements, checked against the rules.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "simsoccer/referee/referee.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using namespace simsoccer::referee;
+using engine::Vec3;
+
+namespace {
+
+RuleBook spl() {
+  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+}
+
+std::array<TeamSetup, 2> teams() {
+  std::array<TeamSetup, 2> t;
+  t[0].number = 13;
+  t[1].number = 5;
+  return t;
+}
+
+// 2 v 2 in their own halves: team 0 defends -x.
+world::Scenario twoVsTwo() {
+  world::Scenario s = test::scenario(0);
+  s.ball_position = {0.0, 0.0, -1.0};
+  const double xs[2][2] = {{-3.0, -1.5}, {3.0, 1.5}};
+  for (int team = 0; team < 2; ++team)
+    for (int n = 0; n < 2; ++n) {
+      world::RobotPlacement p;
+      p.team = team;
+      p.number = n + 1;
+      p.x = xs[team][n];
+      p.y = n == 0 ? 0.0 : 1.0;
+      p.yaw = team == 0 ? 0.0 : M_PI;
+      s.robots.push_back(p);
+    }
+  return s;
+}
+
+void run(world::World& w, Referee& ref, double seconds) {
+  const int periods = static_cast<int>(std::lround(seconds / w.scenario().physics.control_period));
+  for (int i = 0; i < periods; ++i) {
+    w.stepControlPeriod();
+    ref.update();
+  }
+}
+
+void putBall(world::World& w, double x, double y, double z = 0.05) {
+  engine::RigidBodyState b;
+  b.pose = engine::Pose::Identity();
+  b.pose.translation() = Vec3(x, y, z);
+  w.setBallState(b);
+}
+
+// Lets a robot touch the ball: the ball is put against its left foot's toe.
+void touchBall(world::World& w, Referee& ref, world::RobotId r) {
+  const int foot = w.robot(r).model->body->linkIndex("LFoot");
+  const engine::Pose p = w.linkPose(r, foot);
+  const Vec3 toe = p * Vec3(0.12, 0.0075, -0.02);
+  putBall(w, toe.x(), toe.y(), 0.05);
+  run(w, ref, 0.05);
+  ASSERT_TRUE(w.lastBallTouch().has_value());
+  ASSERT_EQ(w.lastBallTouch()->robot, r);
+}
+
+int count(const Game& g, const std::string& type) {
+  int n = 0;
+  for (const auto& e : g.events()) n += e.type == type;
+  return n;
+}
+
+void kickOff(world::World& w, Referee& ref) {
+  // Ready ends early (robots stand still where they are, legally), Set, whistle.
+  for (int i = 0; i < 1000 && ref.game().state() != gc::State::Playing; ++i) run(w, ref, 0.01);
+  ASSERT_EQ(ref.game().state(), gc::State::Playing);
+}
+
+}  // namespace
+
+TEST(Referee, FirstHalfWithScriptedBall) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  const double t0 = g.time();
+  run(w, ref, 1.6);
+  EXPECT_EQ(g.state(), gc::State::Set) << "Ready ends once all stand still in legal places";
+  EXPECT_LT(g.time() - t0, 3.0);
+  run(w, ref, 5.1);
+  ASSERT_EQ(g.state(), gc::State::Playing);
+  EXPECT_EQ(g.kickingTeam(), 0);
+
+  // A goal in the +x goal: team 0 (attacking +x in the first half) scores.
+  putBall(w, 4.7, 0.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  EXPECT_EQ(g.kickingTeam(), 1);  // the conceding team kicks off
+  EXPECT_LT(w.ballState().pose.translation().head<2>().norm(), 0.01);  // back on the centre mark
+  kickOff(w, ref);
+  g.ballFree();
+
+  // Kick-in: team 1 (robot 2) touches the ball last, it leaves over the touchline.
+  touchBall(w, ref, 2);
+  putBall(w, 1.2, 3.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), 3.0, 1e-3);  // on the touchline
+  EXPECT_NEAR(w.ballState().pose.translation().x(), 1.2, 1e-3);  // where it went out
+  run(w, ref, 30.1);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);  // its 30 s are over
+
+  // Corner kick: the -x goal's defender (team 0) touched it last, over its goal line.
+  touchBall(w, ref, 0);
+  putBall(w, -4.7, -2.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::CornerKick);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), -4.5, 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), -3.0, 1e-3);
+  g.ballFree();
+
+  // Goal kick: the +x goal's attacker (team 0) touched it last, over that goal line.
+  touchBall(w, ref, 1);
+  putBall(w, 4.7, 2.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::GoalKick);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), 3.9, 1e-3);  // goal-area corner
+  EXPECT_NEAR(w.ballState().pose.translation().y(), 1.1, 1e-3);
+  // The kicking team moves the ball: the set play is over.
+  touchBall(w, ref, 2);
+  putBall(w, 3.5, 1.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.score(1), 0);
+  EXPECT_EQ(count(g, "goal"), 1);
+  EXPECT_GE(count(g, "set_play"), 6);  // 3 awarded, 3 over
+}
+
+TEST(Referee, LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  w.placeRobot(1, -2.0, -3.6, 0.0);  // walks off: next to the carpet's edge ...
+  w.placeRobot(1, -2.0, -3.9, 0.0);  // ... and beyond it
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::LeavingTheField);
+  EXPECT_NEAR(g.penaltyTime(0, 2), 45, 0.05);
+  // Removed: 0.5 m outside a touchline, level with its own penalty mark (x = -3.2).
+  const Vec3 out = w.torsoPose(1).translation();
+  EXPECT_NEAR(std::abs(out.y()), 3.5, 0.01);
+  EXPECT_NEAR(out.x(), -3.2, 0.01);
+  EXPECT_TRUE(w.isStanding(1));
+  // A second incremental penalty of the team: 55 s.
+  w.placeRobot(0, -5.4, 0.0, 0.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::LeavingTheField);
+  EXPECT_NEAR(g.penaltyTime(0, 1), 55, 0.05);
+  // After its 45 s it comes back onto the touchline (the ball keeps moving
+  // meanwhile, so no game stuck interrupts Playing).
+  g.ballFree();
+  for (int i = 0; i < 9; ++i) {
+    putBall(w, 0.5 * (i % 3), -1.0 + 0.8 * (i % 2));
+    run(w, ref, 5.0);
+  }
+  run(w, ref, 0.1);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  EXPECT_NEAR(std::abs(w.torsoPose(1).translation().y()), 3.0, 0.05);
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::LeavingTheField);  // still 10 s to go
+  putBall(w, 1.0, 1.0);
+  run(w, ref, 10.1);
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);
+}
+
+TEST(Referee, IllegalPositionInSetOrAutoPlacement) {
+  for (const bool auto_place : {false, true}) {
+    world::World w(twoVsTwo());
+    RefereeConfig cfg;
+    cfg.auto_placement = auto_place;
+    Referee ref(w, spl(), teams(), 0, cfg);
+    Game& g = ref.game();
+    g.ready();
+    w.placeRobot(3, -1.0, 1.0, M_PI);  // team 1 player 2 in the opponents' half
+    run(w, ref, 45.1);                 // Ready runs out (not everyone is legal)
+    ASSERT_EQ(g.state(), gc::State::Set);
+    if (auto_place) {
+      EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
+      EXPECT_GT(w.torsoPose(3).translation().x(), 0.7);  // moved into its own half
+    } else {
+      EXPECT_EQ(g.penalty(1, 2), gc::Penalty::IllegalPositionInSet);
+      EXPECT_NEAR(g.penaltyTime(1, 2), 15, 1e-9);
+    }
+  }
+}
+
+TEST(Referee, TooManyDefendersInTheGoalArea) {
+  world::Scenario s = twoVsTwo();
+  // Team 0 gets two more robots: four in all.
+  for (int n = 3; n <= 4; ++n) {
+    world::RobotPlacement p;
+    p.team = 0;
+    p.number = n;
+    p.x = -2.0;
+    p.y = -2.0 + 0.6 * n;
+    s.robots.push_back(p);
+  }
+  world::World w(s);
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  // All four of team 0 into their own goal area (x in [-4.5, -3.9], |y| <= 1.1).
+  const world::RobotId team0[4] = {0, 1, 4, 5};
+  const double ys[4] = {-0.8, -0.3, 0.25, 0.8};
+  const double xs[4] = {-4.3, -4.1, -4.0, -4.2};
+  for (int i = 0; i < 4; ++i) w.placeRobot(team0[i], xs[i], ys[i], 0.0);
+  run(w, ref, 0.02);
+  int penalised = 0;
+  for (int n = 1; n <= 4; ++n) penalised += g.penalty(0, n) == gc::Penalty::IllegalPosition;
+  EXPECT_EQ(penalised, 1);
+  // All entered together: the one closest to the area's border (player 3,
+  // 0.1 m from the front line) goes.
+  EXPECT_EQ(g.penalty(0, 3), gc::Penalty::IllegalPosition);
+
+  // In Playing the robot that enters as the extra one is penalised, even
+  // when it goes deeper than the others.
+  g.unpenalise(0, 3);
+  run(w, ref, 0.02);                 // re-enters at the touchline
+  w.placeRobot(5, -3.0, 2.0, 0.0);   // player 4 leaves
+  w.placeRobot(4, -4.0, 0.25, 0.0);  // player 3 back in the area: three now
+  run(w, ref, 0.02);
+  ASSERT_EQ(g.penalty(0, 3), gc::Penalty::None);
+  w.placeRobot(5, -4.45, 0.0, 0.0);  // player 4 walks in as the fourth
+  run(w, ref, 0.02);
+  penalised = 0;
+  for (int n = 1; n <= 4; ++n) penalised += g.penalty(0, n) == gc::Penalty::IllegalPosition;
+  EXPECT_EQ(penalised, 1);
+  EXPECT_EQ(g.penalty(0, 4), gc::Penalty::IllegalPosition);
+}
+
+TEST(Referee, FallenRobotIsPenalisedAsInactive) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  const auto& joints = w.robot(3).model->body->joints;
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
+  run(w, ref, 9.0);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
+  run(w, ref, 3.0);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
+}
+
+TEST(Referee, GameStuckLocalThenGlobal) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  g.ballFree();
+  // The ball lies still next to robot 2 (team 1 player 1 at (3, 0)).
+  putBall(w, 2.75, 0.05);
+  run(w, ref, 30.2);
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::LocalGameStuck);
+  // Nobody near it now: after another 30 s, a drop ball.
+  putBall(w, 0.0, -2.5);
+  run(w, ref, 30.2);
+  EXPECT_EQ(count(g, "drop_ball"), 1);
+  EXPECT_EQ(g.kickingTeam(), -1);
+}
