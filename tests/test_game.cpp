@@ -237,3 +237,146 @@ TEST(Game, RuleBookErrorsNameTheKey) {
   std::filesystem::remove_all(dir);
   EXPECT_NO_THROW(loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"));
 }
+
+namespace {
+
+// Plays both halves without goals: a drawn game, over.
+Game drawnGame() {
+  Game g(spl(), teams(), 0);
+  for (int half = 0; half < 2; ++half) {
+    g.ready();
+    run(g, 45.1);
+    g.playing();
+    run(g, 600.5);
+    if (half == 0) run(g, 300.1);  // half-time: Initial of the second half
+  }
+  return g;
+}
+
+// One shoot-out kick from the whistle to its end.
+void kick(Game& g, ShotOutcome outcome, int striker = 2, int keeper = 1) {
+  g.shootoutKick(striker, keeper);
+  g.playing();
+  if (outcome == ShotOutcome::Goal)
+    g.goal(g.kickingTeam());
+  else
+    g.finishShot(outcome);
+}
+
+}  // namespace
+
+TEST(Game, ShootoutAfterADrawIsDecidedWhenATeamCanNoLongerCatchUp) {
+  Game g = drawnGame();
+  ASSERT_TRUE(g.gameOver());
+  ASSERT_FALSE(g.winner().has_value());
+  g.startShootout(1);
+  EXPECT_EQ(g.phase(), gc::GamePhase::PenaltyShoot);
+  EXPECT_EQ(g.state(), gc::State::Initial);
+  EXPECT_FALSE(g.gameOver());
+  EXPECT_THROW(g.ready(), std::logic_error);
+  EXPECT_THROW(g.timeout(0), std::logic_error);
+
+  g.shootoutKick(3, 1);  // team 1 shoots first
+  EXPECT_EQ(g.state(), gc::State::Set);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_EQ(g.penalty(1, 3), gc::Penalty::None);
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);  // the keeper
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::Substitute);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::Substitute);
+  g.playing();
+  g.goal(1);  // 1:0 for team 1
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  kick(g, ShotOutcome::Saved);  // team 0
+  kick(g, ShotOutcome::Goal);   // team 1: 2:0
+  EXPECT_FALSE(g.winner().has_value());
+  kick(g, ShotOutcome::Wide);  // team 0: 0 goals, one kick left, cannot catch up
+  ASSERT_TRUE(g.winner().has_value());
+  EXPECT_EQ(*g.winner(), 1);
+  EXPECT_TRUE(g.gameOver());
+  EXPECT_THROW(g.shootoutKick(2, 1), std::logic_error);
+
+  const ControlData d = g.packet(0);
+  EXPECT_EQ(d.game_phase, static_cast<uint8_t>(gc::GamePhase::PenaltyShoot));
+  EXPECT_EQ(d.state, static_cast<uint8_t>(gc::State::Finished));
+  // teams[0] is the left team (team 1 after the half-time swap).
+  EXPECT_EQ(d.teams[0].team_number, 5);
+  EXPECT_EQ(d.teams[0].score, 2);
+  EXPECT_EQ(d.teams[0].penalty_shot, 2);
+  EXPECT_EQ(d.teams[0].single_shots, 0b11);
+  EXPECT_EQ(d.teams[1].score, 0);
+  EXPECT_EQ(d.teams[1].penalty_shot, 2);
+  EXPECT_EQ(d.teams[1].single_shots, 0);
+}
+
+TEST(Game, ShootoutSuddenDeathRanksTheKicks) {
+  Game g(spl(), teams(), 0);
+  g.startShootout(0);  // stand-alone, the rule book's 3 kicks
+  for (int i = 0; i < 3; ++i) {
+    kick(g, i == 0 ? ShotOutcome::Goal : ShotOutcome::Saved);  // team 0
+    kick(g, i == 2 ? ShotOutcome::Goal : ShotOutcome::Wide);   // team 1
+  }
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.score(1), 1);
+  EXPECT_FALSE(g.winner().has_value());
+  // Round 1: both saved -> again. Round 2: wide beats nothing; saved beats wide.
+  kick(g, ShotOutcome::Saved);
+  kick(g, ShotOutcome::Saved);
+  EXPECT_FALSE(g.winner().has_value());
+  kick(g, ShotOutcome::Wide);
+  EXPECT_FALSE(g.winner().has_value());  // team 1 always gets its kick
+  kick(g, ShotOutcome::Saved);
+  ASSERT_TRUE(g.winner().has_value());
+  EXPECT_EQ(*g.winner(), 1);
+  EXPECT_EQ(g.shotsTaken(0), 5);
+  EXPECT_EQ(g.shotsTaken(1), 5);
+}
+
+TEST(Game, ShootoutCoinAfterTheLastSuddenDeathRoundIsSeeded) {
+  auto play = [](uint64_t seed) {
+    Game g(spl(), teams(), 0);
+    g.startShootout(0, 1, seed);  // one regular kick each
+    for (int i = 0; i < 2 * (1 + 3); ++i) kick(g, ShotOutcome::Post);
+    EXPECT_TRUE(g.gameOver());
+    EXPECT_EQ(g.events().back().detail.find("coin toss") != std::string::npos, true);
+    return *g.winner();
+  };
+  int wins0 = 0;
+  for (uint64_t seed = 0; seed < 16; ++seed) {
+    const int w = play(seed);
+    EXPECT_EQ(w, play(seed));  // the same seed, the same coin
+    wins0 += w == 0;
+  }
+  EXPECT_GT(wins0, 0);  // both sides of the coin come up
+  EXPECT_LT(wins0, 16);
+}
+
+TEST(Game, ShotClockRunsOnlyInPlayingAndEndsTheKick) {
+  RuleBook r = spl();
+  r.sudden_death = false;
+  Game g(r, teams(), 0);
+  g.startShootout(0, 2);
+  g.shootoutKick(2, 1);
+  run(g, 10);
+  EXPECT_DOUBLE_EQ(g.secondsRemaining(), 30);  // Set: frozen
+  EXPECT_EQ(g.packet(0).secs_remaining, 30);
+  g.playing();
+  run(g, 29.9);
+  EXPECT_EQ(g.state(), gc::State::Playing);
+  run(g, 0.2);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  EXPECT_EQ(g.shotOutcomes(0).back(), ShotOutcome::NoKick);
+  g.shootoutKick(4, 1);  // team 1
+  g.playing();
+  g.shotKicked();
+  run(g, 30.1);
+  EXPECT_EQ(g.shotOutcomes(1).back(), ShotOutcome::Other);
+  kick(g, ShotOutcome::Goal);
+  kick(g, ShotOutcome::Goal);
+  // 1:1 after two kicks each and no sudden death in this rule book: a draw.
+  EXPECT_TRUE(g.gameOver());
+  EXPECT_FALSE(g.winner().has_value());
+  // Not from the middle of a game.
+  Game h(spl(), teams(), 0);
+  h.ready();
+  EXPECT_THROW(h.startShootout(0), std::logic_error);
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "simsoccer/engine/config.hpp"
 
@@ -46,12 +47,14 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   r.illegal_position_in_set = p["illegal_position_in_set"].positive();
   r.motion_in_set = p["motion_in_set"].positive();
   const ConfigNode s = root["shootout"];
-  s.allowOnly({"enabled", "kicks_per_team", "shot_duration", "sudden_death"});
+  s.allowOnly({"enabled", "kicks_per_team", "shot_duration", "sudden_death", "sudden_death_rounds"});
   r.shootout = s["enabled"].boolean();
   r.shootout_kicks = s["kicks_per_team"].integer();
   if (r.shootout_kicks < 1) s.failKey("kicks_per_team", "must be >= 1");
   r.shootout_shot_duration = s["shot_duration"].positive();
   r.sudden_death = s["sudden_death"].boolean();
+  r.sudden_death_rounds = s["sudden_death_rounds"].integer();
+  if (r.sudden_death_rounds < 1) s.failKey("sudden_death_rounds", "must be >= 1");
   return r;
 }
 
@@ -152,6 +155,16 @@ void Game::advance(double dt) {
       }
   }
 
+  if (phase_ == gc::GamePhase::PenaltyShoot) {
+    // The shot clock counts only in Playing; at 0 the kick is over.
+    if (state_ == gc::State::Playing) {
+      half_clock_ -= dt;
+      if (half_clock_ <= 0.0)
+        endShot(shot_kicked_ ? ShotOutcome::Other : ShotOutcome::NoKick, "shot time over");
+    }
+    return;
+  }
+
   switch (state_) {
     case gc::State::Ready:
       if (halfClockRuns()) half_clock_ -= dt;
@@ -216,12 +229,151 @@ void Game::endHalf() {
     secondary_ = rules_.half_time_break;
   } else {
     game_over_ = true;
+    if (score_[0] != score_[1]) winner_ = score_[0] > score_[1] ? 0 : 1;
     log("game_over", -1, 0,
         score_[0] == score_[1] ? "draw" : (score_[0] > score_[1] ? "team 0 wins" : "team 1 wins"));
   }
 }
 
+const char* shotOutcomeName(ShotOutcome o) {
+  switch (o) {
+    case ShotOutcome::Goal:
+      return "goal";
+    case ShotOutcome::Saved:
+      return "saved";
+    case ShotOutcome::Post:
+      return "post";
+    case ShotOutcome::Wide:
+      return "wide";
+    case ShotOutcome::Other:
+      return "other";
+    case ShotOutcome::NoKick:
+      return "no kick";
+  }
+  return "?";
+}
+
+void Game::startShootout(int first_team, std::optional<int> kicks_per_team, uint64_t coin_seed) {
+  if (first_team != 0 && first_team != 1) throw std::invalid_argument("shoot-out: team 0 or 1");
+  const bool after_draw = game_over_ && !winner_ && phase_ == gc::GamePhase::Normal;
+  const bool stand_alone = state_ == gc::State::Initial && !half_started_ && half_ == Half::First &&
+                           phase_ == gc::GamePhase::Normal;
+  if (!after_draw && !stand_alone)
+    throw std::logic_error("the shoot-out follows a drawn game, or starts a penalty-kick scenario");
+  if (after_draw && !rules_.shootout) throw std::logic_error("this rule book has no shoot-out");
+  shootout_kicks_ = kicks_per_team.value_or(rules_.shootout_kicks);
+  if (shootout_kicks_ < 1) throw std::invalid_argument("shoot-out: kicks per team must be >= 1");
+  first_shooter_ = first_team;
+  coin_seed_ = coin_seed;
+  half_ = Half::PenaltyShootout;
+  phase_ = gc::GamePhase::PenaltyShoot;
+  game_over_ = false;
+  score_ = {0, 0};  // the packet's score counts shoot-out goals from here
+  shots_ = {0, 0};
+  single_shots_ = {0, 0};
+  outcomes_ = {};
+  set_play_ = gc::SetPlay::None;
+  secondary_ = 0.0;
+  half_clock_ = rules_.shootout_shot_duration;
+  kicking_team_ = first_team;
+  log("shootout", first_team, 0,
+      std::to_string(shootout_kicks_) + " kicks per team, team " + std::to_string(first_team) +
+          " first");
+  enter(gc::State::Initial, "penalty shoot-out");
+}
+
+void Game::shootoutKick(int striker, int keeper) {
+  if (!shootoutOpen()) throw std::logic_error("no open shoot-out");
+  if (state_ != gc::State::Initial && state_ != gc::State::Finished)
+    throw std::logic_error("the next kick comes after the previous one ended");
+  const int kicks = shots_[0] + shots_[1];
+  const int team = kicks % 2 == 0 ? first_shooter_ : 1 - first_shooter_;
+  if (striker < 1 || striker > static_cast<int>(gc::kMaxPlayers))
+    throw std::invalid_argument("shoot-out: striker number out of range");
+  if (keeper < 0 || keeper > static_cast<int>(gc::kMaxPlayers))
+    throw std::invalid_argument("shoot-out: keeper number out of range");
+  // Everyone but the two players is a substitute for this kick.
+  for (int t = 0; t < 2; ++t)
+    for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n)
+      player(t, n) = Player{gc::Penalty::Substitute, 0.0};
+  player(team, striker) = Player{};
+  if (keeper > 0) player(1 - team, keeper) = Player{};
+  kicking_team_ = team;
+  striker_ = striker;
+  keeper_ = keeper;
+  shot_kicked_ = false;
+  ++shots_[static_cast<size_t>(team)];
+  half_clock_ = rules_.shootout_shot_duration;
+  log("shot", team, striker,
+      "kick " + std::to_string(shots_[static_cast<size_t>(team)]) + ", keeper " +
+          std::to_string(keeper));
+  enter(gc::State::Set, "shoot-out kick");
+}
+
+void Game::shotKicked() { shot_kicked_ = true; }
+
+void Game::finishShot(ShotOutcome outcome) {
+  if (outcome == ShotOutcome::Goal) throw std::invalid_argument("a scored kick goes through goal()");
+  if (phase_ != gc::GamePhase::PenaltyShoot || state_ != gc::State::Playing)
+    throw std::logic_error("no shoot-out kick is running");
+  endShot(outcome, shotOutcomeName(outcome));
+}
+
+void Game::endShot(ShotOutcome outcome, const std::string& why) {
+  outcomes_[static_cast<size_t>(kicking_team_)].push_back(outcome);
+  log("shot_over", kicking_team_, striker_, why);
+  enter(gc::State::Finished, "shoot-out kick over");
+  decideShootout();
+}
+
+void Game::decideShootout() {
+  const int a = first_shooter_, b = 1 - first_shooter_;
+  const int k = shootout_kicks_;
+  auto goals = [&](int t, int upto) {
+    int g = 0;
+    const auto& o = outcomes_[static_cast<size_t>(t)];
+    for (int i = 0; i < std::min(upto, static_cast<int>(o.size())); ++i)
+      g += o[static_cast<size_t>(i)] == ShotOutcome::Goal;
+    return g;
+  };
+  const int na = static_cast<int>(outcomes_[static_cast<size_t>(a)].size());
+  const int nb = static_cast<int>(outcomes_[static_cast<size_t>(b)].size());
+  auto decide = [&](int team, const std::string& why) {
+    winner_ = team;
+    game_over_ = true;
+    log("game_over", team, 0, "team " + std::to_string(team) + " wins the shoot-out (" + why + ")");
+  };
+  if (na <= k && nb <= k) {
+    // Regular kicks: decided once a team can no longer catch up.
+    const int ga = goals(a, k), gb = goals(b, k);
+    if (ga > gb + (k - nb)) return decide(a, std::to_string(ga) + ":" + std::to_string(gb));
+    if (gb > ga + (k - na)) return decide(b, std::to_string(gb) + ":" + std::to_string(ga));
+    if (na < k || nb < k) return;
+    if (!rules_.sudden_death) {
+      game_over_ = true;
+      log("game_over", -1, 0, "draw after the shoot-out");
+      return;
+    }
+    return;  // level: sudden death
+  }
+  // Sudden death: a round is complete when both kicked; the better category wins.
+  if (na != nb) return;
+  const int round = na - k;
+  const ShotOutcome oa = outcomes_[static_cast<size_t>(a)].back();
+  const ShotOutcome ob = outcomes_[static_cast<size_t>(b)].back();
+  if (oa != ob)
+    return decide(oa < ob ? a : b, std::string("sudden death: ") + shotOutcomeName(oa) + " vs " +
+                                       shotOutcomeName(ob));
+  if (round >= rules_.sudden_death_rounds) {
+    // A coin toss; mt19937_64's sequence is fixed by the standard, so the
+    // same seed gives the same coin on every platform.
+    std::mt19937_64 coin(coin_seed_);
+    return decide((coin() & 1u) ? b : a, "coin toss");
+  }
+}
+
 void Game::standby() {
+  if (phase_ == gc::GamePhase::PenaltyShoot) throw std::logic_error("no Standby in the shoot-out");
   if (state_ != gc::State::Initial && phase_ != gc::GamePhase::Timeout)
     throw std::logic_error("Standby comes from Initial or a timeout");
   phase_ = gc::GamePhase::Normal;
@@ -237,6 +389,8 @@ void Game::startKickOff(int team, const std::string& why) {
 }
 
 void Game::ready() {
+  if (phase_ == gc::GamePhase::PenaltyShoot)
+    throw std::logic_error("the shoot-out goes kick by kick (shootoutKick)");
   if (state_ != gc::State::Initial && state_ != gc::State::Standby &&
       phase_ != gc::GamePhase::Timeout)
     throw std::logic_error("Ready comes from Initial, Standby or a timeout");
@@ -252,6 +406,11 @@ void Game::set() {
 
 void Game::playing() {
   if (state_ != gc::State::Set) throw std::logic_error("Playing comes from Set");
+  if (phase_ == gc::GamePhase::PenaltyShoot) {
+    secondary_ = 0.0;
+    enter(gc::State::Playing, "shoot-out kick");
+    return;
+  }
   half_started_ = true;
   enter(gc::State::Playing, "");
   if (set_play_ == gc::SetPlay::PenaltyKick) {
@@ -268,6 +427,15 @@ void Game::playing() {
 void Game::goal(int team) {
   if (team != 0 && team != 1) throw std::invalid_argument("goal: team 0 or 1");
   if (state_ != gc::State::Playing) throw std::logic_error("goals count in Playing");
+  if (phase_ == gc::GamePhase::PenaltyShoot) {
+    if (team != kicking_team_) throw std::logic_error("in the shoot-out only the kicking team scores");
+    ++score_[static_cast<size_t>(team)];
+    single_shots_[static_cast<size_t>(team)] |=
+        static_cast<uint16_t>(1u << std::min(15, shots_[static_cast<size_t>(team)] - 1));
+    log("goal", team, striker_, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
+    endShot(ShotOutcome::Goal, "goal");
+    return;
+  }
   ++score_[static_cast<size_t>(team)];
   log("goal", team, 0, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
   if (rules_.mercy_goal_difference > 0 &&
@@ -276,6 +444,7 @@ void Game::goal(int team) {
     set_play_ = gc::SetPlay::None;
     enter(gc::State::Finished, "mercy rule");
     game_over_ = true;
+    winner_ = team;
     log("game_over", -1, 0, "mercy rule");
     return;
   }
@@ -349,6 +518,7 @@ void Game::unpenalise(int team, int number) {
 }
 
 void Game::timeout(std::optional<int> team) {
+  if (phase_ == gc::GamePhase::PenaltyShoot) throw std::logic_error("no timeouts in the shoot-out");
   if (state_ == gc::State::Finished) throw std::logic_error("no timeout after the game");
   if (team) {
     if (*team != 0 && *team != 1) throw std::invalid_argument("timeout: team 0 or 1");
@@ -407,6 +577,16 @@ ControlData Game::packet(uint8_t packet_number) const {
     info.goalkeeper_colour = setup.goalkeeper_colour;
     info.goalkeeper = setup.goalkeeper;
     info.score = static_cast<uint8_t>(score_[static_cast<size_t>(t)]);
+    if (phase_ == gc::GamePhase::PenaltyShoot) {
+      info.penalty_shot = static_cast<uint8_t>(shots_[static_cast<size_t>(t)]);
+      info.single_shots = single_shots_[static_cast<size_t>(t)];
+      // The keeper of this kick; a team without one shows its lowest substitute (as GC3).
+      uint8_t gk = 0;
+      if (t != kicking_team_ && keeper_ > 0) gk = static_cast<uint8_t>(keeper_);
+      for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers) && gk == 0; ++n)
+        if (player(t, n).penalty == gc::Penalty::Substitute) gk = static_cast<uint8_t>(n);
+      if (striker_ > 0) info.goalkeeper = gk;
+    }
     info.message_budget = 1200;
     for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n) {
       const Player& p = player(t, n);

@@ -37,6 +37,7 @@ struct RuleBook {
   int shootout_kicks = 3;
   double shootout_shot_duration = 30;
   bool sudden_death = true;
+  int sudden_death_rounds = 3;  // then a coin decides
 };
 
 // Reads and checks a rule book; throws engine::ConfigError (file, key, reason).
@@ -58,6 +59,11 @@ struct RefereeEvent {
 };
 
 enum class Half { First, Second, PenaltyShootout };
+
+// How a shoot-out kick ended, best first: the rules rank sudden-death kicks
+// by these categories.
+enum class ShotOutcome : uint8_t { Goal, Saved, Post, Wide, Other, NoKick };
+const char* shotOutcomeName(ShotOutcome o);
 
 class Game {
  public:
@@ -84,6 +90,27 @@ class Game {
   void timeout(std::optional<int> team);  // a team timeout, or a referee timeout (nullopt)
   void dropBall();  // restart without a kicking team (after a global game stuck)
   void substitute(int team, int player_out, int player_in);
+
+  // --- penalty shoot-out (spl-rules.md section 6) ---------------------------------------
+  // Starts the shoot-out: after a drawn game, or from Initial before any
+  // kick-off as a stand-alone penalty-kick scenario (`kicks_per_team`
+  // overrides the rule book's). `first_team` shoots first; `coin_seed` seeds
+  // the coin that decides after the last sudden-death round.
+  void startShootout(int first_team, std::optional<int> kicks_per_team = std::nullopt,
+                     uint64_t coin_seed = 0);
+  // The next kick (-> Set): the kicking team's striker and the other team's
+  // keeper (0: none); every other robot becomes a substitute.
+  void shootoutKick(int striker, int keeper);
+  void shotKicked();                     // the striker touched the ball (time-out: Other, not NoKick)
+  void finishShot(ShotOutcome outcome);  // the kick ended without a goal (goals: goal())
+  int shotsTaken(int team) const { return shots_[static_cast<size_t>(team)]; }
+  const std::vector<ShotOutcome>& shotOutcomes(int team) const {
+    return outcomes_[static_cast<size_t>(team)];
+  }
+  std::optional<int> winner() const { return winner_; }  // once the game (or shoot-out) is decided
+  bool shootoutOpen() const { return phase_ == gc::GamePhase::PenaltyShoot && !game_over_; }
+  int shootoutStriker() const { return striker_; }
+  int shootoutKeeper() const { return keeper_; }
 
   // --- state ----------------------------------------------------------------------------
   gc::State state() const { return state_; }
@@ -120,6 +147,8 @@ class Game {
   void enter(gc::State s, const std::string& why);
   void startKickOff(int team, const std::string& why);  // -> Ready, kick-off for `team`
   void endHalf();
+  void endShot(ShotOutcome outcome, const std::string& why);
+  void decideShootout();
   void log(const std::string& type, int team, int player, const std::string& detail);
   bool halfClockRuns() const;
   Player& player(int team, int number);
@@ -141,6 +170,14 @@ class Game {
   std::array<int, 2> incremental_{};  // incremental penalties so far, per team
   std::array<int, 2> timeouts_left_{1, 1};
   double half_clock_ = 0.0, secondary_ = 0.0, time_ = 0.0;
+  // Shoot-out.
+  int first_shooter_ = 0, shootout_kicks_ = 3, striker_ = 0, keeper_ = 0;
+  bool shot_kicked_ = false;
+  uint64_t coin_seed_ = 0;
+  std::array<int, 2> shots_{};
+  std::array<uint16_t, 2> single_shots_{};
+  std::array<std::vector<ShotOutcome>, 2> outcomes_;
+  std::optional<int> winner_;
   std::array<std::array<Player, gc::kMaxPlayers>, 2> players_{};
   std::vector<RefereeEvent> events_;
 };
