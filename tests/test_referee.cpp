@@ -281,3 +281,68 @@ TEST(Referee, GameStuckLocalThenGlobal) {
   EXPECT_EQ(count(g, "drop_ball"), 1);
   EXPECT_EQ(g.kickingTeam(), -1);
 }
+
+namespace {
+
+// Sets the ball rolling from where it lies.
+void shoot(world::World& w, double vx, double vy) {
+  engine::RigidBodyState b = w.ballState();
+  b.linear_velocity = Vec3(vx, vy, 0.0);
+  b.angular_velocity = Vec3::Zero();
+  w.setBallState(b);
+}
+
+}  // namespace
+
+TEST(Referee, ShootoutKicksOnTheRealWorld) {
+  world::World w(twoVsTwo());
+  RefereeConfig cfg;
+  cfg.set_duration = 1.0;
+  Referee ref(w, spl(), teams(), 0, cfg);
+  Game& g = ref.game();
+  g.startShootout(0, 2);  // a penalty-kick scenario: two kicks each, team 0 first
+  const auto& f = w.field();
+
+  // Kick 1: team 0's player 2 against team 1's keeper (player 1): a goal.
+  ref.startShootoutKick(2, 1);
+  run(w, ref, 0.02);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), 3.2, 1e-3);
+  EXPECT_NEAR(w.torsoPose(1).translation().x(), 2.85, 0.05);  // the striker
+  EXPECT_NEAR(w.torsoPose(2).translation().x(), 4.45, 0.05);  // the keeper
+  for (world::RobotId r : {0, 3})  // substitutes off the field
+    EXPECT_GT(std::abs(w.torsoPose(r).translation().y()), f.halfWidth());
+  EXPECT_EQ(g.state(), gc::State::Set);
+  run(w, ref, 1.0);
+  ASSERT_EQ(g.state(), gc::State::Playing);
+  touchBall(w, ref, 1);
+  shoot(w, 4.0, 1.7);  // towards the left half of the goal, past the keeper
+  run(w, ref, 2.0);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  EXPECT_EQ(g.score(0), 1);
+  ASSERT_EQ(g.shotOutcomes(0).size(), 1u);
+  EXPECT_EQ(g.shotOutcomes(0)[0], ShotOutcome::Goal);
+
+  // Kick 2: team 1's player 2 shoots straight at team 0's keeper: saved.
+  ref.startShootoutKick(2, 1);
+  run(w, ref, 1.05);
+  ASSERT_EQ(g.state(), gc::State::Playing);
+  touchBall(w, ref, 3);
+  shoot(w, 3.0, 0.0);
+  run(w, ref, 6.0);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  EXPECT_EQ(g.score(1), 0);
+  ASSERT_EQ(g.shotOutcomes(1).size(), 1u);
+  EXPECT_EQ(g.shotOutcomes(1)[0], ShotOutcome::Saved);
+
+  // Kick 3: team 1's keeper steps off its line before the kick: goal awarded,
+  // and team 1 can no longer catch up (2:0 with one kick left).
+  ref.startShootoutKick(2, 1);
+  run(w, ref, 1.05);
+  ASSERT_EQ(g.state(), gc::State::Playing);
+  w.placeRobot(2, 3.9, 0.0, M_PI);
+  run(w, ref, 0.05);
+  EXPECT_EQ(g.score(0), 2);
+  ASSERT_TRUE(g.winner().has_value());
+  EXPECT_EQ(*g.winner(), 0);
+  EXPECT_EQ(count(g, "game_over"), 1);
+}

@@ -84,6 +84,7 @@ bool Referee::legalKickOffPosition(RobotId r) const {
 }
 
 void Referee::onEnterSet() {
+  if (game_.phase() == gc::GamePhase::PenaltyShoot) return;  // placed by startShootoutKick
   // The ball goes to the centre mark for a kick-off (or the penalty mark).
   const auto& f = world_.field();
   if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick && f.penalty_mark_distance) {
@@ -283,6 +284,111 @@ void Referee::removePenalised() {
   }
 }
 
+void Referee::startShootoutKick(int striker, int keeper) {
+  game_.shootoutKick(striker, keeper);
+  const auto& f = world_.field();
+  const double side = config_.shootout_goal_side >= 0 ? 1.0 : -1.0;
+  const double mark = side * (f.halfLength() - f.penalty_mark_distance.value_or(1.3));
+  placeBall(mark, 0.0);
+  const int team = game_.kickingTeam();
+  if (const auto r = robot(team, striker)) {
+    world_.placeRobot(*r, mark - side * 0.35, 0.0, side > 0 ? 0.0 : M_PI);
+    parked_[*r] = false;
+  }
+  if (keeper > 0) {
+    if (const auto r = robot(1 - team, keeper)) {
+      world_.placeRobot(*r, side * (f.halfLength() - 0.05), 0.0, side > 0 ? M_PI : 0.0);
+      parked_[*r] = false;
+    }
+  }
+  removePenalised();  // the substitutes leave at once
+  shot_start_step_ = world_.stepCount();
+  shot_seen_touch_step_ = shot_start_step_;
+  striker_touched_ = keeper_touched_ = hit_post_ = false;
+  ball_still_for_ = 0.0;
+}
+
+void Referee::checkShot() {
+  const auto& f = world_.field();
+  const double side = config_.shootout_goal_side >= 0 ? 1.0 : -1.0;
+  const double dt = world_.scenario().physics.control_period;
+  const int kicking = game_.kickingTeam();
+  const auto striker = robot(kicking, game_.shootoutStriker());
+  const auto keeper = game_.shootoutKeeper() > 0 ? robot(1 - kicking, game_.shootoutKeeper())
+                                                 : std::nullopt;
+  const engine::RigidBodyState b = world_.ballState();
+  const Vec3 p = b.pose.translation();
+  const double r = f.ball.radius;
+  const double x = side * p.x();  // towards the goal
+
+  // Who touched the ball since the last look.
+  const auto touch = world_.lastBallTouch();
+  if (touch && touch->step > shot_seen_touch_step_) {
+    shot_seen_touch_step_ = touch->step;
+    if (striker && touch->robot == *striker) {
+      if (!striker_touched_) {
+        striker_touched_ = true;
+        first_touch_ball_ = p;
+        game_.shotKicked();
+      } else if ((p - first_touch_ball_).head<2>().norm() > config_.ball_replayed) {
+        game_.recordEvent("shot", kicking, game_.shootoutStriker(), "striker played the ball again");
+        return game_.finishShot(keeper_touched_ ? ShotOutcome::Saved : ShotOutcome::Other);
+      }
+    } else if (keeper && touch->robot == *keeper && striker_touched_) {
+      keeper_touched_ = true;
+    }
+  }
+
+  // The keeper touches the goal line and stays on its feet until the kick.
+  if (keeper && !striker_touched_) {
+    const double from_line = std::abs(side * f.halfLength() - world_.torsoPose(*keeper).translation().x());
+    if (!world_.isStanding(*keeper) || from_line > config_.keeper_line_tolerance) {
+      game_.recordEvent("shot", 1 - kicking, game_.shootoutKeeper(),
+                        "keeper left the goal line or fell before the kick: goal awarded");
+      game_.goal(kicking);
+      return;
+    }
+  }
+
+  // A goal: the whole ball over the line between the posts, under the bar.
+  const double line = 0.5 * f.line_width;
+  if (x > f.halfLength() + line + r) {
+    if (std::abs(p.y()) < 0.5 * f.goal.inner_width && p.z() < f.goal.clear_height) {
+      game_.goal(kicking);
+      return;
+    }
+  }
+  // Off a post: the ball came within touching distance of one.
+  const double post_r = 0.5 * f.goal.post_diameter;
+  for (double py : {-1.0, 1.0}) {
+    const Vec3 post(side * f.halfLength(), py * (0.5 * f.goal.inner_width + post_r), 0.0);
+    if ((p - post).head<2>().norm() <= r + post_r + 0.005) hit_post_ = true;
+  }
+  if (!striker_touched_) return;  // the shot clock ends a kick that never comes
+
+  const auto outcome = [&] {
+    if (keeper_touched_) return ShotOutcome::Saved;
+    if (hit_post_) return ShotOutcome::Post;
+    if (x > f.halfLength() + line + r) return ShotOutcome::Wide;
+    return ShotOutcome::Other;
+  };
+  // Out of the penalty area (over the goal line, or back into the field).
+  const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
+  if (x > f.halfLength() + line + r || x < f.halfLength() - area.length - r ||
+      std::abs(p.y()) > 0.5 * area.width + r) {
+    game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball left the penalty area");
+    return game_.finishShot(outcome());
+  }
+  // The ball came to a stop after the striker's touch.
+  ball_still_for_ = b.linear_velocity.head<2>().norm() < config_.ball_stopped_speed
+                        ? ball_still_for_ + dt
+                        : 0.0;
+  if (ball_still_for_ >= config_.ball_stopped_time) {
+    game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball stopped");
+    return game_.finishShot(outcome());
+  }
+}
+
 void Referee::update() {
   const double dt = world_.scenario().physics.control_period;
   game_.advance(dt);
@@ -303,7 +409,16 @@ void Referee::update() {
     time_in_state_ += dt;
   }
 
-  if (!game_.gameOver()) {
+  if (game_.phase() == gc::GamePhase::PenaltyShoot) {
+    if (game_.shootoutOpen() && s == gc::State::Set && config_.set_duration > 0 &&
+        time_in_state_ >= config_.set_duration) {
+      game_.playing();
+      last_state_ = game_.state();
+      time_in_state_ = 0.0;
+    } else if (game_.shootoutOpen() && s == gc::State::Playing) {
+      checkShot();
+    }
+  } else if (!game_.gameOver()) {
     checkPenalties();
     if (s == gc::State::Ready) {
       // Ready ends early when every robot in play stands still in a legal place.

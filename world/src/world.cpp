@@ -190,7 +190,7 @@ void World::step() {
   physics_->linkContacts(contacts_);
   for (const engine::LinkContact& c : contacts_)
     if (c.other_body == static_cast<int>(ball_) && c.articulation < robots_.size())
-      last_touch_ = BallTouch{static_cast<RobotId>(c.articulation), physics_->stepCount()};
+      last_touch_ = BallTouch{static_cast<RobotId>(c.articulation), c.link, physics_->stepCount()};
   if (!scenario_.sensors.enabled) return;
   sensors_->afterStep(*physics_, contacts_);
   const uint64_t steps = physics_->stepCount();

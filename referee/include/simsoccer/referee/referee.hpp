@@ -23,6 +23,12 @@ struct RefereeConfig {
   double ball_moved = 0.05;       // m: the kicking team moved the ball clearly
   double stuck_progress = 0.3;    // m the ball must move within the game-stuck time
   double stuck_radius = 0.5;      // m: a robot this close to a stuck ball is penalised (local)
+  // Penalty shoot-out.
+  int shootout_goal_side = 1;          // all kicks at the goal at x = side * length / 2
+  double ball_stopped_speed = 0.02;    // m/s: the ball has come to a stop ...
+  double ball_stopped_time = 0.5;      // ... for this long
+  double keeper_line_tolerance = 0.3;  // m: the keeper's torso this far from the goal line left it
+  double ball_replayed = 0.3;          // m: the striker touching it again after this ends the kick
 };
 
 class Referee {
@@ -37,6 +43,12 @@ class Referee {
 
   // The world's robot for (team, player number), if there is one.
   std::optional<world::RobotId> robot(int team, int number) const;
+  // The next shoot-out kick (Game::shootoutKick) with the world put in
+  // place: ball on the penalty mark, the striker 0.35 m behind it at the
+  // penalty area's edge facing the goal, the keeper on the goal line; the
+  // other robots leave the field as substitutes.
+  void startShootoutKick(int striker, int keeper);
+
   // Where a penalised robot of `team` waits: 0.5 m outside the touchline,
   // level with its own half's penalty mark, facing the field.
   world::Pose penaltySpot(int team, int index) const;
@@ -48,6 +60,7 @@ class Referee {
   void checkSetPlayOver();
   void checkPenalties();
   void checkGameStuck();
+  void checkShot();
   void onEnterSet();
   bool legalKickOffPosition(world::RobotId r) const;
   bool inOwnGoalArea(world::RobotId r) const;
@@ -69,6 +82,11 @@ class Referee {
   std::vector<bool> parked_;
   engine::Vec3 stuck_ball_ = engine::Vec3::Zero();
   double stuck_for_ = 0.0;
+  // The running shoot-out kick.
+  uint64_t shot_start_step_ = 0, shot_seen_touch_step_ = 0;
+  bool striker_touched_ = false, keeper_touched_ = false, hit_post_ = false;
+  engine::Vec3 first_touch_ball_ = engine::Vec3::Zero();
+  double ball_still_for_ = 0.0;
 };
 
 }  // namespace simsoccer::referee

@@ -46,6 +46,7 @@ struct RobotState {
 // The last robot that touched the ball.
 struct BallTouch {
   RobotId robot = 0;
+  int link = 0;       // the robot's link that touched it (model link index)
   uint64_t step = 0;  // physics step of the touch
 };
 
