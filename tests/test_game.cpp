@@ -4,9 +4,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/referee/game.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "test_support.hpp"
 
 using namespace simsoccer;
@@ -379,4 +381,54 @@ TEST(Game, ShotClockRunsOnlyInPlayingAndEndsTheKick) {
   Game h(spl(), teams(), 0);
   h.ready();
   EXPECT_THROW(h.startShootout(0), std::logic_error);
+}
+
+TEST(GameControllerLink, BroadcastsAt2HzOfSimTimeAndTakesReturnPackets) {
+  UdpReceiver robot(0, "127.0.0.1");  // a robot listening for the GameController
+  GameControllerLinkConfig cfg;
+  cfg.address = "127.0.0.1";
+  cfg.control_port = robot.port();
+  cfg.return_port = 0;
+  cfg.return_bind = "127.0.0.1";
+  GameControllerLink link(cfg);
+  Game g(spl(), teams(), 0);
+  g.ready();
+  for (int i = 0; i < 200; ++i) {  // 2 s in 10 ms control periods
+    g.advance(0.01);
+    link.update(g);
+  }
+  EXPECT_EQ(link.packetsSent(), 4u);  // t = 0.01, 0.51, 1.01, 1.51
+  std::array<uint8_t, 512> buf{};
+  for (uint8_t n = 0; n < 4; ++n) {
+    const size_t size = robot.receive(buf, 2.0);
+    ASSERT_EQ(size, kControlSize);
+    const ControlData d = decodeControl(std::span<const uint8_t>(buf.data(), size));
+    EXPECT_EQ(d.packet_number, n);
+    EXPECT_EQ(d.state, static_cast<uint8_t>(gc::State::Ready));
+    EXPECT_EQ(d.kicking_team, 13);
+    EXPECT_EQ(d.secondary_time, 45 - n / 2);  // the Ready countdown, rounded up
+  }
+  EXPECT_EQ(robot.receive(buf, 0.05), 0u);
+
+  // Return packets: a valid one, one from a team that is not playing, junk.
+  UdpSender to_gc("127.0.0.1", link.returnPort());
+  ReturnData r;
+  r.team_num = 5;
+  r.player_num = 3;
+  r.fallen = 1;
+  to_gc.send(encode(r));
+  r.team_num = 99;
+  to_gc.send(encode(r));
+  const std::array<uint8_t, 7> junk = {'R', 'G', 'r', 't', 4, 1, 2};
+  to_gc.send(junk);
+  for (int i = 0; i < 100 && link.returnsAccepted() + link.returnsRejected() < 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    g.advance(0.01);
+    link.update(g);
+  }
+  EXPECT_EQ(link.returnsAccepted(), 1u);
+  EXPECT_EQ(link.returnsRejected(), 2u);
+  ASSERT_TRUE(link.lastReturn(5, 3).has_value());
+  EXPECT_EQ(link.lastReturn(5, 3)->fallen, 1);
+  EXPECT_FALSE(link.lastReturn(99, 3).has_value());
 }

@@ -1,0 +1,59 @@
+// The simulator as a GameController on the network: the referee's game
+// state broadcast as RoboCupGameControlData every 0.5 s to port 3838, and
+// RoboCupGameControlReturnData received on port 3939, so robot software
+// written against the real GameController runs against the simulator.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "simsoccer/referee/game.hpp"
+#include "simsoccer/referee/gamecontroller.hpp"
+
+namespace simsoccer::referee {
+
+struct GameControllerLinkConfig {
+  std::string address = "255.255.255.255";  // where control packets go (tests: 127.0.0.1)
+  uint16_t control_port = 3838;
+  uint16_t return_port = 3939;  // 0: any free port (tests)
+  std::string return_bind = "0.0.0.0";
+  double period = 0.5;  // s of simulated time between control packets (GC3: 500 ms)
+};
+
+class GameControllerLink {
+ public:
+  explicit GameControllerLink(const GameControllerLinkConfig& config);  // throws on socket errors
+
+  // Once per control period: sends the game's packet when `period` of
+  // simulated time has passed since the last one (the first at once), and
+  // takes in the return packets waiting. Never blocks and never throws for
+  // what arrives: malformed return packets are counted and dropped.
+  void update(const Game& game);
+
+  uint16_t returnPort() const;
+  uint64_t packetsSent() const { return sent_; }
+  uint64_t returnsAccepted() const { return accepted_; }
+  uint64_t returnsRejected() const { return rejected_; }
+  const std::string& lastReturnError() const { return last_error_; }
+  // The latest valid return packet from (team number, player number).
+  std::optional<ReturnData> lastReturn(uint8_t team_number, uint8_t player) const;
+
+ private:
+  void receiveReturns(const ControlData& current);
+
+  GameControllerLinkConfig config_;
+  std::unique_ptr<UdpSender> sender_;
+  std::unique_ptr<UdpReceiver> receiver_;
+  uint8_t packet_number_ = 0;  // wraps from 255 to 0
+  double next_send_ = 0.0;
+  bool sent_any_ = false;
+  uint64_t sent_ = 0, accepted_ = 0, rejected_ = 0;
+  std::string last_error_;
+  std::map<std::pair<uint8_t, uint8_t>, ReturnData> returns_;  // ordered: deterministic iteration
+};
+
+}  // namespace simsoccer::referee
