@@ -309,7 +309,7 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
   EXPECT_NEAR(w.ballState().pose.translation().x(), 3.2, 1e-3);
   EXPECT_NEAR(w.torsoPose(1).translation().x(), 2.85, 0.05);  // the striker
   EXPECT_NEAR(w.torsoPose(2).translation().x(), 4.45, 0.05);  // the keeper
-  for (world::RobotId r : {0, 3})  // substitutes off the field
+  for (world::RobotId r : {0, 3})                             // substitutes off the field
     EXPECT_GT(std::abs(w.torsoPose(r).translation().y()), f.halfWidth());
   EXPECT_EQ(g.state(), gc::State::Set);
   run(w, ref, 1.0);
@@ -345,4 +345,53 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
   ASSERT_TRUE(g.winner().has_value());
   EXPECT_EQ(*g.winner(), 0);
   EXPECT_EQ(count(g, "game_over"), 1);
+}
+
+TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  g.ballFree();
+  // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other.
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.8, -2.0, M_PI);
+  putBall(w, 0.6, -1.5);
+  run(w, ref, 0.5);
+  // Standing face to face without driving: nothing.
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  // Robot 1 drives into robot 3.
+  for (int i = 0; i < 200 && g.penalty(0, 2) == gc::Penalty::None; ++i) {
+    w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
+    run(w, ref, 0.01);
+  }
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);  // the pushed robot
+  EXPECT_EQ(count(g, "pushing"), 1);
+  // The ball was within 1 m: a pushing free kick for the other team.
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
+  EXPECT_EQ(g.kickingTeam(), 1);
+}
+
+TEST(Referee, BallContactWithAnArm) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  g.ballFree();
+  auto ballOnHand = [&](world::RobotId r) {
+    const int hand = w.robot(r).model->body->linkIndex("LWrist");
+    const engine::Pose p = w.linkPose(r, hand);
+    putBall(w, p.translation().x(), p.translation().y() + 0.07, p.translation().z());
+    run(w, ref, 0.1);
+  };
+  // The goalkeeper (player 1) in its own penalty area may.
+  ballOnHand(0);
+  EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);
+  // A field player may not: penalised, the ball put back on the ground there.
+  ballOnHand(1);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::IllegalBallContact);
+  EXPECT_EQ(count(g, "ball_contact"), 1);
 }

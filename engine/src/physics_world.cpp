@@ -661,6 +661,7 @@ void PhysicsWorld::linkContacts(std::vector<LinkContact>& out) const {
         lc.impulse = pt.getAppliedImpulse();
         lc.with_articulation = is_link[1 - side];
         const btCollisionObject* other = bodies[1 - side];
+        if (lc.with_articulation) lc.other_articulation = other->getUserIndex3();
         if (other->getUserIndex3() == kRigidBodyTag) lc.other_body = other->getUserIndex2();
         out.push_back(lc);
       }

@@ -47,7 +47,8 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   r.illegal_position_in_set = p["illegal_position_in_set"].positive();
   r.motion_in_set = p["motion_in_set"].positive();
   const ConfigNode s = root["shootout"];
-  s.allowOnly({"enabled", "kicks_per_team", "shot_duration", "sudden_death", "sudden_death_rounds"});
+  s.allowOnly(
+      {"enabled", "kicks_per_team", "shot_duration", "sudden_death", "sudden_death_rounds"});
   r.shootout = s["enabled"].boolean();
   r.shootout_kicks = s["kicks_per_team"].integer();
   if (r.shootout_kicks < 1) s.failKey("kicks_per_team", "must be >= 1");
@@ -310,10 +311,13 @@ void Game::shootoutKick(int striker, int keeper) {
   enter(gc::State::Set, "shoot-out kick");
 }
 
-void Game::shotKicked() { shot_kicked_ = true; }
+void Game::shotKicked() {
+  shot_kicked_ = true;
+}
 
 void Game::finishShot(ShotOutcome outcome) {
-  if (outcome == ShotOutcome::Goal) throw std::invalid_argument("a scored kick goes through goal()");
+  if (outcome == ShotOutcome::Goal)
+    throw std::invalid_argument("a scored kick goes through goal()");
   if (phase_ != gc::GamePhase::PenaltyShoot || state_ != gc::State::Playing)
     throw std::logic_error("no shoot-out kick is running");
   endShot(outcome, shotOutcomeName(outcome));
@@ -428,7 +432,8 @@ void Game::goal(int team) {
   if (team != 0 && team != 1) throw std::invalid_argument("goal: team 0 or 1");
   if (state_ != gc::State::Playing) throw std::logic_error("goals count in Playing");
   if (phase_ == gc::GamePhase::PenaltyShoot) {
-    if (team != kicking_team_) throw std::logic_error("in the shoot-out only the kicking team scores");
+    if (team != kicking_team_)
+      throw std::logic_error("in the shoot-out only the kicking team scores");
     ++score_[static_cast<size_t>(team)];
     single_shots_[static_cast<size_t>(team)] |=
         static_cast<uint16_t>(1u << std::min(15, shots_[static_cast<size_t>(team)] - 1));
@@ -550,6 +555,9 @@ void Game::substitute(int team, int out, int in) {
     throw std::logic_error("the incoming player is already in play");
   leaving = Player{gc::Penalty::Substitute, 0.0};
   coming = Player{};
+  // The goalkeeper role goes to the incoming player (GC3).
+  TeamSetup& setup = teams_[static_cast<size_t>(team)];
+  if (setup.goalkeeper == out) setup.goalkeeper = static_cast<uint8_t>(in);
   log("substitute", team, in, "for player " + std::to_string(out));
 }
 

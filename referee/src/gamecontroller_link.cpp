@@ -8,10 +8,13 @@ GameControllerLink::GameControllerLink(const GameControllerLinkConfig& config)
     : config_(config),
       sender_(std::make_unique<UdpSender>(config.address, config.control_port)),
       receiver_(std::make_unique<UdpReceiver>(config.return_port, config.return_bind)) {
-  if (!(config.period > 0.0)) throw std::invalid_argument("GameController link: period must be > 0");
+  if (!(config.period > 0.0))
+    throw std::invalid_argument("GameController link: period must be > 0");
 }
 
-uint16_t GameControllerLink::returnPort() const { return receiver_->port(); }
+uint16_t GameControllerLink::returnPort() const {
+  return receiver_->port();
+}
 
 void GameControllerLink::update(const Game& game) {
   const ControlData current = game.packet(packet_number_);
@@ -43,7 +46,8 @@ void GameControllerLink::receiveReturns(const ControlData& current) {
   }
 }
 
-std::optional<ReturnData> GameControllerLink::lastReturn(uint8_t team_number, uint8_t player) const {
+std::optional<ReturnData> GameControllerLink::lastReturn(uint8_t team_number,
+                                                         uint8_t player) const {
   const auto it = returns_.find({team_number, player});
   if (it == returns_.end()) return std::nullopt;
   return it->second;

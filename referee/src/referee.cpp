@@ -14,6 +14,17 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
   fallen_for_.assign(world.robotCount(), 0.0);
   in_goal_area_since_.assign(world.robotCount(), -1.0);
   parked_.assign(world.robotCount(), false);
+  contact_for_.assign(world.robotCount() * world.robotCount(), 0.0);
+  contact_gap_.assign(world.robotCount() * world.robotCount(), 1e9);
+  contact_start_.assign(2 * world.robotCount() * world.robotCount(), Vec3::Zero());
+  for (RobotId r = 0; r < world.robotCount(); ++r) {
+    const auto& links = world.robot(r).model->body->links;
+    std::vector<char> arm(links.size(), 0);
+    for (size_t l = 0; l < links.size(); ++l)
+      for (const char* part : {"Shoulder", "Biceps", "Elbow", "ForeArm", "Wrist", "Hand"})
+        if (links[l].name.find(part) != std::string::npos) arm[l] = 1;
+    arm_link_.push_back(std::move(arm));
+  }
   stuck_ball_ = world.ballState().pose.translation();
 }
 
@@ -68,6 +79,110 @@ double Referee::depthInOwnGoalArea(RobotId r) const {
   const double x = teamSign(world_.robot(r).team) * p.x();
   // The goal line side is not a border one leaves by: robots may stand in the goal.
   return std::min(x - (f.halfLength() - area->length), 0.5 * area->width - std::abs(p.y()));
+}
+
+bool Referee::inOwnPenaltyArea(RobotId r) const {
+  const auto& f = world_.field();
+  const auto area = f.penalty_area ? f.penalty_area : f.goal_area;
+  if (!area) return false;
+  const Vec3 p = world_.torsoPose(r).translation();
+  const double x = teamSign(world_.robot(r).team) * p.x();
+  return x >= f.halfLength() - area->length && x <= f.halfLength() + f.goal.depth &&
+         std::abs(p.y()) <= 0.5 * area->width;
+}
+
+void Referee::checkPushing() {
+  const size_t n = world_.robotCount();
+  const double dt = world_.scenario().physics.control_period;
+  std::vector<char> touching(n * n, 0);
+  for (const engine::LinkContact& c : world_.contacts()) {
+    if (c.other_articulation < 0) continue;
+    const size_t a = std::min<size_t>(c.articulation, static_cast<size_t>(c.other_articulation));
+    const size_t b = std::max<size_t>(c.articulation, static_cast<size_t>(c.other_articulation));
+    if (a == b || b >= n || world_.robot(a).team == world_.robot(b).team) continue;
+    touching[a * n + b] = 1;
+  }
+  for (RobotId a = 0; a < n; ++a)
+    for (RobotId b = a + 1; b < n; ++b) {
+      const size_t k = a * n + b;
+      double& t = contact_for_[k];
+      if (!touching[k]) {
+        // A contact episode lasts through short gaps (a shove bounces).
+        contact_gap_[k] += dt;
+        if (contact_gap_[k] > config_.push_gap) t = 0.0;
+        if (t == 0.0) continue;
+      } else {
+        if (t == 0.0) {  // a new contact
+          contact_start_[2 * k] = world_.torsoPose(a).translation();
+          contact_start_[2 * k + 1] = world_.torsoPose(b).translation();
+        }
+        contact_gap_[k] = 0.0;
+        t += dt;
+      }
+      const auto& ia = world_.robot(a);
+      const auto& ib = world_.robot(b);
+      if (game_.penalty(ia.team, ia.number) != gc::Penalty::None ||
+          game_.penalty(ib.team, ib.number) != gc::Penalty::None)
+        continue;
+      // Who drives into whom: the horizontal speed towards the other.
+      const Vec3 pa = world_.torsoPose(a).translation(), pb = world_.torsoPose(b).translation();
+      Vec3 ab = pb - pa;
+      ab.z() = 0.0;
+      if (ab.norm() < 1e-6) continue;
+      ab.normalize();
+      const double va = world_.physics().rootLinearVelocity(ia.body).dot(ab);
+      const double vb = -world_.physics().rootLinearVelocity(ib.body).dot(ab);
+      const RobotId pusher = va >= vb ? a : b, victim = pusher == a ? b : a;
+      const double speed = std::max(va, vb);
+      const auto& ip = world_.robot(pusher);
+      const auto& iv = world_.robot(victim);
+      // The exceptions the rules list that a world model can see: a
+      // stationary robot, one getting up, the goalkeeper in its own area.
+      if (speed < config_.push_speed || !world_.isStanding(pusher)) continue;
+      if (game_.goalkeeper(ip.team) == ip.number && inOwnPenaltyArea(pusher)) continue;
+      const bool fell = !world_.isStanding(victim);
+      const Vec3 shoved =
+          world_.torsoPose(victim).translation() - contact_start_[2 * k + (victim == a ? 0 : 1)];
+      const bool displaced = shoved.dot(pusher == a ? ab : Vec3(-ab)) >= config_.push_displacement;
+      if (t < config_.push_time && !fell && !displaced) continue;
+      t = 0.0;
+      contact_gap_[k] = 1e9;
+      game_.penalise(ip.team, ip.number, gc::Penalty::PlayerPushing);
+      game_.recordEvent("pushing", ip.team, ip.number,
+                        "pushed team " + std::to_string(iv.team) + " player " +
+                            std::to_string(iv.number) + (fell ? " over" : ""));
+      // Near the ball in open play: a foul, the other team gets a free kick
+      // (a penalty kick when it happened in the pusher's own penalty area).
+      const Vec3 ball = world_.ballState().pose.translation();
+      if (game_.state() == gc::State::Playing && game_.kickingTeam() < 0 &&
+          (ball - (pusher == a ? pa : pb)).head<2>().norm() <= config_.foul_ball_distance) {
+        const bool in_area = inOwnPenaltyArea(pusher);
+        game_.setPlay(in_area ? gc::SetPlay::PenaltyKick : gc::SetPlay::PushingFreeKick, iv.team);
+        set_play_ball_ = ball;
+        set_play_step_ = world_.stepCount();
+      }
+    }
+}
+
+void Referee::checkArmContact() {
+  // Playing with arms: a standing field player (or the goalkeeper outside its
+  // penalty area) touching the ball with an arm. The ball goes back to where
+  // it was touched.
+  const auto touch = world_.lastBallTouch();
+  if (!touch || touch->step <= arm_checked_step_) return;
+  arm_checked_step_ = touch->step;
+  const RobotId r = touch->robot;
+  const auto& arm = arm_link_[r];
+  if (touch->link < 0 || static_cast<size_t>(touch->link) >= arm.size() ||
+      !arm[static_cast<size_t>(touch->link)])
+    return;
+  const auto& info = world_.robot(r);
+  if (game_.penalty(info.team, info.number) != gc::Penalty::None || !world_.isStanding(r)) return;
+  if (game_.goalkeeper(info.team) == info.number && inOwnPenaltyArea(r)) return;
+  game_.penalise(info.team, info.number, gc::Penalty::IllegalBallContact);
+  game_.recordEvent("ball_contact", info.team, info.number, "played the ball with an arm");
+  const Vec3 p = world_.ballState().pose.translation();
+  placeBall(p.x(), p.y());
 }
 
 bool Referee::legalKickOffPosition(RobotId r) const {
@@ -314,8 +429,8 @@ void Referee::checkShot() {
   const double dt = world_.scenario().physics.control_period;
   const int kicking = game_.kickingTeam();
   const auto striker = robot(kicking, game_.shootoutStriker());
-  const auto keeper = game_.shootoutKeeper() > 0 ? robot(1 - kicking, game_.shootoutKeeper())
-                                                 : std::nullopt;
+  const auto keeper =
+      game_.shootoutKeeper() > 0 ? robot(1 - kicking, game_.shootoutKeeper()) : std::nullopt;
   const engine::RigidBodyState b = world_.ballState();
   const Vec3 p = b.pose.translation();
   const double r = f.ball.radius;
@@ -331,7 +446,8 @@ void Referee::checkShot() {
         first_touch_ball_ = p;
         game_.shotKicked();
       } else if ((p - first_touch_ball_).head<2>().norm() > config_.ball_replayed) {
-        game_.recordEvent("shot", kicking, game_.shootoutStriker(), "striker played the ball again");
+        game_.recordEvent("shot", kicking, game_.shootoutStriker(),
+                          "striker played the ball again");
         return game_.finishShot(keeper_touched_ ? ShotOutcome::Saved : ShotOutcome::Other);
       }
     } else if (keeper && touch->robot == *keeper && striker_touched_) {
@@ -341,7 +457,8 @@ void Referee::checkShot() {
 
   // The keeper touches the goal line and stays on its feet until the kick.
   if (keeper && !striker_touched_) {
-    const double from_line = std::abs(side * f.halfLength() - world_.torsoPose(*keeper).translation().x());
+    const double from_line =
+        std::abs(side * f.halfLength() - world_.torsoPose(*keeper).translation().x());
     if (!world_.isStanding(*keeper) || from_line > config_.keeper_line_tolerance) {
       game_.recordEvent("shot", 1 - kicking, game_.shootoutKeeper(),
                         "keeper left the goal line or fell before the kick: goal awarded");
@@ -380,9 +497,8 @@ void Referee::checkShot() {
     return game_.finishShot(outcome());
   }
   // The ball came to a stop after the striker's touch.
-  ball_still_for_ = b.linear_velocity.head<2>().norm() < config_.ball_stopped_speed
-                        ? ball_still_for_ + dt
-                        : 0.0;
+  ball_still_for_ =
+      b.linear_velocity.head<2>().norm() < config_.ball_stopped_speed ? ball_still_for_ + dt : 0.0;
   if (ball_still_for_ >= config_.ball_stopped_time) {
     game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball stopped");
     return game_.finishShot(outcome());
@@ -420,6 +536,7 @@ void Referee::update() {
     }
   } else if (!game_.gameOver()) {
     checkPenalties();
+    if (s == gc::State::Ready || s == gc::State::Set || s == gc::State::Playing) checkPushing();
     if (s == gc::State::Ready) {
       // Ready ends early when every robot in play stands still in a legal place.
       bool all = true;
@@ -440,6 +557,7 @@ void Referee::update() {
       last_state_ = game_.state();
       time_in_state_ = 0.0;
     } else if (s == gc::State::Playing) {
+      checkArmContact();
       checkBall();
       checkSetPlayOver();
       if (game_.state() == gc::State::Playing) checkGameStuck();

@@ -55,6 +55,7 @@ struct LinkContact {
   Vec3 normal = Vec3::Zero();      // unit direction of the normal impulse on the link
   double impulse = 0.0;            // N s applied along `normal` in the last step
   bool with_articulation = false;  // the other body is a link of another articulation
+  int other_articulation = -1;     // ... that articulation's id
   int other_body = -1;             // the other body's BodyId if it is a free rigid body (the ball)
 };
 

@@ -101,7 +101,7 @@ class Game {
   // The next kick (-> Set): the kicking team's striker and the other team's
   // keeper (0: none); every other robot becomes a substitute.
   void shootoutKick(int striker, int keeper);
-  void shotKicked();                     // the striker touched the ball (time-out: Other, not NoKick)
+  void shotKicked();  // the striker touched the ball (time-out: Other, not NoKick)
   void finishShot(ShotOutcome outcome);  // the kick ended without a goal (goals: goal())
   int shotsTaken(int team) const { return shots_[static_cast<size_t>(team)]; }
   const std::vector<ShotOutcome>& shotOutcomes(int team) const {
@@ -127,6 +127,7 @@ class Game {
   gc::Penalty penalty(int team, int player) const;
   // Which team defends the -x goal now (the operator's left).
   int leftTeam() const { return sides_swapped_ ? 1 : 0; }
+  int goalkeeper(int team) const { return teams_[static_cast<size_t>(team)].goalkeeper; }
   const std::vector<RefereeEvent>& events() const { return events_; }
   double time() const { return time_; }
   const RuleBook& rules() const { return rules_; }

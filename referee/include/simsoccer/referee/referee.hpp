@@ -23,6 +23,14 @@ struct RefereeConfig {
   double ball_moved = 0.05;       // m: the kicking team moved the ball clearly
   double stuck_progress = 0.3;    // m the ball must move within the game-stuck time
   double stuck_radius = 0.5;      // m: a robot this close to a stuck ball is penalised (local)
+  // Pushing: sustained contact between opponents in which one drives into
+  // the other, or in which the other falls.
+  double push_time = 1.0;  // s of contact (gaps under push_gap count as one) ...
+  double push_gap = 0.3;   // s
+  double push_displacement =
+      0.15;                 // m ... or the other shoved this far since the contact began ...
+  double push_speed = 0.1;  // m/s: ... while the pusher moves towards the other this fast
+  double foul_ball_distance = 1.0;  // m: pushing this close to the ball in open play is a foul
   // Penalty shoot-out.
   int shootout_goal_side = 1;          // all kicks at the goal at x = side * length / 2
   double ball_stopped_speed = 0.02;    // m/s: the ball has come to a stop ...
@@ -61,6 +69,9 @@ class Referee {
   void checkPenalties();
   void checkGameStuck();
   void checkShot();
+  void checkPushing();
+  void checkArmContact();
+  bool inOwnPenaltyArea(world::RobotId r) const;
   void onEnterSet();
   bool legalKickOffPosition(world::RobotId r) const;
   bool inOwnGoalArea(world::RobotId r) const;
@@ -82,6 +93,12 @@ class Referee {
   std::vector<bool> parked_;
   engine::Vec3 stuck_ball_ = engine::Vec3::Zero();
   double stuck_for_ = 0.0;
+  // Robots x robots (a < b): s in contact, s since the last contact, and
+  // where both stood when the contact began.
+  std::vector<double> contact_for_, contact_gap_;
+  std::vector<engine::Vec3> contact_start_;
+  std::vector<std::vector<char>> arm_link_;  // per robot, per link: an arm
+  uint64_t arm_checked_step_ = 0;
   // The running shoot-out kick.
   uint64_t shot_start_step_ = 0, shot_seen_touch_step_ = 0;
   bool striker_touched_ = false, keeper_touched_ = false, hit_post_ = false;

@@ -106,6 +106,8 @@ class World {
   // or a test); the foot bumpers come from contacts.
   void setTouch(RobotId r, Touch sensor, bool pressed) { sensors_->setTouch(r, sensor, pressed); }
   SensorSystem& sensors() { return *sensors_; }
+  // The robots' link contacts after the last physics step (articulation id = RobotId).
+  const std::vector<engine::LinkContact>& contacts() const { return contacts_; }
 
   WorldSnapshot snapshot() const;
   // 64-bit hash over the full dynamic state and the step count.
