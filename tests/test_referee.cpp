@@ -264,9 +264,26 @@ TEST(Referee, FallenRobotIsPenalisedAsInactive) {
   EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
 }
 
-TEST(Referee, GameStuckLocalThenGlobal) {
+TEST(Referee, StandingIdleNextToTheBallIsInactive) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  g.ballFree();
+  putBall(w, 2.75, 0.05);  // in front of team 1 player 1, who does not move
+  run(w, ref, 9.5);
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);
+  run(w, ref, 1.0);
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::InactivePlayer);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);  // far from the ball
+}
+
+TEST(Referee, GameStuckLocalThenGlobal) {
+  world::World w(twoVsTwo());
+  RefereeConfig cfg;
+  cfg.inactive_time = 1e9;  // the robot at the ball stands still: not an inactive call here
+  Referee ref(w, spl(), teams(), 0, cfg);
   Game& g = ref.game();
   g.ready();
   kickOff(w, ref);
@@ -394,4 +411,98 @@ TEST(Referee, BallContactWithAnArm) {
   ballOnHand(1);
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::IllegalBallContact);
   EXPECT_EQ(count(g, "ball_contact"), 1);
+}
+
+namespace {
+
+bool hasEvent(const Game& g, const std::string& type, const std::string& detail) {
+  for (const auto& e : g.events())
+    if (e.type == type && e.detail.find(detail) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+// A whole (shortened) first half refereed from scripted ball positions on the
+// real world: kick-off, a goal, a kick-in, a corner kick, a goal kick.
+TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
+  RuleBook rules = spl();
+  rules.half_duration = 150.0;  // the rest of the half runs on the clock
+  world::World w(twoVsTwo());
+  Referee ref(w, rules, teams(), 0);
+  Game& g = ref.game();
+  const auto& f = w.field();
+  g.standby();
+  g.ready();
+
+  // Kick-off for team 0 (defends -x); the ball is free once team 0 moves it.
+  kickOff(w, ref);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  EXPECT_NEAR(g.secondaryTime(), 10.0, 0.02);
+  touchBall(w, ref, 1);
+  run(w, ref, 0.05);
+  EXPECT_EQ(g.kickingTeam(), -1);
+
+  // A goal for team 0 in the +x goal: 1:0, Ready with the kick-off for team 1.
+  putBall(w, f.halfLength() + 0.3, 0.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.state(), gc::State::Ready);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  kickOff(w, ref);
+  EXPECT_NEAR(w.ballState().pose.translation().head<2>().norm(), 0.0, 0.01);  // centre mark
+  touchBall(w, ref, 3);
+  run(w, ref, 0.05);
+  EXPECT_EQ(g.kickingTeam(), -1);
+
+  // Team 0 plays it over the touchline: kick-in for team 1 where it left.
+  touchBall(w, ref, 1);
+  putBall(w, 1.0, f.halfWidth() + 0.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), f.halfWidth(), 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), 1.0, 0.05);
+  touchBall(w, ref, 3);  // team 1 takes it
+  run(w, ref, 0.05);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+
+  // Team 0's keeper plays it over its own goal line beside the goal: corner for team 1.
+  touchBall(w, ref, 0);
+  putBall(w, -f.halfLength() - 0.2, 1.5);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::CornerKick);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), -f.halfLength(), 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), f.halfWidth(), 1e-3);
+  // Nobody takes it: the set play ends after its 30 s.
+  run(w, ref, 29.9);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::CornerKick);
+  run(w, ref, 0.2);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+
+  // Team 1 shoots wide of team 0's goal: goal kick for team 0 at the goal area corner.
+  touchBall(w, ref, 2);
+  putBall(w, -f.halfLength() - 0.2, -1.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::GoalKick);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), -f.halfLength() + f.goal_area->length, 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), -0.5 * f.goal_area->width, 1e-3);
+
+  // The half runs out: Finished, 1:0, the events tell the story.
+  run(w, ref, g.secondsRemaining() + 0.1);
+  EXPECT_EQ(g.state(), gc::State::Finished);
+  EXPECT_EQ(g.half(), Half::First);
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(g.score(1), 0);
+  EXPECT_EQ(count(g, "goal"), 1);
+  EXPECT_TRUE(hasEvent(g, "set_play", "KICK_IN"));
+  EXPECT_TRUE(hasEvent(g, "set_play", "CORNER_KICK"));
+  EXPECT_TRUE(hasEvent(g, "set_play", "GOAL_KICK"));
+  EXPECT_TRUE(hasEvent(g, "half", "end of the first half"));
+  const ControlData d = g.packet(0);
+  EXPECT_EQ(d.state, static_cast<uint8_t>(gc::State::Finished));
+  EXPECT_EQ(d.first_half, 1);
+  EXPECT_EQ(d.teams[0].score, 1);  // team 0 is on the left in the first half
 }

@@ -12,6 +12,8 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
                  int kick_off_team, const RefereeConfig& config)
     : world_(world), config_(config), game_(rules, teams, kick_off_team) {
   fallen_for_.assign(world.robotCount(), 0.0);
+  idle_for_.assign(world.robotCount(), 0.0);
+  idle_anchor_.assign(world.robotCount(), Vec3::Zero());
   in_goal_area_since_.assign(world.robotCount(), -1.0);
   parked_.assign(world.robotCount(), false);
   contact_for_.assign(world.robotCount() * world.robotCount(), 0.0);
@@ -306,6 +308,19 @@ void Referee::checkPenalties() {
     if (fallen_for_[r] >= config_.inactive_time) {
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
       fallen_for_[r] = 0.0;
+      continue;
+    }
+    // Inactive: standing without moving while the ball is near (Playing only).
+    const Vec3 ball = world_.ballState().pose.translation();
+    if (game_.state() != gc::State::Playing || !world_.isStanding(r) ||
+        (ball - p).head<2>().norm() > config_.inactive_ball_distance ||
+        (p - idle_anchor_[r]).head<2>().norm() > config_.inactive_motion) {
+      idle_anchor_[r] = p;
+      idle_for_[r] = 0.0;
+    } else if ((idle_for_[r] += dt) >= config_.inactive_time) {
+      game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
+      game_.recordEvent("inactive", info.team, info.number, "stood idle next to the ball");
+      idle_for_[r] = 0.0;
       continue;
     }
     if (inOwnGoalArea(r)) {
