@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -358,4 +359,47 @@ TEST(NetGameState, RefereePacketReachesAgents) {
   EXPECT_EQ(got.teams[1].score, 2);
   EXPECT_EQ(got.teams[0].players[3].penalty, 2);
   EXPECT_EQ(got.teams[0].players[3].secs_till_unpenalised, 40);
+}
+
+// The real program with the referee: its decisions reach agents on the
+// GameState topic and robot code as GameController packets over UDP.
+TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
+  const uint32_t domain = 112;
+  referee::UdpReceiver robot(0, "127.0.0.1");
+  agents::AgentClient agent(dds(domain), 0, 1);
+  int status = -1;
+  std::string out;
+  std::atomic<bool> done{false};
+  std::thread serve([&] {
+    out = runCommand(std::string(SIMSOCCER_BIN) + " serve " + SIMSOCCER_SOURCE_DIR +
+                         "/configs/scenarios/lineup_5v5.yaml --agents 0 --seconds 8 --domain " +
+                         std::to_string(domain) + " --rules " + SIMSOCCER_SOURCE_DIR +
+                         "/configs/rules/spl.yaml --teams 13,5 --gc-address 127.0.0.1 --gc-port " +
+                         std::to_string(robot.port()) + " --gc-return-port 0",
+                     status);
+    done = true;
+  });
+  std::array<uint8_t, 512> buf{};
+  std::vector<referee::ControlData> packets;
+  uint8_t dds_state = 0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < until) {
+    const size_t n = robot.receive(buf, 0.5);
+    if (n > 0) packets.push_back(referee::decodeControl(std::span<const uint8_t>(buf.data(), n)));
+    simsoccer_msg_GameState m{};
+    if (agent.gameState(m) && m.state == 3) dds_state = 3;
+    if (n == 0 && done) break;  // serve is done and nothing is left
+  }
+  serve.join();
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("game: PLAYING"), std::string::npos) << out;
+  // 8 simulated s at 2 Hz: 16 packets, numbered in order, Ready -> Set -> Playing.
+  ASSERT_GE(packets.size(), 15u);
+  for (size_t i = 0; i < packets.size(); ++i) EXPECT_EQ(packets[i].packet_number, i);
+  EXPECT_EQ(packets.front().state, static_cast<uint8_t>(referee::gc::State::Ready));
+  EXPECT_EQ(packets.back().state, static_cast<uint8_t>(referee::gc::State::Playing));
+  EXPECT_EQ(packets.back().teams[0].team_number, 13);
+  EXPECT_EQ(packets.back().kicking_team, 13);
+  EXPECT_EQ(dds_state, 3);  // the agent saw Playing on the GameState topic
 }

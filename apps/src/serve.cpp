@@ -7,6 +7,8 @@
 
 #include "cli.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
+#include "simsoccer/referee/referee.hpp"
 #include "simsoccer/world/realtime_driver.hpp"
 
 namespace simsoccer::apps {
@@ -15,12 +17,20 @@ namespace {
 const char* kHelp =
     "usage: simsoccer serve SCENARIO [--domain D] [--dds-config FILE] [--seconds S]\n"
     "                       [--agents N] [--realtime] [--timeout S] [--limp-on-release]\n"
+    "                       [--rules FILE [--teams A,B] [--auto-placement]\n"
+    "                        [--gc-address ADDR [--gc-port P] [--gc-return-port P]]]\n"
     "\n"
     "Runs the scenario's world as a DDS simulator: waits until N robots (default: all) are\n"
     "claimed by agents, then runs S simulated seconds (default 60) in lockstep (each period\n"
     "waits up to --timeout s of wall time, default 0.5, for every owned robot's command) or,\n"
     "with --realtime, paced to the wall clock with the latest commands. Ctrl-C stops it.\n"
-    "Prints each robot's command counters at the end.\n";
+    "Prints each robot's command counters at the end.\n"
+    "\n"
+    "With --rules (e.g. configs/rules/spl.yaml) the automatic referee runs the game from the\n"
+    "first kick-off (team 0 kicks off; --teams gives the GameController team numbers, default\n"
+    "1,2): its state goes to agents on the GameState topic, and with --gc-address also as\n"
+    "GameController packets over UDP (port 3838, every 0.5 simulated s; return packets on\n"
+    "3939), so robot code written for the SPL GameController runs unchanged.\n";
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
@@ -30,8 +40,9 @@ void onSignal(int) {
 }  // namespace
 
 int serve(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release"},
-                    {"domain", "dds-config", "seconds", "agents", "timeout"});
+  const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
+                    {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
+                     "gc-address", "gc-port", "gc-return-port"});
   if (opt.help(kHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario file");
   world::World w = world::World::fromFile(opt.positional()[0]);
@@ -45,6 +56,53 @@ int serve(int argc, char** argv, int first) {
   const auto wanted =
       static_cast<size_t>(opt.number("agents", static_cast<double>(w.robotCount())));
   net::SimServer server(w, cfg);
+
+  // The referee (optional): the game from the first kick-off.
+  std::unique_ptr<referee::Referee> ref;
+  std::unique_ptr<referee::GameControllerLink> gc_link;
+  if (opt.has("rules")) {
+    const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
+    const std::vector<int> numbers = opt.intList("teams", {1, 2});
+    if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
+        numbers[1] > 255 || numbers[0] == numbers[1])
+      throw UsageError("--teams: two different team numbers 0..255");
+    std::array<referee::TeamSetup, 2> teams;
+    for (size_t t = 0; t < 2; ++t) {
+      teams[t].number = static_cast<uint8_t>(numbers[t]);
+      teams[t].field_player_colour = static_cast<uint8_t>(t);
+    }
+    referee::RefereeConfig rcfg;
+    rcfg.auto_placement = opt.flag("auto-placement");
+    ref = std::make_unique<referee::Referee>(w, rules, teams, 0, rcfg);
+    ref->game().standby();
+    ref->game().ready();
+    if (opt.has("gc-address")) {
+      referee::GameControllerLinkConfig gcfg;
+      gcfg.address = opt.get("gc-address", "");
+      gcfg.control_port = static_cast<uint16_t>(opt.number("gc-port", 3838));
+      gcfg.return_port = static_cast<uint16_t>(opt.number("gc-return-port", 3939));
+      gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
+    }
+  } else if (opt.has("gc-address")) {
+    throw UsageError("--gc-address needs --rules (the referee makes the packets)");
+  }
+  referee::ControlData published{};
+  bool any_published = false;
+  auto refereePeriod = [&] {
+    if (!ref) return;
+    ref->update();
+    const referee::ControlData d = ref->game().packet(0);
+    if (!any_published || !(d == published)) {  // every change; SimServer repeats it at 2 Hz
+      simsoccer_msg_GameState m{};
+      net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
+      server.setGameState(m);
+      published = d;
+      any_published = true;
+    }
+    if (gc_link) gc_link->update(ref->game());
+  };
+  refereePeriod();
+
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::printf("simsoccer serve: %zu robots on DDS domain %u, waiting for %zu agents...\n",
@@ -63,6 +121,7 @@ int serve(int argc, char** argv, int first) {
       std::this_thread::sleep_until(due);
     }
     server.runPeriod();
+    refereePeriod();
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), wall,
@@ -74,6 +133,19 @@ int serve(int argc, char** argv, int first) {
         w.robot(r).team, w.robot(r).number, s.owned ? "owned" : "free",
         (unsigned long long)s.accepted, (unsigned long long)s.rejected,
         (unsigned long long)s.refused, (unsigned long long)s.missed);
+  }
+  if (ref) {
+    const referee::Game& g = ref->game();
+    std::printf("game: %s, score %d:%d, %zu referee events\n", referee::stateName(g.state()),
+                g.score(0), g.score(1), g.events().size());
+    for (const auto& e : g.events())
+      std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, e.type.c_str(), e.team,
+                  e.player, e.detail.c_str());
+    if (gc_link)
+      std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",
+                  (unsigned long long)gc_link->packetsSent(),
+                  (unsigned long long)gc_link->returnsAccepted(),
+                  (unsigned long long)gc_link->returnsRejected());
   }
   return 0;
 }

@@ -459,7 +459,9 @@ void Game::goal(int team) {
 void Game::ballFree() {
   if (state_ != gc::State::Playing) return;
   if (set_play_ != gc::SetPlay::None || kicking_team_ >= 0)
-    log("set_play", kicking_team_, 0, std::string("over: ") + setPlayName(set_play_));
+    log("set_play", kicking_team_, 0,
+        set_play_ == gc::SetPlay::None ? std::string("kick-off over")
+                                       : std::string("over: ") + setPlayName(set_play_));
   set_play_ = gc::SetPlay::None;
   kicking_team_ = -1;
   secondary_ = 0.0;

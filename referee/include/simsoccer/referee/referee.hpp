@@ -19,12 +19,12 @@ struct RefereeConfig {
   double set_duration = 5.0;      // s in Set before the referee whistles (Playing); <= 0: never
   double ready_still_time = 1.0;  // Ready ends early when all stand still in legal places this long
   double still_speed = 0.05;      // m/s: a robot slower than this stands still
-  double inactive_time = 10.0;    // s fallen, or standing idle near the ball, before Inactive Player
+  double inactive_time = 10.0;  // s fallen, or standing idle near the ball, before Inactive Player
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
-  double ball_moved = 0.05;       // m: the kicking team moved the ball clearly
-  double stuck_progress = 0.3;    // m the ball must move within the game-stuck time
-  double stuck_radius = 0.5;      // m: a robot this close to a stuck ball is penalised (local)
+  double ball_moved = 0.05;             // m: the kicking team moved the ball clearly
+  double stuck_progress = 0.3;          // m the ball must move within the game-stuck time
+  double stuck_radius = 0.5;  // m: a robot this close to a stuck ball is penalised (local)
   // Pushing: sustained contact between opponents in which one drives into
   // the other, or in which the other falls.
   double push_time = 1.0;  // s of contact (gaps under push_gap count as one) ...
@@ -90,8 +90,8 @@ class Referee {
   engine::Vec3 set_play_ball_ = engine::Vec3::Zero();  // where the ball was when the set play began
   uint64_t set_play_step_ = 0;                         // world step when it began
   std::vector<double> fallen_for_;
-  std::vector<double> idle_for_;           // s standing without moving with the ball near
-  std::vector<engine::Vec3> idle_anchor_;  // where the idle time started
+  std::vector<double> idle_for_;            // s standing without moving with the ball near
+  std::vector<engine::Vec3> idle_anchor_;   // where the idle time started
   std::vector<double> in_goal_area_since_;  // game time of entering the own goal area; <0 outside
   double clock_ = 0.0;                      // seconds of referee updates, for entry order
   std::vector<bool> parked_;
