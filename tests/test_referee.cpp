@@ -506,3 +506,26 @@ TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
   EXPECT_EQ(d.first_half, 1);
   EXPECT_EQ(d.teams[0].score, 1);  // team 0 is on the left in the first half
 }
+
+TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);  // team 0 kicks off
+  run(w, ref, 0.5);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
+  w.placeRobot(3, -0.5, 1.0, M_PI);  // team 1 player 2 runs into team 0's half
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::IllegalPosition);
+  EXPECT_NEAR(g.penaltyTime(1, 2), 45.0, 0.1);
+
+  g.ballFree();
+  putBall(w, 2.0, -2.0);
+  run(w, ref, 0.02);
+  g.setPlay(gc::SetPlay::PushingFreeKick, 0);
+  w.placeRobot(2, 2.4, -2.0, M_PI);  // team 1 player 1, 0.4 m from the ball
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::IllegalPosition);
+  EXPECT_NEAR(g.penaltyTime(1, 1), 55.0, 0.1);  // the team's second: +10 s
+}

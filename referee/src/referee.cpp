@@ -310,8 +310,28 @@ void Referee::checkPenalties() {
       fallen_for_[r] = 0.0;
       continue;
     }
-    // Inactive: standing without moving while the ball is near (Playing only).
+    // Illegal position before the ball is in play: the defending team
+    // entering the centre circle or the other half at a kick-off, or coming
+    // within the free-kick distance of the ball at a free kick.
     const Vec3 ball = world_.ballState().pose.translation();
+    const int kicking = game_.kickingTeam();
+    if (game_.state() == gc::State::Playing && kicking >= 0 && info.team != kicking) {
+      const gc::SetPlay play = game_.currentSetPlay();
+      bool illegal = false;
+      if (play == gc::SetPlay::None)  // kick-off
+        illegal =
+            teamSign(info.team) * p.x() < 0.0 || std::hypot(p.x(), p.y()) < f.centre_circle_radius;
+      else if (play != gc::SetPlay::PenaltyKick)
+        illegal = (ball - p).head<2>().norm() < config_.free_kick_distance;
+      if (illegal) {
+        game_.penalise(info.team, info.number, gc::Penalty::IllegalPosition);
+        game_.recordEvent("illegal_position", info.team, info.number,
+                          play == gc::SetPlay::None ? "entered at the opponents' kick-off"
+                                                    : "too close to the ball at a free kick");
+        continue;
+      }
+    }
+    // Inactive: standing without moving while the ball is near (Playing only).
     if (game_.state() != gc::State::Playing || !world_.isStanding(r) ||
         (ball - p).head<2>().norm() > config_.inactive_ball_distance ||
         (p - idle_anchor_[r]).head<2>().norm() > config_.inactive_motion) {

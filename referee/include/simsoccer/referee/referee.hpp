@@ -22,6 +22,7 @@ struct RefereeConfig {
   double inactive_time = 10.0;  // s fallen, or standing idle near the ball, before Inactive Player
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
+  double free_kick_distance = 0.75;     // m: defenders keep this far from the ball at a free kick
   double ball_moved = 0.05;             // m: the kicking team moved the ball clearly
   double stuck_progress = 0.3;          // m the ball must move within the game-stuck time
   double stuck_radius = 0.5;  // m: a robot this close to a stuck ball is penalised (local)
