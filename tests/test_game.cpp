@@ -135,6 +135,18 @@ TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
   for (const auto& e : g.events()) lifted += e.type == "unpenalise";
   EXPECT_GE(lifted, 2);
   EXPECT_EQ(g.penalty(0, 6), gc::Penalty::Substitute);  // numbers beyond the 5 players
+
+  // A request for pick-up replaces a running penalty and keeps its timer, at least 45 s.
+  g.penalise(1, 3, gc::Penalty::PlayerPushing);  // incremental: more than 45 s
+  run(g, 2);
+  const double left = g.penaltyTime(1, 3);
+  ASSERT_GT(left, 45.0);
+  g.penalise(1, 3, gc::Penalty::RequestForPickup);
+  EXPECT_EQ(g.penalty(1, 3), gc::Penalty::RequestForPickup);
+  EXPECT_NEAR(g.penaltyTime(1, 3), left, 1e-9);
+  g.penalise(1, 4, gc::Penalty::IllegalMotionInSet);  // 15 s
+  g.penalise(1, 4, gc::Penalty::RequestForPickup);
+  EXPECT_NEAR(g.penaltyTime(1, 4), 45.0, 1e-9);
 }
 
 TEST(Game, HalfTimeSwapsSidesAndTheOtherTeamKicksOff) {

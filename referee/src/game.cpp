@@ -504,6 +504,10 @@ void Game::penalise(int team, int number, gc::Penalty p) {
       seconds = rules_.penalty_base +
                 rules_.penalty_increment * incremental_[static_cast<size_t>(team)]++;
       break;
+    case gc::Penalty::RequestForPickup:
+      // It may replace a running penalty: that timer is kept, at least the base time.
+      if (pl.penalty != gc::Penalty::None) seconds = std::max(pl.remaining, rules_.penalty_base);
+      break;
     case gc::Penalty::Substitute:
     case gc::Penalty::None:
       throw std::invalid_argument("penalise: use substitute() / unpenalise()");
