@@ -529,3 +529,29 @@ TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
   EXPECT_EQ(g.penalty(1, 1), gc::Penalty::IllegalPosition);
   EXPECT_NEAR(g.penaltyTime(1, 1), 55.0, 0.1);  // the team's second: +10 s
 }
+
+TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
+  auto play = [] {
+    world::World w(twoVsTwo());
+    Referee ref(w, spl(), teams(), 0);
+    Game& g = ref.game();
+    g.ready();
+    kickOff(w, ref);
+    g.ballFree();
+    w.placeRobot(1, 0.45, -2.0, 0.0);
+    w.placeRobot(3, 0.8, -2.0, M_PI);
+    putBall(w, 0.6, -1.5);
+    for (int i = 0; i < 150; ++i) {
+      w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
+      run(w, ref, 0.01);
+    }
+    run(w, ref, 2.0);  // removal to the penalty spot, the free kick
+    std::string log;
+    for (const auto& e : g.events()) log += std::to_string(e.time) + e.type + e.detail + ";";
+    return std::make_pair(w.stateHash(), log);
+  };
+  const auto a = play(), b = play();
+  EXPECT_EQ(a.first, b.first);
+  EXPECT_EQ(a.second, b.second);
+  EXPECT_NE(a.second.find("pushing"), std::string::npos);
+}
