@@ -312,14 +312,16 @@ TEST(Game, ShootoutAfterADrawIsDecidedWhenATeamCanNoLongerCatchUp) {
   const ControlData d = g.packet(0);
   EXPECT_EQ(d.game_phase, static_cast<uint8_t>(gc::GamePhase::PenaltyShoot));
   EXPECT_EQ(d.state, static_cast<uint8_t>(gc::State::Finished));
-  // teams[0] is the left team (team 1 after the half-time swap).
-  EXPECT_EQ(d.teams[0].team_number, 5);
-  EXPECT_EQ(d.teams[0].score, 2);
+  // teams[0] swapped at half-time (team 1 on the left) and then before kicks
+  // 2, 3 and 4 (GC3 flips sides for every kick after the first): team 0 now.
+  EXPECT_EQ(d.teams[0].team_number, 13);
+  EXPECT_EQ(d.teams[0].score, 0);
   EXPECT_EQ(d.teams[0].penalty_shot, 2);
-  EXPECT_EQ(d.teams[0].single_shots, 0b11);
-  EXPECT_EQ(d.teams[1].score, 0);
+  EXPECT_EQ(d.teams[0].single_shots, 0);
+  EXPECT_EQ(d.teams[1].team_number, 5);
+  EXPECT_EQ(d.teams[1].score, 2);
   EXPECT_EQ(d.teams[1].penalty_shot, 2);
-  EXPECT_EQ(d.teams[1].single_shots, 0);
+  EXPECT_EQ(d.teams[1].single_shots, 0b11);
 }
 
 TEST(Game, ShootoutSuddenDeathRanksTheKicks) {

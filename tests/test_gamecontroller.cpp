@@ -18,8 +18,8 @@ ControlData knownState() {
   d.packet_number = 42;
   d.players_per_team = 5;
   d.competition_phase = 1;
-  d.competition_type = 0;
-  d.game_phase = static_cast<uint8_t>(gc::GamePhase::Normal);
+  d.competition_type = 1;  // MOST_PASSES: distinct from its neighbours
+  d.game_phase = static_cast<uint8_t>(gc::GamePhase::PenaltyShoot);
   d.state = static_cast<uint8_t>(gc::State::Playing);
   d.set_play = static_cast<uint8_t>(gc::SetPlay::CornerKick);
   d.first_half = 1;
@@ -29,8 +29,9 @@ ControlData knownState() {
   d.teams[0].team_number = 13;
   d.teams[0].field_player_colour = 0;  // blue
   d.teams[0].goalkeeper_colour = 2;
-  d.teams[0].goalkeeper = 1;
+  d.teams[0].goalkeeper = 4;
   d.teams[0].score = 2;
+  d.teams[0].penalty_shot = 3;
   d.teams[0].single_shots = 0x0105;
   d.teams[0].message_budget = 1200;  // 0x04b0
   d.teams[0].players[2] = {static_cast<uint8_t>(gc::Penalty::PlayerPushing), 45};
@@ -55,7 +56,8 @@ TEST(GameControllerPacket, KnownStateAtTheReferenceOffsets) {
   EXPECT_EQ(b[5], 42);     // packetNumber
   EXPECT_EQ(b[6], 5);      // playersPerTeam
   EXPECT_EQ(b[7], 1);      // competitionPhase
-  EXPECT_EQ(b[9], 0);      // gamePhase
+  EXPECT_EQ(b[8], 1);      // competitionType
+  EXPECT_EQ(b[9], 1);      // gamePhase PENALTYSHOOT
   EXPECT_EQ(b[10], 3);     // state PLAYING
   EXPECT_EQ(b[11], 3);     // setPlay CORNER_KICK
   EXPECT_EQ(b[12], 1);     // firstHalf
@@ -65,8 +67,11 @@ TEST(GameControllerPacket, KnownStateAtTheReferenceOffsets) {
   EXPECT_EQ(b[16], 0xfd);  // secondaryTime -3
   EXPECT_EQ(b[17], 0xff);
   EXPECT_EQ(b[18], 13);    // teams[0].teamNumber
+  EXPECT_EQ(b[19], 0);     // fieldPlayerColour
   EXPECT_EQ(b[20], 2);     // goalkeeperColour
+  EXPECT_EQ(b[21], 4);     // goalkeeper
   EXPECT_EQ(b[22], 2);     // teams[0].score (offset 22)
+  EXPECT_EQ(b[23], 3);     // penaltyShot
   EXPECT_EQ(b[24], 0x05);  // singleShots
   EXPECT_EQ(b[25], 0x01);
   EXPECT_EQ(b[26], 0xb0);  // messageBudget 1200 at 26-27
@@ -79,6 +84,18 @@ TEST(GameControllerPacket, KnownStateAtTheReferenceOffsets) {
   EXPECT_EQ(b[76], 0x02);            // teams[1].messageBudget at 76-77
   EXPECT_EQ(b[77], 0x01);
   EXPECT_EQ(b[78 + 2 * 19], 14);  // player 20: SUBSTITUTE
+
+  // All 118 bytes, written out from the reference's offset table: every
+  // byte not set above must be 0 (teams[1].goalkeeper is 1 by default).
+  std::array<uint8_t, 118> want{};
+  const std::vector<std::pair<size_t, uint8_t>> set = {
+      {0, 'R'},   {1, 'G'},   {2, 'm'},   {3, 'e'},   {4, 18},  {5, 42},  {6, 5},     {7, 1},
+      {8, 1},     {9, 1},     {10, 3},    {11, 3},    {12, 1},  {13, 13}, {14, 0x58}, {15, 0x02},
+      {16, 0xfd}, {17, 0xff}, {18, 13},   {19, 0},    {20, 2},  {21, 4},  {22, 2},    {23, 3},
+      {24, 0x05}, {25, 0x01}, {26, 0xb0}, {27, 0x04}, {32, 2},  {33, 45}, {68, 5},    {69, 1},
+      {71, 1},    {72, 1},    {76, 0x02}, {77, 0x01}, {116, 14}};
+  for (const auto& [offset, value] : set) want[offset] = value;
+  for (size_t i = 0; i < want.size(); ++i) EXPECT_EQ(b[i], want[i]) << "byte " << i;
 }
 
 TEST(GameControllerPacket, DecodeOfEncodeIsTheIdentity) {

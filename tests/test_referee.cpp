@@ -95,7 +95,10 @@ TEST(Referee, FirstHalfWithScriptedBall) {
   ASSERT_EQ(g.state(), gc::State::Playing);
   EXPECT_EQ(g.kickingTeam(), 0);
 
-  // A goal in the +x goal: team 0 (attacking +x in the first half) scores.
+  // A goal in the +x goal: team 0 (attacking +x in the first half) scores,
+  // after two of its robots played the ball (indirect kick).
+  touchBall(w, ref, 0);
+  touchBall(w, ref, 1);
   putBall(w, 4.7, 0.2);
   run(w, ref, 0.02);
   EXPECT_EQ(g.score(0), 1);
@@ -196,7 +199,11 @@ TEST(Referee, IllegalPositionInSetOrAutoPlacement) {
     ASSERT_EQ(g.state(), gc::State::Set);
     if (auto_place) {
       EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
-      EXPECT_GT(w.torsoPose(3).translation().x(), 0.7);  // moved into its own half
+      // Moved to the nearest legal spot: just inside its own half, outside the circle.
+      const Vec3 p = w.torsoPose(3).translation();
+      EXPECT_GT(p.x(), 0.2);
+      EXPECT_LT(p.x(), 0.6);
+      EXPECT_GT(std::hypot(p.x(), p.y()), w.field().centre_circle_radius);
     } else {
       EXPECT_EQ(g.penalty(1, 2), gc::Penalty::IllegalPositionInSet);
       EXPECT_NEAR(g.penaltyTime(1, 2), 15, 1e-9);
@@ -374,7 +381,7 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other.
   w.placeRobot(1, 0.45, -2.0, 0.0);
   w.placeRobot(3, 0.8, -2.0, M_PI);
-  putBall(w, 0.6, -1.5);
+  putBall(w, 0.7, -1.7);
   run(w, ref, 0.5);
   // Standing face to face without driving: nothing.
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
@@ -386,7 +393,10 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
   EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);  // the pushed robot
   EXPECT_EQ(count(g, "pushing"), 1);
-  // The ball was within 1 m: a pushing free kick for the other team.
+  EXPECT_NEAR(g.penaltyTime(0, 2), 45.0, 0.05);  // the team's first incremental penalty
+  run(w, ref, 0.02);                             // removed beyond the touchline
+  EXPECT_GT(std::abs(w.torsoPose(1).translation().y()), w.field().halfWidth());
+  // The ball was within 0.5 m: a pushing free kick for the other team.
   EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
   EXPECT_EQ(g.kickingTeam(), 1);
 }
@@ -406,6 +416,12 @@ TEST(Referee, BallContactWithAnArm) {
   };
   // The goalkeeper (player 1) in its own penalty area may.
   ballOnHand(0);
+  ASSERT_TRUE(w.lastBallTouch().has_value());
+  EXPECT_EQ(w.lastBallTouch()->robot, 0u);
+  const std::string link =
+      w.robot(0).model->body->links[static_cast<size_t>(w.lastBallTouch()->link)].name;
+  EXPECT_TRUE(link == "LWrist" || link == "LForeArm" || link == "LElbow" || link == "LBiceps")
+      << link;
   EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);
   // A field player may not: penalised, the ball put back on the ground there.
   ballOnHand(1);
@@ -443,7 +459,9 @@ TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
   run(w, ref, 0.05);
   EXPECT_EQ(g.kickingTeam(), -1);
 
-  // A goal for team 0 in the +x goal: 1:0, Ready with the kick-off for team 1.
+  // A goal for team 0 in the +x goal after a pass (two robots played it):
+  // 1:0, Ready with the kick-off for team 1.
+  touchBall(w, ref, 0);
   putBall(w, f.halfLength() + 0.3, 0.2);
   run(w, ref, 0.02);
   EXPECT_EQ(g.score(0), 1);
@@ -525,7 +543,9 @@ TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
   run(w, ref, 0.02);
   g.setPlay(gc::SetPlay::PushingFreeKick, 0);
   w.placeRobot(2, 2.4, -2.0, M_PI);  // team 1 player 1, 0.4 m from the ball
-  run(w, ref, 0.02);
+  run(w, ref, 4.9);                  // it has 5 s to leave
+  EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);
+  run(w, ref, 0.2);
   EXPECT_EQ(g.penalty(1, 1), gc::Penalty::IllegalPosition);
   EXPECT_NEAR(g.penaltyTime(1, 1), 55.0, 0.1);  // the team's second: +10 s
 }
@@ -540,7 +560,7 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
     g.ballFree();
     w.placeRobot(1, 0.45, -2.0, 0.0);
     w.placeRobot(3, 0.8, -2.0, M_PI);
-    putBall(w, 0.6, -1.5);
+    putBall(w, 0.7, -1.7);
     for (int i = 0; i < 150; ++i) {
       w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
       run(w, ref, 0.01);
@@ -554,4 +574,42 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
   EXPECT_EQ(a.first, b.first);
   EXPECT_EQ(a.second, b.second);
   EXPECT_NE(a.second.find("pushing"), std::string::npos);
+}
+
+TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  const auto& f = w.field();
+  g.ready();
+  kickOff(w, ref);
+  touchBall(w, ref, 1);  // team 0 player 2 takes the kick-off ...
+  run(w, ref, 0.05);
+  putBall(w, f.halfLength() + 0.3, -0.3);  // ... and scores directly
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 0);
+  EXPECT_EQ(count(g, "goal_disallowed"), 1);
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::GoalKick);
+  EXPECT_EQ(g.kickingTeam(), 1);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), f.halfLength() - f.goal_area->length, 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), -0.5 * f.goal_area->width, 1e-3);
+  // Team 1 takes the goal kick; then its keeper puts the ball into its own goal: it counts.
+  touchBall(w, ref, 3);
+  run(w, ref, 0.05);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+  touchBall(w, ref, 2);
+  putBall(w, f.halfLength() + 0.3, 0.3);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 1);
+
+  // The simleague rule book scores directly.
+  world::World w2(twoVsTwo());
+  Referee ref2(w2, loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"),
+               teams(), 0);
+  ref2.game().ready();
+  kickOff(w2, ref2);
+  touchBall(w2, ref2, 1);
+  putBall(w2, w2.field().halfLength() + 0.3, 0.0);
+  run(w2, ref2, 0.02);
+  EXPECT_EQ(ref2.game().score(0), 1);
 }

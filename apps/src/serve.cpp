@@ -74,8 +74,6 @@ int serve(int argc, char** argv, int first) {
     referee::RefereeConfig rcfg;
     rcfg.auto_placement = opt.flag("auto-placement");
     ref = std::make_unique<referee::Referee>(w, rules, teams, 0, rcfg);
-    ref->game().standby();
-    ref->game().ready();
     if (opt.has("gc-address")) {
       referee::GameControllerLinkConfig gcfg;
       gcfg.address = opt.get("gc-address", "");
@@ -90,6 +88,13 @@ int serve(int argc, char** argv, int first) {
   bool any_published = false;
   auto refereePeriod = [&] {
     if (!ref) return;
+    // The operator's part: each half starts (Standby, Ready) as soon as it can.
+    referee::Game& game = ref->game();
+    if (game.state() == referee::gc::State::Initial &&
+        game.phase() == referee::gc::GamePhase::Normal && !game.gameOver()) {
+      game.standby();
+      game.ready();
+    }
     ref->update();
     const referee::ControlData d = ref->game().packet(0);
     if (!any_published || !(d == published)) {  // every change; SimServer repeats it at 2 Hz

@@ -16,9 +16,10 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
                   "half_time_to_initial", "clock_in_ready_and_set", "ready_duration",
                   "ready_penalty_kick_duration", "kick_off_ball_free", "set_play_duration",
                   "penalty_kick_duration", "mercy_goal_difference", "game_stuck_duration",
-                  "goal_area_max_robots", "penalties", "shootout"});
+                  "goal_area_max_robots", "indirect_kick", "penalties", "shootout"});
   RuleBook r;
   r.name = root["rules"].string();
+  r.indirect_kick = root["indirect_kick"].boolean();
   r.source_file = file.string();
   r.players_per_team = root["players_per_team"].integer();
   if (r.players_per_team < 1 || r.players_per_team > static_cast<int>(gc::kMaxPlayers))
@@ -219,6 +220,7 @@ void Game::advance(double dt) {
 
 void Game::endHalf() {
   set_play_ = gc::SetPlay::None;
+  kicking_team_ = -1;  // 255 on the wire until the next kick-off is known
   secondary_ = 0.0;
   // Timed penalties end with the half.
   for (auto& team : players_)
@@ -269,7 +271,8 @@ void Game::startShootout(int first_team, std::optional<int> kicks_per_team, uint
   half_ = Half::PenaltyShootout;
   phase_ = gc::GamePhase::PenaltyShoot;
   game_over_ = false;
-  score_ = {0, 0};  // the packet's score counts shoot-out goals from here
+  // The score carries on: shoot-out goals add to it (as GC3); the result of
+  // the shoot-out itself comes from the kicks' outcomes.
   shots_ = {0, 0};
   single_shots_ = {0, 0};
   outcomes_ = {};
@@ -299,6 +302,8 @@ void Game::shootoutKick(int striker, int keeper) {
       player(t, n) = Player{gc::Penalty::Substitute, 0.0};
   player(team, striker) = Player{};
   if (keeper > 0) player(1 - team, keeper) = Player{};
+  // GC3 flips its side mapping for every kick after the first: teams[0] swaps.
+  if (kicks > 0) sides_swapped_ = !sides_swapped_;
   kicking_team_ = team;
   striker_ = striker;
   keeper_ = keeper;
@@ -447,6 +452,7 @@ void Game::goal(int team) {
       std::abs(score_[0] - score_[1]) >= rules_.mercy_goal_difference) {
     secondary_ = 0.0;
     set_play_ = gc::SetPlay::None;
+    kicking_team_ = -1;
     enter(gc::State::Finished, "mercy rule");
     game_over_ = true;
     winner_ = team;

@@ -1,6 +1,7 @@
 #include "simsoccer/referee/referee.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace simsoccer::referee {
@@ -16,6 +17,7 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
   idle_anchor_.assign(world.robotCount(), Vec3::Zero());
   in_goal_area_since_.assign(world.robotCount(), -1.0);
   parked_.assign(world.robotCount(), false);
+  slot_.assign(world.robotCount(), -1);
   contact_for_.assign(world.robotCount() * world.robotCount(), 0.0);
   contact_gap_.assign(world.robotCount() * world.robotCount(), 1e9);
   contact_start_.assign(2 * world.robotCount() * world.robotCount(), Vec3::Zero());
@@ -158,7 +160,12 @@ void Referee::checkPushing() {
       const Vec3 ball = world_.ballState().pose.translation();
       if (game_.state() == gc::State::Playing && game_.kickingTeam() < 0 &&
           (ball - (pusher == a ? pa : pb)).head<2>().norm() <= config_.foul_ball_distance) {
-        const bool in_area = inOwnPenaltyArea(pusher);
+        // A penalty kick when the pushed robot is in the pusher's own penalty area.
+        const auto& area = world_.field().penalty_area;
+        const double vx = teamSign(ip.team) * world_.torsoPose(victim).translation().x();
+        const bool in_area =
+            area && vx >= world_.field().halfLength() - area->length &&
+            std::abs(world_.torsoPose(victim).translation().y()) <= 0.5 * area->width;
         game_.setPlay(in_area ? gc::SetPlay::PenaltyKick : gc::SetPlay::PushingFreeKick, iv.team);
         set_play_ball_ = ball;
         set_play_step_ = world_.stepCount();
@@ -187,46 +194,120 @@ void Referee::checkArmContact() {
   placeBall(p.x(), p.y());
 }
 
-bool Referee::legalKickOffPosition(RobotId r) const {
+std::vector<char> Referee::legalPositions() const {
+  const auto& f = world_.field();
+  const size_t n = world_.robotCount();
+  std::vector<char> legal(n, 1);
+  const int kicking = game_.kickingTeam();
+  const bool penalty_kick = game_.currentSetPlay() == gc::SetPlay::PenaltyKick;
+  const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
+  // The one kicking-team robot allowed in the centre circle (kick-off) or
+  // in the penalty area (penalty kick): the one nearest the ball's spot.
+  const Vec3 spot =
+      penalty_kick
+          ? Vec3(-teamSign(kicking) * (f.halfLength() - f.penalty_mark_distance.value_or(1.3)), 0.0,
+                 0.0)
+          : Vec3::Zero();
+  std::optional<RobotId> taker;
+  for (RobotId r = 0; r < n; ++r) {
+    const auto& info = world_.robot(r);
+    if (info.team != kicking || game_.penalty(info.team, info.number) != gc::Penalty::None)
+      continue;
+    const double d = (world_.torsoPose(r).translation() - spot).head<2>().norm();
+    if (!taker || d < (world_.torsoPose(*taker).translation() - spot).head<2>().norm()) taker = r;
+  }
+  for (RobotId r = 0; r < n; ++r) {
+    const auto& info = world_.robot(r);
+    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+    const Vec3 p = world_.torsoPose(r).translation();
+    const double own = teamSign(info.team) * p.x();  // > 0 in the own half
+    // On the field, or inside the own goal (not elsewhere on the border strip).
+    const bool in_own_goal = own > f.halfLength() && own <= f.halfLength() + f.goal.depth &&
+                             std::abs(p.y()) < 0.5 * f.goal.inner_width;
+    const bool on_field =
+        (std::abs(p.x()) <= f.halfLength() && std::abs(p.y()) <= f.halfWidth()) || in_own_goal;
+    if (!on_field) {
+      legal[r] = 0;
+      continue;
+    }
+    if (penalty_kick) {
+      // Only the defending goalkeeper and the taker inside the defending team's penalty area.
+      const int defender = 1 - kicking;
+      const double dx = teamSign(defender) * p.x();
+      const bool in_area =
+          dx >= f.halfLength() - area.length && std::abs(p.y()) <= 0.5 * area.width;
+      const bool keeper = info.team == defender && game_.goalkeeper(defender) == info.number;
+      legal[r] = !in_area || keeper || (taker && r == *taker);
+      continue;
+    }
+    const bool in_circle = std::hypot(p.x(), p.y()) <= f.centre_circle_radius;
+    if (info.team == kicking)
+      legal[r] = own > 0.0 || (in_circle && taker && r == *taker);
+    else
+      legal[r] =
+          own > 0.0 && !in_circle;  // defenders (and drop balls): own half, outside the circle
+  }
+  return legal;
+}
+
+Vec3 Referee::nearestLegalPosition(RobotId r, const std::vector<Vec3>& taken) const {
   const auto& f = world_.field();
   const int team = world_.robot(r).team;
-  const Vec3 p = world_.torsoPose(r).translation();
-  const double own = teamSign(team) * p.x();  // > 0 in the own half
-  const bool on_field =
-      std::abs(p.x()) <= f.halfLength() + f.goal.depth && std::abs(p.y()) <= f.halfWidth();
-  const bool in_circle = std::hypot(p.x(), p.y()) <= f.centre_circle_radius;
-  if (!on_field) return false;
-  if (game_.kickingTeam() == team) return own > 0.0 || in_circle;
-  return own > 0.0 && !in_circle;  // defenders (and drop balls): own half, outside the circle
+  const double s = teamSign(team);
+  Vec3 p = world_.torsoPose(r).translation();
+  p.z() = 0.0;
+  p.x() = std::clamp(p.x(), -f.halfLength() + 0.3, f.halfLength() - 0.3);
+  p.y() = std::clamp(p.y(), -f.halfWidth() + 0.3, f.halfWidth() - 0.3);
+  if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick) {
+    // Out of the defending team's penalty area, straight back towards the field.
+    const int defender = 1 - game_.kickingTeam();
+    const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
+    const double edge = f.halfLength() - area.length - 0.3;
+    if (teamSign(defender) * p.x() > edge && std::abs(p.y()) < 0.5 * area.width + 0.3)
+      p.x() = teamSign(defender) * edge;
+  } else {
+    if (s * p.x() < 0.3) p.x() = s * 0.3;  // into the own half
+    const double clear = f.centre_circle_radius + 0.3;
+    if (p.head<2>().norm() < clear) {  // out of the circle, radially
+      Vec3 dir = p.head<2>().norm() > 1e-6 ? Vec3(p.x(), p.y(), 0.0).normalized() : Vec3(s, 0, 0);
+      p = clear * dir;
+    }
+  }
+  // Not onto a robot placed before it: step sideways.
+  for (int i = 0; i < 20; ++i) {
+    bool clash = false;
+    for (const Vec3& q : taken) clash = clash || (q - p).head<2>().norm() < 0.4;
+    if (!clash) break;
+    p.y() += (p.y() <= 0 ? 0.4 : -0.4) * (i % 2 == 0 ? 1 : -1) * (i / 2 + 1);
+    p.y() = std::clamp(p.y(), -f.halfWidth() + 0.3, f.halfWidth() - 0.3);
+  }
+  return p;
 }
 
 void Referee::onEnterSet() {
   if (game_.phase() == gc::GamePhase::PenaltyShoot) return;  // placed by startShootoutKick
-  // The ball goes to the centre mark for a kick-off (or the penalty mark).
+  // The ball goes to the centre mark for a kick-off or drop ball, to the
+  // penalty mark for a penalty kick.
   const auto& f = world_.field();
-  if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick && f.penalty_mark_distance) {
-    const int defender = 1 - game_.kickingTeam();
-    placeBall(teamSign(defender) * (f.halfLength() - *f.penalty_mark_distance), 0.0);
-    return;
-  }
-  placeBall(0.0, 0.0);
-  // Illegal positions: penalised (15 s), or moved by auto-placement.
-  bool kick_off_player = false;
+  if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick)
+    placeBall(
+        -teamSign(game_.kickingTeam()) * (f.halfLength() - f.penalty_mark_distance.value_or(1.3)),
+        0.0);
+  else
+    placeBall(0.0, 0.0);
+  // Illegal positions: penalised (15 s), or moved by auto-placement to the
+  // nearest legal spot.
+  const std::vector<char> legal = legalPositions();
+  std::vector<Vec3> taken;
+  for (RobotId r = 0; r < world_.robotCount(); ++r)
+    if (legal[r]) taken.push_back(world_.torsoPose(r).translation());
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    if (legal[r]) continue;
     const auto& info = world_.robot(r);
-    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
-    const Vec3 p = world_.torsoPose(r).translation();
-    bool legal = legalKickOffPosition(r);
-    // At most one robot of the kicking team outside its own half (in the circle).
-    if (legal && game_.kickingTeam() == info.team && teamSign(info.team) * p.x() <= 0.0) {
-      legal = !kick_off_player;
-      kick_off_player = true;
-    }
-    if (legal) continue;
     if (config_.auto_placement) {
-      const double x = teamSign(info.team) * std::max(f.centre_circle_radius + 0.3, 1.0);
-      const double y = std::clamp(p.y(), -f.halfWidth() + 0.3, f.halfWidth() - 0.3);
-      world_.placeRobot(r, x, y, teamSign(info.team) < 0 ? 0.0 : M_PI);
+      const Vec3 p = nearestLegalPosition(r, taken);
+      taken.push_back(p);
+      world_.placeRobot(r, p.x(), p.y(), teamSign(info.team) < 0 ? 0.0 : M_PI);
       game_.recordEvent("placement", info.team, info.number, "auto-placed to a legal position");
     } else {
       game_.penalise(info.team, info.number, gc::Penalty::IllegalPositionInSet);
@@ -248,6 +329,23 @@ void Referee::checkBall() {
     const int defender = defenderOfSide(side);
     const int attacker = 1 - defender;
     if (std::abs(p.y()) < 0.5 * f.goal.inner_width && p.z() < f.goal.clear_height) {
+      // Indirect kick: after a restart a goal needs two robots of the scoring
+      // team to have played the ball (own goals always count; a penalty kick
+      // may score directly). A direct goal becomes a goal kick.
+      const bool own_goal = last_team == defender;
+      const bool direct = std::popcount(touched_since_restart_[static_cast<size_t>(attacker)]) < 2;
+      if (game_.rules().indirect_kick && !own_goal && direct &&
+          game_.currentSetPlay() != gc::SetPlay::PenaltyKick) {
+        game_.recordEvent("goal_disallowed", attacker, 0,
+                          "indirect kick: fewer than two of its robots played the ball");
+        const auto area = f.goal_area ? f.goal_area : f.penalty_area;
+        game_.setPlay(gc::SetPlay::GoalKick, defender);
+        placeBall(side * (f.halfLength() - (area ? area->length : 0.6)),
+                  (p.y() >= 0 ? 1.0 : -1.0) * 0.5 * (area ? area->width : 2.2));
+        set_play_ball_ = world_.ballState().pose.translation();
+        set_play_step_ = world_.stepCount();
+        return;
+      }
       game_.goal(attacker);  // a goal for the team attacking this goal (own goals too)
       placeBall(0.0, 0.0);
       return;
@@ -322,7 +420,8 @@ void Referee::checkPenalties() {
         illegal =
             teamSign(info.team) * p.x() < 0.0 || std::hypot(p.x(), p.y()) < f.centre_circle_radius;
       else if (play != gc::SetPlay::PenaltyKick)
-        illegal = (ball - p).head<2>().norm() < config_.free_kick_distance;
+        illegal = clock_ - set_play_since_ >= config_.free_kick_clear_time &&
+                  (ball - p).head<2>().norm() < config_.free_kick_distance;
       if (illegal) {
         game_.penalise(info.team, info.number, gc::Penalty::IllegalPosition);
         game_.recordEvent("illegal_position", info.team, info.number,
@@ -366,7 +465,8 @@ void Referee::checkPenalties() {
         return da != db ? da > db : a < b;
       });
       for (size_t i = max; i < list.size(); ++i)
-        game_.penalise(team, world_.robot(list[i]).number, gc::Penalty::IllegalPosition);
+        game_.penalise(team, world_.robot(list[i]).number,
+                       playing ? gc::Penalty::IllegalPosition : gc::Penalty::IllegalPositionInSet);
     }
   }
 }
@@ -409,13 +509,22 @@ void Referee::checkGameStuck() {
 }
 
 void Referee::removePenalised() {
-  std::array<int, 2> waiting{};
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
     const auto& info = world_.robot(r);
     const gc::Penalty pen = game_.penalty(info.team, info.number);
     const bool out = pen != gc::Penalty::None;
     if (out) {
-      const world::Pose spot = penaltySpot(info.team, waiting[static_cast<size_t>(info.team)]++);
+      if (slot_[r] < 0) {
+        // The first free waiting spot of its team; it keeps it while it waits.
+        int s = 0;
+        for (bool taken = true; taken; s += taken ? 1 : 0) {
+          taken = false;
+          for (RobotId o = 0; o < world_.robotCount(); ++o)
+            taken = taken || (o != r && world_.robot(o).team == info.team && slot_[o] == s);
+        }
+        slot_[r] = s;
+      }
+      const world::Pose spot = penaltySpot(info.team, slot_[r]);
       const double yaw = std::atan2(spot.linear()(1, 0), spot.linear()(0, 0));
       // Removed at once, and kept there (re-placed if it wanders off).
       if (!parked_[r] ||
@@ -431,6 +540,7 @@ void Referee::removePenalised() {
                         side > 0 ? -M_PI / 2 : M_PI / 2);
       parked_[r] = false;
     }
+    if (!out) slot_[r] = -1;
   }
 }
 
@@ -544,12 +654,19 @@ void Referee::update() {
   const double dt = world_.scenario().physics.control_period;
   game_.advance(dt);
   clock_ += dt;
+  if (game_.currentSetPlay() != last_set_play_) {
+    set_play_since_ = clock_;
+    if (game_.currentSetPlay() != gc::SetPlay::None) touched_since_restart_ = {0, 0};  // a restart
+  }
+  last_set_play_ = game_.currentSetPlay();
   const gc::State s = game_.state();
   if (s != last_state_) {
     time_in_state_ = 0.0;
     still_for_ = 0.0;
     if (s == gc::State::Set) onEnterSet();
     if (s == gc::State::Playing) {
+      touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick
+      restart_seen_touch_step_ = world_.stepCount();
       set_play_ball_ = world_.ballState().pose.translation();
       set_play_step_ = world_.stepCount();
       stuck_ball_ = set_play_ball_;
@@ -575,10 +692,11 @@ void Referee::update() {
     if (s == gc::State::Ready) {
       // Ready ends early when every robot in play stands still in a legal place.
       bool all = true;
+      const std::vector<char> legal = legalPositions();
       for (RobotId r = 0; r < world_.robotCount() && all; ++r) {
         const auto& info = world_.robot(r);
         if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
-        all = legalKickOffPosition(r) && world_.isStanding(r) &&
+        all = legal[r] && world_.isStanding(r) &&
               world_.physics().rootLinearVelocity(world_.robot(r).body).head<2>().norm() <
                   config_.still_speed;
       }
@@ -592,6 +710,12 @@ void Referee::update() {
       last_state_ = game_.state();
       time_in_state_ = 0.0;
     } else if (s == gc::State::Playing) {
+      if (const auto t = world_.lastBallTouch(); t && t->step > restart_seen_touch_step_) {
+        restart_seen_touch_step_ = t->step;
+        if (t->robot < 64)
+          touched_since_restart_[static_cast<size_t>(world_.robot(t->robot).team)] |= uint64_t{1}
+                                                                                      << t->robot;
+      }
       checkArmContact();
       checkBall();
       checkSetPlayOver();

@@ -31,6 +31,8 @@ struct RuleBook {
   int mercy_goal_difference = 10;
   double game_stuck_duration = 30;
   int goal_area_max_robots = 3;
+  bool indirect_kick =
+      true;  // after a restart two robots of a team must play the ball before it scores
   double penalty_base = 45, penalty_increment = 10;
   double illegal_position_in_set = 15, motion_in_set = 15;
   bool shootout = true;

@@ -22,10 +22,11 @@ struct RefereeConfig {
   double inactive_time = 10.0;  // s fallen, or standing idle near the ball, before Inactive Player
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
-  double free_kick_distance = 0.75;     // m: defenders keep this far from the ball at a free kick
-  double ball_moved = 0.05;             // m: the kicking team moved the ball clearly
-  double stuck_progress = 0.3;          // m the ball must move within the game-stuck time
-  double stuck_radius = 0.5;  // m: a robot this close to a stuck ball is penalised (local)
+  double free_kick_distance = 0.75;   // m: defenders keep this far from the ball at a free kick ...
+  double free_kick_clear_time = 5.0;  // s ... once this long after it was awarded (time to leave)
+  double ball_moved = 0.05;           // m: the kicking team moved the ball clearly
+  double stuck_progress = 0.3;        // m the ball must move within the game-stuck time
+  double stuck_radius = 0.5;          // m: a robot this close to a stuck ball is penalised (local)
   // Pushing: sustained contact between opponents in which one drives into
   // the other, or in which the other falls.
   double push_time = 1.0;  // s of contact (gaps under push_gap count as one) ...
@@ -33,7 +34,7 @@ struct RefereeConfig {
   double push_displacement =
       0.15;                 // m ... or the other shoved this far since the contact began ...
   double push_speed = 0.1;  // m/s: ... while the pusher moves towards the other this fast
-  double foul_ball_distance = 1.0;  // m: pushing this close to the ball in open play is a foul
+  double foul_ball_distance = 0.5;  // m: pushing this close to the ball in open play is a foul
   // Penalty shoot-out.
   int shootout_goal_side = 1;          // all kicks at the goal at x = side * length / 2
   double ball_stopped_speed = 0.02;    // m/s: the ball has come to a stop ...
@@ -76,7 +77,10 @@ class Referee {
   void checkArmContact();
   bool inOwnPenaltyArea(world::RobotId r) const;
   void onEnterSet();
-  bool legalKickOffPosition(world::RobotId r) const;
+  // Per robot: in a legal position for the coming kick-off, drop ball or
+  // penalty kick (penalised robots count as legal).
+  std::vector<char> legalPositions() const;
+  engine::Vec3 nearestLegalPosition(world::RobotId r, const std::vector<engine::Vec3>& taken) const;
   bool inOwnGoalArea(world::RobotId r) const;
   double depthInOwnGoalArea(world::RobotId r) const;  // distance to the area's open border (m)
   void placeBall(double x, double y);
@@ -94,8 +98,14 @@ class Referee {
   std::vector<double> idle_for_;            // s standing without moving with the ball near
   std::vector<engine::Vec3> idle_anchor_;   // where the idle time started
   std::vector<double> in_goal_area_since_;  // game time of entering the own goal area; <0 outside
-  double clock_ = 0.0;                      // seconds of referee updates, for entry order
+  // Robots of each team (bit = RobotId) that played the ball since the last restart.
+  std::array<uint64_t, 2> touched_since_restart_{};
+  uint64_t restart_seen_touch_step_ = 0;
+  gc::SetPlay last_set_play_ = gc::SetPlay::None;
+  double set_play_since_ = 0.0;  // clock_ when the current set play was awarded
+  double clock_ = 0.0;           // seconds of referee updates, for entry order
   std::vector<bool> parked_;
+  std::vector<int> slot_;  // a penalised robot's waiting spot index (kept while it waits), -1 none
   engine::Vec3 stuck_ball_ = engine::Vec3::Zero();
   double stuck_for_ = 0.0;
   // Robots x robots (a < b): s in contact, s since the last contact, and
