@@ -16,10 +16,16 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
                   "half_time_to_initial", "clock_in_ready_and_set", "ready_duration",
                   "ready_penalty_kick_duration", "kick_off_ball_free", "set_play_duration",
                   "penalty_kick_duration", "mercy_goal_difference", "game_stuck_duration",
-                  "goal_area_max_robots", "indirect_kick", "penalties", "shootout"});
+                  "goal_area_max_robots", "indirect_kick", "timeouts", "penalties", "shootout"});
   RuleBook r;
   r.name = root["rules"].string();
   r.indirect_kick = root["indirect_kick"].boolean();
+  const ConfigNode to = root["timeouts"];
+  to.allowOnly({"team", "referee", "per_team"});
+  r.team_timeout = to["team"].positive();
+  r.referee_timeout = to["referee"].positive();
+  r.timeouts_per_team = to["per_team"].integer();
+  if (r.timeouts_per_team < 0) to.failKey("per_team", "must be >= 0");
   r.source_file = file.string();
   r.players_per_team = root["players_per_team"].integer();
   if (r.players_per_team < 1 || r.players_per_team > static_cast<int>(gc::kMaxPlayers))
@@ -101,6 +107,7 @@ Game::Game(const RuleBook& rules, const std::array<TeamSetup, 2>& teams, int kic
   if (kick_off_team != 0 && kick_off_team != 1)
     throw std::invalid_argument("the kick-off team is 0 or 1");
   first_half_kick_off_ = kick_off_team;
+  timeouts_left_ = {rules.timeouts_per_team, rules.timeouts_per_team};
   kicking_team_ = kick_off_team;
   half_clock_ = rules.half_duration;
   for (auto& team : players_)
@@ -544,9 +551,9 @@ void Game::timeout(std::optional<int> team) {
       throw std::logic_error("the team has no timeout left");
     --timeouts_left_[static_cast<size_t>(*team)];
     kicking_team_ = 1 - *team;  // the other team gets the kick-off
-    secondary_ = 300.0;
+    secondary_ = rules_.team_timeout;
   } else {
-    secondary_ = 600.0;  // a referee timeout shows 10 min
+    secondary_ = rules_.referee_timeout;
   }
   phase_ = gc::GamePhase::Timeout;
   set_play_ = gc::SetPlay::None;

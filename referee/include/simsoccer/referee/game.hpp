@@ -31,8 +31,10 @@ struct RuleBook {
   int mercy_goal_difference = 10;
   double game_stuck_duration = 30;
   int goal_area_max_robots = 3;
-  bool indirect_kick =
-      true;  // after a restart two robots of a team must play the ball before it scores
+  // After a restart two robots of a team must play the ball before it scores.
+  bool indirect_kick = true;
+  double team_timeout = 300, referee_timeout = 600;  // s
+  int timeouts_per_team = 1;
   double penalty_base = 45, penalty_increment = 10;
   double illegal_position_in_set = 15, motion_in_set = 15;
   bool shootout = true;
