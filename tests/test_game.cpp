@@ -6,10 +6,10 @@
 #include <fstream>
 #include <thread>
 
+#include "referee_support.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/referee/game.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
-#include "test_support.hpp"
 
 using namespace simsoccer;
 using namespace simsoccer::referee;
@@ -17,16 +17,10 @@ using namespace simsoccer::referee;
 namespace {
 
 RuleBook spl() {
-  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  return test::splRules();
 }
-
 std::array<TeamSetup, 2> teams() {
-  std::array<TeamSetup, 2> t;
-  t[0].number = 13;
-  t[0].field_player_colour = 0;
-  t[1].number = 5;
-  t[1].field_player_colour = 1;
-  return t;
+  return test::twoTeams();
 }
 
 // Advances in 10 ms steps, as the simulator does.

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "referee_support.hpp"
 #include "simsoccer/referee/referee.hpp"
-#include "test_support.hpp"
 
 using namespace simsoccer;
 using namespace simsoccer::referee;
@@ -14,14 +14,10 @@ using engine::Vec3;
 namespace {
 
 RuleBook spl() {
-  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  return test::splRules();
 }
-
 std::array<TeamSetup, 2> teams() {
-  std::array<TeamSetup, 2> t;
-  t[0].number = 13;
-  t[1].number = 5;
-  return t;
+  return test::twoTeams();
 }
 
 // 2 v 2 in their own halves: team 0 defends -x.
@@ -78,6 +74,21 @@ void kickOff(world::World& w, Referee& ref) {
   // Ready ends early (robots stand still where they are, legally), Set, whistle.
   for (int i = 0; i < 1000 && ref.game().state() != gc::State::Playing; ++i) run(w, ref, 0.01);
   ASSERT_EQ(ref.game().state(), gc::State::Playing);
+}
+
+// From the first kick-off to open play (the ball free).
+void openPlay(world::World& w, Referee& ref) {
+  ref.game().ready();
+  kickOff(w, ref);
+  ref.game().ballFree();
+}
+
+// Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other
+// 0.35 m apart, the ball 0.3 m to their side.
+void faceOff(world::World& w) {
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.8, -2.0, M_PI);
+  putBall(w, 0.7, -1.7);
 }
 
 }  // namespace
@@ -275,9 +286,7 @@ TEST(Referee, StandingIdleNextToTheBallIsInactive) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
   Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  g.ballFree();
+  openPlay(w, ref);
   putBall(w, 2.75, 0.05);  // in front of team 1 player 1, who does not move
   run(w, ref, 9.5);
   EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);
@@ -292,9 +301,7 @@ TEST(Referee, GameStuckLocalThenGlobal) {
   cfg.inactive_time = 1e9;  // the robot at the ball stands still: not an inactive call here
   Referee ref(w, spl(), teams(), 0, cfg);
   Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  g.ballFree();
+  openPlay(w, ref);
   // The ball lies still next to robot 2 (team 1 player 1 at (3, 0)).
   putBall(w, 2.75, 0.05);
   run(w, ref, 30.2);
@@ -314,6 +321,17 @@ void shoot(world::World& w, double vx, double vy) {
   b.linear_velocity = Vec3(vx, vy, 0.0);
   b.angular_velocity = Vec3::Zero();
   w.setBallState(b);
+}
+
+// A shoot-out kick after Set: the whistle (1 s), the striker's touch, the
+// ball rolling at (vx, vy), then `seconds` of play.
+void takeKick(world::World& w, Referee& ref, world::RobotId striker, double vx, double vy,
+              double seconds) {
+  run(w, ref, 1.05);
+  ASSERT_EQ(ref.game().state(), gc::State::Playing);
+  touchBall(w, ref, striker);
+  shoot(w, vx, vy);
+  run(w, ref, seconds);
 }
 
 }  // namespace
@@ -336,11 +354,7 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
   for (world::RobotId r : {0, 3})                             // substitutes off the field
     EXPECT_GT(std::abs(w.torsoPose(r).translation().y()), f.halfWidth());
   EXPECT_EQ(g.state(), gc::State::Set);
-  run(w, ref, 1.0);
-  ASSERT_EQ(g.state(), gc::State::Playing);
-  touchBall(w, ref, 1);
-  shoot(w, 4.0, 1.7);  // towards the left half of the goal, past the keeper
-  run(w, ref, 2.0);
+  takeKick(w, ref, 1, 4.0, 1.7, 2.0);  // towards the left half of the goal, past the keeper
   EXPECT_EQ(g.state(), gc::State::Finished);
   EXPECT_EQ(g.score(0), 1);
   ASSERT_EQ(g.shotOutcomes(0).size(), 1u);
@@ -348,11 +362,7 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
 
   // Kick 2: team 1's player 2 shoots straight at team 0's keeper: saved.
   ref.startShootoutKick(2, 1);
-  run(w, ref, 1.05);
-  ASSERT_EQ(g.state(), gc::State::Playing);
-  touchBall(w, ref, 3);
-  shoot(w, 3.0, 0.0);
-  run(w, ref, 6.0);
+  takeKick(w, ref, 3, 3.0, 0.0, 6.0);
   EXPECT_EQ(g.state(), gc::State::Finished);
   EXPECT_EQ(g.score(1), 0);
   ASSERT_EQ(g.shotOutcomes(1).size(), 1u);
@@ -375,13 +385,9 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
   Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  g.ballFree();
+  openPlay(w, ref);
   // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other.
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.8, -2.0, M_PI);
-  putBall(w, 0.7, -1.7);
+  faceOff(w);
   run(w, ref, 0.5);
   // Standing face to face without driving: nothing.
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
@@ -405,9 +411,7 @@ TEST(Referee, BallContactWithAnArm) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
   Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  g.ballFree();
+  openPlay(w, ref);
   auto ballOnHand = [&](world::RobotId r) {
     const int hand = w.robot(r).model->body->linkIndex("LWrist");
     const engine::Pose p = w.linkPose(r, hand);
@@ -555,12 +559,8 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
     world::World w(twoVsTwo());
     Referee ref(w, spl(), teams(), 0);
     Game& g = ref.game();
-    g.ready();
-    kickOff(w, ref);
-    g.ballFree();
-    w.placeRobot(1, 0.45, -2.0, 0.0);
-    w.placeRobot(3, 0.8, -2.0, M_PI);
-    putBall(w, 0.7, -1.7);
+    openPlay(w, ref);
+    faceOff(w);
     for (int i = 0; i < 150; ++i) {
       w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
       run(w, ref, 0.01);
