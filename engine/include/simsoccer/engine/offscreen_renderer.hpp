@@ -1,0 +1,89 @@
+// Off-screen OpenGL rendering through EGL without a display (Mesa's
+// llvmpipe on CPU machines, a GPU's EGL driver where there is one): many
+// camera views of one instanced scene drawn into one framebuffer per frame,
+// read back once.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "simsoccer/engine/model.hpp"
+
+namespace simsoccer::engine {
+
+class RenderError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Unit meshes: box -0.5..0.5 on each axis; sphere of radius 1 (192
+// triangles, for the ball); a coarse sphere (80 triangles, for robot parts);
+// cylinder of radius 1 and length 1 along z, centred (32 triangles).
+enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder };
+
+// One instance of a unit mesh in the world frame.
+struct DrawItem {
+  Primitive shape = Primitive::Box;
+  Eigen::Matrix4f transform = Eigen::Matrix4f::Identity();  // world from unit mesh (with scale)
+  Eigen::Vector3f colour = Eigen::Vector3f::Ones();         // linear RGB, 0..1
+  bool ball_pattern = false;                                // black patches on white (the SPL ball)
+};
+
+// A pinhole camera. `pose` is the camera frame in the world: x forward
+// (optical axis), y left, z up. Pixel (u, v): u right, v down, pixel i
+// covering [i, i + 1); a point at depth d projects to u = cx + fx * (-y / d).
+struct RenderView {
+  Pose pose = Pose::Identity();
+  int width = 640, height = 480;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;  // px
+  double near_clip = 0.01, far_clip = 60.0;       // m
+};
+
+// Intrinsics from the fields of view (rad), centred principal point.
+RenderView pinholeView(const Pose& pose, int width, int height, double horizontal_fov,
+                       double vertical_fov);
+// Where a world point lands in a view (u right, v down, px); false if behind.
+bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, double& v);
+
+struct RenderTiming {
+  double draw_ms = 0.0, readback_ms = 0.0;
+  int atlas_width = 0, atlas_height = 0;
+  size_t triangles_per_view = 0;
+};
+
+class OffscreenRenderer {
+ public:
+  // Opens EGL on the surfaceless Mesa platform (or the first EGL device),
+  // creates an OpenGL 3.3 core context; throws RenderError saying which step failed.
+  OffscreenRenderer();
+  ~OffscreenRenderer();
+  OffscreenRenderer(const OffscreenRenderer&) = delete;
+  OffscreenRenderer& operator=(const OffscreenRenderer&) = delete;
+
+  std::string glRenderer() const;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+
+  // Draws the scene in every view into one framebuffer (one viewport each)
+  // and reads it back once. `images[i]` becomes view i as 8-bit RGB
+  // (CV_8UC3, R first, top row first). Must be called on the thread that
+  // created the renderer.
+  void render(std::span<const DrawItem> scene, std::span<const RenderView> views,
+              std::vector<cv::Mat>& images);
+  const RenderTiming& lastTiming() const { return timing_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  RenderTiming timing_;
+};
+
+// The Nao's image format: YUV 4:2:2 as Y0 U Y1 V (YUYV), from 8-bit RGB,
+// using OpenCV's RGB -> YUV conversion; each pixel pair shares the mean of
+// its two chroma values. `width` must be even.
+cv::Mat rgbToYuyv(const cv::Mat& rgb);
+
+}  // namespace simsoccer::engine

@@ -1,0 +1,463 @@
+#include "simsoccer/engine/offscreen_renderer.hpp"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/glcorearb.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace simsoccer::engine {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in mat4 model;   // locations 2..5
+layout(location = 6) in vec3 colour;
+layout(location = 7) in float pattern;
+uniform mat4 view_projection;
+out vec3 world_normal;
+out vec3 base_colour;
+out vec3 object_position;
+flat out float ball_pattern;
+void main() {
+  gl_Position = view_projection * model * vec4(position, 1.0);
+  world_normal = mat3(model) * normal;
+  base_colour = colour;
+  object_position = position;
+  ball_pattern = pattern;
+}
+)";
+
+// Lambert shading under a fixed sky light; the ball's black patches are the
+// 12 directions of an icosahedron's vertices (a pentagon pattern's centres).
+const char* kFragmentShader = R"(#version 330 core
+in vec3 world_normal;
+in vec3 base_colour;
+in vec3 object_position;
+flat in float ball_pattern;
+out vec4 fragment;
+void main() {
+  vec3 c = base_colour;
+  if (ball_pattern > 0.5) {
+    const float g = 1.618034;
+    vec3 p = normalize(object_position);
+    vec3 a = abs(p);
+    float best = max(max(dot(a, normalize(vec3(0.0, 1.0, g))), dot(a, normalize(vec3(1.0, g, 0.0)))),
+                     dot(a, normalize(vec3(g, 0.0, 1.0))));
+    if (best > 0.93) c = vec3(0.05);
+  }
+  vec3 n = normalize(world_normal);
+  float light = 0.6 + 0.4 * max(dot(n, normalize(vec3(0.3, 0.2, 1.0))), 0.0);
+  fragment = vec4(c * light, 1.0);
+}
+)";
+
+struct Mesh {
+  GLuint vao = 0, vertices = 0, indices = 0, instances = 0;
+  GLsizei index_count = 0;
+};
+
+struct Vertex {
+  float p[3];
+  float n[3];
+};
+
+struct Instance {
+  float model[16];  // column-major
+  float colour[3];
+  float pattern;
+};
+
+void unitBox(std::vector<Vertex>& v, std::vector<uint32_t>& idx) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const auto base = static_cast<uint32_t>(v.size());
+      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+      for (int k = 0; k < 4; ++k) {
+        Vertex x{};
+        x.p[axis] = 0.5f * static_cast<float>(sign);
+        x.p[a1] = (k == 1 || k == 2) ? 0.5f : -0.5f;
+        x.p[a2] = (k >= 2) ? 0.5f : -0.5f;
+        x.n[axis] = static_cast<float>(sign);
+        v.push_back(x);
+      }
+      idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+}
+
+// Low tessellation on purpose: llvmpipe's cost grows with triangles.
+void unitSphere(std::vector<Vertex>& v, std::vector<uint32_t>& idx, int slices, int stacks) {
+  for (int i = 0; i <= stacks; ++i) {
+    const double th = M_PI * i / stacks;
+    for (int j = 0; j <= slices; ++j) {
+      const double ph = 2 * M_PI * j / slices;
+      const float x = static_cast<float>(std::sin(th) * std::cos(ph));
+      const float y = static_cast<float>(std::sin(th) * std::sin(ph));
+      const float z = static_cast<float>(std::cos(th));
+      v.push_back({{x, y, z}, {x, y, z}});
+    }
+  }
+  for (int i = 0; i < stacks; ++i)
+    for (int j = 0; j < slices; ++j) {
+      const auto a = static_cast<uint32_t>(i * (slices + 1) + j);
+      const auto b = static_cast<uint32_t>(a + static_cast<uint32_t>(slices) + 1);
+      idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
+    }
+}
+
+void unitCylinder(std::vector<Vertex>& v, std::vector<uint32_t>& idx, int slices) {
+  for (int j = 0; j <= slices; ++j) {  // side
+    const double ph = 2 * M_PI * j / slices;
+    const float x = static_cast<float>(std::cos(ph)), y = static_cast<float>(std::sin(ph));
+    v.push_back({{x, y, -0.5f}, {x, y, 0}});
+    v.push_back({{x, y, 0.5f}, {x, y, 0}});
+  }
+  for (int j = 0; j < slices; ++j) {
+    const auto a = static_cast<uint32_t>(2 * j);
+    idx.insert(idx.end(), {a, a + 2, a + 1, a + 1, a + 2, a + 3});
+  }
+  for (int cap = 0; cap < 2; ++cap) {
+    const float z = cap == 0 ? -0.5f : 0.5f, nz = cap == 0 ? -1.0f : 1.0f;
+    const auto centre = static_cast<uint32_t>(v.size());
+    v.push_back({{0, 0, z}, {0, 0, nz}});
+    for (int j = 0; j <= slices; ++j) {
+      const double ph = 2 * M_PI * j / slices;
+      v.push_back(
+          {{static_cast<float>(std::cos(ph)), static_cast<float>(std::sin(ph)), z}, {0, 0, nz}});
+    }
+    for (int j = 0; j < slices; ++j) {
+      const auto a = centre + 1 + static_cast<uint32_t>(j);
+      if (cap == 0)
+        idx.insert(idx.end(), {centre, a + 1, a});
+      else
+        idx.insert(idx.end(), {centre, a, a + 1});
+    }
+  }
+}
+
+GLuint compile(GLenum type, const char* source) {
+  const GLuint s = glCreateShader(type);
+  glShaderSource(s, 1, &source, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    std::array<char, 2048> log{};
+    glGetShaderInfoLog(s, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    throw RenderError(std::string("renderer: shader compilation failed: ") + log.data());
+  }
+  return s;
+}
+
+}  // namespace
+
+struct OffscreenRenderer::Impl {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  GLuint program = 0;
+  GLint view_projection = -1;
+  std::array<Mesh, 4> meshes;  // by Primitive
+  GLuint fbo = 0, colour = 0, depth = 0;
+  int fbo_width = 0, fbo_height = 0;
+  std::vector<std::vector<Instance>> batches{4};
+  cv::Mat atlas;  // RGB, bottom row first (as GL reads it)
+
+  void openDisplay() {
+    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!get_platform_display) throw RenderError("renderer: EGL has no eglGetPlatformDisplayEXT");
+    display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0, minor = 0;
+    if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) return;
+    // Second choice: the first EGL device (a GPU driver without Mesa's platform).
+    auto query_devices =
+        reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    EGLDeviceEXT devices[4];
+    EGLint count = 0;
+    if (query_devices && query_devices(4, devices, &count) && count > 0) {
+      display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[0], nullptr);
+      if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) return;
+    }
+    throw RenderError("renderer: no EGL display (surfaceless Mesa or device platform), EGL error " +
+                      std::to_string(eglGetError()));
+  }
+
+  void createContext() {
+    if (!eglBindAPI(EGL_OPENGL_API)) throw RenderError("renderer: eglBindAPI(OpenGL) failed");
+    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
+                                        EGL_OPENGL_BIT, EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint n = 0;
+    eglChooseConfig(display, config_attributes, &config, 1, &n);
+    const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                         3,
+                                         EGL_CONTEXT_MINOR_VERSION,
+                                         3,
+                                         EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                         EGL_NONE};
+    context = eglCreateContext(display, n > 0 ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT,
+                               context_attributes);
+    if (context == EGL_NO_CONTEXT)
+      throw RenderError("renderer: no OpenGL 3.3 core context, EGL error " +
+                        std::to_string(eglGetError()));
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
+      throw RenderError("renderer: eglMakeCurrent without a surface failed");
+  }
+
+  void buildProgram() {
+    const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
+    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
+    program = glCreateProgram();
+    glAttachShader(program, vs);
+    glAttachShader(program, fs);
+    glLinkProgram(program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) throw RenderError("renderer: shader program did not link");
+    view_projection = glGetUniformLocation(program, "view_projection");
+  }
+
+  void buildMesh(Primitive p) {
+    std::vector<Vertex> v;
+    std::vector<uint32_t> idx;
+    if (p == Primitive::Box) unitBox(v, idx);
+    if (p == Primitive::Sphere) unitSphere(v, idx, 12, 8);
+    if (p == Primitive::CoarseSphere) unitSphere(v, idx, 8, 5);
+    if (p == Primitive::Cylinder) unitCylinder(v, idx, 8);
+    Mesh& m = meshes[static_cast<size_t>(p)];
+    glGenVertexArrays(1, &m.vao);
+    glBindVertexArray(m.vao);
+    glGenBuffers(1, &m.vertices);
+    glBindBuffer(GL_ARRAY_BUFFER, m.vertices);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(Vertex)), v.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                          reinterpret_cast<void*>(offsetof(Vertex, n)));
+    glGenBuffers(1, &m.indices);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.indices);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(uint32_t)),
+                 idx.data(), GL_STATIC_DRAW);
+    m.index_count = static_cast<GLsizei>(idx.size());
+    // Per-instance attributes: model matrix (4 columns), colour, pattern flag.
+    glGenBuffers(1, &m.instances);
+    glBindBuffer(GL_ARRAY_BUFFER, m.instances);
+    for (GLuint c = 0; c < 4; ++c) {
+      glEnableVertexAttribArray(2 + c);
+      glVertexAttribPointer(2 + c, 4, GL_FLOAT, GL_FALSE, sizeof(Instance),
+                            reinterpret_cast<void*>(c * 4 * sizeof(float)));
+      glVertexAttribDivisor(2 + c, 1);
+    }
+    glEnableVertexAttribArray(6);
+    glVertexAttribPointer(6, 3, GL_FLOAT, GL_FALSE, sizeof(Instance),
+                          reinterpret_cast<void*>(offsetof(Instance, colour)));
+    glVertexAttribDivisor(6, 1);
+    glEnableVertexAttribArray(7);
+    glVertexAttribPointer(7, 1, GL_FLOAT, GL_FALSE, sizeof(Instance),
+                          reinterpret_cast<void*>(offsetof(Instance, pattern)));
+    glVertexAttribDivisor(7, 1);
+    glBindVertexArray(0);
+  }
+
+  void ensureFramebuffer(int width, int height) {
+    if (fbo && width <= fbo_width && height <= fbo_height) return;
+    if (fbo) {
+      glDeleteFramebuffers(1, &fbo);
+      glDeleteRenderbuffers(1, &colour);
+      glDeleteRenderbuffers(1, &depth);
+    }
+    fbo_width = width;
+    fbo_height = height;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glGenRenderbuffers(1, &colour);
+    glBindRenderbuffer(GL_RENDERBUFFER, colour);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGB8, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw RenderError("renderer: framebuffer " + std::to_string(width) + "x" +
+                        std::to_string(height) + " is incomplete");
+  }
+};
+
+OffscreenRenderer::OffscreenRenderer() : impl_(std::make_unique<Impl>()) {
+  impl_->openDisplay();
+  impl_->createContext();
+  impl_->buildProgram();
+  for (Primitive p :
+       {Primitive::Box, Primitive::Sphere, Primitive::CoarseSphere, Primitive::Cylinder})
+    impl_->buildMesh(p);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_SCISSOR_TEST);
+  glEnable(GL_CULL_FACE);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+}
+
+OffscreenRenderer::~OffscreenRenderer() {
+  if (impl_->display == EGL_NO_DISPLAY) return;
+  eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (impl_->context != EGL_NO_CONTEXT) eglDestroyContext(impl_->display, impl_->context);
+  eglTerminate(impl_->display);
+}
+
+std::string OffscreenRenderer::glRenderer() const {
+  const auto* s = glGetString(GL_RENDERER);
+  return s ? reinterpret_cast<const char*>(s) : "";
+}
+
+void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const RenderView> views,
+                               std::vector<cv::Mat>& images) {
+  Impl& m = *impl_;
+  const auto t0 = Clock::now();
+  // Shelf packing of the views into one framebuffer, rows at most 4096 px wide.
+  const int max_row = 4096;
+  std::vector<std::array<int, 2>> origin(views.size());
+  int x = 0, y = 0, row_height = 0, width = 1, height = 1;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const RenderView& v = views[i];
+    if (v.width <= 0 || v.height <= 0 || v.width > max_row)
+      throw RenderError("renderer: view " + std::to_string(i) + " has an invalid size");
+    if (x + v.width > max_row) {
+      x = 0;
+      y += row_height;
+      row_height = 0;
+    }
+    origin[i] = {x, y};
+    x += v.width;
+    row_height = std::max(row_height, v.height);
+    width = std::max(width, x);
+    height = std::max(height, y + row_height);
+  }
+  m.ensureFramebuffer(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
+
+  // The scene's instances, once for all views.
+  for (auto& b : m.batches) b.clear();
+  for (const DrawItem& d : scene) {
+    Instance in{};
+    std::copy(d.transform.data(), d.transform.data() + 16, in.model);
+    in.colour[0] = d.colour.x();
+    in.colour[1] = d.colour.y();
+    in.colour[2] = d.colour.z();
+    in.pattern = d.ball_pattern ? 1.0f : 0.0f;
+    m.batches[static_cast<size_t>(d.shape)].push_back(in);
+  }
+  size_t triangles = 0;
+  for (size_t p = 0; p < m.meshes.size(); ++p) {
+    glBindBuffer(GL_ARRAY_BUFFER, m.meshes[p].instances);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.batches[p].size() * sizeof(Instance)),
+                 m.batches[p].data(), GL_STREAM_DRAW);
+    triangles += m.batches[p].size() * static_cast<size_t>(m.meshes[p].index_count / 3);
+  }
+
+  glUseProgram(m.program);
+  glClearColor(0.35f, 0.35f, 0.38f, 1.0f);  // the hall around the field
+  // OpenGL's camera looks down -z with y up; ours looks along x with z up.
+  Eigen::Matrix4d gl_from_camera = Eigen::Matrix4d::Zero();
+  gl_from_camera(0, 1) = -1.0;
+  gl_from_camera(1, 2) = 1.0;
+  gl_from_camera(2, 0) = -1.0;
+  gl_from_camera(3, 3) = 1.0;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const RenderView& v = views[i];
+    glViewport(origin[i][0], origin[i][1], v.width, v.height);
+    glScissor(origin[i][0], origin[i][1], v.width, v.height);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    const double w = v.width, h = v.height, n = v.near_clip, f = v.far_clip;
+    Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
+    projection(0, 0) = 2 * v.fx / w;
+    projection(0, 2) = 1 - 2 * v.cx / w;
+    projection(1, 1) = 2 * v.fy / h;
+    projection(1, 2) = 2 * v.cy / h - 1;
+    projection(2, 2) = -(f + n) / (f - n);
+    projection(2, 3) = -2 * f * n / (f - n);
+    projection(3, 2) = -1;
+    const Eigen::Matrix4f vp =
+        (projection * gl_from_camera * v.pose.inverse().matrix()).cast<float>();
+    glUniformMatrix4fv(m.view_projection, 1, GL_FALSE, vp.data());
+    for (size_t p = 0; p < m.meshes.size(); ++p) {
+      if (m.batches[p].empty()) continue;
+      glBindVertexArray(m.meshes[p].vao);
+      glDrawElementsInstanced(GL_TRIANGLES, m.meshes[p].index_count, GL_UNSIGNED_INT, nullptr,
+                              static_cast<GLsizei>(m.batches[p].size()));
+    }
+  }
+  glFinish();
+  timing_.draw_ms = msSince(t0);
+
+  const auto t1 = Clock::now();
+  m.atlas.create(height, width, CV_8UC3);
+  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, m.atlas.data);
+  images.resize(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    const cv::Rect r(origin[i][0], origin[i][1], views[i].width, views[i].height);
+    cv::flip(m.atlas(r), images[i], 0);  // GL rows run bottom-up
+  }
+  timing_.readback_ms = msSince(t1);
+  timing_.atlas_width = width;
+  timing_.atlas_height = height;
+  timing_.triangles_per_view = triangles;
+}
+
+RenderView pinholeView(const Pose& pose, int width, int height, double horizontal_fov,
+                       double vertical_fov) {
+  RenderView v;
+  v.pose = pose;
+  v.width = width;
+  v.height = height;
+  v.fx = 0.5 * width / std::tan(0.5 * horizontal_fov);
+  v.fy = 0.5 * height / std::tan(0.5 * vertical_fov);
+  v.cx = 0.5 * width;
+  v.cy = 0.5 * height;
+  return v;
+}
+
+bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, double& v) {
+  const Vec3 p = view.pose.inverse() * world_point;  // camera frame: x forward, y left, z up
+  if (p.x() <= 1e-9) return false;
+  u = view.cx - view.fx * p.y() / p.x();
+  v = view.cy - view.fy * p.z() / p.x();
+  return true;
+}
+
+cv::Mat rgbToYuyv(const cv::Mat& rgb) {
+  if (rgb.type() != CV_8UC3 || rgb.cols % 2 != 0)
+    throw std::invalid_argument("rgbToYuyv: 8-bit RGB with an even width expected");
+  cv::Mat yuv;
+  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  cv::Mat out(rgb.rows, rgb.cols, CV_8UC2);
+  for (int r = 0; r < rgb.rows; ++r) {
+    const auto* in = yuv.ptr<cv::Vec3b>(r);
+    auto* o = out.ptr<uint8_t>(r);
+    for (int c = 0; c < rgb.cols; c += 2) {
+      const cv::Vec3b a = in[c], b = in[c + 1];
+      o[2 * c + 0] = a[0];
+      o[2 * c + 1] = static_cast<uint8_t>((a[1] + b[1] + 1) / 2);
+      o[2 * c + 2] = b[0];
+      o[2 * c + 3] = static_cast<uint8_t>((a[2] + b[2] + 1) / 2);
+    }
+  }
+  return out;
+}
+
+}  // namespace simsoccer::engine

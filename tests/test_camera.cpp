@@ -1,0 +1,248 @@
+// Off-screen cameras on real EGL (Mesa's llvmpipe here, no display): the
+// pinhole geometry, colours, head motion, determinism, YUYV, and PNGs a
+// person can look at.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "simsoccer/world/render_scene.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using engine::Vec3;
+
+namespace {
+
+engine::OffscreenRenderer& renderer() {
+  // Rendering must not need a display: none is set for this process.
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  static engine::OffscreenRenderer r;
+  return r;
+}
+
+// One Nao at (-2, 1.5) facing +x; the ball where the test puts it.
+world::Scenario oneRobot() {
+  world::Scenario s = test::scenario(1);
+  s.robots[0].x = -2.0;
+  s.robots[0].y = 1.5;
+  s.ball_position = {-1.0, 1.5, -1.0};
+  return s;
+}
+
+void putBall(world::World& w, double x, double y) {
+  engine::RigidBodyState b;
+  b.pose.translation() = Vec3(x, y, w.field().ball.radius);
+  w.setBallState(b);
+}
+
+cv::Mat renderOne(world::World& w, const engine::RenderView& view, bool with_ball = true) {
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  if (!with_ball) std::erase_if(scene, [](const engine::DrawItem& d) { return d.ball_pattern; });
+  std::vector<cv::Mat> images;
+  const engine::RenderView views[1] = {view};
+  renderer().render(scene, views, images);
+  return images[0];
+}
+
+// The ball's blob: pixels that change when the ball is left out.
+struct Blob {
+  double u = 0, v = 0, width = 0;
+  int pixels = 0;
+};
+Blob ballBlob(world::World& w, const engine::RenderView& view) {
+  cv::Mat with = renderOne(w, view, true), without = renderOne(w, view, false), diff, mask;
+  cv::absdiff(with, without, diff);
+  cv::cvtColor(diff, mask, cv::COLOR_RGB2GRAY);
+  mask = mask > 0;
+  Blob b;
+  const cv::Moments m = cv::moments(mask, true);
+  b.pixels = cv::countNonZero(mask);
+  if (m.m00 > 0) {
+    b.u = m.m10 / m.m00 + 0.5;  // pixel centres are at i + 0.5
+    b.v = m.m01 / m.m00 + 0.5;
+    const cv::Rect r = cv::boundingRect(mask);
+    b.width = r.width;
+  }
+  return b;
+}
+
+bool isGreen(const cv::Vec3b& p) {
+  return p[1] > p[0] + 40 && p[1] > p[2] + 40;
+}
+
+}  // namespace
+
+TEST(Camera, RendersWithoutADisplay) {
+  EXPECT_EQ(std::getenv("DISPLAY"), nullptr);
+  const std::string name = renderer().glRenderer();
+  std::printf("OpenGL renderer: %s\n", name.c_str());
+  EXPECT_FALSE(name.empty());
+}
+
+TEST(Camera, BallAppearsWherePinholeModelPredicts) {
+  world::World w(oneRobot());
+  for (const auto& [camera, x, y] :
+       {std::tuple{"CameraTop", -0.2, 1.5}, std::tuple{"CameraTop", 0.3, 1.9},
+        std::tuple{"CameraTop", -0.5, 1.2}, std::tuple{"CameraBottom", -1.55, 1.5},
+        std::tuple{"CameraBottom", -1.6, 1.62}}) {
+    putBall(w, x, y);
+    const bool top = std::string(camera) == "CameraTop";
+    const engine::RenderView view =
+        world::robotCameraView(w, 0, camera, top ? 640 : 320, top ? 480 : 240);
+    const Vec3 centre = w.ballState().pose.translation();
+    double u = 0, v = 0;
+    ASSERT_TRUE(engine::projectPoint(view, centre, u, v));
+    const double depth = (view.pose.inverse() * centre).x();
+    const double predicted_width = 2.0 * view.fx * w.field().ball.radius / depth;
+    const Blob b = ballBlob(w, view);
+    std::printf(
+        "%s ball at (%.2f, %.2f): predicted (%.1f, %.1f) width %.1f, seen (%.1f, %.1f) width "
+        "%.0f\n",
+        camera, x, y, u, v, predicted_width, b.u, b.v, b.width);
+    ASSERT_GT(b.pixels, 10);
+    EXPECT_NEAR(b.u, u, 2.0);
+    EXPECT_NEAR(b.v, v, 2.0);
+    EXPECT_NEAR(b.width, predicted_width, 0.1 * predicted_width + 1.0);
+  }
+}
+
+TEST(Camera, CarpetLinesAndJerseyColours) {
+  world::World w(oneRobot());
+  // Looking ahead: the bottom rows of the top camera see carpet.
+  const cv::Mat top = renderOne(w, world::robotCameraView(w, 0, "CameraTop", 640, 480));
+  EXPECT_TRUE(isGreen(top.at<cv::Vec3b>(470, 320))) << top.at<cv::Vec3b>(470, 320);
+  // Straight down from 2 m onto the centre line (x = 0): white in the middle,
+  // green 0.3 m beside it.
+  engine::Pose down = engine::Pose::Identity();
+  down.translation() = Vec3(0.0, 2.0, 2.0);
+  down.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // x -> -z
+  const engine::RenderView above = engine::pinholeView(down, 200, 200, 0.5, 0.5);
+  double u = 0, v = 0;
+  ASSERT_TRUE(engine::projectPoint(above, Vec3(0.0, 2.0, 0.0), u, v));
+  const cv::Mat img = renderOne(w, above);
+  const cv::Vec3b line = img.at<cv::Vec3b>(static_cast<int>(v), static_cast<int>(u));
+  EXPECT_GT(line[0], 200);
+  EXPECT_GT(line[1], 200);
+  EXPECT_GT(line[2], 200);
+  ASSERT_TRUE(engine::projectPoint(above, Vec3(0.3, 2.0, 0.0), u, v));
+  EXPECT_TRUE(isGreen(img.at<cv::Vec3b>(static_cast<int>(v), static_cast<int>(u))));
+  // The torso from 1 m in front: team 0's blue jersey.
+  const engine::Pose torso = w.torsoPose(0);
+  engine::Pose front = engine::Pose::Identity();
+  front.translation() = torso * Vec3(1.0, 0.0, 0.0);
+  front.linear() = torso.linear() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  const cv::Mat body = renderOne(w, engine::pinholeView(front, 160, 120, 0.6, 0.45));
+  const cv::Vec3b jersey = body.at<cv::Vec3b>(60, 80);
+  EXPECT_GT(jersey[2], jersey[0] + 60) << jersey;  // blue over red
+}
+
+TEST(Camera, TurningTheHeadShiftsTheImageAsPredicted) {
+  world::World w(oneRobot());
+  putBall(w, -0.5, 2.0);  // 18 degrees to the robot's left
+  const Blob before = ballBlob(w, world::robotCameraView(w, 0, "CameraTop", 640, 480));
+  const int head_yaw = w.robot(0).model->body->jointIndex("HeadYaw");
+  w.setJointTarget(0, head_yaw, 0.5, 1.0);  // look 0.5 rad to the left
+  for (int i = 0; i < 100; ++i) w.stepControlPeriod();
+  const engine::RenderView turned = world::robotCameraView(w, 0, "CameraTop", 640, 480);
+  double u = 0, v = 0;
+  ASSERT_TRUE(engine::projectPoint(turned, w.ballState().pose.translation(), u, v));
+  const Blob after = ballBlob(w, turned);
+  std::printf("head yaw %.3f rad: ball u %.1f -> %.1f (predicted %.1f)\n",
+              w.jointPosition(0, head_yaw), before.u, after.u, u);
+  EXPECT_NEAR(w.jointPosition(0, head_yaw), 0.5, 0.02);
+  EXPECT_GT(after.u - before.u, 250.0);  // the ball moves right in the image
+  EXPECT_NEAR(after.u, u, 2.0);
+  EXPECT_NEAR(after.v, v, 2.0);
+}
+
+TEST(Camera, SameStateSameBytesAndOneBatchForAllViews) {
+  world::World w(test::scenario(4));
+  std::vector<engine::RenderView> views;
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    views.push_back(world::robotCameraView(w, r, "CameraTop", 640, 480));
+    views.push_back(world::robotCameraView(w, r, "CameraBottom", 320, 240));
+  }
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  std::vector<cv::Mat> a, b;
+  renderer().render(scene, views, a);
+  const auto t = renderer().lastTiming();
+  std::printf(
+      "8 views in one %dx%d framebuffer: draw %.1f ms, readback %.1f ms, %zu triangles per view\n",
+      t.atlas_width, t.atlas_height, t.draw_ms, t.readback_ms, t.triangles_per_view);
+  renderer().render(scene, views, b);
+  ASSERT_EQ(a.size(), 8u);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].size(), b[i].size());
+    EXPECT_EQ(cv::norm(a[i], b[i], cv::NORM_INF), 0.0) << "view " << i;
+  }
+  EXPECT_EQ(a[1].cols, 320);
+  EXPECT_EQ(a[1].rows, 240);
+  // Robot 0's top image differs from robot 2's (another place on the field).
+  EXPECT_GT(cv::norm(a[0], a[4], cv::NORM_L1), 0.0);
+}
+
+TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
+  cv::Mat rgb(48, 64, CV_8UC3);
+  cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(255));
+  const cv::Mat yuyv = engine::rgbToYuyv(rgb);
+  cv::Mat yuv;
+  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  ASSERT_EQ(yuyv.type(), CV_8UC2);
+  for (int r = 0; r < rgb.rows; ++r)
+    for (int c = 0; c < rgb.cols; c += 2) {
+      const uint8_t* q = yuyv.ptr<uint8_t>(r) + 2 * c;
+      const cv::Vec3b a = yuv.at<cv::Vec3b>(r, c), b = yuv.at<cv::Vec3b>(r, c + 1);
+      EXPECT_EQ(q[0], a[0]);
+      EXPECT_EQ(q[2], b[0]);
+      EXPECT_NEAR(q[1], 0.5 * (a[1] + b[1]), 0.5 + 1e-9);
+      EXPECT_NEAR(q[3], 0.5 * (a[2] + b[2]), 0.5 + 1e-9);
+    }
+  // And back (chroma shared by each pair, OpenCV's YUV -> RGB): a flat colour survives.
+  cv::Mat flat(4, 4, CV_8UC3, cv::Scalar(30, 140, 40)), unpacked(4, 4, CV_8UC3), back;
+  const cv::Mat packed = engine::rgbToYuyv(flat);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) {
+      const uint8_t* q = packed.ptr<uint8_t>(r) + 4 * (c / 2);
+      unpacked.at<cv::Vec3b>(r, c) = {q[c % 2 == 0 ? 0 : 2], q[1], q[3]};
+    }
+  cv::cvtColor(unpacked, back, cv::COLOR_YUV2RGB);
+  EXPECT_LE(cv::norm(flat, back, cv::NORM_INF), 2.0);
+  EXPECT_THROW(engine::rgbToYuyv(cv::Mat(2, 3, CV_8UC3)), std::invalid_argument);
+}
+
+TEST(Camera, WritesTopCameraAndSpectatorPngs) {
+  world::World w(test::scenario(10));
+  putBall(w, -1.5, 0.3);
+  std::vector<engine::RenderView> views = {world::robotCameraView(w, 0, "CameraTop", 640, 480)};
+  engine::Pose side = engine::Pose::Identity();  // above the touchline, looking at the field
+  side.translation() = Vec3(0.0, -5.5, 3.5);
+  side.linear() =
+      (Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()) * Eigen::AngleAxisd(0.55, Vec3::UnitY()))
+          .toRotationMatrix();
+  views.push_back(engine::pinholeView(side, 960, 540, 1.6, 1.0));
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  std::vector<cv::Mat> images;
+  renderer().render(scene, views, images);
+  const auto dir = std::filesystem::current_path();
+  for (const auto& [name, image] :
+       {std::pair{"camera_top.png", images[0]}, std::pair{"spectator.png", images[1]}}) {
+    cv::Mat bgr;
+    cv::cvtColor(image, bgr, cv::COLOR_RGB2BGR);
+    ASSERT_TRUE(cv::imwrite((dir / name).string(), bgr));
+    const cv::Mat back = cv::imread((dir / name).string());
+    EXPECT_EQ(back.size(), image.size());
+    std::printf("wrote %s\n", (dir / name).c_str());
+  }
+  // The spectator sees carpet in the lower middle of its image, the hall above.
+  EXPECT_TRUE(isGreen(images[1].at<cv::Vec3b>(420, 300)));
+  EXPECT_TRUE(isGreen(images[1].at<cv::Vec3b>(400, 700)));
+  EXPECT_FALSE(isGreen(images[1].at<cv::Vec3b>(20, 480)));
+}

@@ -1,0 +1,40 @@
+// The world as the renderer sees it: field, lines, goals, ball and robots as
+// instanced unit primitives, and the robots' camera views.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "simsoccer/engine/offscreen_renderer.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::world {
+
+// Colours (linear RGB): the SPL's green carpet and white lines, grey Naos
+// with their team's jersey on the torso.
+struct SceneColours {
+  Eigen::Vector3f carpet{0.10f, 0.50f, 0.12f};
+  Eigen::Vector3f line{0.95f, 0.95f, 0.95f};
+  Eigen::Vector3f goal{0.97f, 0.97f, 0.97f};
+  Eigen::Vector3f net{0.80f, 0.80f, 0.80f};
+  Eigen::Vector3f floor{0.30f, 0.28f, 0.25f};
+  Eigen::Vector3f robot{0.78f, 0.78f, 0.80f};
+  Eigen::Vector3f ball{0.97f, 0.97f, 0.97f};
+  std::vector<Eigen::Vector3f> jerseys{{0.10f, 0.20f, 0.90f}, {0.90f, 0.10f, 0.10f}};  // per team
+};
+
+// The whole scene of the world's current state (appends to `items`).
+void buildRenderScene(const World& world, std::vector<engine::DrawItem>& items,
+                      const SceneColours& colours = {});
+
+// The Nao V6's cameras (nao.md section 5.1): 56.3 x 43.7 degrees.
+constexpr double kNaoHorizontalFov = 56.3 * M_PI / 180.0;
+constexpr double kNaoVerticalFov = 43.7 * M_PI / 180.0;
+
+// A robot's camera ("CameraTop" or "CameraBottom" from its model) as a view
+// at its current head pose.
+engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,
+                                   int width, int height, double horizontal_fov = kNaoHorizontalFov,
+                                   double vertical_fov = kNaoVerticalFov);
+
+}  // namespace simsoccer::world
