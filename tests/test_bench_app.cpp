@@ -7,19 +7,9 @@
 #include <sstream>
 #include <string>
 
-namespace {
+#include "test_support.hpp"
 
-std::string runCommand(const std::string& cmd, int& status) {
-  std::string out;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  status = pclose(p);
-  return out;
-}
-
-}  // namespace
+using simsoccer::test::runCommand;
 
 TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_test.csv";

@@ -23,6 +23,7 @@
 extern char** environ;
 
 using namespace simsoccer;
+using test::runCommand;
 using Clock = std::chrono::steady_clock;
 
 namespace {
@@ -32,6 +33,15 @@ net::DomainConfig dds(uint32_t domain) {
   c.domain = domain;
   c.config_file = test::sourceDir() / "configs" / "dds" / "loopback.xml";
   return c;
+}
+
+// A lockstep server on `domain` waiting up to `command_timeout` s for commands.
+net::ServerConfig serverConfig(uint32_t domain,
+                               double command_timeout = net::ServerConfig{}.command_timeout) {
+  net::ServerConfig cfg;
+  cfg.dds = dds(domain);
+  cfg.command_timeout = command_timeout;
+  return cfg;
 }
 
 // A simsoccer-agent process, killed (SIGKILL) when this goes.
@@ -94,8 +104,7 @@ double seconds(Clock::time_point a) {
 TEST(Net, RoundTripAgentDrivesItsRobot) {
   const uint32_t domain = 101;
   world::World w(teams(1));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
+  net::ServerConfig cfg = serverConfig(domain);
   net::SimServer server(w, cfg);
   AgentProcess agent(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
@@ -120,9 +129,7 @@ TEST(Net, RoundTripAgentDrivesItsRobot) {
 TEST(Net, LockstepIsDeterministicWithAgentProcesses) {
   auto run = [](uint32_t domain) {
     world::World w(teams(5));
-    net::ServerConfig cfg;
-    cfg.dds = dds(domain);
-    cfg.command_timeout = 5.0;  // a slow machine must not change the result
+    net::ServerConfig cfg = serverConfig(domain, 5.0);  // a slow machine must not change the result
     net::SimServer server(w, cfg);
     std::vector<std::unique_ptr<AgentProcess>> agents;
     for (world::RobotId r = 0; r < w.robotCount(); ++r)
@@ -142,18 +149,20 @@ TEST(Net, LockstepIsDeterministicWithAgentProcesses) {
 TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   const uint32_t domain = 104;
   world::World w(teams(1));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
-  cfg.command_timeout = 2.0;
+  net::ServerConfig cfg = serverConfig(domain, 2.0);
   net::SimServer server(w, cfg);
   AgentProcess owner(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   // An intruder in this process (its own participant) claims the same robot.
   agents::AgentClient intruder(dds(domain), 0, 1);
-  bool granted = true;
-  std::thread([&] { granted = intruder.claim(5.0); }).detach();
-  for (int i = 0; i < 100 && granted; ++i) server.poll(0.02);
-  server.poll(0.2);
+  std::atomic<bool> answered{false}, granted{false};
+  std::thread claimant([&] {
+    granted = intruder.claim(5.0);
+    answered = true;
+  });
+  for (int i = 0; i < 300 && !answered; ++i) server.poll(0.02);
+  claimant.join();
+  EXPECT_FALSE(granted);
   EXPECT_FALSE(intruder.ownsRobot());
   // It sends head-yaw commands for the coming ticks; the owner keeps HeadYaw at 0.
   std::vector<float> pos(25, 0.0f), stiff(25, 1.0f);
@@ -174,9 +183,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
 TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   const uint32_t domain = 105;
   world::World w(teams(2));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
-  cfg.command_timeout = 0.05;
+  net::ServerConfig cfg = serverConfig(domain, 0.05);
   net::SimServer server(w, cfg);
   auto a = std::make_unique<AgentProcess>(domain, 0, 1);
   AgentProcess b(domain, 1, 1);
@@ -204,9 +211,7 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
 TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   const uint32_t domain = 106;
   world::World w(teams(2));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
-  cfg.command_timeout = 2.0;
+  net::ServerConfig cfg = serverConfig(domain, 2.0);
   net::SimServer server(w, cfg);
   AgentProcess garbage(domain, 0, 1, {"--mode", "garbage"});
   AgentProcess good(domain, 1, 1);
@@ -230,9 +235,7 @@ TEST(Net, GarbageCommandsAreRejectedAndCounted) {
 TEST(Net, LockstepTimeoutBoundsAStalledAgent) {
   const uint32_t domain = 107;
   world::World w(teams(1));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
-  cfg.command_timeout = 0.05;
+  net::ServerConfig cfg = serverConfig(domain, 0.05);
   net::SimServer server(w, cfg);
   AgentProcess stall(domain, 0, 1, {"--mode", "stall", "--stall-after", "20"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
@@ -249,8 +252,7 @@ TEST(Net, LockstepTimeoutBoundsAStalledAgent) {
 TEST(Net, TeamMessagesReachTeammatesOnly) {
   const uint32_t domain = 108;
   world::World w(teams(3));  // team 0: numbers 1, 2; team 1: number 1
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
+  net::ServerConfig cfg = serverConfig(domain);
   cfg.lockstep = false;
   cfg.team_message_delay = 0.05;
   net::SimServer server(w, cfg);
@@ -278,20 +280,6 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   EXPECT_EQ(got_b[0].data, hello);
   EXPECT_TRUE(got_c.empty());  // the other team hears nothing
 }
-
-namespace {
-
-std::string runCommand(const std::string& cmd, int& status) {
-  std::string out;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  status = pclose(p);
-  return out;
-}
-
-}  // namespace
 
 TEST(NetApps, BenchNetWritesItsTable) {
   const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_net_test.csv";
@@ -332,8 +320,7 @@ TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {
 TEST(NetGameState, RefereePacketReachesAgents) {
   const uint32_t domain = 111;
   world::World w(teams(1));
-  net::ServerConfig cfg;
-  cfg.dds = dds(domain);
+  net::ServerConfig cfg = serverConfig(domain);
   net::SimServer server(w, cfg);
   agents::AgentClient agent(dds(domain), 0, 1);
   referee::ControlData d;

@@ -2,6 +2,7 @@
 // small scenarios built in code.
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -11,6 +12,16 @@ namespace simsoccer::test {
 
 inline std::filesystem::path sourceDir() {
   return SIMSOCCER_SOURCE_DIR;
+}
+// Runs a shell command; returns its stdout and stderr, `status` as pclose gives it.
+inline std::string runCommand(const std::string& cmd, int& status) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) out += buf;
+  status = pclose(p);
+  return out;
 }
 inline std::filesystem::path dataDir() {
   return sourceDir() / "tests" / "data";

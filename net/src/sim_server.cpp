@@ -385,8 +385,21 @@ void SimServer::poll(double wait_seconds) {
 bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(timeout_seconds));
-  while (ownedCount() < count && Clock::now() < end) poll(0.02);
-  return ownedCount() >= count;
+  auto ready = [&] {
+    std::lock_guard lock(mutex_);
+    size_t owned = 0;
+    for (size_t r = 0; r < robots_.size(); ++r) {
+      if (!robots_[r].stats.owned) continue;
+      ++owned;
+      dds_publication_matched_status_t st{};
+      if (dds_get_publication_matched_status(impl_->frames[r]->get(), &st) != DDS_RETCODE_OK ||
+          st.current_count == 0)
+        return false;
+    }
+    return owned >= count;
+  };
+  while (!ready() && Clock::now() < end) poll(0.02);
+  return ready();
 }
 
 void SimServer::runPeriod() {

@@ -63,7 +63,10 @@ class SimServer {
   // Handle claims and commands for up to `seconds` of wall time without
   // stepping (while agents connect).
   void poll(double seconds);
-  // Polls until `count` robots are owned or the timeout passes.
+  // Polls until `count` robots are owned, and every owned robot's frame
+  // writer has matched its agent's reader (a frame published before that
+  // match is lost, and in lockstep the agent would never answer it), or
+  // until the timeout passes.
   bool waitForOwners(size_t count, double timeout_seconds);
 
   size_t ownedCount() const;
