@@ -141,6 +141,7 @@ struct Articulation {
   // Per link: the Bullet link frame (at the CoM, along the principal axes of
   // inertia) expressed in the link's joint frame.
   std::vector<Pose> bullet_in_joint;
+  std::vector<Pose> joint_in_bullet;  // the inverses, for linkPose
   // Per joint: index into the servo batch, or -1 for a passive joint.
   std::vector<int> servo;
   // Bullet refreshes the links' cached world transforms only inside its
@@ -219,7 +220,7 @@ struct PhysicsWorld::Impl {
   btCollisionShape* linkShape(const Link& link, const Pose& bullet_in_joint) {
     auto compound = std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false,
                                                       static_cast<int>(link.shapes.size()));
-    const Pose joint_in_bullet = bullet_in_joint.inverse();
+    const Pose joint_in_bullet = bullet_in_joint.inverse();  // once per link, at build time
     for (const Shape& s : link.shapes) {
       btCollisionShape* child = keep(makePrimitive(s));
       compound->addChildShape(toBt(Pose(joint_in_bullet * s.pose)), child);
@@ -233,11 +234,12 @@ struct PhysicsWorld::Impl {
     art.kinematics_stale = false;
   }
 
-  void updateKinematics(btMultiBody* mb) {
-    btAlignedObjectArray<btQuaternion> world_to_local;
-    btAlignedObjectArray<btVector3> local_origin;
-    mb->forwardKinematics(world_to_local, local_origin);
-    mb->updateCollisionObjectWorldTransforms(world_to_local, local_origin);
+  // After a state reset: link transforms and colliders current again.
+  void updateKinematics(Articulation& art) {
+    art.body->forwardKinematics(art.scratch_world_to_local, art.scratch_local_origin);
+    art.body->updateCollisionObjectWorldTransforms(art.scratch_world_to_local,
+                                                   art.scratch_local_origin);
+    art.kinematics_stale = false;
   }
 };
 
@@ -356,6 +358,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   Articulation art;
   art.model = model_ptr;
   art.bullet_in_joint.resize(model.links.size());
+  art.joint_in_bullet.resize(model.links.size());
   art.servo.assign(model.joints.size(), -1);
 
   // Inertia per link, in principal axes (armature added about the joint axis).
@@ -376,6 +379,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     p.linear() = axes[i];
     p.translation() = link.com;
     art.bullet_in_joint[i] = p;
+    art.joint_in_bullet[i] = p.inverse();
   }
 
   auto mb = std::make_unique<btMultiBody>(num_links, static_cast<btScalar>(model.links[0].mass),
@@ -495,8 +499,7 @@ void PhysicsWorld::resetArticulation(ArticulationId a, const Pose& root_pose,
                                      std::span<const double> joint_positions) {
   Impl& m = *impl_;
   Articulation& art = m.articulations.at(a);
-  btMultiBody* mb = art.body ? art.body : m.multibodies.at(a).get();
-  art.body = mb;
+  btMultiBody* mb = art.body;
   mb->setBaseWorldTransform(toBt(Pose(root_pose * art.bullet_in_joint[0])));
   mb->setBaseVel(btVector3(0, 0, 0));
   mb->setBaseOmega(btVector3(0, 0, 0));
@@ -509,7 +512,7 @@ void PhysicsWorld::resetArticulation(ArticulationId a, const Pose& root_pose,
     const int s = art.servo.empty() ? -1 : art.servo[static_cast<size_t>(j)];
     if (s >= 0) m.servos.resetHistory(static_cast<size_t>(s));
   }
-  m.updateKinematics(mb);
+  m.updateKinematics(art);
 }
 
 void PhysicsWorld::setRigidBodyState(BodyId b, const RigidBodyState& state) {
@@ -576,10 +579,19 @@ Pose PhysicsWorld::linkPose(ArticulationId a, int link) const {
   Articulation& art = impl_->articulations.at(a);
   if (link < 0 || link >= static_cast<int>(art.model->links.size()))
     throw std::out_of_range("link index " + std::to_string(link) + " out of range");
-  if (link != 0) impl_->refresh(art);  // the root's transform is always current
-  const btTransform t = link == 0 ? art.body->getBaseWorldTransform()
-                                  : art.body->getLink(link - 1).m_cachedWorldTransform;
-  return fromBt(t) * art.bullet_in_joint.at(static_cast<size_t>(link)).inverse();
+  // Bullet keeps the root's and every collider's world transform current
+  // (after each step and each state reset); only a link without collision
+  // shapes needs forward kinematics, once per step.
+  btTransform t;
+  if (link == 0) {
+    t = art.body->getBaseWorldTransform();
+  } else if (const btMultiBodyLinkCollider* col = art.body->getLink(link - 1).m_collider) {
+    t = col->getWorldTransform();
+  } else {
+    impl_->refresh(art);
+    t = art.body->getLink(link - 1).m_cachedWorldTransform;
+  }
+  return fromBt(t) * art.joint_in_bullet[static_cast<size_t>(link)];
 }
 
 Vec3 PhysicsWorld::rootLinearVelocity(ArticulationId a) const {

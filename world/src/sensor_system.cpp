@@ -70,7 +70,7 @@ void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world
 SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldModel& field,
                            std::vector<RobotRef> robots, const engine::PhysicsWorld& physics,
                            engine::BodyId ball, uint64_t seed, double control_period, double dt)
-    : settings_(settings), field_(field), control_period_(control_period), dt_(dt), ball_(ball) {
+    : settings_(settings), field_(field), dt_(dt), ball_(ball) {
   sonar_every_ = std::max(1, static_cast<int>(std::lround(settings.sonar_period / control_period)));
   // Cone directions: a Vogel spiral over the cone's solid angle, with the
   // first ray on the axis; the outermost ray lies just inside the cone.
@@ -206,14 +206,14 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     if (f < 0) continue;
     if (!r.feet_posed) {
       for (int k = 0; k < 2; ++k)
-        r.foot_pose[static_cast<size_t>(k)] =
-            physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link);
+        r.foot_from_world[static_cast<size_t>(k)] =
+            physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link).inverse();
       r.feet_posed = true;
     }
     const Foot& foot = r.feet[static_cast<size_t>(f)];
-    const Pose& pose = r.foot_pose[static_cast<size_t>(f)];
-    const Vec3 p = pose.inverse() * c.position;
-    const Vec3 n = pose.linear().transpose() * c.normal;
+    const Pose& to_foot = r.foot_from_world[static_cast<size_t>(f)];
+    const Vec3 p = to_foot * c.position;
+    const Vec3 n = to_foot.linear() * c.normal;
     const double force = c.impulse / dt_;
     const double up = force * n.z();  // pressing on the sole
     if (up > 0.0 && p.z() < foot.sole_z + 0.01) {

@@ -75,9 +75,9 @@ class SensorSystem {
     engine::ArticulationId body;
     int group = 0;
     const robots::RobotModel* model;
-    std::vector<uint8_t> link_cluster;      // broadphase cluster: torso 0, each limb its own
-    std::vector<engine::Vec3> ray_dirs;     // sonar cone directions, sonar frame (x = axis)
-    std::array<engine::Pose, 2> foot_pose;  // this step's, computed on first use
+    std::vector<uint8_t> link_cluster;            // broadphase cluster: torso 0, each limb its own
+    std::vector<engine::Vec3> ray_dirs;           // sonar cone directions, sonar frame (x = axis)
+    std::array<engine::Pose, 2> foot_from_world;  // this step's, computed on first use
     bool feet_posed = false;
     std::array<Foot, 2> feet;
     engine::Vec3 accel_point = engine::Vec3::Zero();  // torso frame
@@ -105,7 +105,7 @@ class SensorSystem {
 
   SensorSettings settings_;
   const fields::FieldModel& field_;
-  double control_period_, dt_;
+  double dt_;
   int sonar_every_ = 6;  // control periods per sonar update
   engine::BodyId ball_;
   std::vector<Robot> robots_;
