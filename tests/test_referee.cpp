@@ -601,6 +601,14 @@ TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
   putBall(w, f.halfLength() + 0.3, 0.3);
   run(w, ref, 0.02);
   EXPECT_EQ(g.score(0), 1);
+  // Team 1 kicks off (the referee's whistle) and scores straight from it: the
+  // touches of its two robots before the goal do not count any more.
+  kickOff(w, ref);
+  touchBall(w, ref, 3);
+  putBall(w, -f.halfLength() - 0.3, 0.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(1), 0);
+  EXPECT_EQ(count(g, "goal_disallowed"), 2);
 
   // The simleague rule book scores directly.
   world::World w2(twoVsTwo());

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 #include "cli.hpp"
@@ -84,8 +85,7 @@ int serve(int argc, char** argv, int first) {
   } else if (opt.has("gc-address")) {
     throw UsageError("--gc-address needs --rules (the referee makes the packets)");
   }
-  referee::ControlData published{};
-  bool any_published = false;
+  std::optional<referee::ControlData> published;
   auto refereePeriod = [&] {
     if (!ref) return;
     // The operator's part: each half starts (Standby, Ready) as soon as it can.
@@ -97,12 +97,11 @@ int serve(int argc, char** argv, int first) {
     }
     ref->update();
     const referee::ControlData d = ref->game().packet(0);
-    if (!any_published || !(d == published)) {  // every change; SimServer repeats it at 2 Hz
+    if (!published || !(d == *published)) {  // every change; SimServer repeats it at 2 Hz
       simsoccer_msg_GameState m{};
       net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
       server.setGameState(m);
       published = d;
-      any_published = true;
     }
     if (gc_link) gc_link->update(ref->game());
   };
@@ -151,6 +150,8 @@ int serve(int argc, char** argv, int first) {
                   (unsigned long long)gc_link->packetsSent(),
                   (unsigned long long)gc_link->returnsAccepted(),
                   (unsigned long long)gc_link->returnsRejected());
+    if (gc_link && gc_link->returnsRejected() > 0)
+      std::printf("last rejected return packet: %s\n", gc_link->lastReturnError().c_str());
   }
   return 0;
 }

@@ -109,6 +109,7 @@ struct SimServer::Impl {
   };
   std::deque<Pending> pending;
   std::mt19937_64 loss_rng;
+  std::vector<simsoccer_msg_RobotTruth> truth_robots;  // reused every period
   simsoccer_msg_GameState game_state{};
   double game_state_published_at = -1e9;
   simsoccer_msg_SensorFrame frame_msg{};
@@ -147,7 +148,10 @@ struct SimServer::Impl {
 };
 
 SimServer::SimServer(world::World& world, const ServerConfig& config)
-    : world_(world), config_(config) {
+    : world_(world),
+      config_(config),
+      ticks_per_second_(static_cast<uint64_t>(
+          std::max(1L, std::lround(1.0 / world.scenario().physics.control_period)))) {
   impl_ = std::make_unique<Impl>(config, world.scenario().seed ^ 0x7EA3u);
   if (config.world_truth)
     impl_->truth = std::make_unique<Writer<simsoccer_msg_WorldTruth>>(
@@ -314,8 +318,7 @@ void SimServer::handleCommands() {
     }
     // Lockstep: exactly the tick just published. Real time: not newer than
     // it, not older than the last accepted one, at most 1 s old.
-    const uint64_t window =
-        static_cast<uint64_t>(std::lround(1.0 / world_.scenario().physics.control_period));
+    const uint64_t window = ticks_per_second_;
     const bool tick_ok = lockstep
                              ? c.tick == tick
                              : (c.tick <= tick && c.tick >= s.last_tick && c.tick + window >= tick);
@@ -415,11 +418,9 @@ void SimServer::runPeriod() {
   }
 
   // Frames for this tick (the state the commands will answer).
+  // (A frame carries the tick and time of the period it closed: this one's.)
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-    world::SensorFrame f = world_.sensorFrame(r);
-    f.tick = tick;
-    f.time = world_.time();
-    toMessage(f, robots_[r].team, robots_[r].player, impl_->frame_msg);
+    toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, impl_->frame_msg);
     impl_->frames[r]->write(impl_->frame_msg);
   }
   simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
@@ -434,7 +435,8 @@ void SimServer::runPeriod() {
       t.ball_position[k] = static_cast<float>(ball.pose.translation()[k]);
       t.ball_velocity[k] = static_cast<float>(ball.linear_velocity[k]);
     }
-    std::vector<simsoccer_msg_RobotTruth> rt(world_.robotCount());
+    std::vector<simsoccer_msg_RobotTruth>& rt = impl_->truth_robots;
+    rt.resize(world_.robotCount());
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
       const auto pose = world_.torsoPose(r);
       const Eigen::Quaterniond q(pose.linear());
@@ -490,8 +492,7 @@ void SimServer::runPeriod() {
   times_.physics_s += seconds(t2, t3);
   ++times_.periods;
   // Status at 1 Hz of simulated time (and at every ownership change).
-  if (tick % static_cast<uint64_t>(std::lround(1.0 / world_.scenario().physics.control_period)) ==
-      0) {
+  if (tick % ticks_per_second_ == 0) {
     std::lock_guard lock(mutex_);
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) publishStatus(r);
   }

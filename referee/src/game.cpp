@@ -281,7 +281,6 @@ void Game::startShootout(int first_team, std::optional<int> kicks_per_team, uint
   // The score carries on: shoot-out goals add to it (as GC3); the result of
   // the shoot-out itself comes from the kicks' outcomes.
   shots_ = {0, 0};
-  single_shots_ = {0, 0};
   outcomes_ = {};
   set_play_ = gc::SetPlay::None;
   secondary_ = 0.0;
@@ -447,8 +446,6 @@ void Game::goal(int team) {
     if (team != kicking_team_)
       throw std::logic_error("in the shoot-out only the kicking team scores");
     ++score_[static_cast<size_t>(team)];
-    single_shots_[static_cast<size_t>(team)] |=
-        static_cast<uint16_t>(1u << std::min(15, shots_[static_cast<size_t>(team)] - 1));
     log("goal", team, striker_, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
     endShot(ShotOutcome::Goal, "goal");
     return;
@@ -606,7 +603,10 @@ ControlData Game::packet(uint8_t packet_number) const {
     info.score = static_cast<uint8_t>(score_[static_cast<size_t>(t)]);
     if (phase_ == gc::GamePhase::PenaltyShoot) {
       info.penalty_shot = static_cast<uint8_t>(shots_[static_cast<size_t>(t)]);
-      info.single_shots = single_shots_[static_cast<size_t>(t)];
+      // Bit i: the team's kick i + 1 scored.
+      const auto& kicks = outcomes_[static_cast<size_t>(t)];
+      for (size_t i = 0; i < std::min<size_t>(kicks.size(), 16); ++i)
+        if (kicks[i] == ShotOutcome::Goal) info.single_shots |= static_cast<uint16_t>(1u << i);
       // The keeper of this kick; a team without one shows its lowest substitute (as GC3).
       uint8_t gk = 0;
       if (t != kicking_team_ && keeper_ > 0) gk = static_cast<uint8_t>(keeper_);

@@ -17,24 +17,22 @@ uint16_t GameControllerLink::returnPort() const {
 }
 
 void GameControllerLink::update(const Game& game) {
-  const ControlData current = game.packet(packet_number_);
-  if (!sent_any_ || game.time() >= next_send_ - 1e-9) {
-    sender_->send(encode(current));
-    ++packet_number_;  // u8: wraps at 256 as the GameController's
+  if (sent_ == 0 || game.time() >= next_send_ - 1e-9) {
+    // The packet number is a u8 that wraps at 256, as the GameController's.
+    sender_->send(encode(game.packet(static_cast<uint8_t>(sent_))));
+    next_send_ = (sent_ == 0 ? game.time() : next_send_) + config_.period;
     ++sent_;
-    next_send_ = (sent_any_ ? next_send_ : game.time()) + config_.period;
-    sent_any_ = true;
   }
-  receiveReturns(current);
+  receiveReturns(game);
 }
 
-void GameControllerLink::receiveReturns(const ControlData& current) {
+void GameControllerLink::receiveReturns(const Game& game) {
   std::array<uint8_t, 512> buffer{};  // larger than any packet: an oversized one shows its size
   for (size_t n; (n = receiver_->receive(buffer, 0.0)) > 0;) {
     try {
       const ReturnData r = decodeReturn(std::span<const uint8_t>(buffer.data(), n));
       // As GC3: only the playing teams' robots count.
-      if (r.team_num != current.teams[0].team_number && r.team_num != current.teams[1].team_number)
+      if (r.team_num != game.teamNumber(0) && r.team_num != game.teamNumber(1))
         throw PacketError("return packet from team " + std::to_string(r.team_num) +
                           ", which is not playing");
       returns_[{r.team_num, r.player_num}] = r;

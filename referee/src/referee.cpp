@@ -48,8 +48,7 @@ int Referee::defenderOfSide(int side) const {
 
 world::Pose Referee::penaltySpot(int team, int index) const {
   const auto& f = world_.field();
-  const double mark = f.penalty_mark_distance.value_or(1.3);
-  const double x = teamSign(team) * (f.halfLength() - mark) + 0.35 * index * -teamSign(team);
+  const double x = penaltyMarkX(teamSign(team)) + 0.35 * index * -teamSign(team);
   const double side = index % 2 == 0 ? 1.0 : -1.0;  // alternate touchlines
   world::Pose p = world::Pose::Identity();
   p.translation() = Vec3(x, side * (f.halfWidth() + 0.5), 0.0);
@@ -66,33 +65,44 @@ void Referee::placeBall(double x, double y) {
   stuck_for_ = 0.0;
 }
 
-bool Referee::inOwnGoalArea(RobotId r) const {
+fields::AreaSize Referee::penaltyArea() const {
+  return world_.field().penalty_area.value_or(fields::AreaSize{1.65, 4.0});  // SPL sizes
+}
+
+fields::AreaSize Referee::goalArea() const {
+  return world_.field().goal_area.value_or(fields::AreaSize{0.6, 2.2});
+}
+
+double Referee::penaltyMarkX(int side) const {
   const auto& f = world_.field();
-  const auto area = f.goal_area ? f.goal_area : f.penalty_area;
-  if (!area) return false;
-  const Vec3 p = world_.torsoPose(r).translation();
-  const double x = teamSign(world_.robot(r).team) * p.x();  // > 0 towards the own goal
-  return x >= f.halfLength() - area->length && x <= f.halfLength() + f.goal.depth &&
-         std::abs(p.y()) <= 0.5 * area->width;
+  return side * (f.halfLength() - f.penalty_mark_distance.value_or(1.3));
+}
+
+bool Referee::inOwnArea(int team, const Vec3& p, const fields::AreaSize& area) const {
+  const auto& f = world_.field();
+  const double x = teamSign(team) * p.x();  // > 0 towards the own goal
+  return x >= f.halfLength() - area.length && x <= f.halfLength() + f.goal.depth &&
+         std::abs(p.y()) <= 0.5 * area.width;
+}
+
+bool Referee::inOwnArea(RobotId r, const fields::AreaSize& area) const {
+  return inOwnArea(world_.robot(r).team, world_.torsoPose(r).translation(), area);
+}
+
+void Referee::awardGoalKick(int defender, int side, double y) {
+  game_.setPlay(gc::SetPlay::GoalKick, defender);
+  const fields::AreaSize area = goalArea();
+  placeBall(side * (world_.field().halfLength() - area.length),
+            (y >= 0 ? 1.0 : -1.0) * 0.5 * area.width);
 }
 
 double Referee::depthInOwnGoalArea(RobotId r) const {
   const auto& f = world_.field();
-  const auto area = f.goal_area ? f.goal_area : f.penalty_area;
+  const fields::AreaSize area = goalArea();
   const Vec3 p = world_.torsoPose(r).translation();
   const double x = teamSign(world_.robot(r).team) * p.x();
   // The goal line side is not a border one leaves by: robots may stand in the goal.
-  return std::min(x - (f.halfLength() - area->length), 0.5 * area->width - std::abs(p.y()));
-}
-
-bool Referee::inOwnPenaltyArea(RobotId r) const {
-  const auto& f = world_.field();
-  const auto area = f.penalty_area ? f.penalty_area : f.goal_area;
-  if (!area) return false;
-  const Vec3 p = world_.torsoPose(r).translation();
-  const double x = teamSign(world_.robot(r).team) * p.x();
-  return x >= f.halfLength() - area->length && x <= f.halfLength() + f.goal.depth &&
-         std::abs(p.y()) <= 0.5 * area->width;
+  return std::min(x - (f.halfLength() - area.length), 0.5 * area.width - std::abs(p.y()));
 }
 
 void Referee::checkPushing() {
@@ -143,7 +153,7 @@ void Referee::checkPushing() {
       // The exceptions the rules list that a world model can see: a
       // stationary robot, one getting up, the goalkeeper in its own area.
       if (speed < config_.push_speed || !world_.isStanding(pusher)) continue;
-      if (game_.goalkeeper(ip.team) == ip.number && inOwnPenaltyArea(pusher)) continue;
+      if (game_.goalkeeper(ip.team) == ip.number && inOwnArea(pusher, penaltyArea())) continue;
       const bool fell = !world_.isStanding(victim);
       const Vec3 shoved =
           world_.torsoPose(victim).translation() - contact_start_[2 * k + (victim == a ? 0 : 1)];
@@ -161,11 +171,8 @@ void Referee::checkPushing() {
       if (game_.state() == gc::State::Playing && game_.kickingTeam() < 0 &&
           (ball - (pusher == a ? pa : pb)).head<2>().norm() <= config_.foul_ball_distance) {
         // A penalty kick when the pushed robot is in the pusher's own penalty area.
-        const auto& area = world_.field().penalty_area;
-        const double vx = teamSign(ip.team) * world_.torsoPose(victim).translation().x();
         const bool in_area =
-            area && vx >= world_.field().halfLength() - area->length &&
-            std::abs(world_.torsoPose(victim).translation().y()) <= 0.5 * area->width;
+            inOwnArea(ip.team, world_.torsoPose(victim).translation(), penaltyArea());
         game_.setPlay(in_area ? gc::SetPlay::PenaltyKick : gc::SetPlay::PushingFreeKick, iv.team);
         set_play_ball_ = ball;
         set_play_step_ = world_.stepCount();
@@ -187,7 +194,7 @@ void Referee::checkArmContact() {
     return;
   const auto& info = world_.robot(r);
   if (game_.penalty(info.team, info.number) != gc::Penalty::None || !world_.isStanding(r)) return;
-  if (game_.goalkeeper(info.team) == info.number && inOwnPenaltyArea(r)) return;
+  if (game_.goalkeeper(info.team) == info.number && inOwnArea(r, penaltyArea())) return;
   game_.penalise(info.team, info.number, gc::Penalty::IllegalBallContact);
   game_.recordEvent("ball_contact", info.team, info.number, "played the ball with an arm");
   const Vec3 p = world_.ballState().pose.translation();
@@ -200,14 +207,9 @@ std::vector<char> Referee::legalPositions() const {
   std::vector<char> legal(n, 1);
   const int kicking = game_.kickingTeam();
   const bool penalty_kick = game_.currentSetPlay() == gc::SetPlay::PenaltyKick;
-  const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
   // The one kicking-team robot allowed in the centre circle (kick-off) or
   // in the penalty area (penalty kick): the one nearest the ball's spot.
-  const Vec3 spot =
-      penalty_kick
-          ? Vec3(-teamSign(kicking) * (f.halfLength() - f.penalty_mark_distance.value_or(1.3)), 0.0,
-                 0.0)
-          : Vec3::Zero();
+  const Vec3 spot = penalty_kick ? Vec3(penaltyMarkX(-teamSign(kicking)), 0.0, 0.0) : Vec3::Zero();
   std::optional<RobotId> taker;
   for (RobotId r = 0; r < n; ++r) {
     const auto& info = world_.robot(r);
@@ -233,9 +235,7 @@ std::vector<char> Referee::legalPositions() const {
     if (penalty_kick) {
       // Only the defending goalkeeper and the taker inside the defending team's penalty area.
       const int defender = 1 - kicking;
-      const double dx = teamSign(defender) * p.x();
-      const bool in_area =
-          dx >= f.halfLength() - area.length && std::abs(p.y()) <= 0.5 * area.width;
+      const bool in_area = inOwnArea(defender, p, penaltyArea());
       const bool keeper = info.team == defender && game_.goalkeeper(defender) == info.number;
       legal[r] = !in_area || keeper || (taker && r == *taker);
       continue;
@@ -261,7 +261,7 @@ Vec3 Referee::nearestLegalPosition(RobotId r, const std::vector<Vec3>& taken) co
   if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick) {
     // Out of the defending team's penalty area, straight back towards the field.
     const int defender = 1 - game_.kickingTeam();
-    const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
+    const fields::AreaSize area = penaltyArea();
     const double edge = f.halfLength() - area.length - 0.3;
     if (teamSign(defender) * p.x() > edge && std::abs(p.y()) < 0.5 * area.width + 0.3)
       p.x() = teamSign(defender) * edge;
@@ -288,11 +288,8 @@ void Referee::onEnterSet() {
   if (game_.phase() == gc::GamePhase::PenaltyShoot) return;  // placed by startShootoutKick
   // The ball goes to the centre mark for a kick-off or drop ball, to the
   // penalty mark for a penalty kick.
-  const auto& f = world_.field();
   if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick)
-    placeBall(
-        -teamSign(game_.kickingTeam()) * (f.halfLength() - f.penalty_mark_distance.value_or(1.3)),
-        0.0);
+    placeBall(penaltyMarkX(-teamSign(game_.kickingTeam())), 0.0);
   else
     placeBall(0.0, 0.0);
   // Illegal positions: penalised (15 s), or moved by auto-placement to the
@@ -338,28 +335,17 @@ void Referee::checkBall() {
           game_.currentSetPlay() != gc::SetPlay::PenaltyKick) {
         game_.recordEvent("goal_disallowed", attacker, 0,
                           "indirect kick: fewer than two of its robots played the ball");
-        const auto area = f.goal_area ? f.goal_area : f.penalty_area;
-        game_.setPlay(gc::SetPlay::GoalKick, defender);
-        placeBall(side * (f.halfLength() - (area ? area->length : 0.6)),
-                  (p.y() >= 0 ? 1.0 : -1.0) * 0.5 * (area ? area->width : 2.2));
-        set_play_ball_ = world_.ballState().pose.translation();
-        set_play_step_ = world_.stepCount();
+        awardGoalKick(defender, side, p.y());
+      } else {
+        game_.goal(attacker);  // a goal for the team attacking this goal (own goals too)
+        placeBall(0.0, 0.0);
         return;
       }
-      game_.goal(attacker);  // a goal for the team attacking this goal (own goals too)
-      placeBall(0.0, 0.0);
-      return;
-    }
-    const double ys = p.y() >= 0 ? 1.0 : -1.0;
-    if (last_team == attacker || last_team < 0) {
-      // Over the goal line, last touched by the attackers: goal kick.
-      const auto area = f.goal_area ? f.goal_area : f.penalty_area;
-      const double depth = area ? area->length : 0.6, width = area ? area->width : 2.2;
-      game_.setPlay(gc::SetPlay::GoalKick, defender);
-      placeBall(side * (f.halfLength() - depth), ys * 0.5 * width);
+    } else if (last_team == attacker || last_team < 0) {
+      awardGoalKick(defender, side, p.y());  // over the goal line, last touched by the attackers
     } else {
       game_.setPlay(gc::SetPlay::CornerKick, attacker);
-      placeBall(side * f.halfLength(), ys * f.halfWidth());
+      placeBall(side * f.halfLength(), (p.y() >= 0 ? 1.0 : -1.0) * f.halfWidth());
     }
   } else if (std::abs(p.y()) > f.halfWidth() + line + r) {
     // Over a touchline: kick-in for the team that did not touch it last.
@@ -442,7 +428,7 @@ void Referee::checkPenalties() {
       idle_for_[r] = 0.0;
       continue;
     }
-    if (inOwnGoalArea(r)) {
+    if (inOwnArea(r, goalArea())) {
       if (in_goal_area_since_[r] < 0.0) in_goal_area_since_[r] = clock_;
       in_goal_area[static_cast<size_t>(info.team)].push_back(r);
     } else {
@@ -548,7 +534,7 @@ void Referee::startShootoutKick(int striker, int keeper) {
   game_.shootoutKick(striker, keeper);
   const auto& f = world_.field();
   const double side = config_.shootout_goal_side >= 0 ? 1.0 : -1.0;
-  const double mark = side * (f.halfLength() - f.penalty_mark_distance.value_or(1.3));
+  const double mark = penaltyMarkX(static_cast<int>(side));
   placeBall(mark, 0.0);
   const int team = game_.kickingTeam();
   if (const auto r = robot(team, striker)) {
@@ -562,8 +548,7 @@ void Referee::startShootoutKick(int striker, int keeper) {
     }
   }
   removePenalised();  // the substitutes leave at once
-  shot_start_step_ = world_.stepCount();
-  shot_seen_touch_step_ = shot_start_step_;
+  shot_seen_touch_step_ = world_.stepCount();
   striker_touched_ = keeper_touched_ = hit_post_ = false;
   ball_still_for_ = 0.0;
 }
@@ -635,7 +620,7 @@ void Referee::checkShot() {
     return ShotOutcome::Other;
   };
   // Out of the penalty area (over the goal line, or back into the field).
-  const auto area = f.penalty_area ? *f.penalty_area : fields::AreaSize{1.65, 4.0};
+  const fields::AreaSize area = penaltyArea();
   if (x > f.halfLength() + line + r || x < f.halfLength() - area.length - r ||
       std::abs(p.y()) > 0.5 * area.width + r) {
     game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball left the penalty area");
@@ -650,6 +635,23 @@ void Referee::checkShot() {
   }
 }
 
+// Whatever changed the state (the game's own timers, a command, this
+// referee's whistle), the referee's bookkeeping for the new state starts here.
+void Referee::enterState(gc::State s) {
+  time_in_state_ = 0.0;
+  still_for_ = 0.0;
+  last_state_ = s;
+  if (s == gc::State::Set) onEnterSet();
+  if (s == gc::State::Playing) {
+    touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick
+    restart_seen_touch_step_ = world_.stepCount();
+    set_play_ball_ = world_.ballState().pose.translation();
+    set_play_step_ = world_.stepCount();
+    stuck_ball_ = set_play_ball_;
+    stuck_for_ = 0.0;
+  }
+}
+
 void Referee::update() {
   const double dt = world_.scenario().physics.control_period;
   game_.advance(dt);
@@ -660,29 +662,16 @@ void Referee::update() {
   }
   last_set_play_ = game_.currentSetPlay();
   const gc::State s = game_.state();
-  if (s != last_state_) {
-    time_in_state_ = 0.0;
-    still_for_ = 0.0;
-    if (s == gc::State::Set) onEnterSet();
-    if (s == gc::State::Playing) {
-      touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick
-      restart_seen_touch_step_ = world_.stepCount();
-      set_play_ball_ = world_.ballState().pose.translation();
-      set_play_step_ = world_.stepCount();
-      stuck_ball_ = set_play_ball_;
-      stuck_for_ = 0.0;
-    }
-    last_state_ = s;
-  } else {
+  if (s != last_state_)
+    enterState(s);
+  else
     time_in_state_ += dt;
-  }
 
   if (game_.phase() == gc::GamePhase::PenaltyShoot) {
     if (game_.shootoutOpen() && s == gc::State::Set && config_.set_duration > 0 &&
         time_in_state_ >= config_.set_duration) {
-      game_.playing();
-      last_state_ = game_.state();
-      time_in_state_ = 0.0;
+      game_.playing();  // the whistle
+      enterState(game_.state());
     } else if (game_.shootoutOpen() && s == gc::State::Playing) {
       checkShot();
     }
@@ -704,11 +693,8 @@ void Referee::update() {
       if (all && still_for_ >= config_.ready_still_time) game_.set();
     } else if (s == gc::State::Set && config_.set_duration > 0 &&
                time_in_state_ >= config_.set_duration) {
-      game_.playing();
-      set_play_ball_ = world_.ballState().pose.translation();
-      set_play_step_ = world_.stepCount();
-      last_state_ = game_.state();
-      time_in_state_ = 0.0;
+      game_.playing();  // the whistle
+      enterState(game_.state());
     } else if (s == gc::State::Playing) {
       if (const auto t = world_.lastBallTouch(); t && t->step > restart_seen_touch_step_) {
         restart_seen_touch_step_ = t->step;

@@ -106,6 +106,7 @@ class SimServer {
   mutable std::mutex mutex_;
   std::condition_variable answered_;
   uint64_t expected_tick_ = UINT64_MAX;  // lockstep: the tick commands must answer
+  const uint64_t ticks_per_second_;      // control periods per simulated second
   uint64_t published_tick_ = 0;          // the newest tick whose frames went out
   std::unique_ptr<Impl> impl_;
   std::vector<RobotSlot> robots_;

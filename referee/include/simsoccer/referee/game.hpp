@@ -132,6 +132,7 @@ class Game {
   // Which team defends the -x goal now (the operator's left).
   int leftTeam() const { return sides_swapped_ ? 1 : 0; }
   int goalkeeper(int team) const { return teams_[static_cast<size_t>(team)].goalkeeper; }
+  uint8_t teamNumber(int team) const { return teams_[static_cast<size_t>(team)].number; }
   const std::vector<RefereeEvent>& events() const { return events_; }
   double time() const { return time_; }
   const RuleBook& rules() const { return rules_; }
@@ -180,7 +181,6 @@ class Game {
   bool shot_kicked_ = false;
   uint64_t coin_seed_ = 0;
   std::array<int, 2> shots_{};
-  std::array<uint16_t, 2> single_shots_{};
   std::array<std::vector<ShotOutcome>, 2> outcomes_;
   std::optional<int> winner_;
   std::array<std::array<Player, gc::kMaxPlayers>, 2> players_{};

@@ -43,15 +43,13 @@ class GameControllerLink {
   std::optional<ReturnData> lastReturn(uint8_t team_number, uint8_t player) const;
 
  private:
-  void receiveReturns(const ControlData& current);
+  void receiveReturns(const Game& game);
 
   GameControllerLinkConfig config_;
   std::unique_ptr<UdpSender> sender_;
   std::unique_ptr<UdpReceiver> receiver_;
-  uint8_t packet_number_ = 0;  // wraps from 255 to 0
   double next_send_ = 0.0;
-  bool sent_any_ = false;
-  uint64_t sent_ = 0, accepted_ = 0, rejected_ = 0;
+  uint64_t sent_ = 0, accepted_ = 0, rejected_ = 0;  // packet number: sent_ mod 256
   std::string last_error_;
   std::map<std::pair<uint8_t, uint8_t>, ReturnData> returns_;  // ordered: deterministic iteration
 };

@@ -75,14 +75,19 @@ class Referee {
   void checkShot();
   void checkPushing();
   void checkArmContact();
-  bool inOwnPenaltyArea(world::RobotId r) const;
+  void enterState(gc::State s);
   void onEnterSet();
   // Per robot: in a legal position for the coming kick-off, drop ball or
   // penalty kick (penalised robots count as legal).
   std::vector<char> legalPositions() const;
   engine::Vec3 nearestLegalPosition(world::RobotId r, const std::vector<engine::Vec3>& taken) const;
-  bool inOwnGoalArea(world::RobotId r) const;
-  double depthInOwnGoalArea(world::RobotId r) const;  // distance to the area's open border (m)
+  fields::AreaSize penaltyArea() const;  // the field's, or the SPL's
+  fields::AreaSize goalArea() const;
+  double penaltyMarkX(int side) const;  // the mark in front of the goal at x = side * length / 2
+  bool inOwnArea(int team, const engine::Vec3& p, const fields::AreaSize& area) const;
+  bool inOwnArea(world::RobotId r, const fields::AreaSize& area) const;  // by its torso
+  void awardGoalKick(int defender, int side, double y);  // at the goal-area corner on y's side
+  double depthInOwnGoalArea(world::RobotId r) const;     // distance to the area's open border (m)
   void placeBall(double x, double y);
   void removePenalised();
 
@@ -115,7 +120,7 @@ class Referee {
   std::vector<std::vector<char>> arm_link_;  // per robot, per link: an arm
   uint64_t arm_checked_step_ = 0;
   // The running shoot-out kick.
-  uint64_t shot_start_step_ = 0, shot_seen_touch_step_ = 0;
+  uint64_t shot_seen_touch_step_ = 0;
   bool striker_touched_ = false, keeper_touched_ = false, hit_post_ = false;
   engine::Vec3 first_touch_ball_ = engine::Vec3::Zero();
   double ball_still_for_ = 0.0;
