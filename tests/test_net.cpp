@@ -194,6 +194,7 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   while (server.stats(0).owned && seconds(t0) < 10.0) server.runPeriod();
   const double released_after = seconds(t0);
   EXPECT_FALSE(server.stats(0).owned);
+  EXPECT_LT(released_after, 5.0);  // about 2 s measured: the writers unmatch, no hang
   const uint64_t b_accepted = server.stats(1).accepted;
   for (int i = 0; i < 50; ++i) server.runPeriod();
   EXPECT_GE(server.stats(1).accepted, b_accepted + 45);  // the other robot kept going

@@ -158,6 +158,7 @@ TEST(Referee, FirstHalfWithScriptedBall) {
   EXPECT_EQ(g.score(1), 0);
   EXPECT_EQ(count(g, "goal"), 1);
   EXPECT_GE(count(g, "set_play"), 6);  // 3 awarded, 3 over
+  EXPECT_EQ(count(g, "set_play"), 8);  // and the two kick-offs over
 }
 
 TEST(Referee, LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement) {
@@ -311,6 +312,7 @@ TEST(Referee, GameStuckLocalThenGlobal) {
   run(w, ref, 30.2);
   EXPECT_EQ(count(g, "drop_ball"), 1);
   EXPECT_EQ(g.kickingTeam(), -1);
+  EXPECT_EQ(g.state(), gc::State::Ready);  // the drop ball restarts with Ready
 }
 
 namespace {
