@@ -105,17 +105,12 @@ int benchNet(int argc, char** argv, int first) {
                           fmt(sim_seconds / wall_alone, 2)});
     std::fprintf(stderr, "  %d robots done\n", n);
   }
-  std::printf("\n");
-  table.print(stdout);
-  std::printf(
-      "\noverhead = wall time per period minus the world's stepping (publishing frames, "
+  table.finish(
+      "overhead = wall time per period minus the world's stepping (publishing frames, "
       "waiting for and taking commands); world = the same world stepped alone (physics and "
       "sensors); bytes = loopback interface traffic per tick (all processes, RTPS headers "
-      "and acknowledgements included).\n");
-  if (!csv.empty()) {
-    table.writeCsv(csv);
-    std::printf("wrote %s\n", csv.c_str());
-  }
+      "and acknowledgements included).",
+      csv);
   return 0;
 }
 

@@ -117,17 +117,12 @@ int benchPhysics(int argc, char** argv, int first) {
     std::fprintf(stderr, "  %d robots done: %.0f steps/s (median of %d)\n", n, median.first,
                  repeat);
   }
-  std::printf("\n");
-  table.print(stdout);
-  std::printf(
-      "\nStages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
+  table.finish(
+      "Stages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
       "dynamics; solver = contact and joint-limit constraints; integrate = positions; "
       "servo = joint PD torques; other = everything else in the step and the loop "
-      "(commands, contact counting).\n");
-  if (!csv.empty()) {
-    table.writeCsv(csv);
-    std::printf("wrote %s\n", csv.c_str());
-  }
+      "(commands, contact counting).",
+      csv);
   return 0;
 }
 

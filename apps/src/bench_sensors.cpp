@@ -128,17 +128,12 @@ int benchSensors(int argc, char** argv, int first) {
     table.rows.push_back(row);
     std::fprintf(stderr, "  %d robots done\n", n);
   }
-  std::printf("\n");
-  table.print(stdout);
-  std::printf(
-      "\nbatched/reference: one sonar update (all rays of all robots); speedup = reference / "
+  table.finish(
+      "batched/reference: one sonar update (all rays of all robots); speedup = reference / "
       "batched; hits = rays that found something in range. Per period: other sensors, the "
       "sonar's cost spread over the periods between updates, the physics steps; share = "
-      "(other + sonar) / physics.\n");
-  if (!csv.empty()) {
-    table.writeCsv(csv);
-    std::printf("wrote %s\n", csv.c_str());
-  }
+      "(other + sonar) / physics.",
+      csv);
   return 0;
 }
 

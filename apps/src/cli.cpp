@@ -123,3 +123,17 @@ void Table::writeCsv(const std::filesystem::path& file) const {
 }
 
 }  // namespace simsoccer::apps
+
+namespace simsoccer::apps {
+
+void Table::finish(const std::string& legend, const std::filesystem::path& csv) const {
+  std::printf("\n");
+  print(stdout);
+  std::printf("\n%s\n", legend.c_str());
+  if (!csv.empty()) {
+    writeCsv(csv);
+    std::printf("wrote %s\n", csv.c_str());
+  }
+}
+
+}  // namespace simsoccer::apps

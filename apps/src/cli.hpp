@@ -46,6 +46,8 @@ struct Table {
   std::vector<std::vector<std::string>> rows;
   void print(FILE* out) const;
   void writeCsv(const std::filesystem::path& file) const;  // throws on I/O error
+  // What every bench ends with: the table, its legend, and the CSV when asked for.
+  void finish(const std::string& legend, const std::filesystem::path& csv) const;
 };
 
 std::string fmt(double value, int decimals);
