@@ -127,19 +127,14 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
                       "overlaps robots[" + std::to_string(k) + "] (torsos closer than " +
                           engine::formatNumber(kMinRobotSpacing) + " m)");
     placed.emplace_back(x, y, 0.0);
-    // Upright, soles 1 mm above the carpet.
-    Pose torso = Pose::Identity();
-    torso.translation() = Vec3(x, y, model->soleDepth(q) + 0.001);
-    torso.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
     RobotInfo info;
     info.team = p.team;
     info.number = p.number;
     info.model = model;
-    info.body = physics_->addArticulation(model->body, torso, q, static_cast<int>(i));
+    info.body = physics_->addArticulation(model->body, standingTorso(*model, q, x, y, yaw), q,
+                                          static_cast<int>(i));
     robots_.push_back(info);
-    // Hold the posture at full stiffness until commanded otherwise.
-    for (size_t j = 0; j < joints.size(); ++j)
-      if (joints[j].motor >= 0) physics_->setJointTarget(info.body, static_cast<int>(j), q[j], 1.0);
+    holdJoints(static_cast<RobotId>(i), q, 1.0);  // until commanded otherwise
   }
   initSensors();
 }
@@ -177,12 +172,24 @@ void World::setJointTarget(RobotId r, int joint, double target_rad, double stiff
 }
 
 void World::setPoseTarget(RobotId r, const std::string& pose_name, double stiffness) {
+  holdJoints(r, robots_.at(r).model->pose(pose_name), stiffness);
+}
+
+void World::holdJoints(RobotId r, const std::vector<double>& q, double stiffness) {
   const RobotInfo& info = robots_.at(r);
-  const auto& q = info.model->pose(pose_name);
   const auto& joints = info.model->body->joints;
   for (size_t j = 0; j < joints.size(); ++j)
     if (joints[j].motor >= 0)
       physics_->setJointTarget(info.body, static_cast<int>(j), q[j], stiffness);
+}
+
+// Upright at (x, y) facing yaw, soles 1 mm above the carpet.
+Pose World::standingTorso(const robots::RobotModel& model, const std::vector<double>& q, double x,
+                          double y, double yaw) {
+  Pose torso = Pose::Identity();
+  torso.translation() = Vec3(x, y, model.soleDepth(q) + 0.001);
+  torso.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+  return torso;
 }
 
 void World::step() {
@@ -221,11 +228,8 @@ void World::setBallState(const engine::RigidBodyState& state) {
 void World::placeRobot(RobotId r, double x, double y, double yaw, const std::string& posture) {
   const RobotInfo& info = robots_.at(r);
   const std::vector<double>& q = info.model->pose(posture);
-  Pose torso = Pose::Identity();
-  torso.translation() = Vec3(x, y, info.model->soleDepth(q) + 0.001);
-  torso.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
-  physics_->resetArticulation(info.body, torso, q);
-  setPoseTarget(r, posture, 1.0);
+  physics_->resetArticulation(info.body, standingTorso(*info.model, q, x, y, yaw), q);
+  holdJoints(r, q, 1.0);
 }
 
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {

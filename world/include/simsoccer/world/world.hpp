@@ -117,6 +117,9 @@ class World {
   const engine::PhysicsWorld& physics() const { return *physics_; }
 
  private:
+  void holdJoints(RobotId r, const std::vector<double>& q, double stiffness);
+  static Pose standingTorso(const robots::RobotModel& model, const std::vector<double>& q, double x,
+                            double y, double yaw);
   Scenario scenario_;
   std::shared_ptr<const fields::FieldModel> field_;
   std::unique_ptr<engine::PhysicsWorld> physics_;
