@@ -564,17 +564,6 @@ void PhysicsWorld::resetStageTimes() {
   impl_->times = StageTimes{};
 }
 
-size_t PhysicsWorld::articulationCount() const {
-  return impl_->articulations.size();
-}
-size_t PhysicsWorld::rigidBodyCount() const {
-  return impl_->bodies.size();
-}
-
-const ArticulatedModel& PhysicsWorld::model(ArticulationId a) const {
-  return *impl_->articulations.at(a).model;
-}
-
 Pose PhysicsWorld::linkPose(ArticulationId a, int link) const {
   Articulation& art = impl_->articulations.at(a);
   if (link < 0 || link >= static_cast<int>(art.model->links.size()))

@@ -102,10 +102,6 @@ void RayScene::addCylinder(const Vec3f& c, const Vec3f& axis, float half_length,
                   groupKey(owner, cluster));
 }
 
-size_t RayScene::primitiveCount() const {
-  return spheres_.size() + capsules_.size() + boxes_.size() + cylinders_.size();
-}
-
 void RayScene::finalize() {
   for (Columns* c : {&spheres_, &capsules_, &boxes_, &cylinders_}) c->sortByKey();
   // One group per distinct key, ascending: walk the four sorted key arrays

@@ -42,8 +42,6 @@ class ConfigNode {
   // Map keys that are not in `allowed` are errors (catches typos).
   void allowOnly(std::initializer_list<const char*> allowed) const;
 
-  bool isMap() const { return node_.IsMap(); }
-  bool isSequence() const { return node_.IsSequence(); }
   std::vector<ConfigNode> items() const;                            // sequence
   std::vector<std::pair<std::string, ConfigNode>> entries() const;  // map, file order
 

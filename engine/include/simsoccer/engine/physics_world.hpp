@@ -108,9 +108,6 @@ class PhysicsWorld {
   void resetStageTimes();
 
   // --- reading -----------------------------------------------------------------
-  size_t articulationCount() const;
-  size_t rigidBodyCount() const;
-  const ArticulatedModel& model(ArticulationId a) const;
   // Joint frame of a link in the world.
   Pose linkPose(ArticulationId a, int link) const;
   Vec3 rootLinearVelocity(ArticulationId a) const;

@@ -64,7 +64,6 @@ class RayScene {
   // hits[i] = the nearest hit of rays[i] within its max distance.
   void trace(std::span<const Ray> rays, std::span<RayHit> hits) const;
 
-  size_t primitiveCount() const;
 
  private:
   // One primitive type as columns of floats (structure of arrays), with the

@@ -57,7 +57,6 @@ class SensorSystem {
   void traceBatched(const engine::PhysicsWorld& physics, std::vector<engine::RayHit>& hits);
   // The same rays one at a time through Bullet's rayTest (reference path).
   void traceReference(const engine::PhysicsWorld& physics, std::vector<engine::RayHit>& hits);
-  int raysPerSonar() const { return static_cast<int>(rays_per_sonar_); }
 
   void enableTimers(bool on) { timers_on_ = on; }
   const SensorTimes& times() const { return times_; }
