@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
       if (sub == "physics") return benchPhysics(argc, argv, 3);
       if (sub == "sensors") return benchSensors(argc, argv, 3);
       if (sub == "net") return benchNet(argc, argv, 3);
+      if (sub == "cameras") return benchCameras(argc, argv, 3);
       std::fprintf(stderr,
                    "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net)\n",
                    sub.c_str());

@@ -5,6 +5,7 @@
 #include <EGL/eglext.h>
 #include <GL/glcorearb.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -19,52 +20,48 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// Lighting per vertex (Lambert under a fixed sky light), so the fragment
+// stage, which llvmpipe runs for every one of millions of pixels per frame,
+// only writes a colour.
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in mat4 model;   // locations 2..5
 layout(location = 6) in vec3 colour;
-layout(location = 7) in float pattern;
 uniform mat4 view_projection;
-out vec3 world_normal;
-out vec3 base_colour;
+out vec3 lit_colour;
 out vec3 object_position;
-flat out float ball_pattern;
 void main() {
   gl_Position = view_projection * model * vec4(position, 1.0);
-  world_normal = mat3(model) * normal;
-  base_colour = colour;
+  vec3 n = normalize(mat3(model) * normal);
+  lit_colour = colour * (0.6 + 0.4 * max(dot(n, normalize(vec3(0.3, 0.2, 1.0))), 0.0));
   object_position = position;
-  ball_pattern = pattern;
 }
 )";
 
-// Lambert shading under a fixed sky light; the ball's black patches are the
-// 12 directions of an icosahedron's vertices (a pentagon pattern's centres).
-const char* kFragmentShader = R"(#version 330 core
-in vec3 world_normal;
-in vec3 base_colour;
+const char* kPlainFragmentShader = R"(#version 330 core
+in vec3 lit_colour;
+out vec4 fragment;
+void main() { fragment = vec4(lit_colour, 1.0); }
+)";
+
+// The ball's black patches: the 12 directions of an icosahedron's vertices
+// (a pentagon pattern's centres). Only the ball's pixels run this.
+const char* kPatternFragmentShader = R"(#version 330 core
+in vec3 lit_colour;
 in vec3 object_position;
-flat in float ball_pattern;
 out vec4 fragment;
 void main() {
-  vec3 c = base_colour;
-  if (ball_pattern > 0.5) {
-    const float g = 1.618034;
-    vec3 p = normalize(object_position);
-    vec3 a = abs(p);
-    float best = max(max(dot(a, normalize(vec3(0.0, 1.0, g))), dot(a, normalize(vec3(1.0, g, 0.0)))),
-                     dot(a, normalize(vec3(g, 0.0, 1.0))));
-    if (best > 0.93) c = vec3(0.05);
-  }
-  vec3 n = normalize(world_normal);
-  float light = 0.6 + 0.4 * max(dot(n, normalize(vec3(0.3, 0.2, 1.0))), 0.0);
-  fragment = vec4(c * light, 1.0);
+  const float g = 1.618034;
+  vec3 a = abs(normalize(object_position));
+  float best = max(max(dot(a, normalize(vec3(0.0, 1.0, g))), dot(a, normalize(vec3(1.0, g, 0.0)))),
+                   dot(a, normalize(vec3(g, 0.0, 1.0))));
+  fragment = vec4(best > 0.93 ? vec3(0.05) : lit_colour, 1.0);
 }
 )";
 
 struct Mesh {
-  GLuint vao = 0, vertices = 0, indices = 0, instances = 0;
+  GLuint vao = 0, vertices = 0, indices = 0;
   GLsizei index_count = 0;
 };
 
@@ -76,8 +73,36 @@ struct Vertex {
 struct Instance {
   float model[16];  // column-major
   float colour[3];
-  float pattern;
 };
+
+// Draw batches: one per unit mesh, the ball's patterned sphere apart (its own
+// fragment program). Drawn in this order: robots' parts (usually nearest the
+// camera) first, the ground last, so hidden ground pixels fail the early depth test.
+constexpr std::array<Primitive, 5> kBatchMesh{Primitive::CoarseSphere, Primitive::Cylinder,
+                                              Primitive::Sphere, Primitive::Sphere,
+                                              Primitive::Box};
+constexpr size_t kPatternBatch = 3;
+
+size_t batchOf(const DrawItem& d) {
+  if (d.ball_pattern) return kPatternBatch;
+  switch (d.shape) {
+    case Primitive::CoarseSphere: return 0;
+    case Primitive::Cylinder: return 1;
+    case Primitive::Sphere: return 2;
+    case Primitive::Box: return 4;
+  }
+  return 4;
+}
+
+// Radius of the unit mesh's bounding sphere (box corners at sqrt(3)/2; the
+// cylinder's rim at sqrt(1 + 0.25)).
+float unitRadius(Primitive p) {
+  switch (p) {
+    case Primitive::Box: return 0.8661f;
+    case Primitive::Cylinder: return 1.1181f;
+    default: return 1.0f;
+  }
+}
 
 void unitBox(std::vector<Vertex>& v, std::vector<uint32_t>& idx) {
   for (int axis = 0; axis < 3; ++axis)
@@ -165,13 +190,29 @@ GLuint compile(GLenum type, const char* source) {
 struct OffscreenRenderer::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
-  GLuint program = 0;
-  GLint view_projection = -1;
-  std::array<Mesh, 4> meshes;  // by Primitive
+  std::array<GLuint, 2> programs{};          // plain, ball pattern
+  std::array<GLint, 2> view_projection{-1, -1};
+  std::array<Mesh, 4> meshes;                 // by Primitive
+  GLuint instances = 0;                       // every view's instances, one buffer
   GLuint fbo = 0, colour = 0, depth = 0;
   int fbo_width = 0, fbo_height = 0;
-  std::vector<std::vector<Instance>> batches{4};
-  cv::Mat atlas;  // RGB, bottom row first (as GL reads it)
+  std::vector<Instance> all;                  // the scene's instances
+  std::vector<std::array<float, 4>> bounds;   // their bounding spheres (x, y, z, r)
+  std::vector<size_t> batch_of;
+  std::vector<Instance> uploaded;             // per view, per batch, the visible instances
+  std::vector<std::array<std::array<size_t, 2>, kBatchMesh.size()>> ranges;  // [view][batch]
+  cv::Mat atlas;                              // RGBA, every view top row first
+  std::vector<cv::Rect> rects;                // each view's place in the atlas
+
+  // Aims a mesh's per-instance attributes at instances [first, ...) of the buffer.
+  void pointInstances(size_t first) const {
+    const auto base = first * sizeof(Instance);
+    for (GLuint c = 0; c < 4; ++c)
+      glVertexAttribPointer(2 + c, 4, GL_FLOAT, GL_FALSE, sizeof(Instance),
+                            reinterpret_cast<void*>(base + c * 4 * sizeof(float)));
+    glVertexAttribPointer(6, 3, GL_FLOAT, GL_FALSE, sizeof(Instance),
+                          reinterpret_cast<void*>(base + offsetof(Instance, colour)));
+  }
 
   void openDisplay() {
     auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
@@ -216,19 +257,23 @@ struct OffscreenRenderer::Impl {
       throw RenderError("renderer: eglMakeCurrent without a surface failed");
   }
 
-  void buildProgram() {
-    const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-    program = glCreateProgram();
-    glAttachShader(program, vs);
-    glAttachShader(program, fs);
-    glLinkProgram(program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) throw RenderError("renderer: shader program did not link");
-    view_projection = glGetUniformLocation(program, "view_projection");
+  void buildPrograms() {
+    const std::array<const char*, 2> fragment{kPlainFragmentShader, kPatternFragmentShader};
+    for (size_t i = 0; i < programs.size(); ++i) {
+      const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
+      const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment[i]);
+      const GLuint program = glCreateProgram();
+      glAttachShader(program, vs);
+      glAttachShader(program, fs);
+      glLinkProgram(program);
+      glDeleteShader(vs);
+      glDeleteShader(fs);
+      GLint ok = 0;
+      glGetProgramiv(program, GL_LINK_STATUS, &ok);
+      if (!ok) throw RenderError("renderer: shader program did not link");
+      programs[i] = program;
+      view_projection[i] = glGetUniformLocation(program, "view_projection");
+    }
   }
 
   void buildMesh(Primitive p) {
@@ -236,8 +281,8 @@ struct OffscreenRenderer::Impl {
     std::vector<uint32_t> idx;
     if (p == Primitive::Box) unitBox(v, idx);
     if (p == Primitive::Sphere) unitSphere(v, idx, 12, 8);
-    if (p == Primitive::CoarseSphere) unitSphere(v, idx, 8, 5);
-    if (p == Primitive::Cylinder) unitCylinder(v, idx, 8);
+    if (p == Primitive::CoarseSphere) unitSphere(v, idx, 6, 4);
+    if (p == Primitive::Cylinder) unitCylinder(v, idx, 6);
     Mesh& m = meshes[static_cast<size_t>(p)];
     glGenVertexArrays(1, &m.vao);
     glBindVertexArray(m.vao);
@@ -255,23 +300,13 @@ struct OffscreenRenderer::Impl {
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * sizeof(uint32_t)),
                  idx.data(), GL_STATIC_DRAW);
     m.index_count = static_cast<GLsizei>(idx.size());
-    // Per-instance attributes: model matrix (4 columns), colour, pattern flag.
-    glGenBuffers(1, &m.instances);
-    glBindBuffer(GL_ARRAY_BUFFER, m.instances);
-    for (GLuint c = 0; c < 4; ++c) {
-      glEnableVertexAttribArray(2 + c);
-      glVertexAttribPointer(2 + c, 4, GL_FLOAT, GL_FALSE, sizeof(Instance),
-                            reinterpret_cast<void*>(c * 4 * sizeof(float)));
-      glVertexAttribDivisor(2 + c, 1);
+    // Per-instance attributes (model matrix columns, colour) come from the
+    // shared instance buffer; pointInstances() aims them at a range.
+    glBindBuffer(GL_ARRAY_BUFFER, instances);
+    for (GLuint a = 2; a <= 6; ++a) {
+      glEnableVertexAttribArray(a);
+      glVertexAttribDivisor(a, 1);
     }
-    glEnableVertexAttribArray(6);
-    glVertexAttribPointer(6, 3, GL_FLOAT, GL_FALSE, sizeof(Instance),
-                          reinterpret_cast<void*>(offsetof(Instance, colour)));
-    glVertexAttribDivisor(6, 1);
-    glEnableVertexAttribArray(7);
-    glVertexAttribPointer(7, 1, GL_FLOAT, GL_FALSE, sizeof(Instance),
-                          reinterpret_cast<void*>(offsetof(Instance, pattern)));
-    glVertexAttribDivisor(7, 1);
     glBindVertexArray(0);
   }
 
@@ -288,7 +323,8 @@ struct OffscreenRenderer::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glGenRenderbuffers(1, &colour);
     glBindRenderbuffer(GL_RENDERBUFFER, colour);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGB8, width, height);
+    // RGBA: llvmpipe's native 32-bit layout renders and reads back faster than RGB.
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
     glGenRenderbuffers(1, &depth);
     glBindRenderbuffer(GL_RENDERBUFFER, depth);
@@ -303,13 +339,16 @@ struct OffscreenRenderer::Impl {
 OffscreenRenderer::OffscreenRenderer() : impl_(std::make_unique<Impl>()) {
   impl_->openDisplay();
   impl_->createContext();
-  impl_->buildProgram();
+  impl_->buildPrograms();
+  glGenBuffers(1, &impl_->instances);
   for (Primitive p :
        {Primitive::Box, Primitive::Sphere, Primitive::CoarseSphere, Primitive::Cylinder})
     impl_->buildMesh(p);
   glEnable(GL_DEPTH_TEST);
-  glEnable(GL_SCISSOR_TEST);
   glEnable(GL_CULL_FACE);
+  // The projection flips y so that image rows come out top row first in
+  // memory (no flip after the readback); that turns the winding around.
+  glFrontFace(GL_CW);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
 }
 
@@ -325,13 +364,62 @@ std::string OffscreenRenderer::glRenderer() const {
   return s ? reinterpret_cast<const char*>(s) : "";
 }
 
-void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const RenderView> views,
-                               std::vector<cv::Mat>& images) {
+namespace {
+
+// World -> clip space for a view: OpenGL's camera looks down -z with y up,
+// ours looks along x with z up; y is flipped so that row 0 in memory is the
+// image's top row.
+Eigen::Matrix4f viewProjection(const RenderView& v) {
+  Eigen::Matrix4d gl_from_camera = Eigen::Matrix4d::Zero();
+  gl_from_camera(0, 1) = -1.0;
+  gl_from_camera(1, 2) = 1.0;
+  gl_from_camera(2, 0) = -1.0;
+  gl_from_camera(3, 3) = 1.0;
+  const double w = v.width, h = v.height, n = v.near_clip, f = v.far_clip;
+  Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
+  projection(0, 0) = 2 * v.fx / w;
+  projection(0, 2) = 1 - 2 * v.cx / w;
+  projection(1, 1) = -2 * v.fy / h;
+  projection(1, 2) = 1 - 2 * v.cy / h;
+  projection(2, 2) = -(f + n) / (f - n);
+  projection(2, 3) = -2 * f * n / (f - n);
+  projection(3, 2) = -1;
+  return (projection * gl_from_camera * v.pose.inverse().matrix()).cast<float>();
+}
+
+// The view frustum's four side planes and the far plane in the world frame
+// (inward normals), for culling whole instances by their bounding spheres.
+struct Frustum {
+  std::array<Eigen::Vector4f, 5> planes;
+  explicit Frustum(const RenderView& v) {
+    const Eigen::Matrix3d R = v.pose.linear();
+    const Vec3 o = v.pose.translation();
+    // Camera frame: x forward, y left, z up. Edges of the image in camera rays.
+    const double left = v.cx / v.fx, right = (v.width - v.cx) / v.fx;
+    const double top = v.cy / v.fy, bottom = (v.height - v.cy) / v.fy;
+    const std::array<Vec3, 5> normals{
+        Vec3(left, -1, 0), Vec3(right, 1, 0), Vec3(top, 0, -1), Vec3(bottom, 0, 1), Vec3(-1, 0, 0)};
+    for (size_t i = 0; i < normals.size(); ++i) {
+      const Vec3 n = R * normals[i].normalized();
+      const double d = i < 4 ? -n.dot(o) : -n.dot(o + R * Vec3(v.far_clip, 0, 0));
+      planes[i] = Eigen::Vector4f(float(n.x()), float(n.y()), float(n.z()), float(d));
+    }
+  }
+  bool sees(const std::array<float, 4>& s) const {
+    for (const auto& p : planes)
+      if (p.x() * s[0] + p.y() * s[1] + p.z() * s[2] + p.w() < -s[3]) return false;
+    return true;
+  }
+};
+
+}  // namespace
+
+void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const RenderView> views) {
   Impl& m = *impl_;
   const auto t0 = Clock::now();
   // Shelf packing of the views into one framebuffer, rows at most 4096 px wide.
   const int max_row = 4096;
-  std::vector<std::array<int, 2>> origin(views.size());
+  m.rects.resize(views.size());
   int x = 0, y = 0, row_height = 0, width = 1, height = 1;
   for (size_t i = 0; i < views.size(); ++i) {
     const RenderView& v = views[i];
@@ -342,7 +430,7 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
       y += row_height;
       row_height = 0;
     }
-    origin[i] = {x, y};
+    m.rects[i] = cv::Rect(x, y, v.width, v.height);
     x += v.width;
     row_height = std::max(row_height, v.height);
     width = std::max(width, x);
@@ -351,72 +439,87 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
   m.ensureFramebuffer(width, height);
   glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
 
-  // The scene's instances, once for all views.
-  for (auto& b : m.batches) b.clear();
+  // The scene's instances and bounding spheres, then per view the ones
+  // inside its frustum, batch by batch, all in one buffer.
+  m.all.clear();
+  m.bounds.clear();
+  m.batch_of.clear();
   for (const DrawItem& d : scene) {
     Instance in{};
     std::copy(d.transform.data(), d.transform.data() + 16, in.model);
     in.colour[0] = d.colour.x();
     in.colour[1] = d.colour.y();
     in.colour[2] = d.colour.z();
-    in.pattern = d.ball_pattern ? 1.0f : 0.0f;
-    m.batches[static_cast<size_t>(d.shape)].push_back(in);
+    m.all.push_back(in);
+    const Eigen::Matrix3f l = d.transform.block<3, 3>(0, 0);
+    const float scale = std::max({l.col(0).norm(), l.col(1).norm(), l.col(2).norm()});
+    m.bounds.push_back({d.transform(0, 3), d.transform(1, 3), d.transform(2, 3),
+                        scale * unitRadius(d.shape)});
+    m.batch_of.push_back(batchOf(d));
   }
+  m.uploaded.clear();
+  m.ranges.assign(views.size(), {});
   size_t triangles = 0;
-  for (size_t p = 0; p < m.meshes.size(); ++p) {
-    glBindBuffer(GL_ARRAY_BUFFER, m.meshes[p].instances);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.batches[p].size() * sizeof(Instance)),
-                 m.batches[p].data(), GL_STREAM_DRAW);
-    triangles += m.batches[p].size() * static_cast<size_t>(m.meshes[p].index_count / 3);
-  }
-
-  glUseProgram(m.program);
-  glClearColor(0.35f, 0.35f, 0.38f, 1.0f);  // the hall around the field
-  // OpenGL's camera looks down -z with y up; ours looks along x with z up.
-  Eigen::Matrix4d gl_from_camera = Eigen::Matrix4d::Zero();
-  gl_from_camera(0, 1) = -1.0;
-  gl_from_camera(1, 2) = 1.0;
-  gl_from_camera(2, 0) = -1.0;
-  gl_from_camera(3, 3) = 1.0;
   for (size_t i = 0; i < views.size(); ++i) {
-    const RenderView& v = views[i];
-    glViewport(origin[i][0], origin[i][1], v.width, v.height);
-    glScissor(origin[i][0], origin[i][1], v.width, v.height);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    const double w = v.width, h = v.height, n = v.near_clip, f = v.far_clip;
-    Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
-    projection(0, 0) = 2 * v.fx / w;
-    projection(0, 2) = 1 - 2 * v.cx / w;
-    projection(1, 1) = 2 * v.fy / h;
-    projection(1, 2) = 2 * v.cy / h - 1;
-    projection(2, 2) = -(f + n) / (f - n);
-    projection(2, 3) = -2 * f * n / (f - n);
-    projection(3, 2) = -1;
-    const Eigen::Matrix4f vp =
-        (projection * gl_from_camera * v.pose.inverse().matrix()).cast<float>();
-    glUniformMatrix4fv(m.view_projection, 1, GL_FALSE, vp.data());
-    for (size_t p = 0; p < m.meshes.size(); ++p) {
-      if (m.batches[p].empty()) continue;
-      glBindVertexArray(m.meshes[p].vao);
-      glDrawElementsInstanced(GL_TRIANGLES, m.meshes[p].index_count, GL_UNSIGNED_INT, nullptr,
-                              static_cast<GLsizei>(m.batches[p].size()));
+    const Frustum frustum(views[i]);
+    for (size_t b = 0; b < kBatchMesh.size(); ++b) {
+      m.ranges[i][b][0] = m.uploaded.size();
+      for (size_t k = 0; k < m.all.size(); ++k)
+        if (m.batch_of[k] == b && frustum.sees(m.bounds[k])) m.uploaded.push_back(m.all[k]);
+      m.ranges[i][b][1] = m.uploaded.size() - m.ranges[i][b][0];
+      triangles += m.ranges[i][b][1] *
+                   static_cast<size_t>(m.meshes[static_cast<size_t>(kBatchMesh[b])].index_count / 3);
+    }
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, m.instances);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.uploaded.size() * sizeof(Instance)),
+               m.uploaded.data(), GL_STREAM_DRAW);
+
+  // One clear of the whole framebuffer (llvmpipe clears whole tiles fast;
+  // a scissored clear per view writes every pixel).
+  glDisable(GL_SCISSOR_TEST);
+  glClearColor(0.35f, 0.35f, 0.38f, 1.0f);  // the hall around the field
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_SCISSOR_TEST);
+  for (size_t i = 0; i < views.size(); ++i) {
+    const cv::Rect& r = m.rects[i];
+    glViewport(r.x, r.y, r.width, r.height);
+    glScissor(r.x, r.y, r.width, r.height);
+    const Eigen::Matrix4f vp = viewProjection(views[i]);
+    for (size_t b = 0; b < kBatchMesh.size(); ++b) {
+      const auto [first, count] = m.ranges[i][b];
+      if (count == 0) continue;
+      const size_t program = b == kPatternBatch ? 1 : 0;
+      glUseProgram(m.programs[program]);
+      glUniformMatrix4fv(m.view_projection[program], 1, GL_FALSE, vp.data());
+      const Mesh& mesh = m.meshes[static_cast<size_t>(kBatchMesh[b])];
+      glBindVertexArray(mesh.vao);
+      m.pointInstances(first);
+      glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
+                              static_cast<GLsizei>(count));
     }
   }
   glFinish();
   timing_.draw_ms = msSince(t0);
 
+  // One readback; every view is a region of it, already top row first.
   const auto t1 = Clock::now();
-  m.atlas.create(height, width, CV_8UC3);
-  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, m.atlas.data);
-  images.resize(views.size());
-  for (size_t i = 0; i < views.size(); ++i) {
-    const cv::Rect r(origin[i][0], origin[i][1], views[i].width, views[i].height);
-    cv::flip(m.atlas(r), images[i], 0);  // GL rows run bottom-up
-  }
+  m.atlas.create(height, width, CV_8UC4);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, m.atlas.data);
   timing_.readback_ms = msSince(t1);
   timing_.atlas_width = width;
   timing_.atlas_height = height;
-  timing_.triangles_per_view = triangles;
+  timing_.triangles = triangles;
+  timing_.triangles_per_view = views.empty() ? 0 : triangles / views.size();
+}
+
+cv::Mat OffscreenRenderer::image(size_t view) const { return impl_->atlas(impl_->rects.at(view)); }
+
+void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const RenderView> views,
+                               std::vector<cv::Mat>& images) {
+  render(scene, views);
+  images.resize(views.size());
+  for (size_t i = 0; i < views.size(); ++i) cv::cvtColor(image(i), images[i], cv::COLOR_RGBA2RGB);
 }
 
 RenderView pinholeView(const Pose& pose, int width, int height, double horizontal_fov,
@@ -441,22 +544,24 @@ bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, do
 }
 
 cv::Mat rgbToYuyv(const cv::Mat& rgb) {
-  if (rgb.type() != CV_8UC3 || rgb.cols % 2 != 0)
-    throw std::invalid_argument("rgbToYuyv: 8-bit RGB with an even width expected");
+  if ((rgb.type() != CV_8UC3 && rgb.type() != CV_8UC4) || rgb.cols % 2 != 0)
+    throw std::invalid_argument("rgbToYuyv: 8-bit RGB or RGBA with an even width expected");
   cv::Mat yuv;
-  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);  // reads 3 or 4 channels, writes 3
   cv::Mat out(rgb.rows, rgb.cols, CV_8UC2);
-  for (int r = 0; r < rgb.rows; ++r) {
-    const auto* in = yuv.ptr<cv::Vec3b>(r);
-    auto* o = out.ptr<uint8_t>(r);
-    for (int c = 0; c < rgb.cols; c += 2) {
-      const cv::Vec3b a = in[c], b = in[c + 1];
-      o[2 * c + 0] = a[0];
-      o[2 * c + 1] = static_cast<uint8_t>((a[1] + b[1] + 1) / 2);
-      o[2 * c + 2] = b[0];
-      o[2 * c + 3] = static_cast<uint8_t>((a[2] + b[2] + 1) / 2);
+  cv::parallel_for_(cv::Range(0, rgb.rows), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r) {
+      const auto* in = yuv.ptr<cv::Vec3b>(r);
+      auto* o = out.ptr<uint8_t>(r);
+      for (int c = 0; c < rgb.cols; c += 2) {
+        const cv::Vec3b a = in[c], b = in[c + 1];
+        o[2 * c + 0] = a[0];
+        o[2 * c + 1] = static_cast<uint8_t>((a[1] + b[1] + 1) / 2);
+        o[2 * c + 2] = b[0];
+        o[2 * c + 3] = static_cast<uint8_t>((a[2] + b[2] + 1) / 2);
+      }
     }
-  }
+  });
   return out;
 }
 

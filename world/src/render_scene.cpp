@@ -61,15 +61,22 @@ void addLine(std::vector<DrawItem>& items, const fields::Vec2& a, const fields::
 }  // namespace
 
 void buildRenderScene(const World& world, std::vector<DrawItem>& items, const SceneColours& c) {
+  // Nearest things first, the ground last: the renderer keeps this order, and
+  // ground hidden behind robots then fails the early depth test.
+  // Robots from their collision primitives; the torso in the jersey colour.
+  for (RobotId r = 0; r < world.robotCount(); ++r) {
+    const auto& info = world.robot(r);
+    const auto& links = info.model->body->links;
+    const Eigen::Vector3f jersey =
+        c.jerseys.empty() ? c.robot : c.jerseys[static_cast<size_t>(info.team) % c.jerseys.size()];
+    for (size_t l = 0; l < links.size(); ++l) {
+      if (links[l].shapes.empty()) continue;
+      const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
+      for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
+    }
+  }
   const auto& f = world.field();
-  engine::Pose p = engine::Pose::Identity();
-  // Floor around the carpet, the carpet, the lines.
-  p.translation() = Vec3(0, 0, -0.02);
-  add(items, Primitive::Box, p,
-      Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 0.02), c.floor);
-  p.translation() = Vec3(0, 0, -0.0049);
-  add(items, Primitive::Box, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 0.01),
-      c.carpet);
+  // The lines, then the carpet, then the floor around it.
   for (const auto& l : f.lines) addLine(items, l.a, l.b, f.line_width, c.line);
   for (const auto& circle : f.circles) {
     const int segments = 24;  // few triangles: llvmpipe pays per triangle
@@ -85,27 +92,22 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
     addLine(items, m - fields::Vec2(h, 0), m + fields::Vec2(h, 0), f.line_width, c.line);
     addLine(items, m - fields::Vec2(0, h), m + fields::Vec2(0, h), f.line_width, c.line);
   }
+  // The ball.
+  const engine::RigidBodyState ball = world.ballState();
+  add(items, Primitive::Sphere, ball.pose, Vec3::Constant(f.ball.radius), c.ball, true);
   // Goals: posts and crossbar white, net grey.
   for (int side : {-1, 1}) {
     const auto shapes = f.goalShapes(side);
     for (size_t i = 0; i < shapes.size(); ++i)
       addShape(items, shapes[i], engine::Pose::Identity(), i < 3 ? c.goal : c.net);
   }
-  // The ball.
-  const engine::RigidBodyState ball = world.ballState();
-  add(items, Primitive::Sphere, ball.pose, Vec3::Constant(f.ball.radius), c.ball, true);
-  // Robots from their collision primitives; the torso in the jersey colour.
-  for (RobotId r = 0; r < world.robotCount(); ++r) {
-    const auto& info = world.robot(r);
-    const auto& links = info.model->body->links;
-    const Eigen::Vector3f jersey =
-        c.jerseys.empty() ? c.robot : c.jerseys[static_cast<size_t>(info.team) % c.jerseys.size()];
-    for (size_t l = 0; l < links.size(); ++l) {
-      if (links[l].shapes.empty()) continue;
-      const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
-      for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
-    }
-  }
+  engine::Pose p = engine::Pose::Identity();
+  p.translation() = Vec3(0, 0, -0.0049);
+  add(items, Primitive::Box, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 0.01),
+      c.carpet);
+  p.translation() = Vec3(0, 0, -0.02);
+  add(items, Primitive::Box, p,
+      Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 0.02), c.floor);
 }
 
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,

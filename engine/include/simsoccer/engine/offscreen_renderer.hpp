@@ -22,8 +22,8 @@ class RenderError : public std::runtime_error {
 };
 
 // Unit meshes: box -0.5..0.5 on each axis; sphere of radius 1 (192
-// triangles, for the ball); a coarse sphere (80 triangles, for robot parts);
-// cylinder of radius 1 and length 1 along z, centred (32 triangles).
+// triangles, for the ball); a coarse sphere (48 triangles, for robot parts);
+// cylinder of radius 1 and length 1 along z, centred (24 triangles).
 enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder };
 
 // One instance of a unit mesh in the world frame.
@@ -53,7 +53,8 @@ bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, do
 struct RenderTiming {
   double draw_ms = 0.0, readback_ms = 0.0;
   int atlas_width = 0, atlas_height = 0;
-  size_t triangles_per_view = 0;
+  size_t triangles = 0;           // drawn in all views together, after culling
+  size_t triangles_per_view = 0;  // their mean per view
 };
 
 class OffscreenRenderer {
@@ -67,10 +68,14 @@ class OffscreenRenderer {
 
   std::string glRenderer() const;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
 
-  // Draws the scene in every view into one framebuffer (one viewport each)
-  // and reads it back once. `images[i]` becomes view i as 8-bit RGB
-  // (CV_8UC3, R first, top row first). Must be called on the thread that
-  // created the renderer.
+  // Draws the scene in every view into one framebuffer (one viewport each;
+  // instances outside a view's frustum are culled) and reads it back once.
+  // Must be called on the thread that created the renderer.
+  void render(std::span<const DrawItem> scene, std::span<const RenderView> views);
+  // View i of the last render as 8-bit RGBA (CV_8UC4, R first, top row
+  // first): a region of the readback, valid until the next render.
+  cv::Mat image(size_t view) const;
+  // The same, with `images[i]` an RGB copy (CV_8UC3) of view i.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views,
               std::vector<cv::Mat>& images);
   const RenderTiming& lastTiming() const { return timing_; }
@@ -81,7 +86,7 @@ class OffscreenRenderer {
   RenderTiming timing_;
 };
 
-// The Nao's image format: YUV 4:2:2 as Y0 U Y1 V (YUYV), from 8-bit RGB,
+// The Nao's image format: YUV 4:2:2 as Y0 U Y1 V (YUYV), from 8-bit RGB or RGBA,
 // using OpenCV's RGB -> YUV conversion; each pixel pair shares the mean of
 // its two chroma values. `width` must be even.
 cv::Mat rgbToYuyv(const cv::Mat& rgb);
