@@ -29,7 +29,7 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in mat4 model;   // locations 2..5
 layout(location = 6) in vec3 colour;
 uniform mat4 view_projection;
-out vec3 lit_colour;
+flat out vec3 lit_colour;
 out vec3 object_position;
 void main() {
   gl_Position = view_projection * model * vec4(position, 1.0);
@@ -40,7 +40,7 @@ void main() {
 )";
 
 const char* kPlainFragmentShader = R"(#version 330 core
-in vec3 lit_colour;
+flat in vec3 lit_colour;
 out vec4 fragment;
 void main() { fragment = vec4(lit_colour, 1.0); }
 )";
@@ -48,7 +48,7 @@ void main() { fragment = vec4(lit_colour, 1.0); }
 // The ball's black patches: the 12 directions of an icosahedron's vertices
 // (a pentagon pattern's centres). Only the ball's pixels run this.
 const char* kPatternFragmentShader = R"(#version 330 core
-in vec3 lit_colour;
+flat in vec3 lit_colour;
 in vec3 object_position;
 out vec4 fragment;
 void main() {

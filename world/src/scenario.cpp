@@ -8,10 +8,88 @@ namespace simsoccer::world {
 
 using engine::ConfigNode;
 
+namespace {
+
+void readRate(const ConfigNode& n, double control_period, double& rate) {
+  if (!n.has("rate")) return;
+  rate = n["rate"].positive();
+  if (rate * control_period > 1.0 + 1e-9)
+    n.failKey("rate", "at most one image per control period (" +
+                          engine::formatNumber(1.0 / control_period) + " Hz)");
+}
+
+void readSize(const ConfigNode& n, int& width, int& height) {
+  width = n.integer("width", width);
+  height = n.integer("height", height);
+  if (width < 2 || width > 4096 || width % 2 != 0)
+    n.failKey("width", "must be even and 2..4096 px (YUYV pairs pixels)");
+  if (height < 1 || height > 4096) n.failKey("height", "must be 1..4096 px");
+}
+
+void readCameras(const ConfigNode& n, double control_period, CameraSettings& c) {
+  n.allowOnly({"enabled", "top", "bottom", "encoding", "jpeg_quality", "queue", "effects",
+               "calibration", "spectator"});
+  c.enabled = n.boolean("enabled", true);
+  for (auto [key, spec] : {std::pair{"top", &c.top}, std::pair{"bottom", &c.bottom}}) {
+    if (auto k = n.optional(key)) {
+      k->allowOnly({"enabled", "width", "height", "rate"});
+      spec->enabled = k->boolean("enabled", true);
+      readSize(*k, spec->width, spec->height);
+      readRate(*k, control_period, spec->rate);
+    }
+  }
+  if (n.has("encoding")) {
+    c.encoding = n["encoding"].string();
+    if (c.encoding != "yuyv" && c.encoding != "jpeg") n.failKey("encoding", "must be yuyv or jpeg");
+  }
+  c.jpeg_quality = n.integer("jpeg_quality", c.jpeg_quality);
+  if (c.jpeg_quality < 1 || c.jpeg_quality > 100) n.failKey("jpeg_quality", "must be 1..100");
+  c.queue = n.integer("queue", c.queue);
+  if (c.queue < 1 || c.queue > 64) n.failKey("queue", "must be 1..64");
+  if (auto e = n.optional("effects")) {
+    e->allowOnly({"noise", "motion_blur_exposure", "rolling_shutter_readout"});
+    if (e->has("noise")) c.effects.noise = (*e)["noise"].nonNegative();
+    if (e->has("motion_blur_exposure"))
+      c.effects.motion_blur_exposure = (*e)["motion_blur_exposure"].nonNegative();
+    if (e->has("rolling_shutter_readout"))
+      c.effects.rolling_shutter_readout = (*e)["rolling_shutter_readout"].nonNegative();
+  }
+  if (auto cal = n.optional("calibration")) {
+    for (const ConfigNode& k : cal->items()) {
+      k.allowOnly({"team", "number", "camera", "rpy"});
+      CameraCalibration x;
+      x.team = k["team"].integer();
+      if (x.team != 0 && x.team != 1) k.failKey("team", "must be 0 or 1");
+      x.number = k["number"].integer();
+      if (x.number < 1) k.failKey("number", "player numbers start at 1");
+      x.camera = k["camera"].string();
+      if (x.camera != "top" && x.camera != "bottom") k.failKey("camera", "must be top or bottom");
+      x.rpy = k["rpy"].vec3();
+      c.calibration.push_back(x);
+    }
+  }
+  if (auto sp = n.optional("spectator")) {
+    sp->allowOnly({"enabled", "position", "look_at", "width", "height", "horizontal_fov", "rate"});
+    c.spectator.enabled = sp->boolean("enabled", true);
+    if (sp->has("position")) c.spectator.position = (*sp)["position"].vec3();
+    if (sp->has("look_at")) c.spectator.look_at = (*sp)["look_at"].vec3();
+    if ((c.spectator.look_at - c.spectator.position).norm() < 1e-6)
+      sp->failKey("look_at", "must differ from position");
+    readSize(*sp, c.spectator.width, c.spectator.height);
+    if (sp->has("horizontal_fov")) {
+      c.spectator.horizontal_fov = (*sp)["horizontal_fov"].positive();
+      if (c.spectator.horizontal_fov >= 3.0) sp->failKey("horizontal_fov", "must be < 3 rad");
+    }
+    readRate(*sp, control_period, c.spectator.rate);
+  }
+}
+
+}  // namespace
+
 Scenario loadScenario(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"scenario", "field", "robot_model", "physics", "seed", "placement_noise", "ball",
-                  "robots", "sensors", "bench"});
+                  "robots", "sensors", "cameras", "bench"});
   Scenario s;
   s.source_file = file.string();
   s.name = root["scenario"].string();
@@ -76,6 +154,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
       vec("angle_noise", s.sensors.angle_noise, true);
     }
   }
+  if (auto c = root.optional("cameras")) readCameras(*c, s.physics.control_period, s.cameras);
   if (auto b = root.optional("ball")) {
     b->allowOnly({"position", "velocity"});
     const auto p = (*b)["position"].numbers();

@@ -49,6 +49,51 @@ struct SensorSettings {
   engine::Vec3 angle_noise = engine::Vec3::Zero();  // rad std dev (roll, pitch, yaw)
 };
 
+// One kind of robot camera (all robots' top cameras, or bottom cameras).
+struct CameraSpec {
+  bool enabled = true;
+  int width = 640, height = 480;  // px (width even: YUYV pairs pixels)
+  double rate = 30.0;             // Hz, at most one image per control period
+};
+
+// A fixed camera looking at the match (for video).
+struct SpectatorSpec {
+  bool enabled = false;
+  engine::Vec3 position{0.0, -6.5, 4.0};  // m, field frame
+  engine::Vec3 look_at{0.0, 0.0, 0.0};    // m, field frame
+  int width = 960, height = 540;          // px
+  double horizontal_fov = 1.22;           // rad (70 deg)
+  double rate = 30.0;                     // Hz
+};
+
+// A robot camera's mounting error: a rotation of the camera frame (roll
+// about x, pitch about y, yaw about z, rad) after the model's pose.
+struct CameraCalibration {
+  int team = 0, number = 1;
+  std::string camera = "top";  // top | bottom
+  engine::Vec3 rpy = engine::Vec3::Zero();
+};
+
+// Image effects, all off (0) by default.
+struct CameraEffects {
+  double noise = 0.0;                    // Gaussian noise std dev, 8-bit levels
+  double motion_blur_exposure = 0.0;     // s of exposure blurring the image's motion
+  double rolling_shutter_readout = 0.0;  // s from the first row to the last (V6: rows in turn)
+};
+
+// Off-screen cameras: off unless a scenario turns them on.
+struct CameraSettings {
+  bool enabled = false;
+  CameraSpec top{true, 640, 480, 30.0};
+  CameraSpec bottom{true, 320, 240, 30.0};
+  std::string encoding = "yuyv";  // yuyv | jpeg
+  int jpeg_quality = 85;
+  int queue = 2;  // captures waiting or being rendered before the policy applies
+  CameraEffects effects;
+  std::vector<CameraCalibration> calibration;
+  SpectatorSpec spectator;
+};
+
 struct Scenario {
   std::string name;
   std::string source_file;  // for error messages; empty when built in code
@@ -58,6 +103,7 @@ struct Scenario {
   uint64_t seed = 1;
   PlacementNoise noise;
   SensorSettings sensors;
+  CameraSettings cameras;
   engine::Vec3 ball_position{0.0, 0.0, -1.0};  // z < 0: resting on the ground
   engine::Vec3 ball_velocity = engine::Vec3::Zero();
   std::vector<RobotPlacement> robots;

@@ -1,0 +1,124 @@
+// Every robot's cameras (and the spectator's) rendered off the simulation
+// thread. At each control period the simulation thread calls capture(): if a
+// camera is due, it copies the scene and the due views (a few kB) into a job
+// on a bounded queue; the render thread, which owns the EGL context, draws all
+// views of a job in one batch, applies the image effects, converts each view
+// (YUYV or JPEG; BGR for the spectator) and hands it to the sink.
+//
+// When rendering falls behind (the queue holds `queue` captures):
+//   Wait  - capture() blocks until there is room (lockstep: nothing is lost,
+//           and the images of capture c are delivered before capture
+//           c + queue is taken, whatever the machine's speed);
+//   Drop  - the new capture is dropped and counted (real time).
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "simsoccer/engine/offscreen_renderer.hpp"
+#include "simsoccer/world/scenario.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::world {
+
+enum class CameraId : uint8_t { Top = 0, Bottom = 1, Spectator = 2 };
+enum class ImageEncoding : uint8_t { Yuyv = 0, Jpeg = 1, Bgr = 2 };
+enum class BehindPolicy { Wait, Drop };
+
+// One delivered image.
+struct CameraImage {
+  CameraId camera = CameraId::Top;
+  RobotId robot = 0;        // robot cameras only
+  int team = 0, number = 0;  // robot cameras only
+  uint64_t tick = 0;         // control period of the capture
+  double sim_time = 0.0;     // s
+  engine::RenderView view;   // pose (field frame; x forward, y left, z up) and intrinsics
+  ImageEncoding encoding = ImageEncoding::Yuyv;
+  std::vector<uint8_t> data;  // YUYV (width * height * 2 bytes) or a JPEG file
+  cv::Mat bgr;                // the spectator's image (CV_8UC3), empty otherwise
+};
+
+struct CameraStats {
+  uint64_t captures = 0;   // jobs rendered
+  uint64_t views = 0;      // images delivered
+  uint64_t dropped = 0;    // captures dropped (Drop policy)
+  uint64_t pixels = 0;     // rendered
+  double draw_ms = 0.0;    // summed over jobs: drawing (render thread)
+  double readback_ms = 0.0;
+  double convert_ms = 0.0;  // effects + YUYV/JPEG/BGR conversion
+  double deliver_ms = 0.0;  // in the sink
+  double wait_ms = 0.0;     // the simulation thread blocked in capture() (Wait policy)
+  size_t triangles = 0;     // drawn in the last job, all views together
+  size_t last_views = 0;    // views in the last job
+};
+
+class CameraSystem {
+ public:
+  // Called on the render thread, in capture order, once per image.
+  using Sink = std::function<void(const CameraImage&)>;
+
+  // Starts the render thread and its EGL context; throws engine::RenderError
+  // if the context cannot be made, engine::ConfigError if the settings name a
+  // robot that is not in the world.
+  CameraSystem(const World& world, const CameraSettings& settings, BehindPolicy policy, Sink sink);
+  ~CameraSystem();  // delivers what is queued, then stops the thread
+  CameraSystem(const CameraSystem&) = delete;
+  CameraSystem& operator=(const CameraSystem&) = delete;
+
+  // After a control period: queues the cameras due at the world's current tick.
+  void capture(const World& world);
+  // Blocks until every queued capture has been delivered.
+  void flush();
+  CameraStats stats() const;
+  std::string glRenderer() const { return gl_renderer_; }
+
+  // Whether a camera at `rate` Hz takes an image at control period `tick`
+  // (`rate` images per simulated second, the first at tick 0).
+  static bool due(uint64_t tick, double control_period, double rate);
+
+ private:
+  struct ViewJob {
+    CameraId camera;
+    RobotId robot;
+    int team, number;
+    engine::RenderView view;
+    Vec3 angular_velocity;  // camera frame, rad/s (effects)
+  };
+  struct Job {
+    uint64_t tick = 0;
+    double sim_time = 0.0;
+    std::vector<engine::DrawItem> scene;
+    std::vector<ViewJob> views;
+  };
+
+  void run();
+  void process(engine::OffscreenRenderer& renderer, Job& job);
+  // Applies the effects to an RGBA view in place.
+  void applyEffects(cv::Mat& rgba, const ViewJob& v, uint64_t tick) const;
+
+  CameraSettings settings_;
+  BehindPolicy policy_;
+  Sink sink_;
+  uint64_t seed_;
+  double control_period_;
+  std::vector<engine::Pose> calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Job> queue_;  // waiting and in flight (front is being rendered)
+  bool stopping_ = false;
+  std::string start_error_;
+  bool started_ = false;
+  CameraStats stats_;
+  std::string gl_renderer_;
+  std::thread thread_;
+};
+
+}  // namespace simsoccer::world
