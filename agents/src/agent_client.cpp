@@ -1,5 +1,6 @@
 #include "simsoccer/agents/agent_client.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -20,6 +21,8 @@ struct AgentClient::Impl {
   net::Reader<simsoccer_msg_GameState> game;
   net::Reader<simsoccer_msg_TeamMessage> team_deliver;
   net::Entity waitset, frame_condition;
+  std::unique_ptr<net::Reader<simsoccer_msg_CameraImage>> images;  // after subscribeImages()
+  net::Entity image_waitset, image_condition;
   bool have_game = false;
   simsoccer_msg_GameState game_state{};
 
@@ -172,6 +175,52 @@ std::vector<TeamMessageIn> AgentClient::receiveTeamMessages() {
     out.push_back({m.from_player, m.tick,
                    std::vector<uint8_t>(m.data._buffer, m.data._buffer + m.data._length)});
   });
+  return out;
+}
+
+void AgentClient::subscribeImages() {
+  if (impl_->images) return;
+  // Two instances (top, bottom) per robot; keep a few of each so a slow
+  // reader sees every image of a burst.
+  impl_->images = std::make_unique<net::Reader<simsoccer_msg_CameraImage>>(
+      impl_->participant, simsoccer_msg_CameraImage_desc, "simsoccer_CameraImage",
+      QosSpec{true, 4, false, net::robotPartitionName(team_, player_)});
+  impl_->image_waitset =
+      net::Entity(net::check(dds_create_waitset(impl_->participant.get()), "create waitset"));
+  impl_->image_condition = net::Entity(net::check(
+      dds_create_readcondition(impl_->images->get(), DDS_ANY_STATE), "read condition"));
+  net::check(dds_waitset_attach(impl_->image_waitset.get(), impl_->image_condition.get(), 0),
+             "attach");
+}
+
+std::vector<CameraImageIn> AgentClient::receiveImages(double timeout_seconds) {
+  if (!impl_->images) throw std::logic_error("receiveImages() before subscribeImages()");
+  std::vector<CameraImageIn> out;
+  auto grab = [&] {
+    impl_->images->take([&](const simsoccer_msg_CameraImage& m, const dds_sample_info_t&) {
+      if (m.team != team_ || m.player != player_) return;
+      CameraImageIn in;
+      in.camera = m.camera;
+      in.tick = m.tick;
+      in.sim_time = m.sim_time;
+      in.encoding = m.encoding;
+      in.width = m.width;
+      in.height = m.height;
+      std::copy(std::begin(m.position), std::end(m.position), in.position.begin());
+      std::copy(std::begin(m.orientation), std::end(m.orientation), in.orientation.begin());
+      std::copy(std::begin(m.intrinsics), std::end(m.intrinsics), in.intrinsics.begin());
+      in.data.assign(m.data._buffer, m.data._buffer + m.data._length);
+      out.push_back(std::move(in));
+    });
+  };
+  grab();
+  if (out.empty() && timeout_seconds > 0) {
+    dds_waitset_wait(impl_->image_waitset.get(), nullptr, 0,
+                     static_cast<dds_duration_t>(timeout_seconds * 1e9));
+    grab();
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const CameraImageIn& a, const CameraImageIn& b) { return a.tick < b.tick; });
   return out;
 }
 

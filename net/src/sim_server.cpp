@@ -84,10 +84,37 @@ void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_
   std::memcpy(m.touch, f.touch.data(), sizeof m.touch);
 }
 
+void toMessage(const world::CameraImage& image, simsoccer_msg_CameraImage& m) {
+  m.team = static_cast<uint8_t>(image.team);
+  m.player = static_cast<uint8_t>(image.number);
+  m.camera = static_cast<uint8_t>(image.camera);
+  m.tick = image.tick;
+  m.sim_time = image.sim_time;
+  m.encoding = static_cast<uint8_t>(image.encoding);
+  m.width = static_cast<uint16_t>(image.view.width);
+  m.height = static_cast<uint16_t>(image.view.height);
+  const engine::Vec3 p = image.view.pose.translation();
+  const Eigen::Quaterniond q(image.view.pose.linear());
+  for (int k = 0; k < 3; ++k) m.position[k] = static_cast<float>(p[k]);
+  m.orientation[0] = static_cast<float>(q.x());
+  m.orientation[1] = static_cast<float>(q.y());
+  m.orientation[2] = static_cast<float>(q.z());
+  m.orientation[3] = static_cast<float>(q.w());
+  m.intrinsics[0] = static_cast<float>(image.view.fx);
+  m.intrinsics[1] = static_cast<float>(image.view.fy);
+  m.intrinsics[2] = static_cast<float>(image.view.cx);
+  m.intrinsics[3] = static_cast<float>(image.view.cy);
+  m.data._buffer = const_cast<uint8_t*>(image.data.data());  // not owned, not released
+  m.data._length = static_cast<uint32_t>(image.data.size());
+  m.data._maximum = m.data._length;
+  m.data._release = false;
+}
+
 struct SimServer::Impl {
   Participant participant;
   std::vector<std::unique_ptr<Writer<simsoccer_msg_SensorFrame>>>
       frames;  // one per robot partition
+  std::vector<std::unique_ptr<Writer<simsoccer_msg_CameraImage>>> images;  // per robot, cameras on
   Writer<simsoccer_msg_RobotStatus> status;
   Writer<simsoccer_msg_SimClock> clock;
   Writer<simsoccer_msg_GameState> game;
@@ -167,6 +194,26 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
         QosSpec{true, 1, false, robotPartitionName(info.team, info.number)}));
     publishStatus(r);
   }
+  const world::CameraSettings& cameras = world.scenario().cameras;
+  if (cameras.enabled) {
+    for (world::RobotId r = 0; r < world.robotCount(); ++r)
+      impl_->images.push_back(std::make_unique<Writer<simsoccer_msg_CameraImage>>(
+          impl_->participant, simsoccer_msg_CameraImage_desc, "simsoccer_CameraImage",
+          QosSpec{true, 1, false, robotPartitionName(world.robot(r).team, world.robot(r).number)}));
+    // The sink runs on the render thread; DDS writers are thread-safe.
+    cameras_ = std::make_unique<world::CameraSystem>(
+        world, cameras, config.lockstep ? world::BehindPolicy::Wait : world::BehindPolicy::Drop,
+        [this](const world::CameraImage& image) {
+          if (image.camera == world::CameraId::Spectator) {
+            if (config_.spectator_sink) config_.spectator_sink(image);
+            return;
+          }
+          simsoccer_msg_CameraImage m{};
+          toMessage(image, m);
+          impl_->images[image.robot]->write(m);
+        });
+    cameras_->capture(world_);  // the images of tick 0
+  }
   impl_->game_state.kicking_team = 255;
   impl_->game_state.first_half = 1;
   setGameState(impl_->game_state);
@@ -199,6 +246,11 @@ RobotNetStats SimServer::stats(world::RobotId r) const {
 
 SimServer::~SimServer() {
   dds_set_listener(impl_->commands.get(), nullptr);
+  cameras_.reset();  // delivers what is queued while the writers still exist
+}
+
+void SimServer::flushCameras() {
+  if (cameras_) cameras_->flush();
 }
 
 int SimServer::robotIndex(int team, int player) const {
@@ -487,9 +539,11 @@ void SimServer::runPeriod() {
   }
   world_.stepControlPeriod();
   const auto t3 = Clock::now();
+  if (cameras_) cameras_->capture(world_);  // the state the next frames describe
   times_.publish_s += seconds(t0, t1);
   times_.wait_s += seconds(t1, t2);
   times_.physics_s += seconds(t2, t3);
+  times_.camera_s += seconds(t3, Clock::now());
   ++times_.periods;
   // Status at 1 Hz of simulated time (and at every ownership change).
   if (tick % ticks_per_second_ == 0) {

@@ -244,7 +244,12 @@ void CameraSystem::process(engine::OffscreenRenderer& renderer, Job& job) {
       image.encoding = ImageEncoding::Bgr;
       cv::cvtColor(rgba, image.bgr, cv::COLOR_RGBA2BGR);
     } else {
-      applyEffects(rgba, v, job.tick);
+      // Noise seeded per scenario, capture, robot and camera: the same run, the same noise.
+      const uint64_t key =
+          seed_ * 0x9E3779B97F4A7C15ULL ^ (job.tick * 0xBF58476D1CE4E5B9ULL) ^
+          ((static_cast<uint64_t>(v.robot) << 1 | static_cast<uint64_t>(v.camera)) *
+           0x94D049BB133111EBULL);
+      applyCameraEffects(rgba, settings_.effects, v.view, v.angular_velocity, key);
       if (settings_.encoding == "jpeg") {
         image.encoding = ImageEncoding::Jpeg;
         cv::Mat bgr;
@@ -273,13 +278,12 @@ void CameraSystem::process(engine::OffscreenRenderer& renderer, Job& job) {
   stats_.last_views = job.views.size();
 }
 
-void CameraSystem::applyEffects(cv::Mat& rgba, const ViewJob& v, uint64_t tick) const {
-  const CameraEffects& e = settings_.effects;
-  const engine::RenderView& view = v.view;
+void applyCameraEffects(cv::Mat& rgba, const CameraEffects& e, const engine::RenderView& view,
+                        const Vec3& angular_velocity, uint64_t noise_key) {
   // Image motion from the camera's rotation (camera frame x forward, y left,
   // z up): turning left (+z) moves the scene right, pitching down (+y) moves it up.
-  const double du_dt = view.fx * v.angular_velocity.z();
-  const double dv_dt = -view.fy * v.angular_velocity.y();
+  const double du_dt = view.fx * angular_velocity.z();
+  const double dv_dt = -view.fy * angular_velocity.y();
   if (e.rolling_shutter_readout > 0 && (du_dt != 0 || dv_dt != 0)) {
     // Row r is read (r / height - 1/2) * readout after the middle row, when
     // the scene had moved on by that time times the image velocity.
@@ -313,15 +317,11 @@ void CameraSystem::applyEffects(cv::Mat& rgba, const ViewJob& v, uint64_t tick) 
     }
   }
   if (e.noise > 0) {
-    // Seeded per scenario, capture, robot and camera: the same run gives the same noise.
-    const uint64_t key = seed_ * 0x9E3779B97F4A7C15ULL ^ (tick * 0xBF58476D1CE4E5B9ULL) ^
-                         ((static_cast<uint64_t>(v.robot) << 1 | static_cast<uint64_t>(v.camera)) *
-                          0x94D049BB133111EBULL);
-    cv::RNG rng(key);
-    cv::Mat noise(rgba.size(), CV_16SC4);
+    cv::RNG rng(noise_key);
+    cv::Mat noise(rgba.size(), CV_16SC(rgba.channels()));
     rng.fill(noise, cv::RNG::NORMAL, cv::Scalar::all(0), cv::Scalar(e.noise, e.noise, e.noise, 0));
     cv::Mat out;
-    cv::add(rgba, noise, out, cv::noArray(), CV_8UC4);  // saturating
+    cv::add(rgba, noise, out, cv::noArray(), rgba.type());  // saturating
     rgba = out;
   }
 }

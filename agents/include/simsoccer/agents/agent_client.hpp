@@ -4,6 +4,7 @@
 // simulated clock.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -18,6 +19,19 @@ namespace simsoccer::agents {
 struct TeamMessageIn {
   int from_player = 0;
   uint64_t tick = 0;
+  std::vector<uint8_t> data;
+};
+
+// One camera image of this robot (the CameraImage message, data copied).
+struct CameraImageIn {
+  int camera = 0;    // 0 top, 1 bottom
+  uint64_t tick = 0;  // its SensorFrame's tick
+  double sim_time = 0.0;
+  int encoding = 0;  // 0 YUYV 4:2:2, 1 JPEG
+  int width = 0, height = 0;
+  std::array<float, 3> position{};     // camera in the field frame, m
+  std::array<float, 4> orientation{};  // quaternion x y z w
+  std::array<float, 4> intrinsics{};   // fx fy cx cy, px
   std::vector<uint8_t> data;
 };
 
@@ -56,6 +70,13 @@ class AgentClient {
   // this robot's teammates.
   void sendTeamMessage(std::span<const uint8_t> data);
   std::vector<TeamMessageIn> receiveTeamMessages();
+
+  // Subscribes to this robot's camera images (the scenario must turn cameras
+  // on; nothing is sent to an agent that does not subscribe).
+  void subscribeImages();
+  // The images that arrived since the last call, oldest first; waits up to
+  // `timeout_seconds` for the first one if none is there.
+  std::vector<CameraImageIn> receiveImages(double timeout_seconds = 0.0);
 
  private:
   struct Impl;

@@ -12,10 +12,12 @@
 //   simsoccer_GameState     sim -> agents
 //   simsoccer_TeamMessageSend / simsoccer_TeamMessageDeliver
 //   simsoccer_WorldTruth    sim -> monitors (optional)
+//   simsoccer_CameraImage   sim -> agent, partition robot_<team>_<player> (cameras on)
 #pragma once
 
 #include <array>
 #include <condition_variable>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -23,6 +25,7 @@
 
 #include "simsoccer/net/dds.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
+#include "simsoccer/world/camera_system.hpp"
 #include "simsoccer/world/world.hpp"
 #include "simsoccer_msgs.h"
 
@@ -37,6 +40,10 @@ struct ServerConfig {
   double team_message_loss = 0.0;   // probability a copy is lost
   bool world_truth = false;
   double position_margin = 0.5;  // rad beyond a joint's limits before a target is rejected
+  // Cameras: on when the scenario's `cameras.enabled` says so. Lockstep waits
+  // for rendering when it falls behind; real time drops captures (counted).
+  // Spectator images go to this callback (on the render thread), not to DDS.
+  std::function<void(const world::CameraImage&)> spectator_sink;
 };
 
 struct RobotNetStats {
@@ -48,6 +55,7 @@ struct ServerTimes {
   double publish_s = 0.0;  // building and writing frames, clock, status
   double wait_s = 0.0;     // waiting for and taking commands (lockstep)
   double physics_s = 0.0;  // World steps (physics and sensors)
+  double camera_s = 0.0;   // capturing the scene for the render thread (and waiting for it)
   uint64_t periods = 0;
 };
 
@@ -72,6 +80,10 @@ class SimServer {
   size_t ownedCount() const;
   RobotNetStats stats(world::RobotId r) const;
   const ServerTimes& times() const { return times_; }
+  // Null when the scenario has no cameras.
+  const world::CameraSystem* cameras() const { return cameras_.get(); }
+  // Delivers every image captured so far (the end of a run).
+  void flushCameras();
   // The GameState published at every change and every 0.5 s (2 Hz).
   void setGameState(const simsoccer_msg_GameState& state);
 
@@ -111,10 +123,14 @@ class SimServer {
   std::unique_ptr<Impl> impl_;
   std::vector<RobotSlot> robots_;
   ServerTimes times_;
+  std::unique_ptr<world::CameraSystem> cameras_;  // declared last: stopped first
 };
 
 // The referee's GameController packet as the DDS GameState message.
 void toMessage(const referee::ControlData& d, uint64_t tick, simsoccer_msg_GameState& m);
+
+// A camera image as the wire message (`m.data` points into `image.data`).
+void toMessage(const world::CameraImage& image, simsoccer_msg_CameraImage& m);
 
 // Copies a world sensor frame into the wire message.
 void toMessage(const world::SensorFrame& f, int team, int player, simsoccer_msg_SensorFrame& m);

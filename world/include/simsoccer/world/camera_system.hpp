@@ -59,6 +59,14 @@ struct CameraStats {
   size_t last_views = 0;    // views in the last job
 };
 
+// The optional image effects on one 8-bit RGB(A) view, in place: rolling
+// shutter (rows read in turn over the readout time while the camera turns at
+// `angular_velocity`, camera frame x forward, y left, z up, rad/s), motion blur
+// along the image motion during the exposure, and Gaussian noise drawn from
+// `noise_key` (the same key gives the same noise).
+void applyCameraEffects(cv::Mat& image, const CameraEffects& effects, const engine::RenderView& view,
+                        const Vec3& angular_velocity, uint64_t noise_key);
+
 class CameraSystem {
  public:
   // Called on the render thread, in capture order, once per image.
@@ -100,8 +108,6 @@ class CameraSystem {
 
   void run();
   void process(engine::OffscreenRenderer& renderer, Job& job);
-  // Applies the effects to an RGBA view in place.
-  void applyEffects(cv::Mat& rgba, const ViewJob& v, uint64_t tick) const;
 
   CameraSettings settings_;
   BehindPolicy policy_;
