@@ -391,3 +391,61 @@ TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
   EXPECT_EQ(packets.back().kicking_team, 13);
   EXPECT_EQ(dds_state, 3);  // the agent saw Playing on the GameState topic
 }
+
+TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
+  const uint32_t domain = 113;
+  world::Scenario s = teams(1);
+  s.cameras.enabled = true;  // as a scenario's `cameras:` block turns them on
+  s.cameras.top = {true, 64, 48, 30.0};
+  s.cameras.bottom = {true, 32, 24, 10.0};
+  world::World w(s);
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess owner(domain, 0, 1);  // drives the robot in lockstep
+  agents::AgentClient viewer(dds(domain), 0, 1);  // any participant may watch a robot's cameras
+  viewer.subscribeImages();
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  server.poll(0.5);  // the viewer's reader matches the image writer
+  const uint64_t first = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+  const int periods = 100;
+  size_t got[2] = {0, 0};
+  std::vector<agents::CameraImageIn> images;
+  auto take = [&](double timeout) {
+    for (auto& image : viewer.receiveImages(timeout)) {
+      if (image.tick <= first) continue;  // published before the measured interval
+      ++got[image.camera];
+      images.push_back(std::move(image));
+    }
+  };
+  for (int i = 0; i < periods; ++i) {
+    server.runPeriod();
+    take(0.0);  // as an agent would, every period (the reader keeps the last 4 per camera)
+  }
+  server.flushCameras();
+  const uint64_t last = first + periods;  // the capture after the last step
+  size_t expected[2] = {0, 0};
+  for (uint64_t t = first + 1; t <= last; ++t) {
+    expected[0] += world::CameraSystem::due(t, 0.01, 30.0);
+    expected[1] += world::CameraSystem::due(t, 0.01, 10.0);
+  }
+  const auto start = Clock::now();
+  while ((got[0] < expected[0] || got[1] < expected[1]) && seconds(start) < 10.0) take(0.2);
+  std::printf("top %zu of %zu, bottom %zu of %zu images over %d periods\n", got[0], expected[0],
+              got[1], expected[1], periods);
+  EXPECT_EQ(got[0], expected[0]);
+  EXPECT_EQ(got[1], expected[1]);
+  for (const auto& image : images) {
+    const int w_px = image.camera == 0 ? 64 : 32, h_px = image.camera == 0 ? 48 : 24;
+    EXPECT_EQ(image.encoding, 0);  // YUYV
+    EXPECT_EQ(image.width, w_px);
+    EXPECT_EQ(image.height, h_px);
+    EXPECT_EQ(image.data.size(), static_cast<size_t>(w_px * h_px * 2));
+    EXPECT_TRUE(world::CameraSystem::due(image.tick, 0.01, image.camera == 0 ? 30.0 : 10.0));
+    EXPECT_NEAR(image.sim_time, 0.01 * static_cast<double>(image.tick), 1e-9);
+    // The camera sits on the head, about 0.5 m above the carpet, pose a unit quaternion.
+    EXPECT_NEAR(image.position[2], 0.5, 0.1);
+    const auto& q = image.orientation;
+    EXPECT_NEAR(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3], 1.0, 1e-5);
+    EXPECT_NEAR(image.intrinsics[2], 0.5 * w_px, 1e-4);
+  }
+  EXPECT_EQ(server.cameras()->stats().dropped, 0u);  // lockstep waits, never drops
+}
