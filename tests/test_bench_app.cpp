@@ -92,3 +92,33 @@ TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
   EXPECT_EQ(row2.rfind("2,", 0), 0u) << row2;
   std::filesystem::remove(csv);
 }
+
+TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
+  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_cameras_test.csv";
+  std::filesystem::remove(csv);
+  int status = -1;
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench cameras --robots 1,2 --seconds 0.5 --csv " +
+                     csv.string() + " 2>&1",
+                 status);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("llvmpipe"), std::string::npos) << "the renderer is named";
+  std::ifstream f(csv);
+  std::string header, row1, row2;
+  std::getline(f, header);
+  std::getline(f, row1);
+  std::getline(f, row2);
+  EXPECT_EQ(header,
+            "robots,views,views_per_s,ms_per_frame,ms_readback,ms_convert,rtf_cameras,"
+            "rtf_physics_only,triangles_per_view,mbytes_per_sim_s,dropped");
+  // 0.5 s at 30 Hz: 15 captures of 2 views per robot.
+  EXPECT_EQ(row1.rfind("1,30,", 0), 0u) << row1;
+  EXPECT_EQ(row2.rfind("2,60,", 0), 0u) << row2;
+  EXPECT_EQ(row2.substr(row2.rfind(',')), ",0");  // lockstep policy: nothing dropped
+  std::filesystem::remove(csv);
+  EXPECT_NE(runCommand(std::string(SIMSOCCER_BIN) + " bench cameras --encoding png 2>&1", status)
+                .find("--encoding"),
+            std::string::npos);
+  EXPECT_NE(status, 0);
+}
