@@ -310,6 +310,12 @@ TEST(CameraSystem, ScenarioCamerasBlockIsReadAndChecked) {
                         << cameras;
     return file;
   };
+  // The shipped example: every key, cameras on.
+  const world::Scenario example =
+      world::loadScenario(test::sourceDir() / "configs" / "scenarios" / "cameras_2v2.yaml");
+  EXPECT_TRUE(example.cameras.enabled);
+  EXPECT_EQ(example.cameras.calibration.size(), 1u);
+  EXPECT_TRUE(example.cameras.spectator.enabled);
   const world::Scenario off = world::loadScenario(write(""));
   EXPECT_FALSE(off.cameras.enabled);  // off unless a scenario turns them on
   const world::Scenario on = world::loadScenario(

@@ -19,6 +19,7 @@ const char* kUsage =
     "  bench physics   physics scaling benchmark (steps/s against robot count)\n"
     "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
     "  bench net       lockstep with real agent processes over DDS: overhead and bytes per tick\n"
+    "  bench cameras   every robot's two cameras rendered through EGL: views/s, ms per frame, RTF\n"
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
@@ -42,7 +43,7 @@ int main(int argc, char** argv) {
       if (sub == "net") return benchNet(argc, argv, 3);
       if (sub == "cameras") return benchCameras(argc, argv, 3);
       std::fprintf(stderr,
-                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net)\n",
+                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras)\n",
                    sub.c_str());
       return 2;
     }

@@ -1,5 +1,6 @@
 // simsoccer serve: a scenario as a DDS simulator, for agents started
 // elsewhere (on this machine or others).
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -127,9 +128,19 @@ int serve(int argc, char** argv, int first) {
     server.runPeriod();
     refereePeriod();
   }
+  server.flushCameras();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), wall,
               w.time() / wall);
+  if (const world::CameraSystem* cams = server.cameras()) {
+    const world::CameraStats c = cams->stats();
+    std::printf(
+        "cameras (%s): %llu images in %llu batched frames, %.1f ms draw + %.1f ms readback + "
+        "%.1f ms conversion per frame, %llu captures dropped\n",
+        cams->glRenderer().c_str(), (unsigned long long)c.views, (unsigned long long)c.captures,
+        c.draw_ms / std::max<double>(1, c.captures), c.readback_ms / std::max<double>(1, c.captures),
+        c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
+  }
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
     const auto& s = server.stats(r);
     std::printf(
