@@ -246,3 +246,55 @@ TEST(Camera, WritesTopCameraAndSpectatorPngs) {
   EXPECT_TRUE(isGreen(images[1].at<cv::Vec3b>(400, 700)));
   EXPECT_FALSE(isGreen(images[1].at<cv::Vec3b>(20, 480)));
 }
+
+TEST(Camera, CentreLineSeenFromTheRobotWherePredicted) {
+  // The robot at (-2, 1.5) faces +x: the centre line (x = 0, 50 mm wide) is 2 m ahead.
+  world::World w(oneRobot());
+  const engine::RenderView view = world::robotCameraView(w, 0, "CameraTop", 640, 480);
+  const cv::Mat img = renderOne(w, view, false);
+  // Along the image column of y = 1.5 (straight ahead), the white rows should
+  // span the projections of the line's near and far edges (x = -0.025, +0.025).
+  double u_near = 0, v_near = 0, u_far = 0, v_far = 0;
+  ASSERT_TRUE(engine::projectPoint(view, Vec3(-0.025, 1.5, 0.0), u_near, v_near));
+  ASSERT_TRUE(engine::projectPoint(view, Vec3(0.025, 1.5, 0.0), u_far, v_far));
+  const int column = static_cast<int>(u_near);
+  int first = -1, last = -1;
+  for (int row = 0; row < img.rows; ++row) {
+    const cv::Vec3b p = img.at<cv::Vec3b>(row, column);
+    if (p[0] > 200 && p[1] > 200 && p[2] > 200) {
+      if (first < 0) first = row;
+      last = row;
+    }
+  }
+  std::printf("centre line 2 m ahead: predicted rows %.1f..%.1f, white rows %d..%d\n", v_far,
+              v_near, first, last);
+  ASSERT_GE(first, 0) << "no white line in column " << column;
+  EXPECT_NEAR(first, v_far, 1.5);
+  EXPECT_NEAR(last + 1, v_near, 1.5);
+}
+
+TEST(Camera, BottomCameraLooksDownAtTheFeet) {
+  world::World w(oneRobot());
+  const int head_pitch = w.robot(0).model->body->jointIndex("HeadPitch");
+  w.setJointTarget(0, head_pitch, 0.5, 1.0);  // head down, as when dribbling
+  for (int i = 0; i < 100; ++i) w.stepControlPeriod();
+  const engine::RenderView view = world::robotCameraView(w, 0, "CameraBottom", 320, 240);
+  const cv::Mat img = renderOne(w, view);
+  for (const char* foot : {"LFoot", "RFoot"}) {
+    const int link = w.robot(0).model->body->linkIndex(foot);
+    // The toe cap: 9 cm ahead of the ankle, 3 cm above the sole.
+    const Vec3 toe = w.linkPose(0, link) * Vec3(0.09, 0.0, -0.015);
+    double u = 0, v = 0;
+    ASSERT_TRUE(engine::projectPoint(view, toe, u, v));
+    std::printf("%s toe at (%.1f, %.1f) in the bottom image\n", foot, u, v);
+    ASSERT_GE(u, 0);
+    ASSERT_LT(u, 320);
+    ASSERT_GE(v, 0);
+    ASSERT_LT(v, 240);
+    const cv::Vec3b p = img.at<cv::Vec3b>(static_cast<int>(v), static_cast<int>(u));
+    EXPECT_FALSE(isGreen(p)) << foot << " " << p;  // the robot's own body, not carpet
+  }
+  cv::Mat bgr;
+  cv::cvtColor(img, bgr, cv::COLOR_RGB2BGR);
+  cv::imwrite((std::filesystem::current_path() / "camera_bottom_feet.png").string(), bgr);
+}

@@ -98,8 +98,7 @@ TEST(CameraSystem, DeliversEveryDueViewWithItsTickAndPose) {
     ASSERT_NE(it, expected.end()) << "unexpected image at tick " << image.tick;
     EXPECT_TRUE(image.view.pose.isApprox(it->second, 1e-12));
     EXPECT_EQ(image.encoding, world::ImageEncoding::Yuyv);
-    EXPECT_EQ(image.data.size(),
-              static_cast<size_t>(image.view.width * image.view.height * 2));
+    EXPECT_EQ(image.data.size(), static_cast<size_t>(image.view.width * image.view.height * 2));
     EXPECT_EQ(image.team, w.robot(image.robot).team);
     EXPECT_EQ(image.number, w.robot(image.robot).number);
     EXPECT_NEAR(image.sim_time, 0.01 * static_cast<double>(image.tick), 1e-9);
@@ -164,9 +163,8 @@ TEST(CameraSystem, SameStateAndSeedSameBytesNoiseIncluded) {
 
 TEST(CameraSystem, EffectsMoveBlurAndNoiseAsConfigured) {
   // A white vertical bar 4 px wide on grey, seen by a 640x480 camera.
-  const engine::RenderView view =
-      engine::pinholeView(engine::Pose::Identity(), 640, 480, world::kNaoHorizontalFov,
-                          world::kNaoVerticalFov);
+  const engine::RenderView view = engine::pinholeView(
+      engine::Pose::Identity(), 640, 480, world::kNaoHorizontalFov, world::kNaoVerticalFov);
   cv::Mat clean(480, 640, CV_8UC4, cv::Scalar(100, 100, 100, 255));
   clean.colRange(318, 322).setTo(cv::Scalar(250, 250, 250, 255));
   auto barCentre = [](const cv::Mat& img, int row) {

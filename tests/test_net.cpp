@@ -400,7 +400,7 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
   s.cameras.bottom = {true, 32, 24, 10.0};
   world::World w(s);
   net::SimServer server(w, serverConfig(domain, 2.0));
-  AgentProcess owner(domain, 0, 1);  // drives the robot in lockstep
+  AgentProcess owner(domain, 0, 1);               // drives the robot in lockstep
   agents::AgentClient viewer(dds(domain), 0, 1);  // any participant may watch a robot's cameras
   viewer.subscribeImages();
   ASSERT_TRUE(server.waitForOwners(1, 20.0));

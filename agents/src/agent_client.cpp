@@ -187,8 +187,8 @@ void AgentClient::subscribeImages() {
       QosSpec{true, 4, false, net::robotPartitionName(team_, player_)});
   impl_->image_waitset =
       net::Entity(net::check(dds_create_waitset(impl_->participant.get()), "create waitset"));
-  impl_->image_condition = net::Entity(net::check(
-      dds_create_readcondition(impl_->images->get(), DDS_ANY_STATE), "read condition"));
+  impl_->image_condition = net::Entity(
+      net::check(dds_create_readcondition(impl_->images->get(), DDS_ANY_STATE), "read condition"));
   net::check(dds_waitset_attach(impl_->image_waitset.get(), impl_->image_condition.get(), 0),
              "attach");
 }

@@ -76,9 +76,10 @@ int benchCameras(int argc, char** argv, int first) {
   std::fflush(stdout);
 
   Table table;
-  table.header = {"robots",       "views",        "views_per_s",   "ms_per_frame",
-                  "ms_readback",  "ms_convert",   "rtf_cameras",   "rtf_physics_only",
-                  "triangles_per_view", "mbytes_per_sim_s", "dropped"};
+  table.header = {
+      "robots",     "views",       "views_per_s",      "ms_per_frame",       "ms_readback",
+      "ms_convert", "rtf_cameras", "rtf_physics_only", "triangles_per_view", "mbytes_per_sim_s",
+      "dropped"};
   std::string gl_renderer;
   for (const int n : counts) {
     const world::Scenario scenario = placeRobots(cfg, n, field.halfLength(), field.halfWidth());
@@ -107,8 +108,9 @@ int benchCameras(int argc, char** argv, int first) {
       w.stepControlPeriod();
     }
     uint64_t bytes = 0;  // touched on the render thread only, read after flush()
-    world::CameraSystem system(w, cameras, world::BehindPolicy::Wait,
-                               [&](const world::CameraImage& image) { bytes += image.data.size(); });
+    world::CameraSystem system(
+        w, cameras, world::BehindPolicy::Wait,
+        [&](const world::CameraImage& image) { bytes += image.data.size(); });
     gl_renderer = system.glRenderer();
     const auto t0 = Clock::now();
     for (long i = 0; i < periods; ++i) {
@@ -121,10 +123,9 @@ int benchCameras(int argc, char** argv, int first) {
     const world::CameraStats st = system.stats();
     const double frames = static_cast<double>(std::max<uint64_t>(st.captures, 1));
     table.rows.push_back(
-        {std::to_string(n), std::to_string(st.views),
-         fmt(static_cast<double>(st.views) / wall, 1), fmt(st.draw_ms / frames, 1),
-         fmt(st.readback_ms / frames, 1), fmt(st.convert_ms / frames, 1), fmt(seconds / wall, 2),
-         fmt(rtf_physics, 2),
+        {std::to_string(n), std::to_string(st.views), fmt(static_cast<double>(st.views) / wall, 1),
+         fmt(st.draw_ms / frames, 1), fmt(st.readback_ms / frames, 1),
+         fmt(st.convert_ms / frames, 1), fmt(seconds / wall, 2), fmt(rtf_physics, 2),
          std::to_string(st.last_views ? st.triangles / st.last_views : 0),
          fmt(static_cast<double>(bytes) / seconds / 1e6, 1), std::to_string(st.dropped)});
     std::fprintf(stderr, "  %d robots done\n", n);

@@ -42,9 +42,10 @@ int main(int argc, char** argv) {
       if (sub == "sensors") return benchSensors(argc, argv, 3);
       if (sub == "net") return benchNet(argc, argv, 3);
       if (sub == "cameras") return benchCameras(argc, argv, 3);
-      std::fprintf(stderr,
-                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras)\n",
-                   sub.c_str());
+      std::fprintf(
+          stderr,
+          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras)\n",
+          sub.c_str());
       return 2;
     }
     std::fprintf(stderr, "simsoccer: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);

@@ -138,7 +138,8 @@ int serve(int argc, char** argv, int first) {
         "cameras (%s): %llu images in %llu batched frames, %.1f ms draw + %.1f ms readback + "
         "%.1f ms conversion per frame, %llu captures dropped\n",
         cams->glRenderer().c_str(), (unsigned long long)c.views, (unsigned long long)c.captures,
-        c.draw_ms / std::max<double>(1, c.captures), c.readback_ms / std::max<double>(1, c.captures),
+        c.draw_ms / std::max<double>(1, c.captures),
+        c.readback_ms / std::max<double>(1, c.captures),
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {

@@ -79,17 +79,20 @@ struct Instance {
 // fragment program). Drawn in this order: robots' parts (usually nearest the
 // camera) first, the ground last, so hidden ground pixels fail the early depth test.
 constexpr std::array<Primitive, 5> kBatchMesh{Primitive::CoarseSphere, Primitive::Cylinder,
-                                              Primitive::Sphere, Primitive::Sphere,
-                                              Primitive::Box};
+                                              Primitive::Sphere, Primitive::Sphere, Primitive::Box};
 constexpr size_t kPatternBatch = 3;
 
 size_t batchOf(const DrawItem& d) {
   if (d.ball_pattern) return kPatternBatch;
   switch (d.shape) {
-    case Primitive::CoarseSphere: return 0;
-    case Primitive::Cylinder: return 1;
-    case Primitive::Sphere: return 2;
-    case Primitive::Box: return 4;
+    case Primitive::CoarseSphere:
+      return 0;
+    case Primitive::Cylinder:
+      return 1;
+    case Primitive::Sphere:
+      return 2;
+    case Primitive::Box:
+      return 4;
   }
   return 4;
 }
@@ -98,9 +101,12 @@ size_t batchOf(const DrawItem& d) {
 // cylinder's rim at sqrt(1 + 0.25)).
 float unitRadius(Primitive p) {
   switch (p) {
-    case Primitive::Box: return 0.8661f;
-    case Primitive::Cylinder: return 1.1181f;
-    default: return 1.0f;
+    case Primitive::Box:
+      return 0.8661f;
+    case Primitive::Cylinder:
+      return 1.1181f;
+    default:
+      return 1.0f;
   }
 }
 
@@ -190,19 +196,19 @@ GLuint compile(GLenum type, const char* source) {
 struct OffscreenRenderer::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
-  std::array<GLuint, 2> programs{};          // plain, ball pattern
+  std::array<GLuint, 2> programs{};  // plain, ball pattern
   std::array<GLint, 2> view_projection{-1, -1};
-  std::array<Mesh, 4> meshes;                 // by Primitive
-  GLuint instances = 0;                       // every view's instances, one buffer
+  std::array<Mesh, 4> meshes;  // by Primitive
+  GLuint instances = 0;        // every view's instances, one buffer
   GLuint fbo = 0, colour = 0, depth = 0;
   int fbo_width = 0, fbo_height = 0;
-  std::vector<Instance> all;                  // the scene's instances
-  std::vector<std::array<float, 4>> bounds;   // their bounding spheres (x, y, z, r)
+  std::vector<Instance> all;                 // the scene's instances
+  std::vector<std::array<float, 4>> bounds;  // their bounding spheres (x, y, z, r)
   std::vector<size_t> batch_of;
-  std::vector<Instance> uploaded;             // per view, per batch, the visible instances
+  std::vector<Instance> uploaded;  // per view, per batch, the visible instances
   std::vector<std::array<std::array<size_t, 2>, kBatchMesh.size()>> ranges;  // [view][batch]
-  cv::Mat atlas;                              // RGBA, every view top row first
-  std::vector<cv::Rect> rects;                // each view's place in the atlas
+  cv::Mat atlas;                // RGBA, every view top row first
+  std::vector<cv::Rect> rects;  // each view's place in the atlas
 
   // Aims a mesh's per-instance attributes at instances [first, ...) of the buffer.
   void pointInstances(size_t first) const {
@@ -397,8 +403,8 @@ struct Frustum {
     // Camera frame: x forward, y left, z up. Edges of the image in camera rays.
     const double left = v.cx / v.fx, right = (v.width - v.cx) / v.fx;
     const double top = v.cy / v.fy, bottom = (v.height - v.cy) / v.fy;
-    const std::array<Vec3, 5> normals{
-        Vec3(left, -1, 0), Vec3(right, 1, 0), Vec3(top, 0, -1), Vec3(bottom, 0, 1), Vec3(-1, 0, 0)};
+    const std::array<Vec3, 5> normals{Vec3(left, -1, 0), Vec3(right, 1, 0), Vec3(top, 0, -1),
+                                      Vec3(bottom, 0, 1), Vec3(-1, 0, 0)};
     for (size_t i = 0; i < normals.size(); ++i) {
       const Vec3 n = R * normals[i].normalized();
       const double d = i < 4 ? -n.dot(o) : -n.dot(o + R * Vec3(v.far_clip, 0, 0));
@@ -453,8 +459,8 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
     m.all.push_back(in);
     const Eigen::Matrix3f l = d.transform.block<3, 3>(0, 0);
     const float scale = std::max({l.col(0).norm(), l.col(1).norm(), l.col(2).norm()});
-    m.bounds.push_back({d.transform(0, 3), d.transform(1, 3), d.transform(2, 3),
-                        scale * unitRadius(d.shape)});
+    m.bounds.push_back(
+        {d.transform(0, 3), d.transform(1, 3), d.transform(2, 3), scale * unitRadius(d.shape)});
     m.batch_of.push_back(batchOf(d));
   }
   m.uploaded.clear();
@@ -467,8 +473,9 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
       for (size_t k = 0; k < m.all.size(); ++k)
         if (m.batch_of[k] == b && frustum.sees(m.bounds[k])) m.uploaded.push_back(m.all[k]);
       m.ranges[i][b][1] = m.uploaded.size() - m.ranges[i][b][0];
-      triangles += m.ranges[i][b][1] *
-                   static_cast<size_t>(m.meshes[static_cast<size_t>(kBatchMesh[b])].index_count / 3);
+      triangles +=
+          m.ranges[i][b][1] *
+          static_cast<size_t>(m.meshes[static_cast<size_t>(kBatchMesh[b])].index_count / 3);
     }
   }
   glBindBuffer(GL_ARRAY_BUFFER, m.instances);
@@ -513,7 +520,9 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
   timing_.triangles_per_view = views.empty() ? 0 : triangles / views.size();
 }
 
-cv::Mat OffscreenRenderer::image(size_t view) const { return impl_->atlas(impl_->rects.at(view)); }
+cv::Mat OffscreenRenderer::image(size_t view) const {
+  return impl_->atlas(impl_->rects.at(view));
+}
 
 void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const RenderView> views,
                                std::vector<cv::Mat>& images) {

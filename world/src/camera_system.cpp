@@ -88,9 +88,9 @@ CameraSystem::CameraSystem(const World& world, const CameraSettings& settings, B
     for (const char* frame : kCameraFrames) {
       const robots::SensorFrame* s = world.robot(r).model->sensor(frame);
       if (!s || s->type != "camera")
-        throw engine::ConfigError(world.scenario().source_file, "cameras",
-                                  "robot model " + world.robot(r).model->name + " has no " +
-                                      frame + " camera");
+        throw engine::ConfigError(
+            world.scenario().source_file, "cameras",
+            "robot model " + world.robot(r).model->name + " has no " + frame + " camera");
     }
   thread_ = std::thread([this] { run(); });
   std::unique_lock lock(mutex_);

@@ -24,7 +24,7 @@ struct TeamMessageIn {
 
 // One camera image of this robot (the CameraImage message, data copied).
 struct CameraImageIn {
-  int camera = 0;    // 0 top, 1 bottom
+  int camera = 0;     // 0 top, 1 bottom
   uint64_t tick = 0;  // its SensorFrame's tick
   double sim_time = 0.0;
   int encoding = 0;  // 0 YUYV 4:2:2, 1 JPEG

@@ -64,7 +64,6 @@ class RayScene {
   // hits[i] = the nearest hit of rays[i] within its max distance.
   void trace(std::span<const Ray> rays, std::span<RayHit> hits) const;
 
-
  private:
   // One primitive type as columns of floats (structure of arrays), with the
   // object each primitive belongs to and its group key (owner * 256 + cluster).

@@ -35,7 +35,7 @@ enum class BehindPolicy { Wait, Drop };
 // One delivered image.
 struct CameraImage {
   CameraId camera = CameraId::Top;
-  RobotId robot = 0;        // robot cameras only
+  RobotId robot = 0;         // robot cameras only
   int team = 0, number = 0;  // robot cameras only
   uint64_t tick = 0;         // control period of the capture
   double sim_time = 0.0;     // s
@@ -46,11 +46,11 @@ struct CameraImage {
 };
 
 struct CameraStats {
-  uint64_t captures = 0;   // jobs rendered
-  uint64_t views = 0;      // images delivered
-  uint64_t dropped = 0;    // captures dropped (Drop policy)
-  uint64_t pixels = 0;     // rendered
-  double draw_ms = 0.0;    // summed over jobs: drawing (render thread)
+  uint64_t captures = 0;  // jobs rendered
+  uint64_t views = 0;     // images delivered
+  uint64_t dropped = 0;   // captures dropped (Drop policy)
+  uint64_t pixels = 0;    // rendered
+  double draw_ms = 0.0;   // summed over jobs: drawing (render thread)
   double readback_ms = 0.0;
   double convert_ms = 0.0;  // effects + YUYV/JPEG/BGR conversion
   double deliver_ms = 0.0;  // in the sink
@@ -64,8 +64,9 @@ struct CameraStats {
 // `angular_velocity`, camera frame x forward, y left, z up, rad/s), motion blur
 // along the image motion during the exposure, and Gaussian noise drawn from
 // `noise_key` (the same key gives the same noise).
-void applyCameraEffects(cv::Mat& image, const CameraEffects& effects, const engine::RenderView& view,
-                        const Vec3& angular_velocity, uint64_t noise_key);
+void applyCameraEffects(cv::Mat& image, const CameraEffects& effects,
+                        const engine::RenderView& view, const Vec3& angular_velocity,
+                        uint64_t noise_key);
 
 class CameraSystem {
  public:
@@ -114,7 +115,8 @@ class CameraSystem {
   Sink sink_;
   uint64_t seed_;
   double control_period_;
-  std::vector<engine::Pose> calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
+  std::vector<engine::Pose>
+      calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;
