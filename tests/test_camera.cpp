@@ -258,8 +258,10 @@ TEST(Camera, CentreLineSeenFromTheRobotWherePredicted) {
   ASSERT_TRUE(engine::projectPoint(view, Vec3(-0.025, 1.5, 0.0), u_near, v_near));
   ASSERT_TRUE(engine::projectPoint(view, Vec3(0.025, 1.5, 0.0), u_far, v_far));
   const int column = static_cast<int>(u_near);
+  // (Within 20 rows of the prediction: farther up the column are the lines
+  // of the far half.)
   int first = -1, last = -1;
-  for (int row = 0; row < img.rows; ++row) {
+  for (int row = static_cast<int>(v_far) - 20; row < static_cast<int>(v_near) + 20; ++row) {
     const cv::Vec3b p = img.at<cv::Vec3b>(row, column);
     if (p[0] > 200 && p[1] > 200 && p[2] > 200) {
       if (first < 0) first = row;
@@ -269,6 +271,8 @@ TEST(Camera, CentreLineSeenFromTheRobotWherePredicted) {
   std::printf("centre line 2 m ahead: predicted rows %.1f..%.1f, white rows %d..%d\n", v_far,
               v_near, first, last);
   ASSERT_GE(first, 0) << "no white line in column " << column;
+  for (int row = first; row <= last; ++row)  // one unbroken band
+    EXPECT_TRUE(img.at<cv::Vec3b>(row, column)[1] > 200) << "row " << row;
   EXPECT_NEAR(first, v_far, 1.5);
   EXPECT_NEAR(last + 1, v_near, 1.5);
 }

@@ -78,9 +78,12 @@ struct Instance {
 // Draw batches: one per unit mesh, the ball's patterned sphere apart (its own
 // fragment program). Drawn in this order: robots' parts (usually nearest the
 // camera) first, the ground last, so hidden ground pixels fail the early depth test.
-constexpr std::array<Primitive, 5> kBatchMesh{Primitive::CoarseSphere, Primitive::Cylinder,
-                                              Primitive::Sphere, Primitive::Sphere, Primitive::Box};
+constexpr std::array<Primitive, 6> kBatchMesh{Primitive::CoarseSphere, Primitive::Cylinder,
+                                              Primitive::Sphere,       Primitive::Sphere,
+                                              Primitive::Box,          Primitive::Quad};
 constexpr size_t kPatternBatch = 3;
+
+constexpr float kIcosahedronScale = 2.0f / (1.0f + 0.7946545f);
 
 size_t batchOf(const DrawItem& d) {
   if (d.ball_pattern) return kPatternBatch;
@@ -93,6 +96,8 @@ size_t batchOf(const DrawItem& d) {
       return 2;
     case Primitive::Box:
       return 4;
+    case Primitive::Quad:
+      return 5;
   }
   return 4;
 }
@@ -105,6 +110,10 @@ float unitRadius(Primitive p) {
       return 0.8661f;
     case Primitive::Cylinder:
       return 1.1181f;
+    case Primitive::Quad:
+      return 0.7072f;
+    case Primitive::CoarseSphere:
+      return kIcosahedronScale;
     default:
       return 1.0f;
   }
@@ -125,6 +134,45 @@ void unitBox(std::vector<Vertex>& v, std::vector<uint32_t>& idx) {
       }
       idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     }
+}
+
+// An icosahedron standing in for the unit sphere, one normal per face (flat shading).
+void unitIcosahedron(std::vector<Vertex>& v, std::vector<uint32_t>& idx) {
+  const float g = 1.618034f;
+  std::array<Eigen::Vector3f, 12> p{
+      Eigen::Vector3f(-1, g, 0), Eigen::Vector3f(1, g, 0),   Eigen::Vector3f(-1, -g, 0),
+      Eigen::Vector3f(1, -g, 0), Eigen::Vector3f(0, -1, g),  Eigen::Vector3f(0, 1, g),
+      Eigen::Vector3f(0, -1, -g), Eigen::Vector3f(0, 1, -g), Eigen::Vector3f(g, 0, -1),
+      Eigen::Vector3f(g, 0, 1),  Eigen::Vector3f(-g, 0, -1), Eigen::Vector3f(-g, 0, 1)};
+  for (auto& x : p) x.normalize();
+  const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                            {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                            {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                            {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  // Scaled so that the unit sphere lies midway between the faces' centres
+  // (inradius 0.7947 of a unit icosahedron) and the vertices.
+  const float scale = kIcosahedronScale;
+  for (const auto& f : faces) {
+    Eigen::Vector3f n = (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]]).normalized();
+    std::array<int, 3> order{f[0], f[1], f[2]};
+    if (n.dot(p[f[0]]) < 0) {  // outward, counter-clockwise
+      std::swap(order[1], order[2]);
+      n = -n;
+    }
+    for (int k : order) {
+      const Eigen::Vector3f x = p[k] * scale;
+      idx.push_back(static_cast<uint32_t>(v.size()));
+      v.push_back({{x.x(), x.y(), x.z()}, {n.x(), n.y(), n.z()}});
+    }
+  }
+}
+
+void unitQuad(std::vector<Vertex>& v, std::vector<uint32_t>& idx) {
+  v = {{{-0.5f, -0.5f, 0}, {0, 0, 1}},
+       {{0.5f, -0.5f, 0}, {0, 0, 1}},
+       {{0.5f, 0.5f, 0}, {0, 0, 1}},
+       {{-0.5f, 0.5f, 0}, {0, 0, 1}}};
+  idx = {0, 1, 2, 0, 2, 3};
 }
 
 // Low tessellation on purpose: llvmpipe's cost grows with triangles.
@@ -198,7 +246,7 @@ struct OffscreenRenderer::Impl {
   EGLContext context = EGL_NO_CONTEXT;
   std::array<GLuint, 2> programs{};  // plain, ball pattern
   std::array<GLint, 2> view_projection{-1, -1};
-  std::array<Mesh, 4> meshes;  // by Primitive
+  std::array<Mesh, 5> meshes;  // by Primitive
   GLuint instances = 0;        // every view's instances, one buffer
   GLuint fbo = 0, colour = 0, depth = 0;
   int fbo_width = 0, fbo_height = 0;
@@ -287,7 +335,8 @@ struct OffscreenRenderer::Impl {
     std::vector<uint32_t> idx;
     if (p == Primitive::Box) unitBox(v, idx);
     if (p == Primitive::Sphere) unitSphere(v, idx, 12, 8);
-    if (p == Primitive::CoarseSphere) unitSphere(v, idx, 6, 4);
+    if (p == Primitive::CoarseSphere) unitIcosahedron(v, idx);
+    if (p == Primitive::Quad) unitQuad(v, idx);
     if (p == Primitive::Cylinder) unitCylinder(v, idx, 6);
     Mesh& m = meshes[static_cast<size_t>(p)];
     glGenVertexArrays(1, &m.vao);
@@ -348,7 +397,8 @@ OffscreenRenderer::OffscreenRenderer() : impl_(std::make_unique<Impl>()) {
   impl_->buildPrograms();
   glGenBuffers(1, &impl_->instances);
   for (Primitive p :
-       {Primitive::Box, Primitive::Sphere, Primitive::CoarseSphere, Primitive::Cylinder})
+       {Primitive::Box, Primitive::Sphere, Primitive::CoarseSphere, Primitive::Cylinder,
+        Primitive::Quad})
     impl_->buildMesh(p);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_CULL_FACE);

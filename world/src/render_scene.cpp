@@ -48,14 +48,14 @@ void addShape(std::vector<DrawItem>& items, const engine::Shape& s, const engine
   }
 }
 
-// A painted line: a flat box just above the carpet.
+// A painted line: a quad just above the carpet.
 void addLine(std::vector<DrawItem>& items, const fields::Vec2& a, const fields::Vec2& b,
              double width, const Eigen::Vector3f& colour) {
   const fields::Vec2 d = b - a;
   engine::Pose p = engine::Pose::Identity();
   p.rotate(Eigen::AngleAxisd(std::atan2(d.y(), d.x()), Vec3::UnitZ()));
   p.translation() = Vec3(0.5 * (a.x() + b.x()), 0.5 * (a.y() + b.y()), 0.001);
-  add(items, Primitive::Box, p, Vec3(d.norm() + (d.norm() > 0 ? width : 0), width, 0.002), colour);
+  add(items, Primitive::Quad, p, Vec3(d.norm() + (d.norm() > 0 ? width : 0), width, 1.0), colour);
 }
 
 }  // namespace
@@ -101,13 +101,13 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
     for (size_t i = 0; i < shapes.size(); ++i)
       addShape(items, shapes[i], engine::Pose::Identity(), i < 3 ? c.goal : c.net);
   }
+  // The carpet (its surface at z = 0) and the floor around it, 1 cm lower.
   engine::Pose p = engine::Pose::Identity();
-  p.translation() = Vec3(0, 0, -0.0049);
-  add(items, Primitive::Box, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 0.01),
+  add(items, Primitive::Quad, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 1.0),
       c.carpet);
-  p.translation() = Vec3(0, 0, -0.02);
-  add(items, Primitive::Box, p,
-      Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 0.02), c.floor);
+  p.translation() = Vec3(0, 0, -0.01);
+  add(items, Primitive::Quad, p, Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 1.0),
+      c.floor);
 }
 
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,

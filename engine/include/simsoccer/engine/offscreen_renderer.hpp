@@ -21,10 +21,12 @@ class RenderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Unit meshes: box -0.5..0.5 on each axis; sphere of radius 1 (192
-// triangles, for the ball); a coarse sphere (48 triangles, for robot parts);
-// cylinder of radius 1 and length 1 along z, centred (24 triangles).
-enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder };
+// Unit meshes: box -0.5..0.5 on each axis (12 triangles); sphere of radius 1
+// (192 triangles, for the ball); a coarse sphere (an icosahedron, 20
+// triangles, for robot parts); cylinder of radius 1 and length 1 along z,
+// centred (24 triangles); a quad -0.5..0.5 in x and y facing +z (2 triangles,
+// for paint on the ground).
+enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder, Quad };
 
 // One instance of a unit mesh in the world frame.
 struct DrawItem {
