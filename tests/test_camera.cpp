@@ -189,8 +189,14 @@ TEST(Camera, SameStateSameBytesAndOneBatchForAllViews) {
 }
 
 TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
-  cv::Mat rgb(48, 64, CV_8UC3);
-  cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::Mat rgb(480, 640, CV_8UC3);
+  cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
+  // Every 8-bit value of each channel appears: the extremes are where rounding differs.
+  for (int i = 0; i < 256; ++i) {
+    rgb.at<cv::Vec3b>(0, i) = {static_cast<uint8_t>(i), 0, 255};
+    rgb.at<cv::Vec3b>(1, i) = {255, static_cast<uint8_t>(i), 0};
+    rgb.at<cv::Vec3b>(2, i) = {0, 255, static_cast<uint8_t>(i)};
+  }
   const cv::Mat yuyv = engine::rgbToYuyv(rgb);
   cv::Mat yuv;
   cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
@@ -199,11 +205,15 @@ TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
     for (int c = 0; c < rgb.cols; c += 2) {
       const uint8_t* q = yuyv.ptr<uint8_t>(r) + 2 * c;
       const cv::Vec3b a = yuv.at<cv::Vec3b>(r, c), b = yuv.at<cv::Vec3b>(r, c + 1);
-      EXPECT_EQ(q[0], a[0]);
-      EXPECT_EQ(q[2], b[0]);
-      EXPECT_NEAR(q[1], 0.5 * (a[1] + b[1]), 0.5 + 1e-9);
-      EXPECT_NEAR(q[3], 0.5 * (a[2] + b[2]), 0.5 + 1e-9);
+      ASSERT_EQ(q[0], a[0]) << r << "," << c;
+      ASSERT_EQ(q[2], b[0]) << r << "," << c;
+      ASSERT_NEAR(q[1], 0.5 * (a[1] + b[1]), 0.5 + 1e-9) << r << "," << c;
+      ASSERT_NEAR(q[3], 0.5 * (a[2] + b[2]), 0.5 + 1e-9) << r << "," << c;
     }
+  // RGBA input (the renderer's) gives the same bytes.
+  cv::Mat rgba;
+  cv::cvtColor(rgb, rgba, cv::COLOR_RGB2RGBA);
+  EXPECT_EQ(cv::norm(engine::rgbToYuyv(rgba), yuyv, cv::NORM_INF), 0.0);
   // And back (chroma shared by each pair, OpenCV's YUV -> RGB): a flat colour survives.
   cv::Mat flat(4, 4, CV_8UC3, cv::Scalar(30, 140, 40)), unpacked(4, 4, CV_8UC3), back;
   const cv::Mat packed = engine::rgbToYuyv(flat);

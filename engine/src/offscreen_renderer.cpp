@@ -603,11 +603,17 @@ bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, do
 }
 
 cv::Mat rgbToYuyv(const cv::Mat& rgb) {
+  cv::Mat out;
+  rgbToYuyv(rgb, out);
+  return out;
+}
+
+void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out) {
   if ((rgb.type() != CV_8UC3 && rgb.type() != CV_8UC4) || rgb.cols % 2 != 0)
     throw std::invalid_argument("rgbToYuyv: 8-bit RGB or RGBA with an even width expected");
   cv::Mat yuv;
   cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);  // reads 3 or 4 channels, writes 3
-  cv::Mat out(rgb.rows, rgb.cols, CV_8UC2);
+  out.create(rgb.rows, rgb.cols, CV_8UC2);  // kept if it already is that (caller's memory)
   cv::parallel_for_(cv::Range(0, rgb.rows), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r) {
       const auto* in = yuv.ptr<cv::Vec3b>(r);
@@ -621,7 +627,6 @@ cv::Mat rgbToYuyv(const cv::Mat& rgb) {
       }
     }
   });
-  return out;
 }
 
 }  // namespace simsoccer::engine

@@ -238,10 +238,10 @@ void CameraSystem::process(engine::OffscreenRenderer& renderer, Job& job) {
     image.tick = job.tick;
     image.sim_time = job.sim_time;
     image.view = v.view;
-    image.data.clear();
-    image.bgr.release();
+    image.bgr.release();  // (image.data keeps its capacity from view to view)
     if (v.camera == CameraId::Spectator) {
       image.encoding = ImageEncoding::Bgr;
+      image.data.clear();
       cv::cvtColor(rgba, image.bgr, cv::COLOR_RGBA2BGR);
     } else {
       // Noise seeded per scenario, capture, robot and camera: the same run, the same noise.
@@ -257,8 +257,9 @@ void CameraSystem::process(engine::OffscreenRenderer& renderer, Job& job) {
         cv::imencode(".jpg", bgr, image.data, {cv::IMWRITE_JPEG_QUALITY, settings_.jpeg_quality});
       } else {
         image.encoding = ImageEncoding::Yuyv;
-        const cv::Mat yuyv = engine::rgbToYuyv(rgba);
-        image.data.assign(yuyv.datastart, yuyv.dataend);
+        image.data.resize(rgba.total() * 2);
+        cv::Mat yuyv(rgba.rows, rgba.cols, CV_8UC2, image.data.data());  // straight into the image
+        engine::rgbToYuyv(rgba, yuyv);
       }
     }
     convert_ms += msSince(t0);

@@ -92,5 +92,7 @@ class OffscreenRenderer {
 // using OpenCV's RGB -> YUV conversion; each pixel pair shares the mean of
 // its two chroma values. `width` must be even.
 cv::Mat rgbToYuyv(const cv::Mat& rgb);
+// The same into `out` (written in place when it already is rows x cols CV_8UC2).
+void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out);
 
 }  // namespace simsoccer::engine
