@@ -449,3 +449,28 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
   }
   EXPECT_EQ(server.cameras()->stats().dropped, 0u);  // lockstep waits, never drops
 }
+
+TEST(Net, RealTimeAppliesTheLatestCommandEachPeriod) {
+  // Real time: the simulator sleeps between periods; commands that arrive
+  // meanwhile must be applied at the next period, not discarded.
+  const uint32_t domain = 114;
+  world::World w(teams(1));
+  net::ServerConfig cfg = serverConfig(domain);
+  cfg.lockstep = false;
+  net::SimServer server(w, cfg);
+  AgentProcess agent(domain, 0, 1);
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const auto period = std::chrono::milliseconds(10);
+  auto due = Clock::now();
+  const int periods = 150;
+  for (int i = 0; i < periods; ++i) {
+    due += period;
+    std::this_thread::sleep_until(due);
+    server.runPeriod();
+  }
+  const auto& st = server.stats(0);
+  std::printf("real time: %llu commands applied in %d periods\n", (unsigned long long)st.accepted,
+              periods);
+  EXPECT_GE(st.accepted, static_cast<uint64_t>(periods * 0.7));
+  EXPECT_EQ(st.rejected, 0u);
+}

@@ -464,8 +464,12 @@ void SimServer::runPeriod() {
     std::lock_guard lock(mutex_);
     handleJoins();
     checkOwners();
-    for (RobotSlot& s : robots_) s.has_command = false;
-    if (config_.lockstep) expected_tick_ = tick;  // from now on commands for `tick` count
+    if (config_.lockstep) {
+      // Only answers to this tick's frames count. (In real time a command that
+      // came in since the last period is the latest one: it stays.)
+      for (RobotSlot& s : robots_) s.has_command = false;
+      expected_tick_ = tick;  // from now on commands for `tick` count
+    }
     published_tick_ = tick;
   }
 
