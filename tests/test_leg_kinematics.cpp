@@ -1,0 +1,94 @@
+// Leg kinematics on the robot models' own data: forward kinematics against
+// the model's frames, inverse kinematics round trips, limits, the shared
+// HipYawPitch.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "simsoccer/agents/motion/leg_kinematics.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using agents::Leg;
+using agents::LegAngles;
+using engine::Vec3;
+
+namespace {
+
+LegAngles randomLeg(const agents::LegKinematics& k, Leg leg, std::mt19937_64& rng) {
+  LegAngles q;
+  for (int i = 0; i < 6; ++i) {
+    // Inside the limits, knee bent (a standing or walking leg, not a folded one).
+    double lo = k.lower(leg, i), hi = k.upper(leg, i);
+    if (i == 3) lo = std::max(lo, 0.2);
+    if (i == 0) lo = std::max(lo, -0.6), hi = std::min(hi, 0.2);
+    q[i] = std::uniform_real_distribution<double>(lo + 0.02, hi - 0.02)(rng);
+  }
+  return q;
+}
+
+}  // namespace
+
+TEST(LegKinematics, ForwardMatchesTheModelFrames) {
+  const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
+  const agents::LegKinematics k(model);
+  std::mt19937_64 rng(3);
+  std::vector<double> q(model.body->joints.size(), 0.0);
+  for (const Leg leg : {Leg::Left, Leg::Right}) {
+    const LegAngles a = randomLeg(k, leg, rng);
+    for (int i = 0; i < 6; ++i) q[static_cast<size_t>(k.joints(leg)[i])] = a[i];
+    const auto frames = model.body->linkFramesAt(q);
+    const int foot = model.body->joints[static_cast<size_t>(k.joints(leg)[5])].child_link;
+    EXPECT_TRUE(k.forward(leg, a).isApprox(frames[static_cast<size_t>(foot)], 1e-12));
+  }
+  EXPECT_NEAR(k.soleDepth(), 0.04519, 0.0005);  // nao.md: foot height 45.19 mm
+  EXPECT_NEAR(k.hip(Leg::Left).y(), 0.05, 1e-9);
+}
+
+TEST(LegKinematics, InverseOfForwardIsIdentityWithinATenthOfAMillimetre) {
+  for (const auto& file : {test::naoH25(), test::naoH21()}) {
+    const robots::RobotModel model = robots::loadRobotModel(file);
+    const agents::LegKinematics k(model);
+    std::mt19937_64 rng(11);
+    double worst_position = 0, worst_orientation = 0;
+    for (int trial = 0; trial < 500; ++trial) {
+      LegAngles l = randomLeg(k, Leg::Left, rng), r = randomLeg(k, Leg::Right, rng);
+      r[0] = l[0];  // one HipYawPitch motor
+      const agents::Pose fl = k.forward(Leg::Left, l), fr = k.forward(Leg::Right, r);
+      const agents::LegSolution s = k.inverse(fl, fr);
+      for (const auto& [leg, q, target] :
+           {std::tuple{Leg::Left, s.left, fl}, std::tuple{Leg::Right, s.right, fr}}) {
+        const agents::Pose got = k.forward(leg, q);
+        worst_position =
+            std::max(worst_position, (got.translation() - target.translation()).norm());
+        worst_orientation =
+            std::max(worst_orientation,
+                     Eigen::AngleAxisd(got.linear() * target.linear().transpose()).angle());
+        for (int i = 0; i < 6; ++i) {
+          EXPECT_GE(q[i], k.lower(leg, i) - 1e-12);
+          EXPECT_LE(q[i], k.upper(leg, i) + 1e-12);
+        }
+      }
+      EXPECT_EQ(s.left[0], s.right[0]);  // the shared hinge
+    }
+    std::printf(
+        "%s: 500 random reachable foot pairs, worst position error %.2e m, orientation "
+        "%.2e rad\n",
+        model.name.c_str(), worst_position, worst_orientation);
+    EXPECT_LT(worst_position, 1e-4);
+    EXPECT_LT(worst_orientation, 1e-3);
+  }
+}
+
+TEST(LegKinematics, UnreachableTargetsStayWithinLimits) {
+  const agents::LegKinematics k(robots::loadRobotModel(test::naoH25()));
+  agents::Pose far = agents::Pose::Identity();
+  far.translation() = Vec3(0.0, 0.05, -0.5);  // below a straight leg
+  const agents::LegSolution s = k.inverse(far, far);
+  EXPECT_GT(s.position_error, 0.1);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_GE(s.left[i], k.lower(Leg::Left, i));
+    EXPECT_LE(s.left[i], k.upper(Leg::Left, i));
+  }
+  EXPECT_NEAR(s.left[3], 0.0, 0.1);  // the knee as straight as it goes
+}
