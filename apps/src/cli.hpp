@@ -56,6 +56,7 @@ int benchPhysics(int argc, char** argv, int first);
 int benchSensors(int argc, char** argv, int first);
 int benchNet(int argc, char** argv, int first);
 int benchCameras(int argc, char** argv, int first);
+int benchMotion(int argc, char** argv, int first);
 int serve(int argc, char** argv, int first);
 int check(int argc, char** argv, int first);
 

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
       if (sub == "sensors") return benchSensors(argc, argv, 3);
       if (sub == "net") return benchNet(argc, argv, 3);
       if (sub == "cameras") return benchCameras(argc, argv, 3);
+      if (sub == "motion") return benchMotion(argc, argv, 3);
       std::fprintf(
           stderr,
           "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras)\n",

@@ -275,10 +275,9 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;
-  // One friction row per contact, along the slip direction, unless asked for
-  // two: each multibody row costs an articulated-body pass in the solver
-  // set-up, and on feet the single row measured both faster (+40% at 22
-  // robots) and steadier (less creep of a standing robot).
+  // Two friction rows per contact: Bullet's multibody contacts take their
+  // friction directions from the contact normal alone (btPlaneSpace1), so a
+  // single row would resist slip along one fixed tangent only.
   if (settings.friction_directions == 2)
     info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
   else

@@ -27,7 +27,7 @@ using BodyId = uint32_t;
 struct PhysicsSettings {
   double dt = 0.005;            // s, physics step
   int solver_iterations = 10;   // sequential-impulse iterations per step
-  int friction_directions = 1;  // friction rows per contact: 1 (along the slip) or 2
+  int friction_directions = 2;  // friction rows per contact (see world::PhysicsConfig)
   Vec3 gravity{0.0, 0.0, -9.81};
 };
 

@@ -24,7 +24,12 @@ struct PhysicsConfig {
   double dt = 0.005;              // s
   double control_period = 0.010;  // s, a whole multiple of dt
   int solver_iterations = 10;
-  int friction_directions = 1;  // per contact: 1 (along the slip) or 2 (a pyramid)
+  // Friction rows per contact: 2 (a pyramid; the default) or 1. With 1,
+  // Bullet gives a multibody contact a single row along a fixed tangent
+  // (btPlaneSpace1 of the normal: the y axis on flat ground), not along the
+  // slip: feet hold sideways but slide freely forward and back, so robots
+  // cannot walk. Kept for comparisons only.
+  int friction_directions = 2;
   double gravity = -9.81;       // m/s^2 along z
 };
 

@@ -1,0 +1,92 @@
+// An omnidirectional walk for the Nao: an open-loop step generator in the
+// lineage of rUNSWift's Walk2014 and B-Human's walk (nao.md section 8):
+// fixed-duration steps (default 250 ms), the swing foot lifted on a sine and
+// moved to its next placement with a smoothstep, the torso carried along the
+// body path at the commanded speed with a lateral sway over the support foot,
+// and balance feedback from the gyroscope on the support ankle. Everything
+// reaches the joints through LegKinematics: the agent sends joint targets
+// only (no forces, no teleporting).
+//
+// Frames: the walk's 2D "odometry" frame is where the robot started walking
+// (x forward, y left); a pose there is (x, y, yaw).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "simsoccer/agents/motion/leg_kinematics.hpp"
+
+namespace simsoccer::agents {
+
+struct WalkParameters {
+  double step_period = 0.25;     // s, one step (half a gait cycle)
+  double foot_lift = 0.012;      // m, swing apex
+  double ankle_height = 0.265;   // m, ankle below the torso origin while walking
+  double step_width = 0.10;      // m, between the feet's centres
+  double sway = 0.018;           // m, torso over the support foot at mid-step
+  double torso_lean = 0.0;       // rad, forward
+  double torso_offset = 0.0;     // m, torso ahead of the feet's middle
+  double max_forward = 0.065;    // m per step (0.26 m/s at 4 steps/s)
+  double max_backward = 0.04;    // m per step
+  double max_side = 0.05;        // m per step (taken every other step)
+  double max_turn = 0.3;         // rad per step
+  double max_accel = 0.02;       // m per step per step, forward
+  // The support leg's hip roll sags under the body's weight (the servo is a
+  // stiff spring, not a rigid joint): commanded this much further, peaking
+  // at mid-step, so the swing foot stays off the ground.
+  double hip_roll_compensation = 0.05;  // rad
+  double ankle_pitch_gyro = 0.05;  // rad per rad/s of torso pitch rate
+  double ankle_roll_gyro = 0.05;   // rad per rad/s of torso roll rate
+  double stiffness = 1.0;
+};
+
+struct Pose2 {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+};
+
+class WalkEngine {
+ public:
+  WalkEngine(const robots::RobotModel& model, const WalkParameters& parameters = {});
+
+  // The wanted velocity in the robot frame (m/s, m/s, rad/s); clamped to the
+  // parameters' limits, reached over a few steps. Zero: the robot steps on
+  // the spot until stop().
+  void setVelocity(double forward, double left, double turn);
+  // Finishes the step under way, then stands with the feet together.
+  void stop();
+  bool walking() const { return walking_; }
+
+  // Advances by `dt` and writes the joint targets (one per body joint, rad;
+  // only the legs, the arms and the head are left as they are in
+  // `targets`). `gyro`: torso angular velocity (rad/s, torso frame).
+  void update(double dt, const Vec3& gyro, std::vector<double>& targets);
+
+  // Where the walk thinks the body is (odometry frame), and the foot placements.
+  Pose2 odometry() const { return body_; }
+  double phase() const { return phase_; }
+  Leg supportLeg() const { return support_; }
+  const LegKinematics& kinematics() const { return kinematics_; }
+  const WalkParameters& parameters() const { return p_; }
+  // The standing leg angles the walk starts from and ends in.
+  LegSolution standingLegs() const;
+
+ private:
+  void startStep();
+  LegSolution solve(const Pose2& body, double sway_y, const Pose2& left, const Pose2& right,
+                    double left_lift, double right_lift);
+
+  LegKinematics kinematics_;
+  WalkParameters p_;
+  bool walking_ = false, stopping_ = false;
+  double phase_ = 0.0;  // 0..1 within the step
+  Leg support_ = Leg::Right;
+  Pose2 body_, body_start_, body_end_;
+  Pose2 foot_[2];                  // current placements (left, right)
+  Pose2 swing_start_, swing_end_;  // the swing foot's path this step
+  Eigen::Vector3d wanted_ = Eigen::Vector3d::Zero(), step_ = Eigen::Vector3d::Zero();
+  Vec3 gyro_filtered_ = Vec3::Zero();
+  LegSolution last_{};
+  bool have_last_ = false;
+};
+
+}  // namespace simsoccer::agents

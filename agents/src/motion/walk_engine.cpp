@@ -1,0 +1,151 @@
+#include "simsoccer/agents/motion/walk_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace simsoccer::agents {
+namespace {
+
+Pose2 compose(const Pose2& a, double dx, double dy, double dyaw) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  return {a.x + c * dx - s * dy, a.y + s * dx + c * dy, a.yaw + dyaw};
+}
+
+Pose2 lerp(const Pose2& a, const Pose2& b, double t) {
+  return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.yaw + (b.yaw - a.yaw) * t};
+}
+
+double smoothstep(double t) {
+  return t * t * (3.0 - 2.0 * t);
+}
+
+}  // namespace
+
+WalkEngine::WalkEngine(const robots::RobotModel& model, const WalkParameters& parameters)
+    : kinematics_(model), p_(parameters) {
+  foot_[0] = {0.0, 0.5 * p_.step_width, 0.0};
+  foot_[1] = {0.0, -0.5 * p_.step_width, 0.0};
+}
+
+void WalkEngine::setVelocity(double forward, double left, double turn) {
+  wanted_ = {forward * p_.step_period, left * p_.step_period, turn * p_.step_period};
+  wanted_.x() = std::clamp(wanted_.x(), -p_.max_backward, p_.max_forward);
+  wanted_.y() = std::clamp(2.0 * wanted_.y(), -p_.max_side, p_.max_side);  // every other step
+  wanted_.z() = std::clamp(wanted_.z(), -p_.max_turn, p_.max_turn);
+  if (!walking_) {
+    walking_ = true;
+    stopping_ = false;
+    phase_ = 0.0;
+    support_ = Leg::Right;  // the left foot steps first
+    startStep();
+  }
+  stopping_ = false;
+}
+
+void WalkEngine::stop() {
+  if (walking_) stopping_ = true;
+}
+
+void WalkEngine::startStep() {
+  // The step: ramp towards the wanted one; sideways only with the foot on
+  // that side (the other foot closes up on the next step).
+  const int swing = support_ == Leg::Left ? 1 : 0;
+  const double side = swing == 0 ? 1.0 : -1.0;  // +1: the left foot swings
+  Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
+  step_.x() += std::clamp(want.x() - step_.x(), -p_.max_accel, p_.max_accel);
+  step_.y() = (want.y() * side > 0) ? want.y() : 0.0;
+  step_.z() = (want.z() * side > 0) ? want.z() : 0.0;  // open the hip on that side's step
+  body_start_ = body_;
+  body_end_ = compose(body_, step_.x(), step_.y(), step_.z());
+  swing_start_ = foot_[swing];
+  swing_end_ = compose(body_end_, 0.0, side * 0.5 * p_.step_width, 0.0);
+}
+
+LegSolution WalkEngine::solve(const Pose2& body, double sway_y, const Pose2& left,
+                              const Pose2& right, double left_lift, double right_lift) {
+  // Torso pose in the odometry frame (3D), the feet relative to it.
+  const Pose2 torso = compose(body, p_.torso_offset, sway_y, 0.0);
+  Pose t = Pose::Identity();
+  t.translation() = Vec3(torso.x, torso.y, p_.ankle_height);
+  t.rotate(Eigen::AngleAxisd(torso.yaw, Vec3::UnitZ()));
+  t.rotate(Eigen::AngleAxisd(p_.torso_lean, Vec3::UnitY()));
+  const Pose inv = t.inverse();
+  auto foot = [&](const Pose2& f, double lift) {
+    Pose x = Pose::Identity();
+    x.translation() = Vec3(f.x, f.y, lift);
+    x.rotate(Eigen::AngleAxisd(f.yaw, Vec3::UnitZ()));
+    return inv * x;
+  };
+  const LegSolution s =
+      kinematics_.inverse(foot(left, left_lift), foot(right, right_lift), have_last_ ? &last_ : nullptr);
+  last_ = s;
+  have_last_ = true;
+  return s;
+}
+
+LegSolution WalkEngine::standingLegs() const {
+  WalkEngine copy = *this;
+  copy.have_last_ = false;
+  return copy.solve(body_, 0.0, compose(body_, 0.0, 0.5 * p_.step_width, 0.0),
+                    compose(body_, 0.0, -0.5 * p_.step_width, 0.0), 0.0, 0.0);
+}
+
+void WalkEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets) {
+  gyro_filtered_ += 0.5 * (gyro - gyro_filtered_);
+  LegSolution s;
+  if (!walking_) {
+    s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
+  } else {
+    phase_ += dt / p_.step_period;
+    if (phase_ >= 1.0) {
+      // The swing foot is down: it becomes the support.
+      const int swing = support_ == Leg::Left ? 1 : 0;
+      foot_[swing] = swing_end_;
+      body_ = body_end_;
+      support_ = support_ == Leg::Left ? Leg::Right : Leg::Left;
+      phase_ -= 1.0;
+      const bool feet_together = std::abs(step_.x()) < 1e-4 && std::abs(step_.y()) < 1e-6 &&
+                                 std::abs(step_.z()) < 1e-6;
+      if (stopping_ && feet_together) {
+        walking_ = stopping_ = false;
+        phase_ = 0.0;
+        step_.setZero();
+        s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
+        goto write;
+      }
+      startStep();
+    }
+    {
+      const int swing = support_ == Leg::Left ? 1 : 0;
+      const double ph = phase_;
+      const Pose2 body = lerp(body_start_, body_end_, ph);
+      const double support_side = support_ == Leg::Left ? 1.0 : -1.0;
+      const double sway = support_side * p_.sway * std::sin(M_PI * ph);
+      Pose2 feet[2] = {foot_[0], foot_[1]};
+      feet[swing] = lerp(swing_start_, swing_end_, smoothstep(ph));
+      double lift[2] = {0.0, 0.0};
+      lift[swing] = p_.foot_lift * std::sin(M_PI * ph);
+      s = solve(body, sway, feet[0], feet[1], lift[0], lift[1]);
+      LegAngles& support_q = support_ == Leg::Left ? s.left : s.right;
+      support_q[1] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
+    }
+  }
+write:
+  // Balance: the support ankle (both while standing) leans against the
+  // torso's rotation rate.
+  for (int leg = 0; leg < 2; ++leg) {
+    LegAngles& q = leg == 0 ? s.left : s.right;
+    if (walking_ && static_cast<int>(support_) != leg) continue;
+    q[4] += p_.ankle_pitch_gyro * gyro_filtered_.y();
+    q[5] += p_.ankle_roll_gyro * gyro_filtered_.x();
+  }
+  for (int leg = 0; leg < 2; ++leg) {
+    const Leg l = leg == 0 ? Leg::Left : Leg::Right;
+    const LegAngles& q = leg == 0 ? s.left : s.right;
+    for (int i = 0; i < 6; ++i)
+      targets[static_cast<size_t>(kinematics_.joints(l)[i])] =
+          std::clamp(q[i], kinematics_.lower(l, i), kinematics_.upper(l, i));
+  }
+}
+
+}  // namespace simsoccer::agents
