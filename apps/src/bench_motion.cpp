@@ -38,7 +38,6 @@ world::Scenario emptyField() {
   s.field_file = findConfig("", "fields/spl.yaml");
   s.robot_model_file = findConfig("", "robots/nao_v6_h25.yaml");
   s.ball_position = {4.0, 2.5, -1.0};
-  if (getenv("FD2")) s.physics.friction_directions = 2;
   world::RobotPlacement p;
   p.x = -3.0;
   s.robots.push_back(p);
@@ -60,7 +59,7 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
   // Settle into the walk's stance over 1 s.
   const std::vector<double> stand = targets;
   std::vector<double> walk_stance = targets;
-  engine.update(dt, Vec3::Zero(), walk_stance);
+  engine.update(dt, Vec3::Zero(), 0.0, walk_stance);
   for (int i = 0; i < 100; ++i) {
     const double a = std::min(1.0, i / 50.0);
     for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
@@ -73,7 +72,7 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
   const long periods = static_cast<long>(seconds / dt);
   for (long i = 0; i < periods; ++i) {
     const auto& f = w.sensorFrame(0);
-    engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), targets);
+    engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
     send();
     w.stepControlPeriod();
     if (!w.isStanding(0)) {
@@ -107,7 +106,7 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "verbose"}, {"seconds", "csv", "vx", "vy", "turn", "sway", "lift", "period", "offset", "height", "gp", "gr", "lean", "hrc"});
+  const Options opt(argc, argv, first, {"help", "verbose"}, {"seconds", "csv", "vx", "vy", "turn", "sway", "lift", "period", "offset", "height", "gp", "gr", "lean", "hrc", "hg"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const double seconds = opt.number("seconds", 10.0);
@@ -122,6 +121,7 @@ int benchMotion(int argc, char** argv, int first) {
     wp.ankle_roll_gyro = opt.number("gr", wp.ankle_roll_gyro);
     wp.torso_lean = opt.number("lean", wp.torso_lean);
     wp.hip_roll_compensation = opt.number("hrc", wp.hip_roll_compensation);
+    wp.heading_gain = opt.number("hg", wp.heading_gain);
     const WalkResult r = walk(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0),
                               seconds, opt.flag("verbose"), wp);
     std::printf("distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",

@@ -54,7 +54,13 @@ void WalkEngine::startStep() {
   Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
   step_.x() += std::clamp(want.x() - step_.x(), -p_.max_accel, p_.max_accel);
   step_.y() = (want.y() * side > 0) ? want.y() : 0.0;
-  step_.z() = (want.z() * side > 0) ? want.z() : 0.0;  // open the hip on that side's step
+  // Turning: the wanted turn plus the heading correction, taken on the steps
+  // that open the hips (the left foot leads a left turn).
+  intended_yaw_ += want.z();
+  const double measured = yaw_ - yaw_offset_;
+  const double error = std::remainder(intended_yaw_ - measured, 2 * M_PI);
+  const double turn = std::clamp(want.z() + p_.heading_gain * error, -p_.max_turn, p_.max_turn);
+  step_.z() = (turn * side > 0) ? turn : 0.0;
   body_start_ = body_;
   body_end_ = compose(body_, step_.x(), step_.y(), step_.z());
   swing_start_ = foot_[swing];
@@ -90,8 +96,14 @@ LegSolution WalkEngine::standingLegs() const {
                     compose(body_, 0.0, -0.5 * p_.step_width, 0.0), 0.0, 0.0);
 }
 
-void WalkEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets) {
+void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets) {
   gyro_filtered_ += 0.5 * (gyro - gyro_filtered_);
+  if (!yaw_known_) {
+    yaw_offset_ = yaw - body_.yaw;
+    intended_yaw_ = body_.yaw;
+    yaw_known_ = true;
+  }
+  yaw_ = yaw;
   LegSolution s;
   if (!walking_) {
     s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);

@@ -21,11 +21,11 @@ namespace simsoccer::agents {
 struct WalkParameters {
   double step_period = 0.25;     // s, one step (half a gait cycle)
   double foot_lift = 0.012;      // m, swing apex
-  double ankle_height = 0.265;   // m, ankle below the torso origin while walking
+  double ankle_height = 0.255;   // m, ankle below the torso origin while walking
   double step_width = 0.10;      // m, between the feet's centres
   double sway = 0.018;           // m, torso over the support foot at mid-step
   double torso_lean = 0.0;       // rad, forward
-  double torso_offset = 0.0;     // m, torso ahead of the feet's middle
+  double torso_offset = -0.01;   // m, torso ahead of the feet's middle
   double max_forward = 0.065;    // m per step (0.26 m/s at 4 steps/s)
   double max_backward = 0.04;    // m per step
   double max_side = 0.05;        // m per step (taken every other step)
@@ -35,6 +35,10 @@ struct WalkParameters {
   // stiff spring, not a rigid joint): commanded this much further, peaking
   // at mid-step, so the swing foot stays off the ground.
   double hip_roll_compensation = 0.05;  // rad
+  // Heading hold: each step turns by this share of the difference between
+  // the walk's own heading and the IMU's torso yaw (feet slip and the
+  // mechanism is not perfectly symmetric; open loop the robot drifts).
+  double heading_gain = 0.5;
   double ankle_pitch_gyro = 0.05;  // rad per rad/s of torso pitch rate
   double ankle_roll_gyro = 0.05;   // rad per rad/s of torso roll rate
   double stiffness = 1.0;
@@ -57,9 +61,10 @@ class WalkEngine {
   bool walking() const { return walking_; }
 
   // Advances by `dt` and writes the joint targets (one per body joint, rad;
-  // only the legs, the arms and the head are left as they are in
-  // `targets`). `gyro`: torso angular velocity (rad/s, torso frame).
-  void update(double dt, const Vec3& gyro, std::vector<double>& targets);
+  // only the legs are written: the arms and the head are left as they are
+  // in `targets`). `gyro`: torso angular velocity (rad/s, torso frame);
+  // `yaw`: the IMU's torso yaw (rad).
+  void update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets);
 
   // Where the walk thinks the body is (odometry frame), and the foot placements.
   Pose2 odometry() const { return body_; }
@@ -85,6 +90,9 @@ class WalkEngine {
   Pose2 swing_start_, swing_end_;  // the swing foot's path this step
   Eigen::Vector3d wanted_ = Eigen::Vector3d::Zero(), step_ = Eigen::Vector3d::Zero();
   Vec3 gyro_filtered_ = Vec3::Zero();
+  double yaw_ = 0.0, yaw_offset_ = 0.0;  // IMU yaw, and its value when the walk's odometry began
+  bool yaw_known_ = false;
+  double intended_yaw_ = 0.0;  // the heading the commands asked for (odometry frame)
   LegSolution last_{};
   bool have_last_ = false;
 };
