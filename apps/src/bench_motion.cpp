@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <random>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -18,12 +20,14 @@ namespace {
 using engine::Vec3;
 
 const char* kHelp =
-    "usage: simsoccer bench motion [--seconds S] [--csv FILE]\n"
+    "usage: simsoccer bench motion [--random-minutes M] [--seed N] [--csv FILE]\n"
+    "       simsoccer bench motion --vx V [--vy V] [--turn W] [--seconds S] [--verbose]\n"
     "\n"
     "One Nao on an empty SPL field, driven by the walk engine at the control rate through\n"
-    "joint targets only. Per test (forward, sideways, turning): commanded and achieved speed,\n"
-    "path deviation, falls.\n"
-    "  --seconds S   walking time per test (default 10)\n"
+    "joint targets only (the agents' motion, in this process). Per test: commanded and achieved\n"
+    "speed, path deviation, falls: forward 0.25 m/s over 5 m, sideways 0.1 m/s, turning 0.8\n"
+    "rad/s, and M minutes (default 10) of random velocity commands.\n"
+    "With --vx/--vy/--turn: one walk at that command, for tuning.\n"
     "  --csv FILE    also write the table as CSV\n";
 
 struct WalkResult {
@@ -44,8 +48,11 @@ world::Scenario emptyField() {
   return s;
 }
 
-WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose,
-               const agents::WalkParameters& wp) {
+// Commands (vx, vy, omega) as a function of time since the walk began.
+using Schedule = std::function<Eigen::Vector3d(double)>;
+
+WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
+                const agents::WalkParameters& wp, int* falls = nullptr) {
   world::World w(emptyField());
   const auto& model = *w.robot(0).model;
   agents::WalkEngine engine(model, wp);
@@ -60,17 +67,24 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
   const std::vector<double> stand = targets;
   std::vector<double> walk_stance = targets;
   engine.update(dt, Vec3::Zero(), 0.0, walk_stance);
-  for (int i = 0; i < 100; ++i) {
-    const double a = std::min(1.0, i / 50.0);
-    for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
-    send();
-    w.stepControlPeriod();
-  }
+  auto settle = [&] {
+    for (int i = 0; i < 100; ++i) {
+      const double a = std::min(1.0, i / 50.0);
+      for (size_t j = 0; j < targets.size(); ++j)
+        targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
+      send();
+      w.stepControlPeriod();
+    }
+  };
+  settle();
   const engine::Pose start = w.torsoPose(0);
-  engine.setVelocity(vx, vy, omega);
+  const Eigen::Vector3d first = schedule(0.0);
+  const double vx = first.x(), vy = first.y();
   WalkResult r;
   const long periods = static_cast<long>(seconds / dt);
   for (long i = 0; i < periods; ++i) {
+    const Eigen::Vector3d c = schedule(i * dt);
+    engine.setVelocity(c.x(), c.y(), c.z());
     const auto& f = w.sensorFrame(0);
     engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
     send();
@@ -78,15 +92,29 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
     if (!w.isStanding(0)) {
       r.fell = true;
       r.fell_at = i * dt;
-      break;
+      if (!falls) break;
+      // Counting falls: put the robot back up where it fell and walk on.
+      ++*falls;
+      if (verbose) {
+        const Eigen::Vector3d c = schedule(i * dt);
+        std::fprintf(stderr, "fall at %.2f s, command %.2f %.2f %.2f (before: %.2f %.2f %.2f)\n", i * dt,
+                     c.x(), c.y(), c.z(), schedule(std::max(0.0, i * dt - 2.0)).x(),
+                     schedule(std::max(0.0, i * dt - 2.0)).y(), schedule(std::max(0.0, i * dt - 2.0)).z());
+      }
+      const engine::Pose t = w.torsoPose(0);
+      w.placeRobot(0, t.translation().x(), t.translation().y(),
+                   std::atan2(t.linear()(1, 0), t.linear()(0, 0)));
+      engine = agents::WalkEngine(model, wp);
+      settle();  // as at the start: into the walk's stance, then on
+      continue;
     }
     if (verbose && (i < 60 || i % 25 == 0)) {
       const auto t = w.torsoPose(0);
       const int hr = model.body->jointIndex("RHipRoll"), lk = model.body->jointIndex("LKneePitch");
       std::fprintf(stderr, "   RHipRoll cmd %.3f act %.3f  LKnee cmd %.3f act %.3f\n", targets[hr],
                    w.jointPosition(0, hr), targets[lk], w.jointPosition(0, lk));
-      const auto lf = w.linkPose(0, model.body->linkIndex("LFoot")).translation();
-      const auto rf = w.linkPose(0, model.body->linkIndex("RFoot")).translation();
+      const Vec3 lf = w.linkPose(0, model.body->linkIndex("LFoot")).translation();
+      const Vec3 rf = w.linkPose(0, model.body->linkIndex("RFoot")).translation();
       std::fprintf(stderr, "t %.2f ph %.2f sup %d torso %.3f %.3f %.3f  odo %.3f  weight L %.1f R %.1f  LF %.3f %.3f RF %.3f %.3f\n",
                    i * dt, engine.phase(), static_cast<int>(engine.supportLeg()), t.translation().x(),
                    t.translation().y(), t.translation().z(), engine.odometry().x,
@@ -96,8 +124,8 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
   const engine::Pose end = w.torsoPose(0);
   const Vec3 d = start.linear().transpose() * (end.translation() - start.translation());
   r.distance = std::hypot(d.x(), d.y());
-  r.speed = (vx != 0 ? d.x() : d.y()) / seconds;
-  r.lateral = vx != 0 ? d.y() : d.x();
+  r.speed = (vx != 0 || vy == 0 ? d.x() : d.y()) / seconds;
+  r.lateral = vx != 0 || vy == 0 ? d.y() : d.x();
   const Eigen::Matrix3d rel = start.linear().transpose() * end.linear();
   r.turned = std::atan2(rel(1, 0), rel(0, 0));
   return r;
@@ -106,28 +134,86 @@ WalkResult walk(double vx, double vy, double omega, double seconds, bool verbose
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "verbose"}, {"seconds", "csv", "vx", "vy", "turn", "sway", "lift", "period", "offset", "height", "gp", "gr", "lean", "hrc", "hg"});
+  const Options opt(argc, argv, first, {"help", "verbose"},
+                    {"seconds", "csv", "vx", "vy", "turn", "sway", "lift", "period", "offset",
+                     "height", "gp", "gr", "lean", "hrc", "hg", "random-minutes", "seed"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
-  const double seconds = opt.number("seconds", 10.0);
-  if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {
-    agents::WalkParameters wp;
-    wp.sway = opt.number("sway", wp.sway);
-    wp.foot_lift = opt.number("lift", wp.foot_lift);
-    wp.step_period = opt.number("period", wp.step_period);
-    wp.torso_offset = opt.number("offset", wp.torso_offset);
-    wp.ankle_height = opt.number("height", wp.ankle_height);
-    wp.ankle_pitch_gyro = opt.number("gp", wp.ankle_pitch_gyro);
-    wp.ankle_roll_gyro = opt.number("gr", wp.ankle_roll_gyro);
-    wp.torso_lean = opt.number("lean", wp.torso_lean);
-    wp.hip_roll_compensation = opt.number("hrc", wp.hip_roll_compensation);
-    wp.heading_gain = opt.number("hg", wp.heading_gain);
-    const WalkResult r = walk(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0),
-                              seconds, opt.flag("verbose"), wp);
+  agents::WalkParameters wp;
+  wp.sway = opt.number("sway", wp.sway);
+  wp.foot_lift = opt.number("lift", wp.foot_lift);
+  wp.step_period = opt.number("period", wp.step_period);
+  wp.torso_offset = opt.number("offset", wp.torso_offset);
+  wp.ankle_height = opt.number("height", wp.ankle_height);
+  wp.ankle_pitch_gyro = opt.number("gp", wp.ankle_pitch_gyro);
+  wp.ankle_roll_gyro = opt.number("gr", wp.ankle_roll_gyro);
+  wp.torso_lean = opt.number("lean", wp.torso_lean);
+  wp.hip_roll_compensation = opt.number("hrc", wp.hip_roll_compensation);
+  wp.heading_gain = opt.number("hg", wp.heading_gain);
+  if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning
+    const Eigen::Vector3d c(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0));
+    const WalkResult r =
+        walk([&](double) { return c; }, opt.number("seconds", 10.0), opt.flag("verbose"), wp);
     std::printf("distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",
                 r.distance, r.speed, r.lateral, r.turned, r.fell, r.fell_at);
     return 0;
   }
+  const double random_minutes = opt.number("random-minutes", 10.0);
+  const auto seed = static_cast<uint64_t>(opt.number("seed", 1));
+  std::printf("simsoccer bench motion: one Nao H25 on an empty SPL field, walk engine (%.0f ms steps), "
+              "joint targets only\n", wp.step_period * 1e3);
+  std::fflush(stdout);
+  Table table;
+  table.header = {"robots", "test", "commanded", "achieved", "unit", "deviation_pct", "falls",
+                  "sim_seconds"};
+  auto row = [&](const std::string& test, double commanded, double achieved, const char* unit,
+                 double deviation, int falls, double seconds) {
+    table.rows.push_back({"1", test, fmt(commanded, 3), fmt(achieved, 3), unit, fmt(deviation, 1),
+                          std::to_string(falls), fmt(seconds, 0)});
+    std::fprintf(stderr, "  %s done\n", test.c_str());
+  };
+  {
+    const double v = 0.25, seconds = 22.0;  // 5 m and more
+    const WalkResult r = walk([&](double) { return Eigen::Vector3d(v, 0, 0); }, seconds, false, wp);
+    row("walk_forward", v, r.speed, "m/s", 100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9),
+        r.fell, seconds);
+  }
+  {
+    const double v = 0.1, seconds = 10.0;
+    const WalkResult r = walk([&](double) { return Eigen::Vector3d(0, v, 0); }, seconds, false, wp);
+    row("walk_sideways", v, r.speed, "m/s", 100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9),
+        r.fell, seconds);
+  }
+  {
+    const double w = 0.8, seconds = 5.0;  // 4 rad: less than a turn, so the angle is unambiguous
+    const WalkResult r = walk([&](double) { return Eigen::Vector3d(0, 0, w); }, seconds, false, wp);
+    double turned = r.turned;
+    if (turned < 0) turned += 2 * M_PI;
+    row("turn", w * 180 / M_PI, turned / seconds * 180 / M_PI, "deg/s",
+        100.0 * std::abs(turned - w * seconds) / (w * seconds), r.fell, seconds);
+  }
+  {
+    // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
+    // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
+    std::mt19937_64 rng(seed);
+    std::vector<Eigen::Vector3d> commands;
+    const double seconds = random_minutes * 60.0;
+    for (int i = 0; i < static_cast<int>(seconds / 2.0) + 1; ++i) {
+      std::uniform_real_distribution<double> u(0, 1);
+      auto pick = [&](double lo, double hi) { return u(rng) < 0.25 ? 0.0 : lo + (hi - lo) * u(rng); };
+      commands.emplace_back(pick(-0.1, 0.3), pick(-0.1, 0.1), pick(-0.8, 0.8));
+    }
+    int falls = 0;
+    walk([&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds,
+         opt.flag("verbose"), wp, &falls);
+    row("random_commands", 0, 0, "-", 0, falls, seconds);
+  }
+  table.finish(
+      "walk_forward: 0.25 m/s for 22 s (over 5 m), achieved = torso displacement / time (the speed "
+      "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; turn: "
+      "0.8 rad/s for 5 s; random_commands: a new random velocity every 2 s on an empty field, falls "
+      "counted (the robot is put back up after each).",
+      opt.get("csv", ""));
   return 0;
 }
 

@@ -69,7 +69,11 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
   // joints at a limit they push against taken out; restarts from other
   // knee bends if it stalls. Positions weigh more than orientations (0.05 m
   // per rad), so when the feet's yaws disagree the positions are kept.
+  // Weights (m per rad) of the orientation error, in the target foot's
+  // frame: a foot must land flat (roll, pitch), its yaw may give where the
+  // shared HipYawPitch cannot serve both feet.
   const double w = 0.05;
+  const Eigen::Vector3d w_axes(0.2, 0.2, 0.03);
   const std::array<const Pose*, 2> targets{&left_foot, &right_foot};
   auto run = [&](std::array<LegAngles, 2> q, double& pe, double& oe) {
     std::array<Vec3, 2> pos_err{}, rot_err{};
@@ -89,11 +93,12 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
         pos_err[side] = targets[side]->translation() - t.translation();
         rot_err[side] = rotationError(targets[side]->linear(), t.linear());
         e.segment<3>(6 * side) = pos_err[side];
-        e.segment<3>(6 * side + 3) = w * rot_err[side];
+        const Eigen::Matrix3d to_foot = targets[side]->linear().transpose();
+        e.segment<3>(6 * side + 3) = w_axes.asDiagonal() * (to_foot * rot_err[side]);
         for (int i = 0; i < 6; ++i) {
           const int col = i == 0 ? 0 : 1 + 5 * side + (i - 1);
           jac.block<3, 1>(6 * side, col) = a[i].cross(t.translation() - p[i]);
-          jac.block<3, 1>(6 * side + 3, col) = w * a[i];
+          jac.block<3, 1>(6 * side + 3, col) = w_axes.asDiagonal() * (to_foot * a[i]);
         }
       }
       if (e.norm() < 1e-10) break;

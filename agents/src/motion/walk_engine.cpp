@@ -28,10 +28,14 @@ WalkEngine::WalkEngine(const robots::RobotModel& model, const WalkParameters& pa
 }
 
 void WalkEngine::setVelocity(double forward, double left, double turn) {
-  wanted_ = {forward * p_.step_period, left * p_.step_period, turn * p_.step_period};
-  wanted_.x() = std::clamp(wanted_.x(), -p_.max_backward, p_.max_forward);
-  wanted_.y() = std::clamp(2.0 * wanted_.y(), -p_.max_side, p_.max_side);  // every other step
-  wanted_.z() = std::clamp(wanted_.z(), -p_.max_turn, p_.max_turn);
+  // Per-step averages, inside the diamond (L1 ball) of the limits: full
+  // speed forward, sideways and turning cannot be had at once.
+  Eigen::Vector3d w(forward * p_.step_period, left * p_.step_period, turn * p_.step_period);
+  const Eigen::Vector3d limit(w.x() >= 0 ? p_.max_forward : p_.max_backward, 0.5 * p_.max_side,
+                              0.5 * p_.max_turn);
+  const double r = w.cwiseQuotient(limit).lpNorm<1>();  // combined steps are harder: a diamond
+  if (r > 1.0) w /= r;
+  wanted_ = w;
   if (!walking_) {
     walking_ = true;
     stopping_ = false;
@@ -47,22 +51,26 @@ void WalkEngine::stop() {
 }
 
 void WalkEngine::startStep() {
-  // The step: ramp towards the wanted one; sideways only with the foot on
-  // that side (the other foot closes up on the next step).
   const int swing = support_ == Leg::Left ? 1 : 0;
   const double side = swing == 0 ? 1.0 : -1.0;  // +1: the left foot swings
-  Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
-  step_.x() += std::clamp(want.x() - step_.x(), -p_.max_accel, p_.max_accel);
-  step_.y() = (want.y() * side > 0) ? want.y() : 0.0;
-  // Turning: the wanted turn plus the heading correction, taken on the steps
-  // that open the hips (the left foot leads a left turn).
-  intended_yaw_ += want.z();
+  // The per-step average command ramps towards the wanted one.
+  const Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
+  const Eigen::Vector3d max_change(p_.max_accel, p_.max_side_accel, p_.max_turn_accel);
+  average_ += (want - average_).cwiseMax(-max_change).cwiseMin(max_change);
+  step_.x() = average_.x();
+  // Sideways and turning only on the steps that open the legs that way (the
+  // left foot leads to the left), twice the average; the other foot closes up.
+  step_.y() = (average_.y() * side > 0) ? 2.0 * average_.y() : 0.0;
+  // Turning, with the heading hold: the IMU's yaw against the commanded heading.
+  intended_yaw_ += average_.z();
   const double measured = yaw_ - yaw_offset_;
   const double error = std::remainder(intended_yaw_ - measured, 2 * M_PI);
-  const double turn = std::clamp(want.z() + p_.heading_gain * error, -p_.max_turn, p_.max_turn);
+  const double turn =
+      std::clamp(2.0 * average_.z() + p_.heading_gain * error, -p_.max_turn, p_.max_turn);
   step_.z() = (turn * side > 0) ? turn : 0.0;
   body_start_ = body_;
-  body_end_ = compose(body_, step_.x(), step_.y(), step_.z());
+  body_end_ = compose(body_, p_.forward_scale * step_.x(), step_.y(), step_.z());
+  odometry_ = compose(odometry_, step_.x(), step_.y(), step_.z());
   swing_start_ = foot_[swing];
   swing_end_ = compose(body_end_, 0.0, side * 0.5 * p_.step_width, 0.0);
 }
@@ -116,12 +124,13 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
       body_ = body_end_;
       support_ = support_ == Leg::Left ? Leg::Right : Leg::Left;
       phase_ -= 1.0;
-      const bool feet_together = std::abs(step_.x()) < 1e-4 && std::abs(step_.y()) < 1e-6 &&
+      const bool feet_together = average_.norm() < 1e-6 && std::abs(step_.y()) < 1e-6 &&
                                  std::abs(step_.z()) < 1e-6;
       if (stopping_ && feet_together) {
         walking_ = stopping_ = false;
         phase_ = 0.0;
         step_.setZero();
+        average_.setZero();
         s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
         goto write;
       }

@@ -26,11 +26,18 @@ struct WalkParameters {
   double sway = 0.018;           // m, torso over the support foot at mid-step
   double torso_lean = 0.0;       // rad, forward
   double torso_offset = -0.01;   // m, torso ahead of the feet's middle
-  double max_forward = 0.065;    // m per step (0.26 m/s at 4 steps/s)
+  // Measured calibration: with these settings the robot covers 9 % more
+  // ground than its commanded step lengths (the support leg's servos give
+  // under the load, the landing foot reaches further), so forward steps are
+  // shortened by this factor; odometry reports the intended distance.
+  double forward_scale = 0.92;
+  double max_forward = 0.075;    // m per step before scaling (0.3 m/s at 4 steps/s)
   double max_backward = 0.04;    // m per step
-  double max_side = 0.05;        // m per step (taken every other step)
-  double max_turn = 0.3;         // rad per step
+  double max_side = 0.05;        // m per sideways step (taken every other step)
+  double max_turn = 0.4;         // rad per turning step (taken every other step)
   double max_accel = 0.02;       // m per step per step, forward
+  double max_side_accel = 0.01;  // m per step per step (average sideways step)
+  double max_turn_accel = 0.05;  // rad per step per step (average turn per step)
   // The support leg's hip roll sags under the body's weight (the servo is a
   // stiff spring, not a rigid joint): commanded this much further, peaking
   // at mid-step, so the swing foot stays off the ground.
@@ -67,7 +74,7 @@ class WalkEngine {
   void update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets);
 
   // Where the walk thinks the body is (odometry frame), and the foot placements.
-  Pose2 odometry() const { return body_; }
+  Pose2 odometry() const { return odometry_; }
   double phase() const { return phase_; }
   Leg supportLeg() const { return support_; }
   const LegKinematics& kinematics() const { return kinematics_; }
@@ -86,9 +93,12 @@ class WalkEngine {
   double phase_ = 0.0;  // 0..1 within the step
   Leg support_ = Leg::Right;
   Pose2 body_, body_start_, body_end_;
+  Pose2 odometry_;  // the intended path (unscaled steps)
   Pose2 foot_[2];                  // current placements (left, right)
   Pose2 swing_start_, swing_end_;  // the swing foot's path this step
-  Eigen::Vector3d wanted_ = Eigen::Vector3d::Zero(), step_ = Eigen::Vector3d::Zero();
+  // Per-step averages (x m, y m, yaw rad): wanted, and reached so far; the step itself.
+  Eigen::Vector3d wanted_ = Eigen::Vector3d::Zero(), average_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d step_ = Eigen::Vector3d::Zero();
   Vec3 gyro_filtered_ = Vec3::Zero();
   double yaw_ = 0.0, yaw_offset_ = 0.0;  // IMU yaw, and its value when the walk's odometry began
   bool yaw_known_ = false;
