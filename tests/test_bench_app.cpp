@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -121,4 +122,40 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
                 .find("--encoding"),
             std::string::npos);
   EXPECT_NE(status, 0);
+}
+
+TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
+  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_motion_test.csv";
+  std::filesystem::remove(csv);
+  int status = -1;
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --random-minutes 1 --csv " +
+                     csv.string() + " 2>&1",
+                 status);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(status, 0) << out;
+  std::ifstream f(csv);
+  std::string header, line;
+  std::getline(f, header);
+  EXPECT_EQ(header, "robots,test,commanded,achieved,unit,deviation_pct,falls,sim_seconds");
+  std::map<std::string, std::vector<std::string>> rows;
+  while (std::getline(f, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    ASSERT_EQ(cells.size(), 8u) << line;
+    rows[cells[1]] = cells;
+  }
+  ASSERT_EQ(rows.size(), 4u);
+  // The figures: >= 0.25 m/s forward over 5 m, >= 0.10 m/s sideways,
+  // >= 45 deg/s turning, paths within 10 %, no falls.
+  EXPECT_GE(std::stod(rows["walk_forward"][3]), 0.245);
+  EXPECT_GE(std::stod(rows["walk_sideways"][3]), 0.10);
+  EXPECT_GE(std::stod(rows["turn"][3]), 45.0);
+  for (const char* t : {"walk_forward", "walk_sideways", "turn"}) {
+    EXPECT_LT(std::stod(rows[t][5]), 10.0) << t;
+    EXPECT_EQ(rows[t][6], "0") << t;
+  }
+  EXPECT_EQ(rows["random_commands"][6], "0");  // one simulated minute of random commands
+  std::filesystem::remove(csv);
 }

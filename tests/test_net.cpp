@@ -474,3 +474,29 @@ TEST(Net, RealTimeAppliesTheLatestCommandEachPeriod) {
   EXPECT_GE(st.accepted, static_cast<uint64_t>(periods * 0.7));
   EXPECT_EQ(st.rejected, 0u);
 }
+
+TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
+  // Lockstep over DDS: the simsoccer-agent process runs the walk engine on
+  // the sensor frames it receives and answers with joint targets only.
+  const uint32_t domain = 115;
+  world::Scenario s = teams(1);
+  s.robots[0].x = -3.0;
+  s.robots[0].y = 0.0;
+  world::World w(s);
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess agent(domain, 0, 1, {"--mode", "walk", "--vx", "0.2"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const engine::Vec3 start = w.torsoPose(0).translation();
+  bool fell = false;
+  for (int i = 0; i < 700 && !fell; ++i) {  // 1 s easing in + 6 s walking
+    server.runPeriod();
+    fell = !w.isStanding(0);
+  }
+  const engine::Vec3 d = w.torsoPose(0).translation() - start;
+  std::printf("walked %.3f m forward, %.3f m sideways in 7 s; fell %d; missed %llu\n", d.x(), d.y(),
+              fell, (unsigned long long)server.stats(0).missed);
+  EXPECT_FALSE(fell);
+  EXPECT_GT(d.x(), 1.0);
+  EXPECT_LT(std::abs(d.y()), 0.15);
+  EXPECT_EQ(server.stats(0).missed, 0u);
+}

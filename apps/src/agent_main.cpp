@@ -13,17 +13,20 @@
 
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
 namespace {
 
 const char* kHelp =
     "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE]\n"
-    "                       [--robot FILE] [--mode nod|garbage|stall] [--stall-after N]\n"
-    "                       [--ticks N] [--claim-timeout S]\n"
+    "                       [--robot FILE] [--mode nod|walk|garbage|stall] [--stall-after N]\n"
+    "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
     "\n"
     "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame with\n"
     "the stand pose of the robot model and a nodding head (0.2 rad at 0.5 Hz).\n"
+    "  --mode walk      eases into the walk's stance for 1 s, then walks at --vx, --vy (m/s)\n"
+    "                   and --turn (rad/s) with the walk engine (default 0.2 m/s forward)\n"
     "  --mode garbage   also sends an invalid command before each valid one (NaN, wrong\n"
     "                   sizes, stale and future ticks, stiffness out of range)\n"
     "  --mode stall     answers --stall-after ticks, then keeps running without answering\n"
@@ -37,7 +40,7 @@ int main(int argc, char** argv) {
   try {
     const apps::Options opt(argc, argv, 1, {"help"},
                             {"team", "player", "domain", "dds-config", "robot", "mode",
-                             "stall-after", "ticks", "claim-timeout"});
+                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn"});
     if (opt.help(kHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -49,8 +52,8 @@ int main(int argc, char** argv) {
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
     const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
     const std::string mode = opt.get("mode", "nod");
-    if (mode != "nod" && mode != "garbage" && mode != "stall")
-      throw apps::UsageError("--mode must be nod, garbage or stall");
+    if (mode != "nod" && mode != "walk" && mode != "garbage" && mode != "stall")
+      throw apps::UsageError("--mode must be nod, walk, garbage or stall");
     const long stall_after = static_cast<long>(opt.number("stall-after", 50));
     const long max_ticks = static_cast<long>(opt.number("ticks", -1));
 
@@ -64,6 +67,14 @@ int main(int argc, char** argv) {
         position[a] = static_cast<float>(stand[static_cast<size_t>(act.index)]);
       if (act.name == "HeadPitch") head_pitch = static_cast<int>(a);
     }
+
+    // Walk mode: the walk engine writes the legs' targets (body joint order).
+    agents::WalkEngine walk(model);
+    std::vector<double> targets = stand, walk_stance = stand;
+    walk.update(0.01, engine::Vec3::Zero(), 0.0, walk_stance);
+    const double vx = opt.number("vx", 0.2), vy = opt.number("vy", 0.0),
+                 turn = opt.number("turn", 0.0);
+    double start_time = -1.0, last_time = 0.0;
 
     agents::AgentClient client(dds, team, player);
     if (!client.claim(opt.number("claim-timeout", 10.0))) {
@@ -85,9 +96,28 @@ int main(int argc, char** argv) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;
       if (max_ticks >= 0 && answered >= max_ticks) return;
-      if (head_pitch >= 0)
+      if (mode == "walk") {
+        if (start_time < 0) start_time = last_time = frame.sim_time;
+        const double t = frame.sim_time - start_time, dt = frame.sim_time - last_time;
+        last_time = frame.sim_time;
+        if (t < 1.0) {  // ease from the stand pose into the walk's stance
+          const double a = std::min(1.0, 2.0 * t);
+          for (size_t j = 0; j < targets.size(); ++j)
+            targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
+        } else {
+          walk.setVelocity(vx, vy, turn);
+          walk.update(dt > 0 ? dt : 0.01,
+                      engine::Vec3(frame.gyroscope[0], frame.gyroscope[1], frame.gyroscope[2]),
+                      frame.angles[2], targets);
+        }
+        for (size_t a = 0; a < model.actuators.size() && a < 25; ++a)
+          if (model.actuators[a].kind == robots::Actuator::Kind::Joint)
+            position[a] =
+                static_cast<float>(targets[static_cast<size_t>(model.actuators[a].index)]);
+      } else if (head_pitch >= 0) {
         position[static_cast<size_t>(head_pitch)] =
             static_cast<float>(0.2 * std::sin(2.0 * std::numbers::pi * 0.5 * frame.sim_time));
+      }
       if (mode == "garbage") {
         // One invalid command of each kind in turn, then the valid answer.
         simsoccer_msg_JointCommand bad{};

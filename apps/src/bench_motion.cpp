@@ -3,9 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <random>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -61,7 +61,8 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
   const double dt = w.scenario().physics.control_period;
   auto send = [&] {
     for (size_t j = 0; j < targets.size(); ++j)
-      if (model.body->joints[j].mimic_of < 0) w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
+      if (model.body->joints[j].mimic_of < 0)
+        w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
   };
   // Settle into the walk's stance over 1 s.
   const std::vector<double> stand = targets;
@@ -97,9 +98,10 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
       ++*falls;
       if (verbose) {
         const Eigen::Vector3d c = schedule(i * dt);
-        std::fprintf(stderr, "fall at %.2f s, command %.2f %.2f %.2f (before: %.2f %.2f %.2f)\n", i * dt,
-                     c.x(), c.y(), c.z(), schedule(std::max(0.0, i * dt - 2.0)).x(),
-                     schedule(std::max(0.0, i * dt - 2.0)).y(), schedule(std::max(0.0, i * dt - 2.0)).z());
+        std::fprintf(stderr, "fall at %.2f s, command %.2f %.2f %.2f (before: %.2f %.2f %.2f)\n",
+                     i * dt, c.x(), c.y(), c.z(), schedule(std::max(0.0, i * dt - 2.0)).x(),
+                     schedule(std::max(0.0, i * dt - 2.0)).y(),
+                     schedule(std::max(0.0, i * dt - 2.0)).z());
       }
       const engine::Pose t = w.torsoPose(0);
       w.placeRobot(0, t.translation().x(), t.translation().y(),
@@ -115,10 +117,13 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
                    w.jointPosition(0, hr), targets[lk], w.jointPosition(0, lk));
       const Vec3 lf = w.linkPose(0, model.body->linkIndex("LFoot")).translation();
       const Vec3 rf = w.linkPose(0, model.body->linkIndex("RFoot")).translation();
-      std::fprintf(stderr, "t %.2f ph %.2f sup %d torso %.3f %.3f %.3f  odo %.3f  weight L %.1f R %.1f  LF %.3f %.3f RF %.3f %.3f\n",
-                   i * dt, engine.phase(), static_cast<int>(engine.supportLeg()), t.translation().x(),
-                   t.translation().y(), t.translation().z(), engine.odometry().x,
-                   f.foot_weight[0], f.foot_weight[1], lf.x(), lf.z(), rf.x(), rf.z());
+      std::fprintf(stderr,
+                   "t %.2f ph %.2f sup %d torso %.3f %.3f %.3f  odo %.3f  weight L %.1f R %.1f  LF "
+                   "%.3f %.3f RF %.3f %.3f\n",
+                   i * dt, engine.phase(), static_cast<int>(engine.supportLeg()),
+                   t.translation().x(), t.translation().y(), t.translation().z(),
+                   engine.odometry().x, f.foot_weight[0], f.foot_weight[1], lf.x(), lf.z(), rf.x(),
+                   rf.z());
     }
   }
   const engine::Pose end = w.torsoPose(0);
@@ -154,18 +159,21 @@ int benchMotion(int argc, char** argv, int first) {
     const Eigen::Vector3d c(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0));
     const WalkResult r =
         walk([&](double) { return c; }, opt.number("seconds", 10.0), opt.flag("verbose"), wp);
-    std::printf("distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",
-                r.distance, r.speed, r.lateral, r.turned, r.fell, r.fell_at);
+    std::printf(
+        "distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",
+        r.distance, r.speed, r.lateral, r.turned, r.fell, r.fell_at);
     return 0;
   }
   const double random_minutes = opt.number("random-minutes", 10.0);
   const auto seed = static_cast<uint64_t>(opt.number("seed", 1));
-  std::printf("simsoccer bench motion: one Nao H25 on an empty SPL field, walk engine (%.0f ms steps), "
-              "joint targets only\n", wp.step_period * 1e3);
+  std::printf(
+      "simsoccer bench motion: one Nao H25 on an empty SPL field, walk engine (%.0f ms steps), "
+      "joint targets only\n",
+      wp.step_period * 1e3);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots", "test", "commanded", "achieved", "unit", "deviation_pct", "falls",
-                  "sim_seconds"};
+  table.header = {"robots", "test",          "commanded", "achieved",
+                  "unit",   "deviation_pct", "falls",     "sim_seconds"};
   auto row = [&](const std::string& test, double commanded, double achieved, const char* unit,
                  double deviation, int falls, double seconds) {
     table.rows.push_back({"1", test, fmt(commanded, 3), fmt(achieved, 3), unit, fmt(deviation, 1),
@@ -181,8 +189,8 @@ int benchMotion(int argc, char** argv, int first) {
   {
     const double v = 0.1, seconds = 10.0;
     const WalkResult r = walk([&](double) { return Eigen::Vector3d(0, v, 0); }, seconds, false, wp);
-    row("walk_sideways", v, r.speed, "m/s", 100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9),
-        r.fell, seconds);
+    row("walk_sideways", v, r.speed, "m/s",
+        100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9), r.fell, seconds);
   }
   {
     const double w = 0.8, seconds = 5.0;  // 4 rad: less than a turn, so the angle is unambiguous
@@ -200,7 +208,9 @@ int benchMotion(int argc, char** argv, int first) {
     const double seconds = random_minutes * 60.0;
     for (int i = 0; i < static_cast<int>(seconds / 2.0) + 1; ++i) {
       std::uniform_real_distribution<double> u(0, 1);
-      auto pick = [&](double lo, double hi) { return u(rng) < 0.25 ? 0.0 : lo + (hi - lo) * u(rng); };
+      auto pick = [&](double lo, double hi) {
+        return u(rng) < 0.25 ? 0.0 : lo + (hi - lo) * u(rng);
+      };
       commands.emplace_back(pick(-0.1, 0.3), pick(-0.1, 0.1), pick(-0.8, 0.8));
     }
     int falls = 0;
@@ -210,8 +220,10 @@ int benchMotion(int argc, char** argv, int first) {
   }
   table.finish(
       "walk_forward: 0.25 m/s for 22 s (over 5 m), achieved = torso displacement / time (the speed "
-      "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; turn: "
-      "0.8 rad/s for 5 s; random_commands: a new random velocity every 2 s on an empty field, falls "
+      "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; "
+      "turn: "
+      "0.8 rad/s for 5 s; random_commands: a new random velocity every 2 s on an empty field, "
+      "falls "
       "counted (the robot is put back up after each).",
       opt.get("csv", ""));
   return 0;

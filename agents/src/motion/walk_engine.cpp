@@ -90,8 +90,8 @@ LegSolution WalkEngine::solve(const Pose2& body, double sway_y, const Pose2& lef
     x.rotate(Eigen::AngleAxisd(f.yaw, Vec3::UnitZ()));
     return inv * x;
   };
-  const LegSolution s =
-      kinematics_.inverse(foot(left, left_lift), foot(right, right_lift), have_last_ ? &last_ : nullptr);
+  const LegSolution s = kinematics_.inverse(foot(left, left_lift), foot(right, right_lift),
+                                            have_last_ ? &last_ : nullptr);
   last_ = s;
   have_last_ = true;
   return s;
@@ -112,10 +112,7 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
     yaw_known_ = true;
   }
   yaw_ = yaw;
-  LegSolution s;
-  if (!walking_) {
-    s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
-  } else {
+  if (walking_) {
     phase_ += dt / p_.step_period;
     if (phase_ >= 1.0) {
       // The swing foot is down: it becomes the support.
@@ -124,34 +121,35 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
       body_ = body_end_;
       support_ = support_ == Leg::Left ? Leg::Right : Leg::Left;
       phase_ -= 1.0;
-      const bool feet_together = average_.norm() < 1e-6 && std::abs(step_.y()) < 1e-6 &&
-                                 std::abs(step_.z()) < 1e-6;
-      if (stopping_ && feet_together) {
+      const bool feet_together =
+          average_.norm() < 1e-6 && std::abs(step_.y()) < 1e-6 && std::abs(step_.z()) < 1e-6;
+      if (stopping_ && feet_together) {  // stopped: stand
         walking_ = stopping_ = false;
         phase_ = 0.0;
         step_.setZero();
         average_.setZero();
-        s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
-        goto write;
+      } else {
+        startStep();
       }
-      startStep();
-    }
-    {
-      const int swing = support_ == Leg::Left ? 1 : 0;
-      const double ph = phase_;
-      const Pose2 body = lerp(body_start_, body_end_, ph);
-      const double support_side = support_ == Leg::Left ? 1.0 : -1.0;
-      const double sway = support_side * p_.sway * std::sin(M_PI * ph);
-      Pose2 feet[2] = {foot_[0], foot_[1]};
-      feet[swing] = lerp(swing_start_, swing_end_, smoothstep(ph));
-      double lift[2] = {0.0, 0.0};
-      lift[swing] = p_.foot_lift * std::sin(M_PI * ph);
-      s = solve(body, sway, feet[0], feet[1], lift[0], lift[1]);
-      LegAngles& support_q = support_ == Leg::Left ? s.left : s.right;
-      support_q[1] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
     }
   }
-write:
+  LegSolution s;
+  if (!walking_) {
+    s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
+  } else {
+    const int swing = support_ == Leg::Left ? 1 : 0;
+    const double ph = phase_;
+    const Pose2 body = lerp(body_start_, body_end_, ph);
+    const double support_side = support_ == Leg::Left ? 1.0 : -1.0;
+    const double sway = support_side * p_.sway * std::sin(M_PI * ph);
+    Pose2 feet[2] = {foot_[0], foot_[1]};
+    feet[swing] = lerp(swing_start_, swing_end_, smoothstep(ph));
+    double lift[2] = {0.0, 0.0};
+    lift[swing] = p_.foot_lift * std::sin(M_PI * ph);
+    s = solve(body, sway, feet[0], feet[1], lift[0], lift[1]);
+    LegAngles& support_q = support_ == Leg::Left ? s.left : s.right;
+    support_q[1] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
+  }
   // Balance: the support ankle (both while standing) leans against the
   // torso's rotation rate.
   for (int leg = 0; leg < 2; ++leg) {

@@ -19,13 +19,13 @@
 namespace simsoccer::agents {
 
 struct WalkParameters {
-  double step_period = 0.25;     // s, one step (half a gait cycle)
-  double foot_lift = 0.012;      // m, swing apex
-  double ankle_height = 0.255;   // m, ankle below the torso origin while walking
-  double step_width = 0.10;      // m, between the feet's centres
-  double sway = 0.018;           // m, torso over the support foot at mid-step
-  double torso_lean = 0.0;       // rad, forward
-  double torso_offset = -0.01;   // m, torso ahead of the feet's middle
+  double step_period = 0.25;    // s, one step (half a gait cycle)
+  double foot_lift = 0.012;     // m, swing apex
+  double ankle_height = 0.255;  // m, ankle below the torso origin while walking
+  double step_width = 0.10;     // m, between the feet's centres
+  double sway = 0.018;          // m, torso over the support foot at mid-step
+  double torso_lean = 0.0;      // rad, forward
+  double torso_offset = -0.01;  // m, torso ahead of the feet's middle
   // Measured calibration: with these settings the robot covers 9 % more
   // ground than its commanded step lengths (the support leg's servos give
   // under the load, the landing foot reaches further), so forward steps are
@@ -93,7 +93,7 @@ class WalkEngine {
   double phase_ = 0.0;  // 0..1 within the step
   Leg support_ = Leg::Right;
   Pose2 body_, body_start_, body_end_;
-  Pose2 odometry_;  // the intended path (unscaled steps)
+  Pose2 odometry_;                 // the intended path (unscaled steps)
   Pose2 foot_[2];                  // current placements (left, right)
   Pose2 swing_start_, swing_end_;  // the swing foot's path this step
   // Per-step averages (x m, y m, yaw rad): wanted, and reached so far; the step itself.
