@@ -20,6 +20,7 @@ const char* kUsage =
     "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
     "  bench net       lockstep with real agent processes over DDS: overhead and bytes per tick\n"
     "  bench cameras   every robot's two cameras rendered through EGL: views/s, ms per frame, RTF\n"
+    "  bench motion    the agents' walk on the physics: speeds, path deviation, falls\n"
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
@@ -45,7 +46,7 @@ int main(int argc, char** argv) {
       if (sub == "motion") return benchMotion(argc, argv, 3);
       std::fprintf(
           stderr,
-          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras)\n",
+          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras, motion)\n",
           sub.c_str());
       return 2;
     }
