@@ -89,7 +89,7 @@ void readCameras(const ConfigNode& n, double control_period, CameraSettings& c) 
 Scenario loadScenario(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"scenario", "field", "robot_model", "physics", "seed", "placement_noise", "ball",
-                  "robots", "sensors", "cameras", "bench"});
+                  "robots", "sensors", "cameras", "perception", "bench"});
   Scenario s;
   s.source_file = file.string();
   s.name = root["scenario"].string();
@@ -155,6 +155,29 @@ Scenario loadScenario(const std::filesystem::path& file) {
     }
   }
   if (auto c = root.optional("cameras")) readCameras(*c, s.physics.control_period, s.cameras);
+  if (auto n = root.optional("perception")) {
+    n->allowOnly({"enabled", "profile", "ball_range", "post_range", "robot_range", "distance_noise",
+                  "bearing_noise", "miss_base", "miss_per_metre", "false_ball_rate",
+                  "pose_noise_xy", "pose_noise_yaw"});
+    PerceptionSettings& p = s.perception;
+    p.enabled = n->boolean("enabled", true);
+    const std::string profile = n->has("profile") ? (*n)["profile"].string() : "ideal";
+    if (profile != "ideal" && profile != "realistic")
+      n->failKey("profile", "must be ideal or realistic");
+    p.realistic = profile == "realistic";
+    for (auto [key, value] :
+         {std::pair{"ball_range", &p.ball_range}, std::pair{"post_range", &p.post_range},
+          std::pair{"robot_range", &p.robot_range}, std::pair{"distance_noise", &p.distance_noise},
+          std::pair{"bearing_noise", &p.bearing_noise}, std::pair{"miss_base", &p.miss_base},
+          std::pair{"miss_per_metre", &p.miss_per_metre},
+          std::pair{"false_ball_rate", &p.false_ball_rate},
+          std::pair{"pose_noise_xy", &p.pose_noise_xy},
+          std::pair{"pose_noise_yaw", &p.pose_noise_yaw}})
+      if (n->has(key)) *value = (*n)[key].nonNegative();
+    for (auto [key, value] :
+         {std::pair{"miss_base", p.miss_base}, std::pair{"false_ball_rate", p.false_ball_rate}})
+      if (value > 1.0) n->failKey(key, "a probability: 0..1");
+  }
   if (auto b = root.optional("ball")) {
     b->allowOnly({"position", "velocity"});
     const auto p = (*b)["position"].numbers();

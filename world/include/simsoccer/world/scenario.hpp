@@ -30,7 +30,7 @@ struct PhysicsConfig {
   // slip: feet hold sideways but slide freely forward and back, so robots
   // cannot walk. Kept for comparisons only.
   int friction_directions = 2;
-  double gravity = -9.81;       // m/s^2 along z
+  double gravity = -9.81;  // m/s^2 along z
 };
 
 // Standard deviations of the seeded random perturbations applied when the
@@ -99,6 +99,22 @@ struct CameraSettings {
   SpectatorSpec spectator;
 };
 
+// The geometric perception the simulator publishes to agents (world/perception.hpp).
+struct PerceptionSettings {
+  bool enabled = false;
+  bool realistic = false;          // profile: ideal (false) or realistic
+  double ball_range = 6.0;         // m (realistic)
+  double post_range = 9.0;         // m
+  double robot_range = 6.0;        // m
+  double distance_noise = 0.05;    // std dev as a fraction of the distance
+  double bearing_noise = 0.02;     // rad std dev
+  double miss_base = 0.02;         // probability of not seeing a visible object...
+  double miss_per_metre = 0.04;    // ...growing with distance
+  double false_ball_rate = 0.005;  // per control period
+  double pose_noise_xy = 0.05;     // m std dev of the self-pose estimate (realistic)
+  double pose_noise_yaw = 0.03;    // rad
+};
+
 struct Scenario {
   std::string name;
   std::string source_file;  // for error messages; empty when built in code
@@ -109,6 +125,7 @@ struct Scenario {
   PlacementNoise noise;
   SensorSettings sensors;
   CameraSettings cameras;
+  PerceptionSettings perception;
   engine::Vec3 ball_position{0.0, 0.0, -1.0};  // z < 0: resting on the ground
   engine::Vec3 ball_velocity = engine::Vec3::Zero();
   std::vector<RobotPlacement> robots;
