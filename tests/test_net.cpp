@@ -500,3 +500,34 @@ TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
   EXPECT_LT(std::abs(d.y()), 0.15);
   EXPECT_EQ(server.stats(0).missed, 0u);
 }
+
+TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
+  const uint32_t domain = 116;
+  world::Scenario s = teams(1);
+  s.robots[0].x = -2.0;
+  s.robots[0].y = 1.5;
+  s.ball_position = {-1.0, 1.5, -1.0};  // 1 m ahead
+  s.perception.enabled = true;          // as a scenario's `perception:` block does
+  world::World w(s);
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess owner(domain, 0, 1);
+  agents::AgentClient viewer(dds(domain), 0, 1);
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  server.poll(0.5);  // the viewer's reader matches
+  int received = 0;
+  agents::PerceptionIn p;
+  for (int i = 0; i < 50; ++i) {
+    server.runPeriod();
+    const auto start = Clock::now();
+    while (!viewer.perception(p) && seconds(start) < 1.0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (p.tick == static_cast<uint64_t>(w.stepCount() / w.stepsPerControlPeriod()) - 1) ++received;
+  }
+  std::printf("perception received for %d of 50 periods; ball at (%.3f, %.3f), in view %d\n",
+              received, p.ball.x, p.ball.y, p.ball.in_view);
+  EXPECT_GE(received, 45);
+  EXPECT_TRUE(p.ball.in_view);
+  EXPECT_NEAR(p.ball.x, 1.0, 0.05);
+  EXPECT_NEAR(p.ball.y, 0.0, 0.05);
+  EXPECT_NEAR(p.self_pose[0], -2.0, 0.05);
+}

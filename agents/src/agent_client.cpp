@@ -19,6 +19,7 @@ struct AgentClient::Impl {
   net::Reader<simsoccer_msg_SensorFrame> frames;
   net::Reader<simsoccer_msg_RobotStatus> status;
   net::Reader<simsoccer_msg_GameState> game;
+  net::Reader<simsoccer_msg_Perception> perception;
   net::Reader<simsoccer_msg_TeamMessage> team_deliver;
   net::Entity waitset, frame_condition;
   std::unique_ptr<net::Reader<simsoccer_msg_CameraImage>> images;  // after subscribeImages()
@@ -39,6 +40,8 @@ struct AgentClient::Impl {
         status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
                {true, 1, true, ""}),
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 1, true, ""}),
+        perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
+                   {true, 1, false, net::robotPartitionName(team, player)}),
         team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
                      {true, 16, false, ""}) {
     waitset = net::Entity(net::check(dds_create_waitset(participant.get()), "create waitset"));
@@ -222,6 +225,36 @@ std::vector<CameraImageIn> AgentClient::receiveImages(double timeout_seconds) {
   std::stable_sort(out.begin(), out.end(),
                    [](const CameraImageIn& a, const CameraImageIn& b) { return a.tick < b.tick; });
   return out;
+}
+
+namespace {
+PerceivedIn fromMessage(const simsoccer_msg_PerceivedObject& m) {
+  PerceivedIn o;
+  o.kind = m.kind;
+  o.team = m.team == 255 ? -1 : m.team;
+  o.in_view = m.in_view != 0;
+  o.x = m.position[0];
+  o.y = m.position[1];
+  o.last_seen = m.last_seen;
+  return o;
+}
+}  // namespace
+
+bool AgentClient::perception(PerceptionIn& out) {
+  bool got = false;
+  impl_->perception.take([&](const simsoccer_msg_Perception& m, const dds_sample_info_t&) {
+    if (m.team != team_ || m.player != player_ || (got && m.tick < out.tick)) return;
+    out.tick = m.tick;
+    out.sim_time = m.sim_time;
+    out.ball = fromMessage(m.ball);
+    for (size_t k = 0; k < 4; ++k) out.posts[k] = fromMessage(m.posts[k]);
+    out.robots.clear();
+    for (uint32_t i = 0; i < m.robots._length; ++i)
+      out.robots.push_back(fromMessage(m.robots._buffer[i]));
+    for (size_t k = 0; k < 3; ++k) out.self_pose[k] = m.self_pose[k];
+    got = true;
+  });
+  return got;
 }
 
 }  // namespace simsoccer::agents

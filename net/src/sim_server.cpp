@@ -110,11 +110,48 @@ void toMessage(const world::CameraImage& image, simsoccer_msg_CameraImage& m) {
   m.data._release = false;
 }
 
+namespace {
+simsoccer_msg_PerceivedObject toMessage(const world::PerceivedObject& o) {
+  simsoccer_msg_PerceivedObject m{};
+  m.kind = static_cast<uint8_t>(o.kind);
+  m.team = o.team < 0 ? 255 : static_cast<uint8_t>(o.team);
+  m.in_view = o.in_view;
+  m.camera = o.camera < 0 ? 255 : static_cast<uint8_t>(o.camera);
+  m.position[0] = static_cast<float>(o.x);
+  m.position[1] = static_cast<float>(o.y);
+  m.last_seen = o.last_seen;
+  return m;
+}
+}  // namespace
+
+void toMessage(const world::Perception& p, int team, int player, simsoccer_msg_Perception& m,
+               std::vector<simsoccer_msg_PerceivedObject>& scratch) {
+  m.team = static_cast<uint8_t>(team);
+  m.player = static_cast<uint8_t>(player);
+  m.tick = p.tick;
+  m.sim_time = p.time;
+  m.ball = toMessage(p.ball);
+  for (size_t k = 0; k < 4; ++k) m.posts[k] = toMessage(p.posts[k]);
+  scratch.clear();
+  for (const auto& r : p.robots) {
+    if (scratch.size() >= 40) break;
+    scratch.push_back(toMessage(r));
+  }
+  m.robots._buffer = scratch.data();
+  m.robots._length = m.robots._maximum = static_cast<uint32_t>(scratch.size());
+  m.robots._release = false;
+  m.self_pose[0] = static_cast<float>(p.self_x);
+  m.self_pose[1] = static_cast<float>(p.self_y);
+  m.self_pose[2] = static_cast<float>(p.self_yaw);
+}
+
 struct SimServer::Impl {
   Participant participant;
   std::vector<std::unique_ptr<Writer<simsoccer_msg_SensorFrame>>>
       frames;  // one per robot partition
   std::vector<std::unique_ptr<Writer<simsoccer_msg_CameraImage>>> images;  // per robot, cameras on
+  std::vector<std::unique_ptr<Writer<simsoccer_msg_Perception>>> perceptions;  // perception on
+  std::vector<simsoccer_msg_PerceivedObject> perceived_scratch;
   Writer<simsoccer_msg_RobotStatus> status;
   Writer<simsoccer_msg_SimClock> clock;
   Writer<simsoccer_msg_GameState> game;
@@ -193,6 +230,13 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
         impl_->participant, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
         QosSpec{true, 1, false, robotPartitionName(info.team, info.number)}));
     publishStatus(r);
+  }
+  if (world.scenario().perception.enabled) {
+    perception_ = std::make_unique<world::PerceptionSystem>(world, world.scenario().perception);
+    for (world::RobotId r = 0; r < world.robotCount(); ++r)
+      impl_->perceptions.push_back(std::make_unique<Writer<simsoccer_msg_Perception>>(
+          impl_->participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
+          QosSpec{true, 1, false, robotPartitionName(world.robot(r).team, world.robot(r).number)}));
   }
   const world::CameraSettings& cameras = world.scenario().cameras;
   if (cameras.enabled) {
@@ -478,6 +522,15 @@ void SimServer::runPeriod() {
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
     toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, impl_->frame_msg);
     impl_->frames[r]->write(impl_->frame_msg);
+  }
+  if (perception_) {
+    perception_->update(world_);
+    simsoccer_msg_Perception m{};
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+      toMessage(perception_->perception(r), robots_[r].team, robots_[r].player, m,
+                impl_->perceived_scratch);
+      impl_->perceptions[r]->write(m);
+    }
   }
   simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
   impl_->clock.write(clock);

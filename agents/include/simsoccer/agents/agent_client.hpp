@@ -35,6 +35,22 @@ struct CameraImageIn {
   std::vector<uint8_t> data;
 };
 
+// What the robot's cameras see (the Perception message, copied).
+struct PerceivedIn {
+  int kind = 0, team = -1;  // kind: 0 ball, 1 goal post, 2 robot
+  bool in_view = false;
+  float x = 0, y = 0;       // robot frame, m
+  double last_seen = -1.0;  // s
+};
+struct PerceptionIn {
+  uint64_t tick = 0;
+  double sim_time = 0.0;
+  PerceivedIn ball;
+  std::array<PerceivedIn, 4> posts;
+  std::vector<PerceivedIn> robots;
+  std::array<float, 3> self_pose{};  // x, y, yaw in the field frame
+};
+
 class AgentClient {
  public:
   AgentClient(const net::DomainConfig& dds, int team, int player);
@@ -70,6 +86,10 @@ class AgentClient {
   // this robot's teammates.
   void sendTeamMessage(std::span<const uint8_t> data);
   std::vector<TeamMessageIn> receiveTeamMessages();
+
+  // Takes the newest Perception of this robot that arrived since the last
+  // call; false if none did (the scenario must turn perception on).
+  bool perception(PerceptionIn& out);
 
   // Subscribes to this robot's camera images (the scenario must turn cameras
   // on; nothing is sent to an agent that does not subscribe).

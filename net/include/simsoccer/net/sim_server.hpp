@@ -13,6 +13,7 @@
 //   simsoccer_TeamMessageSend / simsoccer_TeamMessageDeliver
 //   simsoccer_WorldTruth    sim -> monitors (optional)
 //   simsoccer_CameraImage   sim -> agent, partition robot_<team>_<player> (cameras on)
+//   simsoccer_Perception    sim -> agent, partition robot_<team>_<player> (perception on)
 #pragma once
 
 #include <array>
@@ -26,6 +27,7 @@
 #include "simsoccer/net/dds.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/world/camera_system.hpp"
+#include "simsoccer/world/perception.hpp"
 #include "simsoccer/world/world.hpp"
 #include "simsoccer_msgs.h"
 
@@ -123,11 +125,16 @@ class SimServer {
   std::unique_ptr<Impl> impl_;
   std::vector<RobotSlot> robots_;
   ServerTimes times_;
+  std::unique_ptr<world::PerceptionSystem> perception_;  // null unless the scenario turns it on
   std::unique_ptr<world::CameraSystem> cameras_;  // declared last: stopped first
 };
 
 // The referee's GameController packet as the DDS GameState message.
 void toMessage(const referee::ControlData& d, uint64_t tick, simsoccer_msg_GameState& m);
+
+// A robot's perception as the wire message (`m.robots` points into `scratch`).
+void toMessage(const world::Perception& p, int team, int player, simsoccer_msg_Perception& m,
+               std::vector<simsoccer_msg_PerceivedObject>& scratch);
 
 // A camera image as the wire message (`m.data` points into `image.data`).
 void toMessage(const world::CameraImage& image, simsoccer_msg_CameraImage& m);
