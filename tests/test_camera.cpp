@@ -34,12 +34,6 @@ world::Scenario oneRobot() {
   return s;
 }
 
-void putBall(world::World& w, double x, double y) {
-  engine::RigidBodyState b;
-  b.pose.translation() = Vec3(x, y, w.field().ball.radius);
-  w.setBallState(b);
-}
-
 cv::Mat renderOne(world::World& w, const engine::RenderView& view, bool with_ball = true) {
   std::vector<engine::DrawItem> scene;
   world::buildRenderScene(w, scene);
@@ -91,7 +85,7 @@ TEST(Camera, BallAppearsWherePinholeModelPredicts) {
        {std::tuple{"CameraTop", -0.2, 1.5}, std::tuple{"CameraTop", 0.3, 1.9},
         std::tuple{"CameraTop", -0.5, 1.2}, std::tuple{"CameraBottom", -1.55, 1.5},
         std::tuple{"CameraBottom", -1.6, 1.62}}) {
-    putBall(w, x, y);
+    test::putBallOnCarpet(w, x, y);
     const bool top = std::string(camera) == "CameraTop";
     const engine::RenderView view =
         world::robotCameraView(w, 0, camera, top ? 640 : 320, top ? 480 : 240);
@@ -144,7 +138,7 @@ TEST(Camera, CarpetLinesAndJerseyColours) {
 
 TEST(Camera, TurningTheHeadShiftsTheImageAsPredicted) {
   world::World w(oneRobot());
-  putBall(w, -0.5, 2.0);  // 18 degrees to the robot's left
+  test::putBallOnCarpet(w, -0.5, 2.0);  // 18 degrees to the robot's left
   const Blob before = ballBlob(w, world::robotCameraView(w, 0, "CameraTop", 640, 480));
   const int head_yaw = w.robot(0).model->body->jointIndex("HeadYaw");
   w.setJointTarget(0, head_yaw, 0.5, 1.0);  // look 0.5 rad to the left
@@ -229,7 +223,7 @@ TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
 
 TEST(Camera, WritesTopCameraAndSpectatorPngs) {
   world::World w(test::scenario(10));
-  putBall(w, -1.5, 0.3);
+  test::putBallOnCarpet(w, -1.5, 0.3);
   std::vector<engine::RenderView> views = {world::robotCameraView(w, 0, "CameraTop", 640, 480)};
   engine::Pose side = engine::Pose::Identity();  // above the touchline, looking at the field
   side.translation() = Vec3(0.0, -5.5, 3.5);

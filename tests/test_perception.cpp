@@ -28,12 +28,6 @@ world::Scenario scene(int robots = 1) {
   return s;
 }
 
-void putBall(world::World& w, double x, double y) {
-  engine::RigidBodyState b;
-  b.pose.translation() = Vec3(x, y, w.field().ball.radius);
-  w.setBallState(b);
-}
-
 // The frustum by hand: the point in the camera frame (x forward, y left,
 // z up) within half the field of view each way.
 bool byHand(const world::World& w, const char* camera, const Vec3& p) {
@@ -53,7 +47,7 @@ TEST(Perception, InViewFlagsMatchTheFrustumsWorkedOutByHand) {
   int agree = 0, seen = 0, total = 0;
   for (double x = -3.5; x <= 1.0; x += 0.25)
     for (double y = -0.5; y <= 3.5; y += 0.25) {
-      putBall(w, x, y);
+      test::putBallOnCarpet(w, x, y);
       perception.update(w);
       const Vec3 ball = w.ballState().pose.translation();
       const bool expected = byHand(w, "CameraTop", ball) || byHand(w, "CameraBottom", ball);
@@ -79,13 +73,13 @@ TEST(Perception, RemembersWhereAndWhenTheBallWasLastSeenAndHeadTurnsBringItIn) {
   world::PerceptionSettings ideal;
   ideal.enabled = true;
   world::PerceptionSystem perception(w, ideal);
-  putBall(w, -1.0, 1.5);  // 1 m ahead
+  test::putBallOnCarpet(w, -1.0, 1.5);  // 1 m ahead
   perception.update(w);
   const auto seen = perception.perception(0).ball;
   ASSERT_TRUE(seen.in_view);
   EXPECT_NEAR(seen.x, 1.0, 0.02);
   w.stepControlPeriod();
-  putBall(w, -1.2, 2.8);  // 58 degrees to the left: outside both frustums
+  test::putBallOnCarpet(w, -1.2, 2.8);  // 58 degrees to the left: outside both frustums
   perception.update(w);
   const auto lost = perception.perception(0).ball;
   EXPECT_FALSE(lost.in_view);
@@ -95,7 +89,7 @@ TEST(Perception, RemembersWhereAndWhenTheBallWasLastSeenAndHeadTurnsBringItIn) {
   const int head_yaw = w.robot(0).model->body->jointIndex("HeadYaw");
   w.setJointTarget(0, head_yaw, 1.0, 1.0);
   for (int i = 0; i < 100; ++i) w.stepControlPeriod();
-  putBall(w, -1.2, 2.8);
+  test::putBallOnCarpet(w, -1.2, 2.8);
   perception.update(w);
   EXPECT_TRUE(perception.perception(0).ball.in_view);
   EXPECT_NEAR(perception.perception(0).ball.y, 1.3, 0.05);
@@ -134,7 +128,7 @@ TEST(Perception, RealisticProfileHasRangeOcclusionNoiseAndMissesAndIsSeeded) {
     p.enabled = true;
     p.realistic = true;
     world::PerceptionSystem perception(w, p);
-    putBall(w, ball_x, 1.5);
+    test::putBallOnCarpet(w, ball_x, 1.5);
     std::vector<double> distances;
     int seen = 0;
     for (int i = 0; i < 400; ++i) {

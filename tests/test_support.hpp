@@ -55,4 +55,11 @@ inline world::Scenario scenario(int robots, uint64_t seed = 1) {
   return s;
 }
 
+// The ball at rest on the carpet at (x, y).
+inline void putBallOnCarpet(world::World& w, double x, double y) {
+  engine::RigidBodyState b;
+  b.pose.translation() = engine::Vec3(x, y, w.field().ball.radius);
+  w.setBallState(b);
+}
+
 }  // namespace simsoccer::test
