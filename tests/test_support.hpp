@@ -7,6 +7,7 @@
 #include <string>
 
 #include "simsoccer/world/scenario.hpp"
+#include "simsoccer/world/world.hpp"
 
 namespace simsoccer::test {
 
