@@ -11,6 +11,7 @@
 
 #include "bench_scene.hpp"
 #include "cli.hpp"
+#include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -136,12 +137,68 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
   return r;
 }
 
+struct KickResult {
+  double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)
+  bool fell = false;
+};
+
+// One kick from the walk's stance with the ball in front of the kicking foot
+// (offset sideways by `ball_offset`); the ball's travel after 6 s.
+KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
+                const agents::KickParameters& kp) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  world::World w(s);
+  const auto& model = *w.robot(0).model;
+  agents::WalkEngine walk(model);
+  agents::KickEngine engine(model, walk.parameters(), kp);
+  std::vector<double> targets = model.pose("stand");
+  const std::vector<double> stand = targets;
+  std::vector<double> stance = targets;
+  walk.update(0.01, Vec3::Zero(), 0.0, stance);
+  auto send = [&] {
+    for (size_t j = 0; j < targets.size(); ++j)
+      if (model.body->joints[j].mimic_of < 0)
+        w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
+  };
+  for (int i = 0; i < 100; ++i) {
+    const double a = std::min(1.0, i / 50.0);
+    for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * stand[j] + a * stance[j];
+    send();
+    w.stepControlPeriod();
+  }
+  const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
+  const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
+  engine::RigidBodyState b;
+  b.pose.translation() = Vec3(f.x() + 0.1025 + w.field().ball.radius + 0.015, f.y() + ball_offset,
+                              w.field().ball.radius);
+  w.setBallState(b);
+  const Vec3 start = b.pose.translation();
+  engine.start(foot);
+  KickResult r;
+  for (int i = 0; i < 600; ++i) {
+    const auto& fr = w.sensorFrame(0);
+    if (engine.active()) {
+      engine.update(0.01, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
+      send();
+    }
+    w.stepControlPeriod();
+    r.fell = r.fell || !w.isStanding(0);
+  }
+  const Vec3 d = w.ballState().pose.translation() - start;
+  r.distance = std::hypot(d.x(), d.y());
+  r.direction = std::atan2(d.y(), d.x());
+  return r;
+}
+
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "verbose"},
-                    {"seconds", "csv", "vx", "vy", "turn", "sway", "lift", "period", "offset",
-                     "height", "gp", "gr", "lean", "hrc", "hg", "random-minutes", "seed"});
+  const Options opt(
+      argc, argv, first, {"help", "verbose", "kick"},
+      {"seconds", "csv",    "vx",    "vy",    "turn",  "sway", "lift", "period",
+       "offset",  "height", "gp",    "gr",    "lean",  "hrc",  "hg",   "random-minutes",
+       "seed",    "reach",  "swing", "shift", "klift", "back", "khrc", "foot"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   agents::WalkParameters wp;
@@ -155,6 +212,19 @@ int benchMotion(int argc, char** argv, int first) {
   wp.torso_lean = opt.number("lean", wp.torso_lean);
   wp.hip_roll_compensation = opt.number("hrc", wp.hip_roll_compensation);
   wp.heading_gain = opt.number("hg", wp.heading_gain);
+  if (opt.flag("kick")) {  // one kick, for tuning
+    agents::KickParameters kp;
+    kp.reach = opt.number("reach", kp.reach);
+    kp.swing_time = opt.number("swing", kp.swing_time);
+    kp.shift = opt.number("shift", kp.shift);
+    kp.lift = opt.number("klift", kp.lift);
+    kp.draw_back = opt.number("back", kp.draw_back);
+    kp.hip_roll_compensation = opt.number("khrc", kp.hip_roll_compensation);
+    const KickResult r = kick(opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
+                              opt.number("offset", 0), 1, kp);
+    std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
+    return 0;
+  }
   if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning
     const Eigen::Vector3d c(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0));
     const WalkResult r =
@@ -201,6 +271,24 @@ int benchMotion(int argc, char** argv, int first) {
         100.0 * std::abs(turned - w * seconds) / (w * seconds), r.fell, seconds);
   }
   {
+    // 20 kicks, 10 with each foot, the ball up to 2 cm either side of the
+    // foot's middle (seeded); a success: >= 3 m within 15 degrees of straight.
+    std::mt19937_64 rng(seed + 100);
+    double sum = 0, worst_angle = 0;
+    int ok = 0, falls = 0;
+    for (int i = 0; i < 20; ++i) {
+      const double offset = -0.02 + 0.04 * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+      const KickResult k = kick(i % 2 ? agents::Leg::Left : agents::Leg::Right, offset,
+                                seed + static_cast<uint64_t>(i), agents::KickParameters{});
+      sum += k.distance;
+      worst_angle = std::max(worst_angle, std::abs(k.direction));
+      ok += k.distance >= 3.0 && std::abs(k.direction) <= 15 * M_PI / 180;
+      falls += k.fell;
+    }
+    row("kick_distance", 3.0, sum / 20, "m", worst_angle * 180 / M_PI, falls, 20 * 9.0);
+    row("kick_success", 0.9, ok / 20.0, "share", 0, falls, 20 * 9.0);
+  }
+  {
     // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
     // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
     std::mt19937_64 rng(seed);
@@ -221,10 +309,11 @@ int benchMotion(int argc, char** argv, int first) {
   table.finish(
       "walk_forward: 0.25 m/s for 22 s (over 5 m), achieved = torso displacement / time (the speed "
       "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; "
-      "turn: "
-      "0.8 rad/s for 5 s; random_commands: a new random velocity every 2 s on an empty field, "
-      "falls "
-      "counted (the robot is put back up after each).",
+      "turn: 0.8 rad/s for 5 s; kick_distance: mean ball travel of 20 kicks (10 per foot, the "
+      "ball up to 2 cm sideways of the foot's middle), deviation = the largest angle off "
+      "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; random_commands: a new "
+      "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
+      "after each).",
       opt.get("csv", ""));
   return 0;
 }

@@ -1,0 +1,53 @@
+// A forward kick with either foot from the walk's stance, straight ahead
+// (aiming is the behaviour's part: it lines the robot up behind the ball;
+// swinging the foot diagonally was tried and the ball still left along the
+// foot's face): shift the torso over the support foot, lift and draw back the
+// kicking foot, swing it through, draw it back, put it down, shift back. Keyframes of the torso's
+// sideways offset and the kicking foot's offset (along the aim, and up), smoothly interpolated,
+// reach the joints through LegKinematics: joint targets only.
+#pragma once
+
+#include <vector>
+
+#include "simsoccer/agents/motion/walk_engine.hpp"
+
+namespace simsoccer::agents {
+
+struct KickParameters {
+  double shift = 0.052;       // m, torso towards the support foot
+  double lift = 0.035;        // m, kicking foot up
+  double draw_back = 0.06;    // m, behind its stance position
+  double reach = 0.11;        // m, ahead of it at the end of the swing
+  double shift_time = 0.6;    // s
+  double lift_time = 0.3;     // s
+  double swing_time = 0.07;   // s (the foot through the ball: as fast as the servos follow)
+  double retract_time = 0.3;  // s
+  double lower_time = 0.3;    // s
+  double return_time = 0.6;   // s
+  double hip_roll_compensation = 0.07;  // rad, the support hip's sag (see WalkParameters)
+};
+
+class KickEngine {
+ public:
+  KickEngine(const robots::RobotModel& model, const WalkParameters& stance = {},
+             const KickParameters& parameters = {});
+
+  // Starts a kick with `foot`.
+  void start(Leg foot);
+  bool active() const { return active_; }
+  double duration() const;
+  // Advances by dt and writes the legs' targets (body joint order).
+  void update(double dt, const Vec3& gyro, std::vector<double>& targets);
+
+ private:
+  LegKinematics kinematics_;
+  WalkParameters stance_;
+  KickParameters p_;
+  bool active_ = false;
+  Leg foot_ = Leg::Right;
+  double t_ = 0.0;
+  LegSolution last_{};
+  bool have_last_ = false;
+};
+
+}  // namespace simsoccer::agents
