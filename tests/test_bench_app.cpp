@@ -3,7 +3,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -11,6 +10,7 @@
 #include "test_support.hpp"
 
 using simsoccer::test::runCommand;
+namespace test = simsoccer::test;
 
 TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_test.csv";
@@ -24,15 +24,13 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("steps_per_s"), std::string::npos);
   EXPECT_NE(out.find("real_time_factor"), std::string::npos);
-  std::ifstream f(csv);
-  std::string header, row1, row2, extra;
-  std::getline(f, header);
-  std::getline(f, row1);
-  std::getline(f, row2);
+  const std::vector<std::string> lines = test::readLines(csv);
+  ASSERT_GE(lines.size(), 3u);
+  const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,", 0), 0u) << header;
   EXPECT_EQ(row1.rfind("1,", 0), 0u) << row1;
   EXPECT_EQ(row2.rfind("2,", 0), 0u) << row2;
-  EXPECT_FALSE(std::getline(f, extra) && !extra.empty());
+  EXPECT_FALSE(lines.size() > 3 && !lines[3].empty());  // no further rows
   // Both robots of the pair still stand: "2/2" in the standing column.
   EXPECT_NE(row2.find(",2/2,"), std::string::npos) << row2;
   std::filesystem::remove(csv);
@@ -80,11 +78,9 @@ TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
                                      status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
-  std::ifstream f(csv);
-  std::string header, row1, row2;
-  std::getline(f, header);
-  std::getline(f, row1);
-  std::getline(f, row2);
+  const std::vector<std::string> lines = test::readLines(csv);
+  ASSERT_GE(lines.size(), 3u);
+  const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,batched_us_rays9,reference_us_rays9,speedup_rays9", 0), 0u)
       << header;
   EXPECT_NE(header.find("speedup_rays32"), std::string::npos);
@@ -105,11 +101,9 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("llvmpipe"), std::string::npos) << "the renderer is named";
-  std::ifstream f(csv);
-  std::string header, row1, row2;
-  std::getline(f, header);
-  std::getline(f, row1);
-  std::getline(f, row2);
+  const std::vector<std::string> lines = test::readLines(csv);
+  ASSERT_GE(lines.size(), 3u);
+  const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header,
             "robots,views,views_per_s,ms_per_frame,ms_readback,ms_convert,rtf_cameras,"
             "rtf_physics_only,triangles_per_view,mbytes_per_sim_s,dropped");
@@ -134,12 +128,12 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
                  status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
-  std::ifstream f(csv);
-  std::string header, line;
-  std::getline(f, header);
-  EXPECT_EQ(header, "robots,test,commanded,achieved,unit,deviation_pct,falls,sim_seconds");
+  const std::vector<std::string> lines = test::readLines(csv);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "robots,test,commanded,achieved,unit,deviation_pct,falls,sim_seconds");
   std::map<std::string, std::vector<std::string>> rows;
-  while (std::getline(f, line)) {
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
     std::vector<std::string> cells;
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);

@@ -292,11 +292,9 @@ TEST(NetApps, BenchNetWritesItsTable) {
                  status);
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
-  std::ifstream f(csv);
-  std::string header, row1, row2;
-  std::getline(f, header);
-  std::getline(f, row1);
-  std::getline(f, row2);
+  const std::vector<std::string> lines = test::readLines(csv);
+  ASSERT_GE(lines.size(), 3u);
+  const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,overhead_ms_per_period", 0), 0u) << header;
   EXPECT_NE(header.find("bytes_per_tick"), std::string::npos);
   EXPECT_EQ(row1.rfind("1,", 0), 0u);

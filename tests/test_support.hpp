@@ -4,7 +4,9 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "simsoccer/world/scenario.hpp"
 #include "simsoccer/world/world.hpp"
@@ -61,6 +63,14 @@ inline void putBallOnCarpet(world::World& w, double x, double y) {
   engine::RigidBodyState b;
   b.pose.translation() = engine::Vec3(x, y, w.field().ball.radius);
   w.setBallState(b);
+}
+
+// The lines of a file (a benchmark's CSV: the header first); empty if it is missing.
+inline std::vector<std::string> readLines(const std::filesystem::path& file) {
+  std::ifstream f(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(f, line);) lines.push_back(line);
+  return lines;
 }
 
 }  // namespace simsoccer::test

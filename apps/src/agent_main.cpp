@@ -70,8 +70,7 @@ int main(int argc, char** argv) {
 
     // Walk mode: the walk engine writes the legs' targets (body joint order).
     agents::WalkEngine walk(model);
-    std::vector<double> targets = stand, walk_stance = stand;
-    walk.update(0.01, engine::Vec3::Zero(), 0.0, walk_stance);
+    std::vector<double> targets = stand;
     const double vx = opt.number("vx", 0.2), vy = opt.number("vy", 0.0),
                  turn = opt.number("turn", 0.0);
     double start_time = -1.0, last_time = 0.0;
@@ -100,10 +99,8 @@ int main(int argc, char** argv) {
         if (start_time < 0) start_time = last_time = frame.sim_time;
         const double t = frame.sim_time - start_time, dt = frame.sim_time - last_time;
         last_time = frame.sim_time;
-        if (t < 1.0) {  // ease from the stand pose into the walk's stance
-          const double a = std::min(1.0, 2.0 * t);
-          for (size_t j = 0; j < targets.size(); ++j)
-            targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
+        if (t < 1.0) {  // ease from the stand pose into the walk's stance, then hold it
+          walk.easeIn(stand, t, targets);
         } else {
           walk.setVelocity(vx, vy, turn);
           walk.update(dt > 0 ? dt : 0.01,

@@ -7,6 +7,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_scene.hpp"
@@ -28,7 +29,11 @@ const char* kHelp =
     "joint targets only (the agents' motion, in this process). Per test: commanded and achieved\n"
     "speed, path deviation, falls: forward 0.25 m/s over 5 m, sideways 0.1 m/s, turning 0.8\n"
     "rad/s, and M minutes (default 10) of random velocity commands.\n"
-    "With --vx/--vy/--turn: one walk at that command, for tuning.\n"
+    "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M]:\n"
+    "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
+    "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
+    "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
+    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll).\n"
     "  --csv FILE    also write the table as CSV\n";
 
 struct WalkResult {
@@ -52,33 +57,33 @@ world::Scenario emptyField() {
 // Commands (vx, vy, omega) as a function of time since the walk began.
 using Schedule = std::function<Eigen::Vector3d(double)>;
 
+// Joint targets (body joint order) as the robot's commands, full stiffness
+// (a mimic joint follows its master's command).
+void send(world::World& w, const std::vector<double>& targets) {
+  const auto& joints = w.robot(0).model->body->joints;
+  for (size_t j = 0; j < targets.size(); ++j)
+    if (joints[j].mimic_of < 0) w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
+}
+
+// 1 s from the stand pose into the walk's stance (eased in, then held).
+void settleIntoStance(world::World& w, agents::WalkEngine& engine, std::vector<double>& targets) {
+  const std::vector<double>& stand = w.robot(0).model->pose("stand");
+  const double dt = w.scenario().physics.control_period;
+  for (int i = 0; i < 100; ++i) {
+    engine.easeIn(stand, i * dt, targets);
+    send(w, targets);
+    w.stepControlPeriod();
+  }
+}
+
 WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
                 const agents::WalkParameters& wp, int* falls = nullptr) {
   world::World w(emptyField());
   const auto& model = *w.robot(0).model;
   agents::WalkEngine engine(model, wp);
   std::vector<double> targets = model.pose("stand");
-  std::vector<double> stiffness(targets.size(), 1.0);
   const double dt = w.scenario().physics.control_period;
-  auto send = [&] {
-    for (size_t j = 0; j < targets.size(); ++j)
-      if (model.body->joints[j].mimic_of < 0)
-        w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
-  };
-  // Settle into the walk's stance over 1 s.
-  const std::vector<double> stand = targets;
-  std::vector<double> walk_stance = targets;
-  engine.update(dt, Vec3::Zero(), 0.0, walk_stance);
-  auto settle = [&] {
-    for (int i = 0; i < 100; ++i) {
-      const double a = std::min(1.0, i / 50.0);
-      for (size_t j = 0; j < targets.size(); ++j)
-        targets[j] = (1 - a) * stand[j] + a * walk_stance[j];
-      send();
-      w.stepControlPeriod();
-    }
-  };
-  settle();
+  settleIntoStance(w, engine, targets);
   const engine::Pose start = w.torsoPose(0);
   const Eigen::Vector3d first = schedule(0.0);
   const double vx = first.x(), vy = first.y();
@@ -89,7 +94,7 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
     engine.setVelocity(c.x(), c.y(), c.z());
     const auto& f = w.sensorFrame(0);
     engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
-    send();
+    send(w, targets);
     w.stepControlPeriod();
     if (!w.isStanding(0)) {
       r.fell = true;
@@ -108,23 +113,14 @@ WalkResult walk(const Schedule& schedule, double seconds, bool verbose,
       w.placeRobot(0, t.translation().x(), t.translation().y(),
                    std::atan2(t.linear()(1, 0), t.linear()(0, 0)));
       engine = agents::WalkEngine(model, wp);
-      settle();  // as at the start: into the walk's stance, then on
+      settleIntoStance(w, engine, targets);  // as at the start, then on
       continue;
     }
-    if (verbose && (i < 60 || i % 25 == 0)) {
-      const auto t = w.torsoPose(0);
-      const int hr = model.body->jointIndex("RHipRoll"), lk = model.body->jointIndex("LKneePitch");
-      std::fprintf(stderr, "   RHipRoll cmd %.3f act %.3f  LKnee cmd %.3f act %.3f\n", targets[hr],
-                   w.jointPosition(0, hr), targets[lk], w.jointPosition(0, lk));
-      const Vec3 lf = w.linkPose(0, model.body->linkIndex("LFoot")).translation();
-      const Vec3 rf = w.linkPose(0, model.body->linkIndex("RFoot")).translation();
-      std::fprintf(stderr,
-                   "t %.2f ph %.2f sup %d torso %.3f %.3f %.3f  odo %.3f  weight L %.1f R %.1f  LF "
-                   "%.3f %.3f RF %.3f %.3f\n",
-                   i * dt, engine.phase(), static_cast<int>(engine.supportLeg()),
-                   t.translation().x(), t.translation().y(), t.translation().z(),
-                   engine.odometry().x, f.foot_weight[0], f.foot_weight[1], lf.x(), lf.z(), rf.x(),
-                   rf.z());
+    if (verbose && i % 25 == 0) {  // a trace every 0.25 s, for tuning
+      const Vec3 t = w.torsoPose(0).translation();
+      std::fprintf(stderr, "t %.2f torso %.3f %.3f %.3f  odometry %.3f  feet %.1f / %.1f N\n",
+                   i * dt, t.x(), t.y(), t.z(), engine.odometry().x, f.foot_weight[0],
+                   f.foot_weight[1]);
     }
   }
   const engine::Pose end = w.torsoPose(0);
@@ -145,28 +141,15 @@ struct KickResult {
 // One kick from the walk's stance with the ball in front of the kicking foot
 // (offset sideways by `ball_offset`); the ball's travel after 6 s.
 KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
-                const agents::KickParameters& kp) {
+                const agents::WalkParameters& wp, const agents::KickParameters& kp) {
   world::Scenario s = emptyField();
   s.seed = seed;
   world::World w(s);
   const auto& model = *w.robot(0).model;
-  agents::WalkEngine walk(model);
-  agents::KickEngine engine(model, walk.parameters(), kp);
+  agents::WalkEngine walk(model, wp);
+  agents::KickEngine engine(model, wp, kp);
   std::vector<double> targets = model.pose("stand");
-  const std::vector<double> stand = targets;
-  std::vector<double> stance = targets;
-  walk.update(0.01, Vec3::Zero(), 0.0, stance);
-  auto send = [&] {
-    for (size_t j = 0; j < targets.size(); ++j)
-      if (model.body->joints[j].mimic_of < 0)
-        w.setJointTarget(0, static_cast<int>(j), targets[j], 1.0);
-  };
-  for (int i = 0; i < 100; ++i) {
-    const double a = std::min(1.0, i / 50.0);
-    for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * stand[j] + a * stance[j];
-    send();
-    w.stepControlPeriod();
-  }
+  settleIntoStance(w, walk, targets);
   const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
   const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
   engine::RigidBodyState b;
@@ -180,7 +163,7 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
     const auto& fr = w.sensorFrame(0);
     if (engine.active()) {
       engine.update(0.01, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
-      send();
+      send(w, targets);
     }
     w.stepControlPeriod();
     r.fell = r.fell || !w.isStanding(0);
@@ -194,34 +177,36 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
-  const Options opt(
-      argc, argv, first, {"help", "verbose", "kick"},
-      {"seconds", "csv",    "vx",    "vy",    "turn",  "sway", "lift", "period",
-       "offset",  "height", "gp",    "gr",    "lean",  "hrc",  "hg",   "random-minutes",
-       "seed",    "reach",  "swing", "shift", "klift", "back", "khrc", "foot"});
+  // Tuning knobs: the walk's and the kick's parameters by name.
+  agents::WalkParameters wp;
+  agents::KickParameters kp;
+  const std::vector<std::pair<std::string, double*>> knobs{
+      {"sway", &wp.sway},
+      {"lift", &wp.foot_lift},
+      {"period", &wp.step_period},
+      {"torso-offset", &wp.torso_offset},
+      {"height", &wp.ankle_height},
+      {"ankle-pitch-gyro", &wp.ankle_pitch_gyro},
+      {"ankle-roll-gyro", &wp.ankle_roll_gyro},
+      {"lean", &wp.torso_lean},
+      {"hip-roll", &wp.hip_roll_compensation},
+      {"heading-gain", &wp.heading_gain},
+      {"kick-reach", &kp.reach},
+      {"kick-swing", &kp.swing_time},
+      {"kick-shift", &kp.shift},
+      {"kick-lift", &kp.lift},
+      {"kick-draw-back", &kp.draw_back},
+      {"kick-hip-roll", &kp.hip_roll_compensation}};
+  std::vector<std::string> valued{"seconds",        "csv",  "vx",   "vy",         "turn",
+                                  "random-minutes", "seed", "foot", "ball-offset"};
+  for (const auto& k : knobs) valued.push_back(k.first);
+  const Options opt(argc, argv, first, {"help", "verbose", "kick"}, valued);
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
-  agents::WalkParameters wp;
-  wp.sway = opt.number("sway", wp.sway);
-  wp.foot_lift = opt.number("lift", wp.foot_lift);
-  wp.step_period = opt.number("period", wp.step_period);
-  wp.torso_offset = opt.number("offset", wp.torso_offset);
-  wp.ankle_height = opt.number("height", wp.ankle_height);
-  wp.ankle_pitch_gyro = opt.number("gp", wp.ankle_pitch_gyro);
-  wp.ankle_roll_gyro = opt.number("gr", wp.ankle_roll_gyro);
-  wp.torso_lean = opt.number("lean", wp.torso_lean);
-  wp.hip_roll_compensation = opt.number("hrc", wp.hip_roll_compensation);
-  wp.heading_gain = opt.number("hg", wp.heading_gain);
+  for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
   if (opt.flag("kick")) {  // one kick, for tuning
-    agents::KickParameters kp;
-    kp.reach = opt.number("reach", kp.reach);
-    kp.swing_time = opt.number("swing", kp.swing_time);
-    kp.shift = opt.number("shift", kp.shift);
-    kp.lift = opt.number("klift", kp.lift);
-    kp.draw_back = opt.number("back", kp.draw_back);
-    kp.hip_roll_compensation = opt.number("khrc", kp.hip_roll_compensation);
     const KickResult r = kick(opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
-                              opt.number("offset", 0), 1, kp);
+                              opt.number("ball-offset", 0), 1, wp, kp);
     std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
     return 0;
   }
@@ -279,7 +264,7 @@ int benchMotion(int argc, char** argv, int first) {
     for (int i = 0; i < 20; ++i) {
       const double offset = -0.02 + 0.04 * static_cast<double>(rng() >> 11) * 0x1.0p-53;
       const KickResult k = kick(i % 2 ? agents::Leg::Left : agents::Leg::Right, offset,
-                                seed + static_cast<uint64_t>(i), agents::KickParameters{});
+                                seed + static_cast<uint64_t>(i), wp, kp);
       sum += k.distance;
       worst_angle = std::max(worst_angle, std::abs(k.direction));
       ok += k.distance >= 3.0 && std::abs(k.direction) <= 15 * M_PI / 180;

@@ -22,24 +22,6 @@ engine::Pose robotFrame(const World& world, RobotId r) {
   return f;
 }
 
-// Whether the segment from `a` to `b` passes through a robot's body,
-// approximated by a vertical cylinder (radius 0.12 m, up to 0.58 m).
-bool blockedByRobot(const World& world, RobotId skip_a, RobotId skip_b, const Vec3& a,
-                    const Vec3& b) {
-  for (RobotId r = 0; r < world.robotCount(); ++r) {
-    if (r == skip_a || r == skip_b) continue;
-    const Vec3 c = world.torsoPose(r).translation();
-    // Closest approach in the ground plane along the segment.
-    const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y()), d2(b.x() - a.x(), b.y() - a.y());
-    const double len2 = d2.squaredNorm();
-    const double t = len2 > 0 ? std::clamp(-a2.dot(d2) / len2, 0.0, 1.0) : 0.0;
-    if ((a2 + t * d2).norm() > 0.12) continue;
-    const double z = a.z() + t * (b.z() - a.z());
-    if (t > 0.02 && t < 0.98 && z < 0.58) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 PerceptionSystem::PerceptionSystem(const World& world, const PerceptionSettings& settings)
@@ -72,28 +54,43 @@ double PerceptionSystem::uniform() {
   return static_cast<double>(uniform_() >> 11) * 0x1.0p-53;
 }
 
-bool PerceptionSystem::inFrustum(const World& world, RobotId r, int camera, const Vec3& point) {
-  const engine::RenderView v =
-      robotCameraView(world, r, kCameras[camera], kSize[camera][0], kSize[camera][1]);
+bool PerceptionSystem::inFrustum(const engine::RenderView& v, const Vec3& point) {
   double u = 0, w = 0;
   if (!engine::projectPoint(v, point, u, w)) return false;
   return u >= 0 && u < v.width && w >= 0 && w < v.height;
 }
 
-void PerceptionSystem::observe(const World& world, RobotId r, const Vec3& point, double range,
-                               PerceivedObject& object, const engine::Pose& frame, RobotId skip) {
+// Whether the segment from `a` to `b` passes through a robot's body,
+// approximated by a vertical cylinder (radius 0.12 m, up to 0.58 m).
+bool PerceptionSystem::blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3& a,
+                                      const Vec3& b) const {
+  for (RobotId r = 0; r < torsos_.size(); ++r) {
+    if (r == skip_a || r == skip_b) continue;
+    const Vec3& c = torsos_[r];
+    // Closest approach in the ground plane along the segment.
+    const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y()), d2(b.x() - a.x(), b.y() - a.y());
+    const double len2 = d2.squaredNorm();
+    const double t = len2 > 0 ? std::clamp(-a2.dot(d2) / len2, 0.0, 1.0) : 0.0;
+    if ((a2 + t * d2).norm() > 0.12) continue;
+    const double z = a.z() + t * (b.z() - a.z());
+    if (t > 0.02 && t < 0.98 && z < 0.58) return true;
+  }
+  return false;
+}
+
+void PerceptionSystem::observe(const World& world, const Viewpoint& from, const Vec3& point,
+                               double range, PerceivedObject& object, RobotId skip) {
   object.in_view = false;
   int camera = -1;
   for (int c = 0; c < 2 && camera < 0; ++c)
-    if (inFrustum(world, r, c, point)) camera = c;
+    if (inFrustum(from.cameras[static_cast<size_t>(c)], point)) camera = c;
   if (camera < 0) return;
-  const Vec3 rel = frame.inverse() * point;
+  const Vec3 rel = from.frame.inverse() * point;
   const double distance = std::hypot(rel.x(), rel.y());
   if (settings_.realistic) {
     if (distance > range) return;
-    const Vec3 eye = world.linkPose(r, world.robot(r).model->sensor(kCameras[camera])->link) *
-                     world.robot(r).model->sensor(kCameras[camera])->pose.translation();
-    if (blockedByRobot(world, r, skip, eye, point)) return;
+    const Vec3 eye = from.cameras[static_cast<size_t>(camera)].pose.translation();
+    if (blockedByRobot(from.robot, skip, eye, point)) return;
     if (uniform() < settings_.miss_base + settings_.miss_per_metre * distance) return;
     const double d = distance * (1.0 + settings_.distance_noise * noise_());
     const double bearing = std::atan2(rel.y(), rel.x()) + settings_.bearing_noise * noise_();
@@ -112,11 +109,17 @@ void PerceptionSystem::update(const World& world) {
   if (!settings_.enabled) return;
   const uint64_t tick = world.stepCount() / static_cast<uint64_t>(world.stepsPerControlPeriod());
   const Vec3 ball = world.ballState().pose.translation();
+  torsos_.resize(world.robotCount());
+  for (RobotId r = 0; r < world.robotCount(); ++r) torsos_[r] = world.torsoPose(r).translation();
   for (RobotId r = 0; r < world.robotCount(); ++r) {
     Perception& p = state_[r];
     p.tick = tick;
     p.time = world.time();
-    const engine::Pose frame = robotFrame(world, r);
+    // The robot's frame and camera views, once for all the objects it looks at.
+    Viewpoint from{r, robotFrame(world, r), {}};
+    for (size_t c = 0; c < 2; ++c)
+      from.cameras[c] = robotCameraView(world, r, kCameras[c], kSize[c][0], kSize[c][1]);
+    const engine::Pose& frame = from.frame;
     // Where the robot thinks it is.
     const double yaw = std::atan2(frame.linear()(1, 0), frame.linear()(0, 0));
     p.self_x = frame.translation().x();
@@ -127,7 +130,7 @@ void PerceptionSystem::update(const World& world) {
       p.self_y += settings_.pose_noise_xy * noise_();
       p.self_yaw = std::remainder(p.self_yaw + settings_.pose_noise_yaw * noise_(), 2 * M_PI);
     }
-    observe(world, r, ball, settings_.ball_range, p.ball, frame, r);
+    observe(world, from, ball, settings_.ball_range, p.ball, r);
     if (settings_.realistic && !p.ball.in_view && uniform() < settings_.false_ball_rate) {
       // A false ball somewhere ahead (a white robot part, a line crossing).
       const double d = 0.5 + 3.0 * uniform(), b = (uniform() - 0.5) * 1.0;
@@ -138,12 +141,11 @@ void PerceptionSystem::update(const World& world) {
       p.ball.last_seen = world.time();
     }
     for (size_t k = 0; k < posts_.size(); ++k)
-      observe(world, r, posts_[k], settings_.post_range, p.posts[k], frame, r);
+      observe(world, from, posts_[k], settings_.post_range, p.posts[k], r);
     size_t i = 0;
     for (RobotId o = 0; o < world.robotCount(); ++o) {
       if (o == r) continue;
-      observe(world, r, world.torsoPose(o).translation(), settings_.robot_range, p.robots[i++],
-              frame, o);
+      observe(world, from, torsos_[o], settings_.robot_range, p.robots[i++], o);
     }
   }
 }

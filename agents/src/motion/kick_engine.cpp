@@ -84,13 +84,7 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
   sq[1] += (foot_ == Leg::Left ? -1.0 : 1.0) * p_.hip_roll_compensation * shift;
   sq[4] += stance_.ankle_pitch_gyro * gyro.y();
   sq[5] += stance_.ankle_roll_gyro * gyro.x();
-  for (int leg = 0; leg < 2; ++leg) {
-    const Leg l = leg == 0 ? Leg::Left : Leg::Right;
-    const LegAngles& q = leg == 0 ? out.left : out.right;
-    for (int i = 0; i < 6; ++i)
-      targets[static_cast<size_t>(kinematics_.joints(l)[i])] =
-          std::clamp(q[i], kinematics_.lower(l, i), kinematics_.upper(l, i));
-  }
+  kinematics_.writeTargets(out, targets);
 }
 
 }  // namespace simsoccer::agents

@@ -183,4 +183,13 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
   return s;
 }
 
+void LegKinematics::writeTargets(const LegSolution& legs, std::vector<double>& targets) const {
+  for (int side = 0; side < 2; ++side) {
+    const Chain& c = legs_[static_cast<size_t>(side)];
+    const LegAngles& q = side == 0 ? legs.left : legs.right;
+    for (int i = 0; i < 6; ++i)
+      targets[static_cast<size_t>(c.joint[i])] = std::clamp(q[i], c.lower[i], c.upper[i]);
+  }
+}
+
 }  // namespace simsoccer::agents

@@ -97,11 +97,11 @@ LegSolution WalkEngine::solve(const Pose2& body, double sway_y, const Pose2& lef
   return s;
 }
 
-LegSolution WalkEngine::standingLegs() const {
-  WalkEngine copy = *this;
-  copy.have_last_ = false;
-  return copy.solve(body_, 0.0, compose(body_, 0.0, 0.5 * p_.step_width, 0.0),
-                    compose(body_, 0.0, -0.5 * p_.step_width, 0.0), 0.0, 0.0);
+void WalkEngine::easeIn(const std::vector<double>& from, double t, std::vector<double>& targets) {
+  std::vector<double> stance = from;
+  kinematics_.writeTargets(solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0), stance);
+  const double a = std::clamp(t / kEaseTime, 0.0, 1.0);
+  for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * from[j] + a * stance[j];
 }
 
 void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets) {
@@ -158,13 +158,7 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
     q[4] += p_.ankle_pitch_gyro * gyro_filtered_.y();
     q[5] += p_.ankle_roll_gyro * gyro_filtered_.x();
   }
-  for (int leg = 0; leg < 2; ++leg) {
-    const Leg l = leg == 0 ? Leg::Left : Leg::Right;
-    const LegAngles& q = leg == 0 ? s.left : s.right;
-    for (int i = 0; i < 6; ++i)
-      targets[static_cast<size_t>(kinematics_.joints(l)[i])] =
-          std::clamp(q[i], kinematics_.lower(l, i), kinematics_.upper(l, i));
-  }
+  kinematics_.writeTargets(s, targets);
 }
 
 }  // namespace simsoccer::agents

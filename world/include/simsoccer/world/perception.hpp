@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "simsoccer/engine/offscreen_renderer.hpp"
 #include "simsoccer/engine/random.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -48,18 +49,25 @@ class PerceptionSystem {
   const Perception& perception(RobotId r) const { return state_.at(r); }
   const PerceptionSettings& settings() const { return settings_; }
 
-  // Whether a field-frame point is inside robot r's camera `camera` (0 top,
-  // 1 bottom) frustum (and in front of it).
-  static bool inFrustum(const World& world, RobotId r, int camera, const Vec3& point);
+  // Whether a field-frame point is inside a camera view's frustum (and in front of it).
+  static bool inFrustum(const engine::RenderView& view, const Vec3& point);
 
  private:
-  void observe(const World& world, RobotId r, const Vec3& point, double range,
-               PerceivedObject& object, const engine::Pose& robot_frame, RobotId skip);
+  // One robot's view of the world this period: its frame and its cameras.
+  struct Viewpoint {
+    RobotId robot;
+    engine::Pose frame;  // robot frame in the field
+    std::array<engine::RenderView, 2> cameras;
+  };
+  void observe(const World& world, const Viewpoint& from, const Vec3& point, double range,
+               PerceivedObject& object, RobotId skip);
+  bool blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3& a, const Vec3& b) const;
 
   PerceptionSettings settings_;
   std::vector<Perception> state_;
   std::array<Vec3, 4> posts_;
-  double uniform();  // [0, 1), the same on every standard library
+  std::vector<Vec3> torsos_;  // every robot's torso this period (occlusion)
+  double uniform();           // [0, 1), the same on every standard library
   engine::NormalSampler noise_;
   std::mt19937_64 uniform_;
 };

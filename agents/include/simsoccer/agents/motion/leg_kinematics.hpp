@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "simsoccer/robots/robot_model.hpp"
 
@@ -42,6 +43,10 @@ class LegKinematics {
   // limits. `start` (e.g. the last solution) speeds convergence up.
   LegSolution inverse(const Pose& left_foot, const Pose& right_foot,
                       const LegSolution* start = nullptr) const;
+
+  // Writes both legs' angles into `targets` (one per body joint), clamped to
+  // the joint limits.
+  void writeTargets(const LegSolution& legs, std::vector<double>& targets) const;
 
   // Body joint indices of a leg's six joints (for commands and sensor frames).
   const std::array<int, 6>& joints(Leg leg) const { return legs_[static_cast<size_t>(leg)].joint; }

@@ -79,8 +79,11 @@ class WalkEngine {
   Leg supportLeg() const { return support_; }
   const LegKinematics& kinematics() const { return kinematics_; }
   const WalkParameters& parameters() const { return p_; }
-  // The standing leg angles the walk starts from and ends in.
-  LegSolution standingLegs() const;
+  // Before the first step: the legs' targets eased from `from` (body joint
+  // angles, e.g. the model's stand pose) into the walk's stance, fully there
+  // after `kEaseTime` (`t`: seconds since easing began).
+  static constexpr double kEaseTime = 0.5;
+  void easeIn(const std::vector<double>& from, double t, std::vector<double>& targets);
 
  private:
   void startStep();
