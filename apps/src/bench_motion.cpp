@@ -13,6 +13,7 @@
 #include "bench_scene.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
+#include "simsoccer/agents/motion/motion_controller.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -34,6 +35,8 @@ const char* kHelp =
     "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
     "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
     "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll).\n"
+    "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
+    "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
     "  --csv FILE    also write the table as CSV\n";
 
 struct WalkResult {
@@ -174,6 +177,68 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
   return r;
 }
 
+struct GetUpResult {
+  bool success = false;
+  double seconds = -1.0;  // from lying still on the ground to standing in the stance
+  int attempts = 0;
+};
+
+// One get-up trial: the robot dropped on its front or back (seeded heading,
+// spot and joint jitter), the motion controller (fall detector, get-up,
+// stance) given 12 s with a "stand" request. Success: standing (world truth)
+// in the controller's stance within the time.
+GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, bool verbose) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  world::World w(s);
+  const auto& model = *w.robot(0).model;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double yaw = M_PI * u(rng);
+  engine::Pose torso = engine::Pose::Identity();
+  torso.linear() = (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
+                    Eigen::AngleAxisd((front ? 1 : -1) * (M_PI / 2 + 0.1 * u(rng)), Vec3::UnitY()))
+                       .toRotationMatrix();
+  torso.translation() = Vec3(-3.0 + 0.5 * u(rng), 0.5 * u(rng), 0.16);
+  w.placeRobot(0, torso, "stand");
+  agents::MotionController motion(model,
+                                  agents::loadKeyframeMotion(motions_dir + "/get_up_front.yaml", model),
+                                  agents::loadKeyframeMotion(motions_dir + "/get_up_back.yaml", model));
+  std::vector<float> position(25), stiffness(25);
+  const auto& joints = model.body->joints;
+  const double dt = w.scenario().physics.control_period;
+  // Lying limp for 1 s first (as after a fall), then the controller takes over.
+  for (int i = 0; i < 100; ++i) {
+    for (size_t j = 0; j < joints.size(); ++j)
+      if (joints[j].mimic_of < 0)
+        w.setJointTarget(0, static_cast<int>(j), w.jointPosition(0, static_cast<int>(j)), 0.1);
+    w.stepControlPeriod();
+  }
+  GetUpResult r;
+  double standing_for = 0.0;
+  for (int i = 0; i < 1200; ++i) {
+    agents::MotionRequest stand;
+    motion.update(dt, agents::motionSensors(w.sensorFrame(0)), stand, position, stiffness);
+    std::vector<double> p(position.begin(), position.end()), k(stiffness.begin(), stiffness.end());
+    w.setCommand(0, p, k);
+    w.stepControlPeriod();
+    if (verbose && i % 10 == 0) {
+      const engine::Pose t = w.torsoPose(0);
+      std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f\n", i * dt,
+                   agents::motionStateName(motion.state()), motion.tilt(), t.translation().z());
+    }
+    const bool stance = motion.state() == agents::MotionState::Stance;
+    standing_for = stance && w.isStanding(0) ? standing_for + dt : 0.0;
+    if (standing_for >= 1.0) {
+      r.success = true;
+      r.seconds = (i + 1) * dt - 1.0;
+      break;
+    }
+  }
+  r.attempts = motion.counters().get_ups + motion.counters().failed_get_ups;
+  return r;
+}
+
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
@@ -198,12 +263,22 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation}};
   std::vector<std::string> valued{"seconds",        "csv",  "vx",   "vy",         "turn",
-                                  "random-minutes", "seed", "foot", "ball-offset"};
+                                  "random-minutes", "seed", "foot", "ball-offset", "get-up", "get-up-trials"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first, {"help", "verbose", "kick"}, valued);
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
+  const std::string motions_dir = findConfig("", "configs/motions").string();
+  if (opt.has("get-up")) {  // one get-up, for tuning
+    const std::string side = opt.get("get-up", "");
+    if (side != "front" && side != "back") throw UsageError("--get-up must be front or back");
+    const GetUpResult r = getUp(side == "front", static_cast<uint64_t>(opt.number("seed", 1)),
+                                motions_dir, opt.flag("verbose"));
+    std::printf("get-up from the %s: %s in %.2f s, %d attempts\n", side.c_str(),
+                r.success ? "standing" : "FAILED", r.seconds, r.attempts);
+    return 0;
+  }
   if (opt.flag("kick")) {  // one kick, for tuning
     const KickResult r = kick(opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
                               opt.number("ball-offset", 0), 1, wp, kp);
@@ -274,6 +349,22 @@ int benchMotion(int argc, char** argv, int first) {
     row("kick_success", 0.9, ok / 20.0, "share", 0, falls, 20 * 9.0);
   }
   {
+    // Get-up: N trials from each side (seeded heading, spot, tilt); success:
+    // standing in the stance within 12 s of lying still.
+    const int trials = static_cast<int>(opt.number("get-up-trials", 20));
+    for (const bool front : {true, false}) {
+      int ok = 0;
+      double worst = 0.0;
+      for (int i = 0; i < trials; ++i) {
+        const GetUpResult g = getUp(front, seed + 200 + static_cast<uint64_t>(i), motions_dir, false);
+        ok += g.success && g.seconds < 8.0;
+        worst = std::max(worst, g.success ? g.seconds : 12.0);
+      }
+      row(front ? "get_up_front" : "get_up_back", 0.95, ok / std::max(1.0, double(trials)),
+          "share", worst, 0, trials * 13.0);
+    }
+  }
+  {
     // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
     // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
     std::mt19937_64 rng(seed);
@@ -296,7 +387,10 @@ int benchMotion(int argc, char** argv, int first) {
       "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; "
       "turn: 0.8 rad/s for 5 s; kick_distance: mean ball travel of 20 kicks (10 per foot, the "
       "ball up to 2 cm sideways of the foot's middle), deviation = the largest angle off "
-      "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; random_commands: a new "
+      "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; get_up_front / "
+      "get_up_back: share of trials (robot dropped on its front / back, seeded) standing in the "
+      "stance within 8 s, deviation column = the slowest trial's seconds (12: failed); "
+      "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
       "after each).",
       opt.get("csv", ""));

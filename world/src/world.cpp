@@ -232,6 +232,13 @@ void World::placeRobot(RobotId r, double x, double y, double yaw, const std::str
   holdJoints(r, q, 1.0);
 }
 
+void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture) {
+  const RobotInfo& info = robots_.at(r);
+  const std::vector<double>& q = info.model->pose(posture);
+  physics_->resetArticulation(info.body, torso, q);
+  holdJoints(r, q, 1.0);
+}
+
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {
   const Pose torso = torsoPose(r);
   const double up_z = torso.linear()(2, 2);

@@ -98,6 +98,9 @@ class World {
   // Teleports a robot upright onto the carpet at (x, y, yaw) in a named pose,
   // at rest, holding that pose (a referee placing or removing a robot).
   void placeRobot(RobotId r, double x, double y, double yaw, const std::string& posture = "stand");
+  // Puts the robot's torso at `torso` (field frame) with its joints in `posture`, at rest
+  // (e.g. lying on the ground for get-up trials; the caller keeps it clear of the ground).
+  void placeRobot(RobotId r, const Pose& torso, const std::string& posture);
 
   // The sensor frame of the last completed control period (stays the
   // initial one when the scenario turns sensors off).

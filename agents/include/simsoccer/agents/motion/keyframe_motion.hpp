@@ -1,0 +1,51 @@
+// Keyframe motions (get-up from the front or the back, ...) as data: a
+// sequence of whole-body joint targets, each reached from the one before
+// over its duration with a smoothstep, the first from wherever the joints
+// are when the motion starts. Files: configs/motions/*.yaml.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "simsoccer/robots/robot_model.hpp"
+
+namespace simsoccer::agents {
+
+struct Keyframe {
+  double duration = 0.5;         // s to reach this frame from the previous one
+  double stiffness = 1.0;        // 0..1, every joint while moving to this frame
+  std::vector<double> position;  // per body joint, rad
+};
+
+struct KeyframeMotion {
+  std::string name;
+  std::vector<Keyframe> frames;
+  double duration() const;
+};
+
+// Reads a motion for `model`: frames: [{duration, stiffness, pose: NAME (a
+// pose of the robot model), joints: {Name: rad, ...}}]. A frame starts from
+// the previous frame (the first from the model's `stand` pose) or from its
+// `pose`, then sets its `joints`; mimic joints follow their masters. Throws
+// engine::ConfigError (file, key, reason).
+KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
+                                  const robots::RobotModel& model);
+
+// Plays one motion: start() with the measured joint angles, then update()
+// every control period until done().
+class KeyframePlayer {
+ public:
+  void start(const KeyframeMotion& motion, const std::vector<double>& measured);
+  bool active() const { return motion_ != nullptr; }
+  double elapsed() const { return t_; }
+  // Advances by dt and writes targets (per body joint) and the stiffness.
+  void update(double dt, std::vector<double>& targets, double& stiffness);
+
+ private:
+  const KeyframeMotion* motion_ = nullptr;
+  std::vector<double> from_;
+  double t_ = 0.0;
+};
+
+}  // namespace simsoccer::agents

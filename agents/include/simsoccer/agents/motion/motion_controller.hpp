@@ -1,0 +1,116 @@
+// The motion layer of an agent: takes what the behaviour wants (stand, walk
+// at a velocity, kick with a foot, where the head looks) and the robot's
+// sensors, and produces the joint targets and stiffnesses for one control
+// period. It owns the walk, the kick and the get-up motions, switches
+// between them only where that is safe (a kick from a standing stance, the
+// walk stopped first), and runs the fall detector: while the robot falls its
+// joints go soft (safe stiffness), once it lies still it gets up from the
+// front or the back (keyframe motions), and then eases back into the stance.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "simsoccer/agents/motion/keyframe_motion.hpp"
+#include "simsoccer/agents/motion/kick_engine.hpp"
+#include "simsoccer/agents/motion/walk_engine.hpp"
+
+namespace simsoccer::agents {
+
+struct MotionRequest {
+  enum class Kind { Stand, Walk, Kick };
+  Kind kind = Kind::Stand;
+  double forward = 0.0, left = 0.0, turn = 0.0;  // m/s, m/s, rad/s (robot frame)
+  Leg kick_foot = Leg::Right;
+  double head_yaw = 0.0, head_pitch = 0.0;  // rad
+};
+
+// What the motion layer reads each period (filled from a SensorFrame).
+struct MotionSensors {
+  std::span<const float> position;  // rad, actuator order
+  Vec3 gyro = Vec3::Zero();         // rad/s, torso frame
+  Vec3 accel = Vec3(0, 0, 9.81);    // m/s^2, torso frame (specific force)
+  double yaw = 0.0;                 // rad, the IMU's torso yaw
+};
+
+struct FallDetectorParameters {
+  double falling_tilt = 0.65;     // rad from upright: the robot is falling
+  double lying_tilt = 1.0;        // rad: it lies ...
+  double lying_rate = 0.6;        // rad/s: ... once it turns slower than this ...
+  double lying_time = 0.3;        // s ... for this long
+  double upright_tilt = 0.35;     // rad: a get-up that ends within this succeeded
+  double safe_stiffness = 0.15;   // while falling and lying
+  double head_stiffness = 0.6;    // the head's stiffness in normal motion
+  // Try to get up once lying still. Off: the robot stays down, soft (the
+  // referee takes it out as an inactive player). See the README: the get-up
+  // motions do not succeed yet, and with the robot off its feet the leg
+  // servos can go unstable at the 5 ms step.
+  bool get_up = true;
+};
+
+enum class MotionState { Easing, Stance, Walking, Kicking, Falling, Lying, GettingUp };
+const char* motionStateName(MotionState s);
+
+struct MotionCounters {
+  int falls = 0, get_ups = 0, failed_get_ups = 0, kicks = 0;
+};
+
+class MotionController {
+ public:
+  MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
+                   KeyframeMotion get_up_back, const WalkParameters& walk = {},
+                   const KickParameters& kick = {}, const FallDetectorParameters& fall = {});
+
+  // One control period: writes 25 targets (rad) and stiffnesses (0..1) in
+  // actuator order.
+  void update(double dt, const MotionSensors& sensors, const MotionRequest& request,
+              std::span<float> position, std::span<float> stiffness);
+  // Starts over from the measured joints (after the robot was moved by the
+  // referee, e.g. a penalty): eases into the stance.
+  void restart();
+
+  MotionState state() const { return state_; }
+  const MotionCounters& counters() const { return counters_; }
+  // Torso tilt from upright (rad), from the accelerometer (filtered).
+  double tilt() const { return tilt_; }
+  bool upright() const;
+  const WalkEngine& walk() const { return walk_; }
+  const robots::RobotModel& model() const { return model_; }
+
+ private:
+  void enter(MotionState s);
+  void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
+
+  const robots::RobotModel& model_;
+  KeyframeMotion get_up_front_, get_up_back_;
+  WalkParameters walk_parameters_;
+  KickParameters kick_parameters_;
+  FallDetectorParameters fall_;
+  WalkEngine walk_;
+  KickEngine kick_;
+  KeyframePlayer player_;
+  MotionState state_ = MotionState::Easing;
+  MotionCounters counters_;
+  std::vector<double> targets_, ease_from_;
+  double state_time_ = 0.0, still_for_ = 0.0, tilt_ = 0.0;
+  Vec3 gravity_ = Vec3(0, 0, 9.81);  // low-passed accelerometer
+  double stiffness_ = 1.0;
+  int head_yaw_ = -1, head_pitch_ = -1;  // body joint indices
+  bool restart_ = true;
+};
+
+// A MotionSensors view of a SensorFrame-like struct (the DDS message or the
+// world's frame: both name their fields the same).
+template <class Frame>
+MotionSensors motionSensors(const Frame& f) {
+  MotionSensors s;
+  s.position = std::span<const float>(&f.position[0], 25);
+  s.gyro = Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]);
+  s.accel = Vec3(f.accelerometer[0], f.accelerometer[1], f.accelerometer[2]);
+  s.yaw = f.angles[2];
+  return s;
+}
+
+}  // namespace simsoccer::agents

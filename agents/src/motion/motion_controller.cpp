@@ -1,0 +1,187 @@
+#include "simsoccer/agents/motion/motion_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace simsoccer::agents {
+
+const char* motionStateName(MotionState s) {
+  switch (s) {
+    case MotionState::Easing: return "easing";
+    case MotionState::Stance: return "stance";
+    case MotionState::Walking: return "walking";
+    case MotionState::Kicking: return "kicking";
+    case MotionState::Falling: return "falling";
+    case MotionState::Lying: return "lying";
+    case MotionState::GettingUp: return "getting_up";
+  }
+  return "?";
+}
+
+MotionController::MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
+                                   KeyframeMotion get_up_back, const WalkParameters& walk,
+                                   const KickParameters& kick, const FallDetectorParameters& fall)
+    : model_(model),
+      get_up_front_(std::move(get_up_front)),
+      get_up_back_(std::move(get_up_back)),
+      walk_parameters_(walk),
+      kick_parameters_(kick),
+      fall_(fall),
+      walk_(model, walk),
+      kick_(model, walk, kick),
+      targets_(model.pose("stand")) {
+  head_yaw_ = model.body->jointIndex("HeadYaw");
+  head_pitch_ = model.body->jointIndex("HeadPitch");
+}
+
+void MotionController::restart() {
+  restart_ = true;
+}
+
+bool MotionController::upright() const {
+  return tilt_ < fall_.upright_tilt;
+}
+
+void MotionController::enter(MotionState s) {
+  state_ = s;
+  state_time_ = 0.0;
+  still_for_ = 0.0;
+}
+
+void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const {
+  const auto& joints = model_.body->joints;
+  q.assign(joints.size(), 0.0);
+  for (size_t a = 0; a < model_.actuators.size() && a < sensors.position.size(); ++a)
+    if (model_.actuators[a].kind == robots::Actuator::Kind::Joint)
+      q[static_cast<size_t>(model_.actuators[a].index)] = sensors.position[a];
+  for (size_t j = 0; j < q.size(); ++j)
+    if (joints[j].mimic_of >= 0)
+      q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+}
+
+void MotionController::update(double dt, const MotionSensors& sensors,
+                              const MotionRequest& request, std::span<float> position,
+                              std::span<float> stiffness) {
+  // The direction of "up" in the torso frame from the accelerometer, low-passed
+  // (steps and kicks shake it; a fall takes ~0.5 s).
+  gravity_ = 0.8 * gravity_ + 0.2 * sensors.accel;
+  tilt_ = gravity_.norm() > 1e-6 ? std::acos(std::clamp(gravity_.z() / gravity_.norm(), -1.0, 1.0))
+                                 : 0.0;
+  const double rate = sensors.gyro.norm();
+  state_time_ += dt;
+  std::vector<double> measured;
+  measuredJoints(sensors, measured);
+
+  if (restart_) {
+    restart_ = false;
+    ease_from_ = measured;
+    walk_ = WalkEngine(model_, walk_parameters_);
+    kick_ = KickEngine(model_, walk_parameters_, kick_parameters_);
+    player_ = KeyframePlayer();
+    targets_ = measured;
+    stiffness_ = 1.0;
+    enter(MotionState::Easing);
+  }
+  const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
+                      state_ == MotionState::Walking || state_ == MotionState::Kicking;
+  if (normal && tilt_ > fall_.falling_tilt) {
+    ++counters_.falls;
+    enter(MotionState::Falling);
+  }
+
+  switch (state_) {
+    case MotionState::Easing:
+      stiffness_ = 1.0;
+      walk_.easeIn(ease_from_, state_time_, targets_);
+      if (state_time_ >= WalkEngine::kEaseTime) enter(MotionState::Stance);
+      break;
+    case MotionState::Stance:
+    case MotionState::Walking:
+      stiffness_ = 1.0;
+      if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
+          !walk_.walking()) {
+        kick_.start(request.kick_foot);
+        ++counters_.kicks;
+        enter(MotionState::Kicking);
+        kick_.update(dt, sensors.gyro, targets_);
+        break;
+      }
+      if (request.kind == MotionRequest::Kind::Walk)
+        walk_.setVelocity(request.forward, request.left, request.turn);
+      else
+        walk_.stop();  // stand, or stop before a kick
+      walk_.update(dt, sensors.gyro, sensors.yaw, targets_);
+      state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
+      break;
+    case MotionState::Kicking:
+      kick_.update(dt, sensors.gyro, targets_);
+      if (!kick_.active()) enter(MotionState::Stance);
+      break;
+    case MotionState::Falling:
+    case MotionState::Lying:
+      // Soft joints that keep their current angles: no servo fights the impact.
+      targets_ = measured;
+      stiffness_ = fall_.safe_stiffness;
+      if (tilt_ > fall_.lying_tilt && rate < fall_.lying_rate)
+        still_for_ += dt;
+      else
+        still_for_ = 0.0;
+      if (state_ == MotionState::Falling && tilt_ < fall_.upright_tilt && rate < fall_.lying_rate &&
+          state_time_ > 0.5) {
+        restart_ = true;  // caught itself: back to the stance
+        break;
+      }
+      if (still_for_ >= fall_.lying_time && fall_.get_up) {
+        // Up in the torso frame: -x lying on the front (chest down), +x on the back.
+        const bool front = gravity_.x() < 0.0;
+        enter(MotionState::GettingUp);
+        player_.start(front ? get_up_front_ : get_up_back_, measured);
+      } else if (state_ == MotionState::Falling && tilt_ > fall_.lying_tilt) {
+        state_ = MotionState::Lying;
+      }
+      break;
+    case MotionState::GettingUp:
+      player_.update(dt, targets_, stiffness_);
+      if (!player_.active()) {
+        if (upright()) {
+          ++counters_.get_ups;
+          ease_from_ = targets_;
+          walk_ = WalkEngine(model_, walk_parameters_);
+          enter(MotionState::Easing);
+        } else {
+          ++counters_.failed_get_ups;
+          enter(MotionState::Falling);
+        }
+      }
+      break;
+  }
+
+  // Head: the behaviour's targets, within the joints' limits, unless falling.
+  const auto& joints = model_.body->joints;
+  const bool soft = state_ == MotionState::Falling || state_ == MotionState::Lying;
+  if (!soft && state_ != MotionState::GettingUp) {
+    if (head_yaw_ >= 0)
+      targets_[static_cast<size_t>(head_yaw_)] =
+          std::clamp(request.head_yaw, joints[static_cast<size_t>(head_yaw_)].lower,
+                     joints[static_cast<size_t>(head_yaw_)].upper);
+    if (head_pitch_ >= 0)
+      targets_[static_cast<size_t>(head_pitch_)] =
+          std::clamp(request.head_pitch, joints[static_cast<size_t>(head_pitch_)].lower,
+                     joints[static_cast<size_t>(head_pitch_)].upper);
+  }
+  for (size_t a = 0; a < model_.actuators.size() && a < position.size(); ++a) {
+    const auto& act = model_.actuators[a];
+    if (act.kind != robots::Actuator::Kind::Joint) {
+      position[a] = 0.0f;
+      stiffness[a] = soft ? 0.0f : static_cast<float>(stiffness_);
+      continue;
+    }
+    const int j = act.index;
+    position[a] = static_cast<float>(targets_[static_cast<size_t>(j)]);
+    const bool head = j == head_yaw_ || j == head_pitch_;
+    stiffness[a] = static_cast<float>(head && !soft ? std::min(stiffness_, fall_.head_stiffness)
+                                                    : stiffness_);
+  }
+}
+
+}  // namespace simsoccer::agents
