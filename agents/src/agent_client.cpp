@@ -240,18 +240,23 @@ PerceivedIn fromMessage(const simsoccer_msg_PerceivedObject& m) {
 }
 }  // namespace
 
+PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m) {
+  PerceptionIn out;
+  out.tick = m.tick;
+  out.sim_time = m.sim_time;
+  out.ball = fromMessage(m.ball);
+  for (size_t k = 0; k < 4; ++k) out.posts[k] = fromMessage(m.posts[k]);
+  for (uint32_t i = 0; i < m.robots._length; ++i)
+    out.robots.push_back(fromMessage(m.robots._buffer[i]));
+  for (size_t k = 0; k < 3; ++k) out.self_pose[k] = m.self_pose[k];
+  return out;
+}
+
 bool AgentClient::perception(PerceptionIn& out) {
   bool got = false;
   impl_->perception.take([&](const simsoccer_msg_Perception& m, const dds_sample_info_t&) {
     if (m.team != team_ || m.player != player_ || (got && m.tick < out.tick)) return;
-    out.tick = m.tick;
-    out.sim_time = m.sim_time;
-    out.ball = fromMessage(m.ball);
-    for (size_t k = 0; k < 4; ++k) out.posts[k] = fromMessage(m.posts[k]);
-    out.robots.clear();
-    for (uint32_t i = 0; i < m.robots._length; ++i)
-      out.robots.push_back(fromMessage(m.robots._buffer[i]));
-    for (size_t k = 0; k < 3; ++k) out.self_pose[k] = m.self_pose[k];
+    out = perceptionFromMessage(m);
     got = true;
   });
   return got;

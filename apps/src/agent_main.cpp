@@ -1,6 +1,8 @@
-// simsoccer-agent: a minimal agent. It claims a robot, then answers every
-// SensorFrame with the stand pose and a nodding head, to prove the loop.
-// Test modes send malformed commands or stop answering.
+// simsoccer-agent: the built-in agent. It claims a robot, then answers every
+// SensorFrame: with --role, the soccer behaviour and the motion layer (walk,
+// kick, fall detector) driven by the robot's perception, the GameState and
+// team messages; without, simple modes (stand and nod, walk at a velocity)
+// and test modes that send malformed commands or stop answering.
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,6 +15,8 @@
 
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+#include "simsoccer/agents/motion/motion_controller.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
@@ -20,11 +24,21 @@ namespace {
 
 const char* kHelp =
     "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE]\n"
-    "                       [--robot FILE] [--mode nod|walk|garbage|stall] [--stall-after N]\n"
+    "                       [--robot FILE] [--role ROLE [--config FILE] [--field FILE]\n"
+    "                        [--team-number N] [--seed N] [--get-up] [--verbose]]\n"
+    "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
     "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
     "\n"
-    "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame with\n"
-    "the stand pose of the robot model and a nodding head (0.2 rad at 0.5 Hz).\n"
+    "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
+    "  --role ROLE      play soccer: auto (the GameState's goalkeeper keeps goal, the field\n"
+    "                   players share striker / supporter / defender by distance to the ball\n"
+    "                   over team messages), striker, supporter, defender, goalkeeper,\n"
+    "                   penalty-kicker or penalty-goalkeeper. Needs perception on in the\n"
+    "                   scenario; obeys the GameState (team number --team-number, default T+1).\n"
+    "                   --config: the behaviour (default configs/agents/soccer.yaml); --field:\n"
+    "                   the field (default fields/spl.yaml); --get-up: try to get up after a\n"
+    "                   fall (off by default: the motions do not succeed yet, see the README)\n"
+    "Without --role, --mode (default nod): the stand pose and a nodding head (0.2 rad at 0.5 Hz).\n"
     "  --mode walk      eases into the walk's stance for 1 s, then walks at --vx, --vy (m/s)\n"
     "                   and --turn (rad/s) with the walk engine (default 0.2 m/s forward)\n"
     "  --mode garbage   also sends an invalid command before each valid one (NaN, wrong\n"
@@ -38,9 +52,10 @@ const char* kHelp =
 int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
-    const apps::Options opt(argc, argv, 1, {"help"},
+    const apps::Options opt(argc, argv, 1, {"help", "get-up", "verbose"},
                             {"team", "player", "domain", "dds-config", "robot", "mode",
-                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn"});
+                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
+                             "config", "field", "team-number", "seed"});
     if (opt.help(kHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -58,6 +73,34 @@ int main(int argc, char** argv) {
     const long max_ticks = static_cast<long>(opt.number("ticks", -1));
 
     const robots::RobotModel model = robots::loadRobotModel(robot_file);
+
+    // Soccer (--role): behaviour and motion, loaded before claiming so a bad
+    // file stops here.
+    std::unique_ptr<agents::SoccerBehaviour> behaviour;
+    std::unique_ptr<agents::MotionController> motion;
+    if (opt.has("role")) {
+      const auto role = agents::roleFromName(opt.get("role", ""));
+      if (!role)
+        throw apps::UsageError(
+            "--role must be auto, striker, supporter, defender, goalkeeper, penalty-kicker or "
+            "penalty-goalkeeper");
+      const auto config = agents::loadBehaviourConfig(
+          apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml"));
+      const auto field =
+          fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml"));
+      const int number = static_cast<int>(opt.number("team-number", team + 1));
+      behaviour = std::make_unique<agents::SoccerBehaviour>(
+          config, field, team, number, player, *role,
+          static_cast<uint64_t>(opt.number("seed", 1)));
+      const std::string motions = apps::findConfig("", "configs/motions").string();
+      agents::FallDetectorParameters fall;
+      fall.get_up = opt.flag("get-up");
+      motion = std::make_unique<agents::MotionController>(
+          model, agents::loadKeyframeMotion(motions + "/get_up_front.yaml", model),
+          agents::loadKeyframeMotion(motions + "/get_up_back.yaml", model),
+          agents::WalkParameters{}, agents::KickParameters{}, fall);
+    }
+    const bool verbose = opt.flag("verbose");
     const auto& stand = model.pose("stand");
     std::vector<float> position(25, 0.0f), stiffness(25, 1.0f);
     int head_pitch = -1;
@@ -91,10 +134,46 @@ int main(int argc, char** argv) {
           .count();
     };
     last_frame_ns = now_ns();
+    agents::PerceptionIn seen;
+    bool have_seen = false;
+    simsoccer_msg_GameState game{};
+    bool have_game = false;
     client.onFrame([&](const simsoccer_msg_SensorFrame& frame) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;
       if (max_ticks >= 0 && answered >= max_ticks) return;
+      if (behaviour) {
+        // The soccer agent: this tick's perception (published before the
+        // frame), the game, teammates' messages, then behaviour and motion.
+        const double dt = last_time > 0 ? frame.sim_time - last_time : 0.01;
+        last_time = frame.sim_time;
+        agents::PerceptionIn p;
+        if (client.perception(p)) {
+          seen = std::move(p);
+          have_seen = true;
+        }
+        if (client.gameState(game)) have_game = true;
+        for (const auto& m : client.receiveTeamMessages()) behaviour->receive(m, frame.sim_time);
+        agents::SoccerBehaviour::Input in;
+        in.time = frame.sim_time;
+        in.perception = have_seen && seen.tick == frame.tick ? &seen : nullptr;
+        in.game = have_game ? &game : nullptr;
+        in.motion = motion->state();
+        in.fallen = motion->state() == agents::MotionState::Falling ||
+                    motion->state() == agents::MotionState::Lying ||
+                    motion->state() == agents::MotionState::GettingUp;
+        const agents::MotionRequest request = behaviour->update(in);
+        if (behaviour->takeMotionRestart()) motion->restart();
+        if (auto out = behaviour->outgoing(in)) client.sendTeamMessage(*out);
+        motion->update(dt > 0 ? dt : 0.01, agents::motionSensors(frame), request, position,
+                       stiffness);
+        if (verbose && frame.tick % 100 == 0)
+          std::fprintf(stderr, "agent %d/%d t %.1f %s %s\n", team, player, frame.sim_time,
+                       agents::motionStateName(motion->state()), behaviour->status().c_str());
+        client.send(frame.tick, position, stiffness);
+        ++answered;
+        return;
+      }
       if (mode == "walk") {
         if (start_time < 0) start_time = last_time = frame.sim_time;
         const double t = frame.sim_time - start_time, dt = frame.sim_time - last_time;

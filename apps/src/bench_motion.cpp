@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bench_scene.hpp"
+#include "inprocess_agents.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/motion_controller.hpp"
@@ -239,6 +240,109 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
   return r;
 }
 
+// The ball in a goal: past the goal line between the posts (field frame),
+// +1 / -1 for the goal at +x / -x, 0 none.
+int goalScored(const world::World& w) {
+  const Vec3 b = w.ballState().pose.translation();
+  const auto& f = w.field();
+  if (std::abs(b.y()) >= 0.5 * f.goal.inner_width || b.z() > f.goal.clear_height) return 0;
+  if (b.x() > f.halfLength() + f.ball.radius) return 1;
+  if (b.x() < -f.halfLength() - f.ball.radius) return -1;
+  return 0;
+}
+
+struct StrikerResult {
+  bool scored = false;
+  double seconds = 0.0;
+  int falls = 0;
+};
+
+// A striker alone (team 0, attacking +x): robot and ball at seeded random
+// spots in the field; up to `limit` s to score.
+StrikerResult strikerTrial(uint64_t seed, double limit, bool verbose) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  world::World probe(s);
+  const double hl = probe.field().halfLength() - 0.5, hw = probe.field().halfWidth() - 0.5;
+  s.robots[0].x = hl * u(rng);
+  s.robots[0].y = hw * u(rng);
+  s.robots[0].yaw = M_PI * u(rng);
+  double bx = 0, by = 0;
+  do {
+    bx = (hl - 0.5) * u(rng);
+    by = hw * u(rng);
+  } while (std::hypot(bx - s.robots[0].x, by - s.robots[0].y) < 0.6);
+  s.ball_position = {bx, by, -1.0};
+  world::World w(s);
+  InProcessAgents agents(w, {agents::Role::Striker}, seed);
+  StrikerResult r;
+  const double dt = w.scenario().physics.control_period;
+  for (int i = 0; i < static_cast<int>(limit / dt); ++i) {
+    agents.period();
+    w.stepControlPeriod();
+    if (verbose && (i % 100 == 0 || (i < 150 && i % 10 == 0)))
+      std::fprintf(stderr, "t %5.2f %-10s tilt %.2f %s\n", i * dt,
+                   agents::motionStateName(agents.motion(0).state()), agents.motion(0).tilt(),
+                   agents.behaviour(0).status().c_str());
+    if (goalScored(w) == 1) {
+      r.scored = true;
+      r.seconds = (i + 1) * dt;
+      break;
+    }
+  }
+  r.falls = agents.motion(0).counters().falls;
+  return r;
+}
+
+enum class PenaltyOutcome { Goal, Saved, Missed, Timeout };
+
+// One penalty: kicker (team 0) behind the ball on the +x penalty mark,
+// keeper (team 1) on that goal line; ends on a goal, the ball out or stopped
+// after the kick, or after `limit` s.
+PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  world::World probe(s);
+  const auto& f = probe.field();
+  const double mark = f.halfLength() - f.penalty_mark_distance.value_or(1.3);
+  s.robots[0].x = mark - 0.5;
+  s.robots[0].y = 0.0;
+  s.robots[0].yaw = 0.0;
+  world::RobotPlacement keeper;
+  keeper.team = 1;
+  keeper.x = f.halfLength() - 0.05;
+  keeper.yaw = M_PI;
+  s.robots.push_back(keeper);
+  s.ball_position = {mark, 0.0, -1.0};
+  world::World w(s);
+  InProcessAgents agents(w, {agents::Role::PenaltyKicker, agents::Role::PenaltyGoalkeeper}, seed);
+  const double dt = w.scenario().physics.control_period;
+  bool kicked = false;
+  double still = 0.0;
+  for (int i = 0; i < static_cast<int>(limit / dt); ++i) {
+    agents.period();
+    w.stepControlPeriod();
+    if (verbose && i % 100 == 0)
+      std::fprintf(stderr, "t %5.1f kicker %s | keeper %s\n", i * dt,
+                   agents.behaviour(0).status().c_str(), agents.behaviour(1).status().c_str());
+    const auto ball = w.ballState();
+    if (goalScored(w) == 1) return PenaltyOutcome::Goal;
+    const Vec3 b = ball.pose.translation();
+    if (!kicked && std::hypot(b.x() - mark, b.y()) > 0.05) kicked = true;
+    if (!kicked) continue;
+    if (b.x() > f.halfLength() || std::abs(b.y()) > f.halfWidth()) return PenaltyOutcome::Missed;
+    still = ball.linear_velocity.norm() < 0.02 ? still + dt : 0.0;
+    if (still > 0.5) {
+      // Stopped in play: the keeper's (touched, or it came to rest before the line).
+      const auto& touch = w.lastBallTouch();
+      return touch && touch->robot == 1 ? PenaltyOutcome::Saved : PenaltyOutcome::Missed;
+    }
+  }
+  return PenaltyOutcome::Timeout;
+}
+
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
@@ -263,9 +367,10 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation}};
   std::vector<std::string> valued{"seconds",        "csv",  "vx",   "vy",         "turn",
-                                  "random-minutes", "seed", "foot", "ball-offset", "get-up", "get-up-trials"};
+                                  "random-minutes", "seed", "foot", "ball-offset", "get-up", "get-up-trials", "striker-trials",
+                                  "penalty-trials"};
   for (const auto& k : knobs) valued.push_back(k.first);
-  const Options opt(argc, argv, first, {"help", "verbose", "kick"}, valued);
+  const Options opt(argc, argv, first, {"help", "verbose", "kick", "striker", "penalty"}, valued);
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
@@ -277,6 +382,20 @@ int benchMotion(int argc, char** argv, int first) {
                                 motions_dir, opt.flag("verbose"));
     std::printf("get-up from the %s: %s in %.2f s, %d attempts\n", side.c_str(),
                 r.success ? "standing" : "FAILED", r.seconds, r.attempts);
+    return 0;
+  }
+  if (opt.flag("striker")) {  // one striker trial, for tuning
+    const StrikerResult r =
+        strikerTrial(static_cast<uint64_t>(opt.number("seed", 1)), 60.0, opt.flag("verbose"));
+    std::printf("striker: %s in %.1f s, %d falls\n", r.scored ? "scored" : "no goal", r.seconds,
+                r.falls);
+    return 0;
+  }
+  if (opt.flag("penalty")) {  // one penalty, for tuning
+    const PenaltyOutcome o =
+        penaltyTrial(static_cast<uint64_t>(opt.number("seed", 1)), 30.0, opt.flag("verbose"));
+    const char* names[] = {"goal", "saved", "missed", "timeout"};
+    std::printf("penalty: %s\n", names[static_cast<int>(o)]);
     return 0;
   }
   if (opt.flag("kick")) {  // one kick, for tuning

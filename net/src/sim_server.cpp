@@ -517,12 +517,10 @@ void SimServer::runPeriod() {
     published_tick_ = tick;
   }
 
-  // Frames for this tick (the state the commands will answer).
+  // Perception first, then the frames for this tick (the state the commands
+  // will answer): an agent that answers in its frame callback finds this
+  // tick's perception already there (one writer, in order, on loopback).
   // (A frame carries the tick and time of the period it closed: this one's.)
-  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-    toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, impl_->frame_msg);
-    impl_->frames[r]->write(impl_->frame_msg);
-  }
   if (perception_) {
     perception_->update(world_);
     simsoccer_msg_Perception m{};
@@ -531,6 +529,10 @@ void SimServer::runPeriod() {
                 impl_->perceived_scratch);
       impl_->perceptions[r]->write(m);
     }
+  }
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+    toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, impl_->frame_msg);
+    impl_->frames[r]->write(impl_->frame_msg);
   }
   simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
   impl_->clock.write(clock);

@@ -50,6 +50,13 @@ void MotionController::enter(MotionState s) {
 
 void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const {
   const auto& joints = model_.body->joints;
+  // A frame from before the first control period carries no joint angles
+  // (all zero): read it as the stand pose the robot was placed in.
+  if (std::all_of(sensors.position.begin(), sensors.position.end(),
+                  [](float v) { return v == 0.0f; })) {
+    q = model_.pose("stand");
+    return;
+  }
   q.assign(joints.size(), 0.0);
   for (size_t a = 0; a < model_.actuators.size() && a < sensors.position.size(); ++a)
     if (model_.actuators[a].kind == robots::Actuator::Kind::Joint)

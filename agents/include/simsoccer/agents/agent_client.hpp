@@ -51,6 +51,9 @@ struct PerceptionIn {
   std::array<float, 3> self_pose{};  // x, y, yaw in the field frame
 };
 
+// The Perception message as the agent side keeps it.
+PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m);
+
 class AgentClient {
  public:
   AgentClient(const net::DomainConfig& dds, int team, int player);

@@ -1,0 +1,162 @@
+// Soccer behaviour for one robot: what a RoboCup team's behaviour layer
+// decides each control period from the robot's perception, the GameState and
+// its teammates' messages, handed to the MotionController as a MotionRequest.
+//
+// Roles: striker (gets behind the ball on the line to the goal, lines up a
+// foot, kicks), supporter (beside and behind the ball for the rebound or
+// pass), defender (between the ball and the own goal), goalkeeper (on its
+// goal line, shifting to the ball's predicted crossing point; clears a ball
+// that comes close), penalty kicker and penalty goalkeeper (shoot-out). With
+// Role::Auto the goalkeeper is the GameState's goalkeeper number and the field
+// players share the other roles by their distance to the ball, announced in
+// team messages (TeamMessageCodec, 20 bytes; sent as the SPL message budget
+// allows).
+//
+// The GameState rules: stand in Initial, Standby, Set and Finished and while
+// penalised; walk to the kick-off formation in Ready; play in Playing,
+// keeping clear of the ball while the opponents take a kick-off or set play.
+//
+// Frames: "own" is the field frame turned so that this team attacks +x.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/agents/motion/motion_controller.hpp"
+#include "simsoccer/fields/field_model.hpp"
+
+namespace simsoccer::agents {
+
+enum class Role : uint8_t {
+  Auto = 0,
+  Striker,
+  Supporter,
+  Defender,
+  Goalkeeper,
+  PenaltyKicker,
+  PenaltyGoalkeeper
+};
+const char* roleName(Role r);
+std::optional<Role> roleFromName(const std::string& name);
+
+struct BehaviourConfig {
+  // Kick-off formation per player number (index 0 = player 1), own frame
+  // (x < 0: own half): x and y as shares of the half-length and half-width
+  // (so one formation fits any field), yaw in rad. Players beyond the list
+  // stand in a line.
+  std::vector<Pose2> ready_positions;
+  Pose2 kick_off_position{-0.25, 0.0, 0.0};  // the kicking team's striker in Ready
+  double max_forward = 0.25, max_side = 0.10, max_turn = 0.8;  // m/s, m/s, rad/s
+  double kick_ball_x = 0.17;       // m ahead of the torso: the ball where a kick meets it
+  double kick_ball_y = 0.05;       // m sideways: in front of the kicking foot
+  double kick_tolerance_x = 0.03;  // m
+  double kick_tolerance_y = 0.025;  // m
+  double kick_tolerance_angle = 0.15;  // rad off the aim
+  double approach_distance = 0.35;  // m behind the ball before lining up
+  double ball_lost_time = 3.0;      // s: after this, the own sighting is stale
+  double team_ball_time = 4.0;      // s: a teammate's sighting counts this long
+  double keep_clear = 0.8;          // m from the ball at the opponents' kick-off / set play
+  double message_interval = 1.0;    // s, the fastest; slower when the budget asks
+};
+// Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
+BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
+
+// What one robot tells its teammates (field frame), in 20 bytes.
+struct TeamMessageData {
+  int player = 0;
+  Role role = Role::Auto;
+  bool fallen = false, ball_seen = false;
+  double x = 0, y = 0, yaw = 0;      // m, m, rad
+  double ball_x = 0, ball_y = 0;     // m
+  double ball_age = 0;               // s since seen
+  double cost = 0;                   // the striker bid: lower is better (m)
+};
+std::vector<uint8_t> encodeTeamMessage(const TeamMessageData& d);
+std::optional<TeamMessageData> decodeTeamMessage(const std::vector<uint8_t>& bytes);
+
+class SoccerBehaviour {
+ public:
+  SoccerBehaviour(const BehaviourConfig& config, const fields::FieldModel& field, int team,
+                  int team_number, int player, Role role, uint64_t seed);
+
+  struct Input {
+    double time = 0.0;                              // s of simulated time
+    const PerceptionIn* perception = nullptr;       // this period's, if any
+    const simsoccer_msg_GameState* game = nullptr;  // the latest, if any
+    MotionState motion = MotionState::Stance;
+    bool fallen = false;
+  };
+  MotionRequest update(const Input& in);
+  // Teammates' messages as they arrive (stamped with the period they were sent in).
+  void receive(const TeamMessageIn& message, double time);
+  // A message to send this period, if it is time for one (budget allowing).
+  std::optional<std::vector<uint8_t>> outgoing(const Input& in);
+  // True once after the robot was moved by the referee (penalty, placement):
+  // the motion layer should start over from the stance.
+  bool takeMotionRestart();
+
+  Role role() const { return role_; }  // the role in force (never Auto)
+  std::string status() const;          // one line: role, game state, ball, target
+
+ private:
+  struct Teammate {
+    TeamMessageData data;
+    double received = -1.0;
+  };
+  struct Vec2 {
+    double x = 0, y = 0;
+  };
+  void readGame(const Input& in);
+  void updateBall(const Input& in);
+  Role chooseRole(const Input& in);
+  MotionRequest play(const Input& in);
+  MotionRequest ready();
+  MotionRequest striker(double aim_y, bool penalty);
+  MotionRequest goalkeeper(bool shootout);
+  MotionRequest walkTo(const Pose2& target, bool face_ball);
+  void head(MotionRequest& r, const Input& in);
+  Vec2 toOwn(double fx, double fy) const;    // field -> own frame
+  Vec2 fromOwn(double ox, double oy) const;  // own -> field frame
+  Vec2 toRobot(const Vec2& own) const;       // own -> robot frame
+
+  BehaviourConfig config_;
+  fields::FieldModel field_;
+  int team_, team_number_, player_;
+  Role fixed_role_, role_ = Role::Striker;
+  uint64_t seed_;
+  // Game.
+  bool have_game_ = false;
+  int state_ = 3;  // gc::State numbering; Playing without a GameState
+  int set_play_ = 0, phase_ = 0;
+  bool our_kick_ = false, kick_pending_ = false, penalised_ = false, was_penalised_ = false;
+  int attack_sign_ = 1;  // +1: this team attacks +x
+  int goalkeeper_number_ = 1, players_per_team_ = 5, secs_remaining_ = 600, budget_ = 1200;
+  bool first_half_ = true;
+  int last_state_ = -1;
+  bool restart_motion_ = false;
+  // Self and ball (own frame).
+  Pose2 self_;
+  bool self_known_ = false;
+  Vec2 ball_, ball_robot_;  // own frame; robot frame (own sighting)
+  double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
+  bool ball_from_team_ = false;
+  Vec2 ball_velocity_;
+  Vec2 last_ball_;
+  double last_ball_time_ = -1e9;
+  std::vector<Teammate> mates_;
+  double last_sent_ = -1e9, now_ = 0.0;
+  Leg kick_foot_ = Leg::Right;
+  // A kick once decided is kept asked for (the walk stops first) until the
+  // motion layer is seen kicking, or this time passes.
+  double kick_commit_until_ = -1.0;
+  int penalty_side_ = 1;
+  Pose2 target_;
+  double head_phase_ = 0.0;
+};
+
+}  // namespace simsoccer::agents

@@ -1,0 +1,523 @@
+#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "simsoccer/engine/config.hpp"
+
+namespace simsoccer::agents {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// gc::State / gc::SetPlay / gc::GamePhase numbering (the GameController's).
+constexpr int kInitial = 0, kReady = 1, kSet = 2, kPlaying = 3, kFinished = 4, kStandby = 5;
+constexpr int kPhasePenaltyShoot = 1;
+constexpr uint8_t kNoTeam = 255;
+
+double wrap(double a) {
+  while (a > kPi) a -= 2 * kPi;
+  while (a < -kPi) a += 2 * kPi;
+  return a;
+}
+
+void put16(std::vector<uint8_t>& b, int v) {
+  const auto u = static_cast<uint16_t>(static_cast<int16_t>(std::clamp(v, -32768, 32767)));
+  b.push_back(static_cast<uint8_t>(u & 0xff));
+  b.push_back(static_cast<uint8_t>(u >> 8));
+}
+int get16s(const std::vector<uint8_t>& b, size_t i) {
+  return static_cast<int16_t>(static_cast<uint16_t>(b[i] | (b[i + 1] << 8)));
+}
+int get16u(const std::vector<uint8_t>& b, size_t i) {
+  return static_cast<uint16_t>(b[i] | (b[i + 1] << 8));
+}
+
+}  // namespace
+
+const char* roleName(Role r) {
+  switch (r) {
+    case Role::Auto: return "auto";
+    case Role::Striker: return "striker";
+    case Role::Supporter: return "supporter";
+    case Role::Defender: return "defender";
+    case Role::Goalkeeper: return "goalkeeper";
+    case Role::PenaltyKicker: return "penalty-kicker";
+    case Role::PenaltyGoalkeeper: return "penalty-goalkeeper";
+  }
+  return "?";
+}
+
+std::optional<Role> roleFromName(const std::string& name) {
+  for (Role r : {Role::Auto, Role::Striker, Role::Supporter, Role::Defender, Role::Goalkeeper,
+                 Role::PenaltyKicker, Role::PenaltyGoalkeeper})
+    if (name == roleName(r)) return r;
+  return std::nullopt;
+}
+
+BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
+  const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
+  root.allowOnly({"behaviour", "ready_positions", "kick_off_position", "max_forward", "max_side",
+                  "max_turn", "kick_ball", "kick_tolerance", "approach_distance",
+                  "ball_lost_time", "team_ball_time", "keep_clear", "message_interval"});
+  BehaviourConfig c;
+  auto pose = [](const engine::ConfigNode& n) {
+    const auto v = n.numbers(3);
+    return Pose2{v[0], v[1], v[2]};
+  };
+  for (const auto& item : root["ready_positions"].items()) c.ready_positions.push_back(pose(item));
+  if (auto n = root.optional("kick_off_position")) c.kick_off_position = pose(*n);
+  c.max_forward = root.number("max_forward", c.max_forward);
+  c.max_side = root.number("max_side", c.max_side);
+  c.max_turn = root.number("max_turn", c.max_turn);
+  if (auto n = root.optional("kick_ball")) {
+    const auto v = n->numbers(2);
+    c.kick_ball_x = v[0];
+    c.kick_ball_y = v[1];
+  }
+  if (auto n = root.optional("kick_tolerance")) {
+    const auto v = n->numbers(3);
+    c.kick_tolerance_x = v[0];
+    c.kick_tolerance_y = v[1];
+    c.kick_tolerance_angle = v[2];
+  }
+  c.approach_distance = root.number("approach_distance", c.approach_distance);
+  c.ball_lost_time = root.number("ball_lost_time", c.ball_lost_time);
+  c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
+  c.keep_clear = root.number("keep_clear", c.keep_clear);
+  c.message_interval = root.number("message_interval", c.message_interval);
+  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance",
+                        "message_interval"})
+    if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
+  return c;
+}
+
+std::vector<uint8_t> encodeTeamMessage(const TeamMessageData& d) {
+  std::vector<uint8_t> b{'S', 'S', 1, static_cast<uint8_t>(d.player),
+                         static_cast<uint8_t>(d.role),
+                         static_cast<uint8_t>((d.fallen ? 1 : 0) | (d.ball_seen ? 2 : 0))};
+  put16(b, static_cast<int>(std::lround(d.x * 1000)));
+  put16(b, static_cast<int>(std::lround(d.y * 1000)));
+  put16(b, static_cast<int>(std::lround(wrap(d.yaw) * 1000)));
+  put16(b, static_cast<int>(std::lround(d.ball_x * 1000)));
+  put16(b, static_cast<int>(std::lround(d.ball_y * 1000)));
+  put16(b, static_cast<int>(std::lround(std::clamp(d.ball_age, 0.0, 3000.0) * 10)));
+  put16(b, static_cast<int>(std::lround(std::clamp(d.cost, 0.0, 300.0) * 100)));
+  return b;
+}
+
+std::optional<TeamMessageData> decodeTeamMessage(const std::vector<uint8_t>& b) {
+  if (b.size() != 20 || b[0] != 'S' || b[1] != 'S' || b[2] != 1 || b[4] > 6) return std::nullopt;
+  TeamMessageData d;
+  d.player = b[3];
+  d.role = static_cast<Role>(b[4]);
+  d.fallen = b[5] & 1;
+  d.ball_seen = b[5] & 2;
+  d.x = get16s(b, 6) / 1000.0;
+  d.y = get16s(b, 8) / 1000.0;
+  d.yaw = get16s(b, 10) / 1000.0;
+  d.ball_x = get16s(b, 12) / 1000.0;
+  d.ball_y = get16s(b, 14) / 1000.0;
+  d.ball_age = get16u(b, 16) / 10.0;
+  d.cost = get16u(b, 18) / 100.0;
+  return d;
+}
+
+SoccerBehaviour::SoccerBehaviour(const BehaviourConfig& config, const fields::FieldModel& field,
+                                 int team, int team_number, int player, Role role, uint64_t seed)
+    : config_(config),
+      field_(field),
+      team_(team),
+      team_number_(team_number),
+      player_(player),
+      fixed_role_(role),
+      seed_(seed) {
+  attack_sign_ = team == 0 ? 1 : -1;  // without a GameState: team 0 defends -x
+  role_ = role == Role::Auto ? (player == 1 ? Role::Goalkeeper : Role::Striker) : role;
+  // The penalty kicker's corner: from the seed (deterministic, varies by trial).
+  penalty_side_ = ((seed * 0x9E3779B97F4A7C15ull) >> 63) ? 1 : -1;
+}
+
+SoccerBehaviour::Vec2 SoccerBehaviour::toOwn(double fx, double fy) const {
+  return {attack_sign_ * fx, attack_sign_ * fy};
+}
+SoccerBehaviour::Vec2 SoccerBehaviour::fromOwn(double ox, double oy) const {
+  return {attack_sign_ * ox, attack_sign_ * oy};
+}
+SoccerBehaviour::Vec2 SoccerBehaviour::toRobot(const Vec2& p) const {
+  const double dx = p.x - self_.x, dy = p.y - self_.y;
+  const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+  return {c * dx + s * dy, -s * dx + c * dy};
+}
+
+void SoccerBehaviour::readGame(const Input& in) {
+  if (!in.game) return;
+  const simsoccer_msg_GameState& g = *in.game;
+  have_game_ = true;
+  state_ = g.state;
+  set_play_ = g.set_play;
+  phase_ = g.game_phase;
+  first_half_ = g.first_half != 0;
+  secs_remaining_ = g.secs_remaining;
+  players_per_team_ = std::max<int>(1, g.players_per_team);
+  our_kick_ = g.kicking_team == team_number_;
+  kick_pending_ = g.kicking_team != kNoTeam && g.secondary_time > 0;
+  // teams[0] defends -x (the operator's left).
+  const int side = g.teams[0].team_number == team_number_ ? 0 : 1;
+  attack_sign_ = side == 0 ? 1 : -1;
+  const auto& t = g.teams[side];
+  goalkeeper_number_ = t.goalkeeper;
+  budget_ = t.message_budget;
+  penalised_ = player_ >= 1 && player_ <= 20 && t.players[player_ - 1].penalty != 0;
+  // A state change that moves robots (Set: placement; leaving a penalty: the
+  // robot re-enters elsewhere) restarts the motion from the stance.
+  if (was_penalised_ && !penalised_) restart_motion_ = true;
+  if (penalised_ && !was_penalised_) restart_motion_ = true;
+  if (state_ != last_state_ && (state_ == kSet || state_ == kInitial)) restart_motion_ = true;
+  was_penalised_ = penalised_;
+  last_state_ = state_;
+}
+
+bool SoccerBehaviour::takeMotionRestart() {
+  const bool r = restart_motion_;
+  restart_motion_ = false;
+  return r;
+}
+
+void SoccerBehaviour::updateBall(const Input& in) {
+  if (in.perception) {
+    const PerceptionIn& p = *in.perception;
+    const Vec2 own = toOwn(p.self_pose[0], p.self_pose[1]);
+    self_ = {own.x, own.y, wrap(p.self_pose[2] + (attack_sign_ > 0 ? 0.0 : kPi))};
+    self_known_ = true;
+    if (p.ball.last_seen >= 0) {
+      ball_seen_at_ = p.ball.last_seen;
+      ball_robot_ = {p.ball.x, p.ball.y};
+      // The ball in the own frame, from where the robot is now (the sighting is relative).
+      const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+      const Vec2 b{self_.x + c * p.ball.x - s * p.ball.y, self_.y + s * p.ball.x + c * p.ball.y};
+      if (p.ball.in_view) {
+        if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.05) {
+          const double dt = in.time - last_ball_time_;
+          const Vec2 v{(b.x - last_ball_.x) / dt, (b.y - last_ball_.y) / dt};
+          ball_velocity_ = {0.7 * ball_velocity_.x + 0.3 * v.x, 0.7 * ball_velocity_.y + 0.3 * v.y};
+          last_ball_ = b;
+          last_ball_time_ = in.time;
+        } else if (last_ball_time_ < -1e8) {
+          last_ball_ = b;
+          last_ball_time_ = in.time;
+        }
+      }
+      ball_ = b;
+      ball_known_at_ = ball_seen_at_;
+      ball_from_team_ = false;
+    }
+  }
+  // A teammate's fresher sighting replaces a stale own one.
+  if (in.time - ball_seen_at_ > config_.ball_lost_time) {
+    for (const Teammate& m : mates_) {
+      if (!m.data.ball_seen || m.received < 0) continue;
+      const double seen = m.received - m.data.ball_age;
+      if (in.time - seen < config_.team_ball_time && seen > ball_known_at_) {
+        ball_ = toOwn(m.data.ball_x, m.data.ball_y);
+        ball_known_at_ = seen;
+        ball_from_team_ = true;
+      }
+    }
+  }
+}
+
+void SoccerBehaviour::receive(const TeamMessageIn& message, double time) {
+  const auto d = decodeTeamMessage(message.data);
+  if (!d || d->player == player_) return;
+  for (Teammate& m : mates_)
+    if (m.data.player == d->player) {
+      m.data = *d;
+      m.received = time;
+      return;
+    }
+  mates_.push_back({*d, time});
+  std::sort(mates_.begin(), mates_.end(),
+            [](const Teammate& a, const Teammate& b) { return a.data.player < b.data.player; });
+}
+
+Role SoccerBehaviour::chooseRole(const Input& in) {
+  if (phase_ == kPhasePenaltyShoot) return our_kick_ ? Role::PenaltyKicker : Role::PenaltyGoalkeeper;
+  if (fixed_role_ != Role::Auto) return fixed_role_;
+  if (player_ == goalkeeper_number_) return Role::Goalkeeper;
+  // Field players still in the game (teammates heard from recently), with
+  // their bids; the lowest bid strikes, then the one nearest the own goal
+  // defends, the rest support.
+  struct Bid {
+    int player;
+    double cost, x;
+  };
+  const double my_cost =
+      std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
+  std::vector<Bid> bids{{player_, my_cost, self_.x}};
+  for (const Teammate& m : mates_) {
+    if (m.data.player == goalkeeper_number_ || in.time - m.received > 3.0 * config_.message_interval + 6.0)
+      continue;
+    bids.push_back({m.data.player, m.data.cost, toOwn(m.data.x, m.data.y).x});
+  }
+  // Hysteresis: the current striker keeps the role unless clearly beaten.
+  for (Bid& b : bids)
+    if (b.player == player_ && role_ == Role::Striker) b.cost -= 0.3;
+  std::sort(bids.begin(), bids.end(), [](const Bid& a, const Bid& b) {
+    return a.cost != b.cost ? a.cost < b.cost : a.player < b.player;
+  });
+  if (bids.front().player == player_) return Role::Striker;
+  std::vector<Bid> rest(bids.begin() + 1, bids.end());
+  std::sort(rest.begin(), rest.end(),
+            [](const Bid& a, const Bid& b) { return a.x != b.x ? a.x < b.x : a.player < b.player; });
+  const size_t defenders = (rest.size() + 1) / 2;
+  for (size_t i = 0; i < rest.size(); ++i)
+    if (rest[i].player == player_) return i < defenders ? Role::Defender : Role::Supporter;
+  return Role::Supporter;
+}
+
+std::optional<std::vector<uint8_t>> SoccerBehaviour::outgoing(const Input& in) {
+  if (!self_known_ || penalised_) return std::nullopt;
+  if (have_game_ && state_ != kPlaying && state_ != kReady && state_ != kSet) return std::nullopt;
+  // Pace to the budget: what is left spread over the game's remaining time
+  // (both halves' worth in the first), for every player of the team.
+  double interval = config_.message_interval;
+  if (have_game_) {
+    const double left = std::max(1, secs_remaining_) * (first_half_ ? 2.0 : 1.0);
+    interval = std::max(interval, left * players_per_team_ / std::max(1, budget_ - 20));
+    if (budget_ <= 20) return std::nullopt;
+  }
+  if (in.time - last_sent_ < interval) return std::nullopt;
+  last_sent_ = in.time;
+  TeamMessageData d;
+  d.player = player_;
+  d.role = role_;
+  d.fallen = in.fallen;
+  const Vec2 f = fromOwn(self_.x, self_.y);
+  d.x = f.x;
+  d.y = f.y;
+  d.yaw = wrap(self_.yaw + (attack_sign_ > 0 ? 0.0 : kPi));
+  d.ball_seen = in.time - ball_seen_at_ < config_.ball_lost_time;
+  const Vec2 b = fromOwn(ball_.x, ball_.y);
+  d.ball_x = b.x;
+  d.ball_y = b.y;
+  d.ball_age = std::max(0.0, in.time - ball_seen_at_);
+  d.cost = std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
+  return encodeTeamMessage(d);
+}
+
+MotionRequest SoccerBehaviour::walkTo(const Pose2& target, bool face_ball) {
+  target_ = target;
+  MotionRequest r;
+  r.kind = MotionRequest::Kind::Walk;
+  const Vec2 rel = toRobot({target.x, target.y});
+  const double dist = std::hypot(rel.x, rel.y);
+  double heading = target.yaw;
+  if (face_ball) heading = std::atan2(ball_.y - self_.y, ball_.x - self_.x);
+  if (dist > 0.5) {
+    // Far: turn towards the target and walk, forward speed falling off with the angle.
+    const double bearing = std::atan2(rel.y, rel.x);
+    r.turn = std::clamp(1.2 * bearing, -config_.max_turn, config_.max_turn);
+    r.forward = config_.max_forward * std::max(0.0, std::cos(bearing)) *
+                (std::abs(bearing) > 0.8 ? 0.0 : 1.0);
+    r.left = std::clamp(0.5 * rel.y, -config_.max_side, config_.max_side) * 0.5;
+  } else {
+    const double err = wrap(heading - self_.yaw);
+    r.forward = std::clamp(0.8 * rel.x, -0.1, config_.max_forward);
+    r.left = std::clamp(0.8 * rel.y, -config_.max_side, config_.max_side);
+    r.turn = std::clamp(1.2 * err, -config_.max_turn, config_.max_turn);
+    if (dist < 0.08 && std::abs(err) < 0.15) r = MotionRequest{};  // there: stand
+  }
+  return r;
+}
+
+MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
+  if (now_ < kick_commit_until_) {
+    MotionRequest r;
+    r.kind = MotionRequest::Kind::Kick;
+    r.kick_foot = kick_foot_;
+    return r;
+  }
+  // Aim: the opponent goal (own frame +x), at aim_y.
+  const Vec2 goal{field_.halfLength(), aim_y};
+  const double ax = goal.x - ball_.x, ay = goal.y - ball_.y;
+  const double an = std::max(1e-6, std::hypot(ax, ay));
+  const Vec2 dir{ax / an, ay / an};
+  const double aim = std::atan2(dir.y, dir.x);
+  const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
+  // Behind the ball: the robot's projection on the aim line is behind it.
+  const double along = (self_.x - ball_.x) * dir.x + (self_.y - ball_.y) * dir.y;
+  const double across = -(self_.x - ball_.x) * dir.y + (self_.y - ball_.y) * dir.x;
+  const bool behind = along < -0.1 && std::abs(across) < std::max(0.25, -0.8 * along);
+  if (to_ball > config_.approach_distance + 0.2 || !behind) {
+    Pose2 t{ball_.x - dir.x * config_.approach_distance, ball_.y - dir.y * config_.approach_distance,
+            aim};
+    if (!behind && along > -0.2) {
+      // In front of or beside the ball: go round it on the near side.
+      const double side = across >= 0 ? 1.0 : -1.0;
+      t.x = ball_.x - dir.x * 0.3 - dir.y * side * 0.4;
+      t.y = ball_.y - dir.y * 0.3 + dir.x * side * 0.4;
+    }
+    MotionRequest r = walkTo(t, false);
+    if (r.kind == MotionRequest::Kind::Stand) r.kind = MotionRequest::Kind::Walk;
+    return r;
+  }
+  // Line up: the ball in front of a foot, the body along the aim. Fine
+  // control on the robot-frame sighting (what the robot sees directly).
+  const Vec2 b = ball_robot_;
+  if (std::abs(b.y) > 0.02 || kick_foot_ == Leg::Right)
+    kick_foot_ = b.y >= 0 ? Leg::Left : Leg::Right;
+  const double foot_y = kick_foot_ == Leg::Left ? config_.kick_ball_y : -config_.kick_ball_y;
+  const double ex = b.x - config_.kick_ball_x, ey = b.y - foot_y;
+  const double ea = wrap(aim - self_.yaw);
+  MotionRequest r;
+  if (std::abs(ex) < config_.kick_tolerance_x && std::abs(ey) < config_.kick_tolerance_y &&
+      std::abs(ea) < config_.kick_tolerance_angle) {
+    r.kind = MotionRequest::Kind::Kick;
+    r.kick_foot = kick_foot_;
+    kick_commit_until_ = now_ + 1.5;
+    return r;
+  }
+  r.kind = MotionRequest::Kind::Walk;
+  r.forward = std::clamp(0.9 * ex, -0.06, penalty ? 0.1 : 0.15);
+  r.left = std::clamp(0.9 * ey, -0.06, 0.06);
+  r.turn = std::clamp(1.0 * ea, -0.4, 0.4);
+  target_ = {ball_.x, ball_.y, aim};
+  return r;
+}
+
+MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
+  const double line = -field_.halfLength() + (shootout ? 0.05 : 0.25);
+  const double half_goal = 0.5 * field_.goal.inner_width - 0.15;
+  double y = std::clamp(ball_.y * (shootout ? 0.4 : 0.5), -half_goal, half_goal);
+  // A ball rolling at the goal: stand where it will cross the line.
+  if (ball_velocity_.x < -0.3 && ball_.x > line) {
+    const double t = (line - ball_.x) / ball_velocity_.x;
+    y = std::clamp(ball_.y + ball_velocity_.y * t, -half_goal - 0.1, half_goal + 0.1);
+  }
+  const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
+  const bool area =
+      field_.penalty_area && ball_.x < -field_.halfLength() + field_.penalty_area->length &&
+      std::abs(ball_.y) < 0.5 * field_.penalty_area->width;
+  if (!shootout && area && to_ball < 1.0 && std::hypot(ball_velocity_.x, ball_velocity_.y) < 0.3)
+    return striker(0.0, false);  // clear it
+  return walkTo({line, y, 0.0}, false);
+}
+
+MotionRequest SoccerBehaviour::ready() {
+  const size_t i = static_cast<size_t>(std::max(0, player_ - 1));
+  Pose2 t{-0.2 - 0.05 * static_cast<double>(i), 0.0, 0.0};
+  if (i < config_.ready_positions.size()) t = config_.ready_positions[i];
+  t.x *= field_.halfLength();
+  t.y *= field_.halfWidth();
+  if (our_kick_ && role_ == Role::Striker) t = config_.kick_off_position;
+  return walkTo(t, false);
+}
+
+MotionRequest SoccerBehaviour::play(const Input& in) {
+  const bool ball_known = in.time - ball_known_at_ < config_.ball_lost_time + config_.team_ball_time;
+  // The opponents' kick-off or set play: keep clear of the ball.
+  const bool theirs = have_game_ && !our_kick_ && (kick_pending_ || set_play_ != 0);
+  MotionRequest r;
+  switch (role_) {
+    case Role::Goalkeeper:
+      r = goalkeeper(false);
+      break;
+    case Role::PenaltyGoalkeeper:
+      r = goalkeeper(true);
+      break;
+    case Role::PenaltyKicker:
+      if (!ball_known) return MotionRequest{};
+      r = striker(penalty_side_ * (0.5 * field_.goal.inner_width - 0.25), true);
+      break;
+    case Role::Striker:
+      if (!ball_known) {
+        // Search: turn on the spot.
+        r.kind = MotionRequest::Kind::Walk;
+        r.turn = 0.6;
+        target_ = self_;
+        return r;
+      }
+      r = striker(0.0, false);
+      break;
+    case Role::Supporter: {
+      const double side = ball_.y > 0 ? -1.0 : 1.0;
+      Pose2 t{std::clamp(ball_.x - 1.2, -field_.halfLength() + 1.0, field_.halfLength() - 1.0),
+              std::clamp(ball_.y + side * 1.2, -field_.halfWidth() + 0.4, field_.halfWidth() - 0.4),
+              0.0};
+      r = walkTo(t, true);
+      break;
+    }
+    case Role::Defender: {
+      const Vec2 own_goal{-field_.halfLength(), 0.0};
+      Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x), own_goal.y + 0.45 * (ball_.y - own_goal.y),
+              0.0};
+      t.x = std::clamp(std::min(t.x, ball_.x - 0.8), -field_.halfLength() + 0.8, 0.0);
+      r = walkTo(t, true);
+      break;
+    }
+    case Role::Auto:
+      break;
+  }
+  if (theirs && r.kind != MotionRequest::Kind::Stand) {
+    const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
+    if (to_ball < config_.keep_clear || r.kind == MotionRequest::Kind::Kick) {
+      // Back off straight away from the ball.
+      const Vec2 away{self_.x + (self_.x - ball_.x), self_.y + (self_.y - ball_.y)};
+      r = walkTo({away.x, away.y, 0.0}, true);
+    } else if (std::hypot(target_.x - ball_.x, target_.y - ball_.y) < config_.keep_clear) {
+      r = MotionRequest{};
+    }
+  }
+  return r;
+}
+
+void SoccerBehaviour::head(MotionRequest& r, const Input& in) {
+  const bool seen = in.time - ball_seen_at_ < 0.5;
+  if (seen) {
+    // Track: the head turned to the ball, pitched by its distance (the top
+    // camera sees far, the bottom one near the feet).
+    const double d = std::hypot(ball_robot_.x, ball_robot_.y);
+    r.head_yaw = std::atan2(ball_robot_.y, ball_robot_.x);
+    r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
+  } else {
+    // Scan: side to side, 4 s a sweep.
+    head_phase_ += 0.01;
+    r.head_yaw = 1.2 * std::sin(2 * kPi * head_phase_ / 4.0);
+    r.head_pitch = 0.2;
+  }
+}
+
+MotionRequest SoccerBehaviour::update(const Input& in) {
+  now_ = in.time;
+  if (in.motion == MotionState::Kicking || in.fallen) kick_commit_until_ = -1.0;
+  readGame(in);
+  updateBall(in);
+  MotionRequest r;
+  if (have_game_ && (penalised_ || state_ == kInitial || state_ == kStandby ||
+                     state_ == kFinished)) {
+    head(r, in);
+    r.head_yaw = 0.0;
+    return r;
+  }
+  role_ = chooseRole(in);
+  if (have_game_ && state_ == kReady && phase_ != kPhasePenaltyShoot)
+    r = ready();
+  else if (have_game_ && state_ == kSet)
+    r = MotionRequest{};
+  else if (self_known_)
+    r = play(in);
+  head(r, in);
+  return r;
+}
+
+std::string SoccerBehaviour::status() const {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s state %d self (%.2f %.2f %.2f) ball (%.2f %.2f) target (%.2f %.2f)",
+                roleName(role_), state_, self_.x, self_.y, self_.yaw, ball_.x, ball_.y, target_.x,
+                target_.y);
+  return buf;
+}
+
+}  // namespace simsoccer::agents
