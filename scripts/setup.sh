@@ -9,6 +9,7 @@ PACKAGES=(
   libeigen3-dev                 # maths
   libopencv-dev                 # images, video, plots
   libyaml-cpp-dev               # configs
+  zlib1g-dev                    # match logs (deflated blocks)
   cyclonedds-dev cyclonedds-tools  # DDS transport and its IDL compiler (idlc)
   libgtest-dev libgmock-dev     # tests
   libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # off-screen EGL rendering (Mesa llvmpipe on CPU)

@@ -58,6 +58,9 @@ int benchNet(int argc, char** argv, int first);
 int benchCameras(int argc, char** argv, int first);
 int benchMotion(int argc, char** argv, int first);
 int serve(int argc, char** argv, int first);
+int match(int argc, char** argv, int first);
+int penalty(int argc, char** argv, int first);
+int replay(int argc, char** argv, int first);
 int check(int argc, char** argv, int first);
 
 }  // namespace simsoccer::apps

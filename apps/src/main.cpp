@@ -15,6 +15,9 @@ const char* kUsage =
     "usage: simsoccer <command> [options]\n"
     "\n"
     "commands:\n"
+    "  match CONFIG    play a whole game with agent processes: summary, log, video, heatmap\n"
+    "  penalty CONFIG  N seeded penalty kicks, striker against goalkeeper: scoring rate\n"
+    "  replay LOG      re-render (--video) or re-simulate (--physics) a match log\n"
     "  check SCENARIO  load and validate a scenario file, print what it contains\n"
     "  bench physics   physics scaling benchmark (steps/s against robot count)\n"
     "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
@@ -37,6 +40,9 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "check") return check(argc, argv, 2);
     if (cmd == "serve") return serve(argc, argv, 2);
+    if (cmd == "match") return match(argc, argv, 2);
+    if (cmd == "penalty") return penalty(argc, argv, 2);
+    if (cmd == "replay") return replay(argc, argv, 2);
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);

@@ -20,10 +20,14 @@ class ChildProcess {
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
   bool started() const { return pid_ > 0; }
+  // False once the process has exited (reaped; exitStatus() then tells how).
+  bool running();
+  int exitStatus() const { return exit_status_; }  // exit code, or 128 + signal
   void stop();
 
  private:
   pid_t pid_ = -1;
+  int exit_status_ = -1;
 };
 
 // The simsoccer-agent program beside the running executable.

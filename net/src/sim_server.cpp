@@ -1,5 +1,7 @@
 #include "simsoccer/net/sim_server.hpp"
 
+#include "simsoccer/world/match_log.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -423,8 +425,8 @@ void SimServer::handleCommands() {
       return;
     }
     for (size_t a = 0; a < world::kActuators; ++a) {
-      s.position[a] = c.position._buffer[a];
-      s.stiffness[a] = c.stiffness._buffer[a];
+      s.position[a] = world::quantizeCommand(c.position._buffer[a]);
+      s.stiffness[a] = world::quantizeStiffness(c.stiffness._buffer[a]);
     }
     s.has_command = true;
     s.last_tick = c.tick;
@@ -446,6 +448,7 @@ void SimServer::relayTeamMessages(uint64_t tick) {
       ++sender.stats.refused;
       return;
     }
+    ++team_messages_[m.team == 0 ? 0 : 1];
     for (const RobotSlot& to : robots_) {
       if (to.team != m.team || to.player == m.from_player) continue;
       if (config_.team_message_loss > 0.0 && unit(impl_->loss_rng) < config_.team_message_loss)
@@ -590,6 +593,7 @@ void SimServer::runPeriod() {
     std::lock_guard lock(mutex_);
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
       RobotSlot& s = robots_[r];
+      s.applied = s.has_command;
       if (!s.has_command) continue;
       world_.setCommand(r, s.position, s.stiffness);
       ++s.stats.accepted;

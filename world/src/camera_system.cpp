@@ -35,18 +35,6 @@ Vec3 linkAngularVelocity(const World& world, RobotId r, int link) {
   return omega;
 }
 
-engine::Pose lookAt(const Vec3& position, const Vec3& target) {
-  const Vec3 x = (target - position).normalized();
-  Vec3 y = Vec3::UnitZ().cross(x);
-  if (y.norm() < 1e-6) y = Vec3::UnitY();  // looking straight down or up
-  y.normalize();
-  engine::Pose p = engine::Pose::Identity();
-  p.linear().col(0) = x;
-  p.linear().col(1) = y;
-  p.linear().col(2) = x.cross(y);
-  p.translation() = position;
-  return p;
-}
 
 }  // namespace
 
@@ -162,7 +150,7 @@ void CameraSystem::capture(const World& world) {
     const double vertical_fov =
         2 * std::atan(std::tan(0.5 * sp.horizontal_fov) * sp.height / sp.width);
     job.views.push_back({CameraId::Spectator, 0, 0, 0,
-                         engine::pinholeView(lookAt(sp.position, sp.look_at), sp.width, sp.height,
+                         engine::pinholeView(lookAtPose(sp.position, sp.look_at), sp.width, sp.height,
                                              sp.horizontal_fov, vertical_fov),
                          Vec3::Zero()});
   }

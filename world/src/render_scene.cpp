@@ -121,4 +121,17 @@ engine::RenderView robotCameraView(const World& world, RobotId r, const std::str
                              vertical_fov);
 }
 
+engine::Pose lookAtPose(const Vec3& position, const Vec3& target) {
+  const Vec3 x = (target - position).normalized();
+  Vec3 y = Vec3::UnitZ().cross(x);
+  if (y.norm() < 1e-6) y = Vec3::UnitY();  // looking straight down or up
+  y.normalize();
+  engine::Pose p = engine::Pose::Identity();
+  p.linear().col(0) = x;
+  p.linear().col(1) = y;
+  p.linear().col(2) = x.cross(y);
+  p.translation() = position;
+  return p;
+}
+
 }  // namespace simsoccer::world

@@ -188,6 +188,14 @@ bool SoccerBehaviour::takeMotionRestart() {
 void SoccerBehaviour::updateBall(const Input& in) {
   if (in.perception) {
     const PerceptionIn& p = *in.perception;
+    if (phase_ == kPhasePenaltyShoot && p.ball.last_seen >= 0) {
+      // Every shoot-out kick goes at one goal: the one nearer the ball (the
+      // penalty mark). The kicker attacks it, the keeper defends it.
+      const double c = std::cos(p.self_pose[2]), s = std::sin(p.self_pose[2]);
+      const double bx = p.self_pose[0] + c * p.ball.x - s * p.ball.y;
+      const int goal = bx >= 0 ? 1 : -1;
+      attack_sign_ = our_kick_ ? goal : -goal;
+    }
     const Vec2 own = toOwn(p.self_pose[0], p.self_pose[1]);
     self_ = {own.x, own.y, wrap(p.self_pose[2] + (attack_sign_ > 0 ? 0.0 : kPi))};
     self_known_ = true;

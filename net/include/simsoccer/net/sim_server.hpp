@@ -81,6 +81,17 @@ class SimServer {
 
   size_t ownedCount() const;
   RobotNetStats stats(world::RobotId r) const;
+  // Team messages of `team` (index) relayed so far (each sent message once).
+  uint64_t teamMessagesRelayed(int team) const { return team_messages_[team == 0 ? 0 : 1]; }
+  // The command applied to robot r in the last period (quantised as the
+  // match log keeps it: world::quantizeCommand), if one was.
+  bool commandApplied(world::RobotId r) const { return robots_.at(r).applied; }
+  const std::array<double, world::kActuators>& commandPosition(world::RobotId r) const {
+    return robots_.at(r).position;
+  }
+  const std::array<double, world::kActuators>& commandStiffness(world::RobotId r) const {
+    return robots_.at(r).stiffness;
+  }
   const ServerTimes& times() const { return times_; }
   // Null when the scenario has no cameras.
   const world::CameraSystem* cameras() const { return cameras_.get(); }
@@ -91,6 +102,7 @@ class SimServer {
 
  private:
   struct Impl;
+  std::array<uint64_t, 2> team_messages_{};
   struct RobotSlot {
     int team = 0, player = 0;
     RobotNetStats stats;
@@ -99,6 +111,7 @@ class SimServer {
     bool has_command = false;              // a valid command waits to be applied
     uint64_t last_tick = 0;                // tick of the last accepted command
     std::array<double, world::kActuators> position{}, stiffness{};
+    bool applied = false;  // a command was applied in the last period
   };
 
   void handleJoins();

@@ -27,6 +27,10 @@ struct SceneColours {
 void buildRenderScene(const World& world, std::vector<engine::DrawItem>& items,
                       const SceneColours& colours = {});
 
+// A camera pose at `position` looking at `target` (camera x forward, y left,
+// z up; the horizon level).
+engine::Pose lookAtPose(const Vec3& position, const Vec3& target);
+
 // The Nao V6's cameras (nao.md section 5.1): 56.3 x 43.7 degrees.
 constexpr double kNaoHorizontalFov = 56.3 * M_PI / 180.0;
 constexpr double kNaoVerticalFov = 43.7 * M_PI / 180.0;

@@ -1,0 +1,239 @@
+#include "match_session.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/engine/state_hash.hpp"
+#include "simsoccer/referee/gamecontroller.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+std::string fileBytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+MatchConfig loadMatchConfig(const std::filesystem::path& file) {
+  const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
+  root.allowOnly({"match", "penalty", "scenario", "rules", "half_duration", "half_time_break",
+                  "teams", "agents", "team_messages", "lockstep", "set_duration", "video", "seed",
+                  "kicks"});
+  MatchConfig c;
+  c.file = file.string();
+  if (root.has("match"))
+    c.name = root["match"].string();
+  else if (root.has("penalty"))
+    c.name = root["penalty"].string();
+  else
+    root.fail("needs `match: NAME` (a game) or `penalty: NAME` (a penalty-kick scenario)");
+  auto path = [&](const char* key) {
+    const engine::ConfigNode n = root[key];
+    const auto p = engine::resolveBeside(c.file, n.string());
+    if (!std::filesystem::exists(p)) n.fail("no such file: " + p.string());
+    return p;
+  };
+  c.scenario = path("scenario");
+  c.rules = path("rules");
+  if (root.has("half_duration")) c.half_duration = root["half_duration"].positive();
+  if (root.has("half_time_break")) c.half_time_break = root["half_time_break"].nonNegative();
+  if (root.has("teams")) {
+    const auto t = root["teams"].numbers(2);
+    for (size_t i = 0; i < 2; ++i) {
+      if (t[i] < 0 || t[i] > 254 || t[i] != std::floor(t[i]))
+        root["teams"].fail("GameController team numbers are whole numbers 0..254");
+      c.team_numbers[i] = static_cast<int>(t[i]);
+    }
+    if (c.team_numbers[0] == c.team_numbers[1]) root["teams"].fail("the two teams need different numbers");
+  }
+  if (auto a = root.optional("agents")) {
+    a->allowOnly({"config", "role", "get_up", "restart_limit"});
+    if (a->has("config")) {
+      c.agent_config = engine::resolveBeside(c.file, (*a)["config"].string());
+      if (!std::filesystem::exists(c.agent_config))
+        (*a)["config"].fail("no such file: " + c.agent_config.string());
+    }
+    if (a->has("role")) c.role = (*a)["role"].string();
+    c.get_up = a->boolean("get_up", c.get_up);
+    c.restart_limit = a->integer("restart_limit", c.restart_limit);
+    if (c.restart_limit < 0) (*a)["restart_limit"].fail("must be >= 0");
+  }
+  if (auto t = root.optional("team_messages")) {
+    t->allowOnly({"delay", "loss"});
+    c.message_delay = t->number("delay", 0.0);
+    c.message_loss = t->number("loss", 0.0);
+    if (c.message_delay < 0) (*t)["delay"].fail("must be >= 0");
+    if (c.message_loss < 0 || c.message_loss > 1) (*t)["loss"].fail("must be within 0..1");
+  }
+  if (auto l = root.optional("lockstep")) {
+    l->allowOnly({"timeout"});
+    c.command_timeout = (*l)["timeout"].positive();
+  }
+  c.set_duration = root.number("set_duration", c.set_duration);
+  if (auto v = root.optional("video")) {
+    v->allowOnly({"enabled", "fps", "size", "position", "look_at", "horizontal_fov"});
+    c.video.enabled = v->boolean("enabled", true);
+    if (v->has("fps")) c.video.fps = (*v)["fps"].positive();
+    if (v->has("size")) {
+      const auto s = (*v)["size"].numbers(2);
+      if (s[0] < 16 || s[1] < 16 || s[0] > 4096 || s[1] > 4096)
+        (*v)["size"].fail("width and height must be 16..4096 px");
+      c.video.width = static_cast<int>(s[0]);
+      c.video.height = static_cast<int>(s[1]);
+    }
+    if (v->has("position")) c.video.position = (*v)["position"].vec3();
+    if (v->has("look_at")) c.video.look_at = (*v)["look_at"].vec3();
+    if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
+  }
+  c.seed = static_cast<uint64_t>(root.integer("seed", 1));
+  if (root.has("penalty")) {
+    c.penalty_kicks = root.integer("kicks", 5);
+    if (c.penalty_kicks < 1) root["kicks"].fail("must be >= 1");
+  }
+  // The rule book and scenario must load (their own errors name them).
+  referee::loadRuleBook(c.rules);
+  world::loadScenario(c.scenario);
+  const std::string bytes = fileBytes(file) + fileBytes(c.scenario) + fileBytes(c.rules);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(engine::hashBytes(bytes.data(), bytes.size())));
+  c.hash = hex;
+  return c;
+}
+
+MatchSession::MatchSession(const MatchConfig& config, uint64_t seed) : config_(config) {
+  world::Scenario s = world::loadScenario(config.scenario);
+  s.seed = seed;
+  s.perception.enabled = true;
+  world_ = std::make_unique<world::World>(s);
+  referee::RuleBook rules = referee::loadRuleBook(config.rules);
+  if (config.half_duration) rules.half_duration = *config.half_duration;
+  if (config.half_time_break) {
+    rules.half_time_break = *config.half_time_break;
+    rules.half_time_to_initial = std::min(rules.half_time_to_initial, *config.half_time_break);
+  }
+  std::array<referee::TeamSetup, 2> teams;
+  for (size_t t = 0; t < 2; ++t) {
+    teams[t].number = static_cast<uint8_t>(config.team_numbers[t]);
+    teams[t].field_player_colour = static_cast<uint8_t>(t);
+  }
+  referee::RefereeConfig rc;
+  rc.set_duration = config.set_duration;
+  rc.auto_placement = true;  // robots still walking at Set are placed, as a human referee would
+  referee_ = std::make_unique<referee::Referee>(*world_, rules, teams, 0, rc);
+  if (config.penalty_kicks > 0) referee_->game().startShootout(0, 1, seed);
+  for (world::RobotId r = 0; r < world_->robotCount(); ++r) {
+    RobotRecord rec;
+    rec.team = world_->robot(r).team;
+    rec.number = world_->robot(r).number;
+    rec.last = world_->torsoPose(r).translation();
+    records_.push_back(rec);
+  }
+  operatorPart();
+}
+
+void MatchSession::operatorPart() {
+  referee::Game& g = referee_->game();
+  using referee::gc::State;
+  // Each half starts as soon as it can (Standby, then Ready).
+  if (g.state() == State::Initial && g.phase() == referee::gc::GamePhase::Normal && !g.gameOver()) {
+    g.standby();
+    g.ready();
+  }
+  // A drawn game goes to the shoot-out when the rule book calls for it.
+  if (g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
+      g.rules().shootout && config_.penalty_kicks == 0)
+    g.startShootout(0, std::nullopt, world_->scenario().seed);
+  // The next shoot-out kick: the kicking team's field players in turn against
+  // the other team's goalkeeper.
+  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished)) {
+    const int team = g.shotsTaken(0) <= g.shotsTaken(1) ? 0 : 1;
+    std::vector<int> strikers;
+    for (world::RobotId r = 0; r < world_->robotCount(); ++r)
+      if (world_->robot(r).team == team && world_->robot(r).number != g.goalkeeper(team))
+        strikers.push_back(world_->robot(r).number);
+    if (strikers.empty()) strikers.push_back(g.goalkeeper(team));
+    const int striker = strikers[static_cast<size_t>(next_striker_[team]++) % strikers.size()];
+    int keeper = g.goalkeeper(1 - team);
+    if (!referee_->robot(1 - team, keeper)) keeper = 0;
+    referee_->startShootoutKick(striker, keeper);
+  }
+}
+
+bool MatchSession::over() const {
+  const referee::Game& g = referee_->game();
+  if (config_.penalty_kicks > 0) return !g.shotOutcomes(0).empty() || g.gameOver();
+  return g.gameOver() && !g.shootoutOpen() &&
+         !(g.phase() == referee::gc::GamePhase::Normal && !g.winner() && g.rules().shootout);
+}
+
+void MatchSession::record() {
+  const double dt = world_->scenario().physics.control_period;
+  const engine::Vec3 ball = world_->ballState().pose.translation();
+  double nearest[2] = {1e9, 1e9};
+  for (world::RobotId r = 0; r < world_->robotCount(); ++r) {
+    RobotRecord& rec = records_[r];
+    const engine::Vec3 p = world_->torsoPose(r).translation();
+    const bool standing = world_->isStanding(r);
+    if (rec.standing && !standing) ++rec.falls;
+    rec.standing = standing;
+    const double step = (p - rec.last).head<2>().norm();
+    if (standing && step < 0.05) rec.distance += step;  // more: the referee moved it
+    rec.last = p;
+    const double d = (p - ball).head<2>().norm();
+    nearest[rec.team] = std::min(nearest[rec.team], d);
+  }
+  // Possession: the team with a robot nearest the ball, within 0.5 m.
+  const int team = nearest[0] <= nearest[1] ? 0 : 1;
+  if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
+  if (const auto& touch = world_->lastBallTouch())
+    last_touch_player_[static_cast<size_t>(world_->robot(touch->robot).team)] =
+        world_->robot(touch->robot).number;
+}
+
+void MatchSession::afterStep(std::vector<world::LogEvent>& events) {
+  referee_->update();
+  operatorPart();
+  record();
+  const auto& all = referee_->game().events();
+  for (; events_seen_ < all.size(); ++events_seen_) {
+    const referee::RefereeEvent& e = all[events_seen_];
+    events.push_back({e.time, e.type, e.team, e.player, e.detail});
+    if (e.type == "goal") {
+      Goal g{world_->time(), e.team, e.player, false};
+      if (g.scorer == 0 && e.team >= 0) {
+        // The last robot to touch the ball: the scorer, or an own goal.
+        if (const auto& touch = world_->lastBallTouch()) {
+          const auto& info = world_->robot(touch->robot);
+          g.scorer = info.number;
+          g.own_goal = info.team != e.team;
+        }
+      }
+      goals_.push_back(g);
+    }
+  }
+}
+
+std::array<double, 2> MatchSession::possession() const {
+  const double total = possession_[0] + possession_[1];
+  if (total <= 0) return {0.0, 0.0};
+  return {possession_[0] / total, possession_[1] / total};
+}
+
+referee::ControlData MatchSession::controlData() const {
+  return referee_->game().packet(0);
+}
+
+std::vector<uint8_t> MatchSession::packet() const {
+  const auto bytes = referee::encode(controlData());
+  return {bytes.begin(), bytes.end()};
+}
+
+}  // namespace simsoccer::apps

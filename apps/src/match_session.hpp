@@ -1,0 +1,98 @@
+// A game as the match runner plays it and the replay re-runs it: the match
+// config, the world, the referee (with the operator's part: starting halves,
+// the shoot-out) and the per-period bookkeeping that goes into the summary.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "simsoccer/referee/referee.hpp"
+#include "simsoccer/world/match_log.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::apps {
+
+struct VideoSettings {
+  bool enabled = true;
+  double fps = 25.0;
+  int width = 640, height = 360;
+  engine::Vec3 position{0.0, -7.0, 5.0}, look_at{0.0, 0.0, 0.0};  // m, field frame
+  double horizontal_fov = 1.1;                                      // rad
+};
+
+struct MatchConfig {
+  std::string file, name;
+  std::filesystem::path scenario, rules, agent_config, field;
+  std::optional<double> half_duration, half_time_break;
+  std::array<int, 2> team_numbers{1, 2};
+  std::string role = "auto";
+  bool get_up = false;
+  int restart_limit = 3;
+  double message_delay = 0.0, message_loss = 0.0;
+  double command_timeout = 0.5;  // s of wall time a lockstep period waits for commands
+  double set_duration = 5.0;     // s in Set before the referee whistles
+  VideoSettings video;
+  uint64_t seed = 1;
+  int penalty_kicks = 0;  // > 0: a penalty-kick scenario (simsoccer penalty)
+  std::string hash;       // of the config and scenario files' bytes
+};
+// Reads a match or penalty config; throws engine::ConfigError (file, key, reason).
+MatchConfig loadMatchConfig(const std::filesystem::path& file);
+
+struct RobotRecord {
+  int team = 0, number = 0;
+  int falls = 0;
+  double distance = 0.0;  // m walked (torso, teleports left out)
+  bool standing = true;
+  engine::Vec3 last{0, 0, 0};
+};
+
+class MatchSession {
+ public:
+  // `seed` overrides the config's. The world is built from the scenario with
+  // that seed; the rule book's half duration and break as the config says.
+  MatchSession(const MatchConfig& config, uint64_t seed);
+
+  world::World& world() { return *world_; }
+  referee::Referee& referee() { return *referee_; }
+  const referee::Game& game() const { return referee_->game(); }
+  const MatchConfig& config() const { return config_; }
+
+  // After each world step: the operator (start the halves, the shoot-out
+  // kicks), the referee, and the records. New referee events since the last
+  // call are appended to `events`.
+  void afterStep(std::vector<world::LogEvent>& events);
+  bool over() const;  // the game (and any shoot-out) is decided, or the penalty kicks are done
+
+  const std::vector<RobotRecord>& robots() const { return records_; }
+  std::array<double, 2> possession() const;  // share of the time each team had the ball
+  struct Goal {
+    double time;
+    int team, scorer;  // scorer: player number of the last touch by that team (0: unknown)
+    bool own_goal;
+  };
+  const std::vector<Goal>& goals() const { return goals_; }
+  // The GameController packet for now (bytes, for the log).
+  std::vector<uint8_t> packet() const;
+  referee::ControlData controlData() const;
+
+ private:
+  void operatorPart();
+  void record();
+
+  MatchConfig config_;
+  std::unique_ptr<world::World> world_;
+  std::unique_ptr<referee::Referee> referee_;
+  std::vector<RobotRecord> records_;
+  std::array<double, 2> possession_{};
+  std::vector<Goal> goals_;
+  size_t events_seen_ = 0;
+  int next_striker_[2] = {0, 0};
+  std::array<int, 2> last_touch_player_{};
+};
+
+}  // namespace simsoccer::apps
