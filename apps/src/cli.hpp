@@ -57,6 +57,7 @@ int benchSensors(int argc, char** argv, int first);
 int benchNet(int argc, char** argv, int first);
 int benchCameras(int argc, char** argv, int first);
 int benchMotion(int argc, char** argv, int first);
+int benchScaling(int argc, char** argv, int first);
 int serve(int argc, char** argv, int first);
 int match(int argc, char** argv, int first);
 int penalty(int argc, char** argv, int first);

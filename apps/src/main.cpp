@@ -23,7 +23,8 @@ const char* kUsage =
     "  bench sensors   sonar tracer (batched vs Bullet rayTest) and sensor cost per robot count\n"
     "  bench net       lockstep with real agent processes over DDS: overhead and bytes per tick\n"
     "  bench cameras   every robot's two cameras rendered through EGL: views/s, ms per frame, RTF\n"
-    "  bench motion    the agents' walk on the physics: speeds, path deviation, falls\n"
+    "  bench motion    the agents' motion and behaviour: walk, kick, get-up, striker, penalty\n"
+    "  bench scaling   the full pipeline with agent processes, 1..22 robots, vs USARSim\n"
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
@@ -50,9 +51,10 @@ int main(int argc, char** argv) {
       if (sub == "net") return benchNet(argc, argv, 3);
       if (sub == "cameras") return benchCameras(argc, argv, 3);
       if (sub == "motion") return benchMotion(argc, argv, 3);
+      if (sub == "scaling") return benchScaling(argc, argv, 3);
       std::fprintf(
           stderr,
-          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras, motion)\n",
+          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras, motion, scaling)\n",
           sub.c_str());
       return 2;
     }

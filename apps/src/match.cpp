@@ -492,9 +492,9 @@ const char* kPenaltyHelp =
     "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n";
 
 const char* kReplayHelp =
-    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics]\n"
+    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics] [--events]\n"
     "\n"
-    "Reads a match log: prints what it holds; --video renders the spectator camera over\n"
+    "Reads a match log: prints what it holds (--events: every referee event); --video renders the spectator camera over\n"
     "[--from, --to] s (default the whole log) to FILE (.mp4 or .avi; .png: one still at\n"
     "--from); --physics re-runs the\n"
     "game through the physics and the referee with the recorded commands and checks every\n"
@@ -637,7 +637,7 @@ int penalty(int argc, char** argv, int first) {
 }
 
 int replay(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "physics"}, {"video", "from", "to"});
+  const Options opt(argc, argv, first, {"help", "physics", "events"}, {"video", "from", "to"});
   if (opt.help(kReplayHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match log");
   const std::filesystem::path file = opt.positional()[0];
@@ -654,6 +654,10 @@ int replay(int argc, char** argv, int first) {
     if (first_time < 0) first_time = f.time;
     last_time = f.time;
     events += static_cast<int>(f.events.size());
+    if (opt.flag("events"))
+      for (const auto& e : f.events)
+        std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, e.type.c_str(), e.team,
+                    e.player, e.detail.c_str());
     ++frames;
   }
   std::printf("%s: %d frames (%.2f .. %.2f s), %zu robots, %d referee events, seed %s, config %s\n",

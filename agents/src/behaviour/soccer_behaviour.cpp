@@ -188,12 +188,11 @@ bool SoccerBehaviour::takeMotionRestart() {
 void SoccerBehaviour::updateBall(const Input& in) {
   if (in.perception) {
     const PerceptionIn& p = *in.perception;
-    if (phase_ == kPhasePenaltyShoot && p.ball.last_seen >= 0) {
-      // Every shoot-out kick goes at one goal: the one nearer the ball (the
-      // penalty mark). The kicker attacks it, the keeper defends it.
-      const double c = std::cos(p.self_pose[2]), s = std::sin(p.self_pose[2]);
-      const double bx = p.self_pose[0] + c * p.ball.x - s * p.ball.y;
-      const int goal = bx >= 0 ? 1 : -1;
+    if (phase_ == kPhasePenaltyShoot) {
+      // Every shoot-out kick goes at one goal, and the referee puts both the
+      // kicker (at the penalty mark) and the keeper (on the line) in that
+      // half: the kicker attacks it, the keeper defends it.
+      const int goal = p.self_pose[0] >= 0 ? 1 : -1;
       attack_sign_ = our_kick_ ? goal : -goal;
     }
     const Vec2 own = toOwn(p.self_pose[0], p.self_pose[1]);
@@ -335,8 +334,13 @@ MotionRequest SoccerBehaviour::walkTo(const Pose2& target, bool face_ball) {
     r.forward = std::clamp(0.8 * rel.x, -0.1, config_.max_forward);
     r.left = std::clamp(0.8 * rel.y, -config_.max_side, config_.max_side);
     r.turn = std::clamp(1.2 * err, -config_.max_turn, config_.max_turn);
-    if (dist < 0.08 && std::abs(err) < 0.15) r = MotionRequest{};  // there: stand
+    // There: stand (and stay until the target moves away or the robot drifts off).
+    if (dist < (arrived_ ? 0.25 : 0.1) && std::abs(err) < (arrived_ ? 0.4 : 0.2)) {
+      arrived_ = true;
+      return MotionRequest{};
+    }
   }
+  arrived_ = false;
   return r;
 }
 

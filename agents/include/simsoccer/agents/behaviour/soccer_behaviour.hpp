@@ -156,6 +156,7 @@ class SoccerBehaviour {
   double kick_commit_until_ = -1.0;
   int penalty_side_ = 1;
   Pose2 target_;
+  bool arrived_ = false;  // at the walk target: standing
   double head_phase_ = 0.0;
 };
 

@@ -1,0 +1,229 @@
+// simsoccer bench scaling: the full pipeline per robot count (physics,
+// sensors, perception, DDS with real agent processes playing soccer, the
+// referee; cameras with --cameras), against the published USARSim figures.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "process.hpp"
+#include "simsoccer/net/sim_server.hpp"
+#include "simsoccer/referee/referee.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--seconds S] [--cameras]\n"
+    "                               [--csv FILE] [--png FILE] [--domain D]\n"
+    "\n"
+    "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
+    "3D-league-sized field beyond), perception on, the automatic referee (simleague rule book),\n"
+    "and N simsoccer-agent processes (--role auto: walking, kicking, team messages) over\n"
+    "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready.\n"
+    "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
+    "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
+    "real-time factor and the time per control period split into physics (with sensors),\n"
+    "messaging (perception and frames out, commands in), referee and rendering; writes the\n"
+    "CSV and a plot (default scaling.png): real-time factor and frames per second against\n"
+    "robots, log scale, beside USARSim's published 110, 55, 30, 10 fps for 1-4 Naos.\n";
+
+using Clock = std::chrono::steady_clock;
+
+struct Row {
+  int robots = 0;
+  double steps_per_s = 0, fps = 0, rtf = 0;
+  double physics_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
+  uint64_t missed = 0;
+};
+
+world::Scenario scalingScenario(int n, bool cameras) {
+  world::Scenario s;
+  s.name = "bench_scaling";
+  const bool large = n > 14;
+  s.field_file = findConfig("", large ? "fields/simleague.yaml" : "fields/spl.yaml");
+  s.robot_model_file = findConfig("", "robots/nao_v6_h25.yaml");
+  s.seed = 1;
+  s.perception.enabled = true;
+  s.perception.realistic = true;
+  s.cameras.enabled = cameras;
+  const fields::FieldModel f = fields::loadFieldModel(s.field_file);
+  const double hl = f.halfLength(), hw = f.halfWidth();
+  // The behaviour's kick-off formation (shares of the half-length / half-width).
+  const double formation[11][2] = {{-0.95, 0.0}, {-0.65, -0.35}, {-0.65, 0.35}, {-0.35, -0.55},
+                                   {-0.25, 0.3}, {-0.45, 0.0},   {-0.2, -0.2},  {-0.8, -0.6},
+                                   {-0.8, 0.6},  {-0.3, 0.75},   {-0.3, -0.85}};
+  for (int i = 0; i < n; ++i) {
+    world::RobotPlacement p;
+    p.team = i % 2;
+    p.number = i / 2 + 1;
+    const auto& fr = formation[(p.number - 1) % 11];
+    const double sign = p.team == 0 ? 1.0 : -1.0;
+    p.x = sign * fr[0] * hl;
+    p.y = sign * fr[1] * hw;
+    p.yaw = p.team == 0 ? 0.0 : M_PI;
+    s.robots.push_back(p);
+  }
+  return s;
+}
+
+Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
+  world::Scenario s = scalingScenario(n, cameras);
+  world::World w(s);
+  net::ServerConfig sc;
+  sc.dds.domain = domain;
+  sc.dds.config_file = findConfig("", "configs/dds/loopback.xml");
+  sc.lockstep = true;
+  sc.command_timeout = 2.0;
+  net::SimServer server(w, sc);
+  const referee::RuleBook rules = referee::loadRuleBook(findConfig("", "configs/rules/simleague.yaml"));
+  std::array<referee::TeamSetup, 2> teams;
+  for (size_t t = 0; t < 2; ++t) {
+    teams[t].number = static_cast<uint8_t>(t + 1);
+    teams[t].field_player_colour = static_cast<uint8_t>(t);
+  }
+  referee::Referee ref(w, rules, teams, 0);
+  ref.game().standby();
+  ref.game().ready();
+  std::vector<std::unique_ptr<ChildProcess>> agents;
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    const auto& info = w.robot(r);
+    agents.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
+        agentProgram().string(), "--team", std::to_string(info.team), "--player",
+        std::to_string(info.number), "--domain", std::to_string(domain), "--role", "auto",
+        "--field", s.field_file.string()}));
+  }
+  const auto t_wait = Clock::now();
+  while (!server.waitForOwners(w.robotCount(), 0.5))
+    if (std::chrono::duration<double>(Clock::now() - t_wait).count() > 60)
+      throw std::runtime_error("agents did not claim their robots within 60 s");
+  const double period = s.physics.control_period;
+  const auto periods = static_cast<long>(seconds / period);
+  const net::ServerTimes before = server.times();
+  double referee_s = 0.0;
+  std::optional<referee::ControlData> published;
+  const auto t0 = Clock::now();
+  for (long i = 0; i < periods; ++i) {
+    server.runPeriod();
+    const auto r0 = Clock::now();
+    ref.update();
+    const referee::ControlData d = ref.game().packet(0);
+    if (!published || !(d == *published)) {
+      simsoccer_msg_GameState m{};
+      net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
+      server.setGameState(m);
+      published = d;
+    }
+    referee_s += std::chrono::duration<double>(Clock::now() - r0).count();
+  }
+  server.flushCameras();
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  const net::ServerTimes& t = server.times();
+  Row row;
+  row.robots = n;
+  row.steps_per_s = periods * w.stepsPerControlPeriod() / wall;
+  row.fps = periods / wall;
+  row.rtf = periods * period / wall;
+  const double per = 1e3 / static_cast<double>(periods);
+  row.physics_ms = (t.physics_s - before.physics_s) * per;
+  row.messaging_ms = (t.publish_s - before.publish_s + t.wait_s - before.wait_s) * per;
+  row.referee_ms = referee_s * per;
+  row.render_ms = (t.camera_s - before.camera_s) * per;
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;
+  for (auto& a : agents) a->stop();
+  return row;
+}
+
+void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
+  const int W = 900, H = 560, L = 80, R = 30, T = 50, B = 70;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  const double xmin = std::log10(1.0), xmax = std::log10(24.0), ymin = -1.0, ymax = 4.0;  // 0.1 .. 10^4
+  auto px = [&](double robots, double value) {
+    const double x = L + (std::log10(robots) - xmin) / (xmax - xmin) * (W - L - R);
+    const double y = H - B - (std::log10(std::max(value, 0.1)) - ymin) / (ymax - ymin) * (H - T - B);
+    return cv::Point(static_cast<int>(x), static_cast<int>(y));
+  };
+  for (int e = -1; e <= 4; ++e) {
+    cv::line(img, px(1, std::pow(10, e)), px(24, std::pow(10, e)), cv::Scalar(225, 225, 225), 1);
+    cv::putText(img, fmt(std::pow(10, e), e < 0 ? 1 : 0), px(1, std::pow(10, e)) + cv::Point(-60, 5),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
+  }
+  for (int n : {1, 2, 4, 8, 11, 22}) {
+    cv::line(img, px(n, 0.1), px(n, 1e4), cv::Scalar(235, 235, 235), 1);
+    cv::putText(img, std::to_string(n), px(n, 0.1) + cv::Point(-8, 22), cv::FONT_HERSHEY_SIMPLEX,
+                0.5, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+  }
+  cv::putText(img, "robots", cv::Point(W / 2 - 30, H - 20), cv::FONT_HERSHEY_SIMPLEX, 0.6,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  auto series = [&](const std::vector<std::pair<double, double>>& pts, const cv::Scalar& colour) {
+    for (size_t i = 0; i < pts.size(); ++i) {
+      cv::circle(img, px(pts[i].first, pts[i].second), 5, colour, cv::FILLED, cv::LINE_AA);
+      if (i) cv::line(img, px(pts[i - 1].first, pts[i - 1].second), px(pts[i].first, pts[i].second), colour, 2, cv::LINE_AA);
+    }
+  };
+  std::vector<std::pair<double, double>> fps, rtf;
+  for (const Row& r : rows) {
+    fps.emplace_back(r.robots, r.fps);
+    rtf.emplace_back(r.robots, r.rtf);
+  }
+  series({{1, 110}, {2, 55}, {3, 30}, {4, 10}}, cv::Scalar(40, 40, 200));
+  series(fps, cv::Scalar(200, 90, 20));
+  series(rtf, cv::Scalar(30, 150, 30));
+  cv::putText(img, "simsoccer control frames/s (100 per simulated s)", cv::Point(L + 10, T - 25),
+              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(200, 90, 20), 1, cv::LINE_AA);
+  cv::putText(img, "simsoccer real-time factor", cv::Point(L + 10, T - 8), cv::FONT_HERSHEY_SIMPLEX,
+              0.5, cv::Scalar(30, 150, 30), 1, cv::LINE_AA);
+  cv::putText(img, "USARSim fps (published, 1-4 Naos)", cv::Point(L + 450, T - 25),
+              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
+  if (!cv::imwrite(file.string(), img)) throw std::runtime_error(file.string() + ": cannot write the plot");
+}
+
+}  // namespace
+
+int benchScaling(int argc, char** argv, int first) {
+  const Options opt(argc, argv, first, {"help", "cameras"}, {"robots", "seconds", "csv", "png", "domain"});
+  if (opt.help(kHelp)) return 0;
+  opt.noPositional();
+  const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
+  for (int n : counts)
+    if (n < 1 || n > 22) throw UsageError("--robots: 1..22 robots per row");
+  const double seconds = opt.number("seconds", 20.0);
+  if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
+  const bool cameras = opt.flag("cameras");
+  const auto domain = static_cast<uint32_t>(opt.number("domain", 43));
+  const std::filesystem::path png = opt.get("png", "scaling.png");
+  std::printf(
+      "simsoccer bench scaling: full pipeline (physics, sensors, perception, DDS lockstep with N "
+      "soccer agent processes, referee%s), %.0f s simulated per row\n",
+      cameras ? ", cameras" : "", seconds);
+  std::fflush(stdout);
+  Table table;
+  table.header = {"robots",     "steps_per_s",  "fps",        "rtf",       "physics_ms",
+                  "messaging_ms", "referee_ms", "render_ms", "missed"};
+  std::vector<Row> rows;
+  for (int n : counts) {
+    const Row r = runRow(n, seconds, cameras, domain);
+    rows.push_back(r);
+    table.rows.push_back({std::to_string(n), fmt(r.steps_per_s, 0), fmt(r.fps, 0), fmt(r.rtf, 2),
+                          fmt(r.physics_ms, 2), fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
+                          fmt(r.render_ms, 2), std::to_string(r.missed)});
+    std::fprintf(stderr, "  %d robots done\n", n);
+  }
+  table.finish(
+      "fps: control periods (frames) per wall second, 100 per simulated second; rtf: simulated / "
+      "wall time; ms per control period: physics (with sensors), messaging (perception and "
+      "frames out, waiting for and applying the agents' commands), referee, render (cameras); "
+      "missed: lockstep periods an agent did not answer in time. USARSim (published): 1 Nao "
+      "110 fps, 2: 55, 3: 30, 4: 10.",
+      opt.get("csv", ""));
+  plot(rows, png);
+  std::printf("plot: %s\n", png.string().c_str());
+  return 0;
+}
+
+}  // namespace simsoccer::apps
