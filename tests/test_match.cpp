@@ -1,0 +1,271 @@
+// The main job end to end: `simsoccer match` with real agent processes over
+// DDS, its summary, log, video and heatmap; the same seed twice; replay
+// through the physics; an agent killed mid-match; Ctrl-C; the penalty
+// scenario; bench scaling. (Label: match, slow.)
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <map>
+#include <opencv2/videoio.hpp>
+#include <regex>
+#include <thread>
+
+#include "simsoccer/world/match_log.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+
+namespace {
+
+const std::string kBin = SIMSOCCER_BIN;
+
+std::string readFile(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The value of a top-level "key": number or string in our summary's JSON.
+std::string jsonValue(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\": (\"[^\"]*\"|[-0-9.]+|null|true|false|\\[[^\\]]*\\])");
+  std::smatch m;
+  return std::regex_search(json, m, re) ? m[1].str() : "";
+}
+
+// The summary without the lines that hold wall-clock figures.
+std::string withoutWallTimes(const std::string& json) {
+  std::stringstream in(json), out;
+  for (std::string line; std::getline(in, line);)
+    if (line.find("wall_seconds") == std::string::npos &&
+        line.find("real_time_factor") == std::string::npos)
+      out << line << "\n";
+  return out.str();
+}
+
+std::filesystem::path tempDir(const std::string& name) {
+  auto d = std::filesystem::temp_directory_path() / ("simsoccer_test_" + name);
+  std::filesystem::remove_all(d);
+  return d;
+}
+
+// One short 2 v 2 game (2 x 15 s halves), shared by the tests below.
+struct ShortMatch {
+  std::filesystem::path dir;
+  std::string out;
+  int status = -1;
+};
+const ShortMatch& shortMatch() {
+  static ShortMatch m = [] {
+    ShortMatch r;
+    r.dir = tempDir("match_a");
+    r.out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                                 " --half 15 --domain 131 --out " + r.dir.string(),
+                             r.status);
+    return r;
+  }();
+  return m;
+}
+
+}  // namespace
+
+TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
+  const ShortMatch& m = shortMatch();
+  ASSERT_EQ(m.status, 0) << m.out;
+  const std::string summary = readFile(m.dir / "summary.json");
+  ASSERT_FALSE(summary.empty());
+  for (const char* key : {"final_score", "goals", "referee_events", "penalties", "robots",
+                          "possession", "agent_restarts", "simulated_seconds", "wall_seconds",
+                          "real_time_factor", "seed", "config_hash", "final_state_hash"})
+    EXPECT_NE(summary.find(std::string("\"") + key + "\""), std::string::npos) << key;
+  EXPECT_EQ(jsonValue(summary, "interrupted"), "false");
+  EXPECT_EQ(jsonValue(summary, "aborted"), "null");
+  // The game was played: halves and a result.
+  EXPECT_NE(summary.find("end of the second half"), std::string::npos);
+  EXPECT_NE(summary.find("\"game_over\""), std::string::npos);
+
+  // The log: valid, one frame per control period, its goal events add up to the score.
+  world::MatchLogReader log(m.dir / "match.log");
+  EXPECT_EQ(log.header().robots.size(), 4u);
+  world::LogFrame f;
+  int frames = 0, goals[2] = {0, 0};
+  double last = 0.0;
+  while (log.next(f)) {
+    ++frames;
+    EXPECT_NEAR(f.time - last, 0.01, 1e-6);
+    last = f.time;
+    for (const auto& e : f.events)
+      if (e.type == "goal" && e.team >= 0 && e.team < 2) ++goals[e.team];
+  }
+  EXPECT_EQ(std::to_string(frames), jsonValue(summary, "log_frames"));
+  EXPECT_NEAR(last, std::stod(jsonValue(summary, "simulated_seconds")), 0.011);
+  char score[64];
+  std::snprintf(score, sizeof score, "[%d, %d]", goals[0], goals[1]);
+  EXPECT_EQ(jsonValue(summary, "final_score"), score);
+  // A few MB per minute at most.
+  const double mb_per_minute = std::filesystem::file_size(m.dir / "match.log") / 1e6 / (last / 60.0);
+  EXPECT_LT(mb_per_minute, 5.0);
+
+  // The video: 25 frames per simulated second of the log.
+  cv::VideoCapture video((m.dir / "match.mp4").string());
+  ASSERT_TRUE(video.isOpened());
+  const double expected = std::ceil(last * 25.0 - 1e-6);
+  EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), expected, 2.0);
+  EXPECT_GT(std::filesystem::file_size(m.dir / "heatmap.png"), 1000u);
+}
+
+TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
+  const ShortMatch& a = shortMatch();
+  ASSERT_EQ(a.status, 0) << a.out;
+  const auto dir = tempDir("match_b");
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+          " --half 15 --no-video --domain 132 --out " + dir.string(),
+      status);
+  ASSERT_EQ(status, 0) << out;
+  const std::string one = readFile(a.dir / "summary.json"), two = readFile(dir / "summary.json");
+  EXPECT_EQ(jsonValue(one, "final_state_hash"), jsonValue(two, "final_state_hash"));
+  EXPECT_EQ(withoutWallTimes(one), withoutWallTimes(two));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
+  const ShortMatch& m = shortMatch();
+  ASSERT_EQ(m.status, 0) << m.out;
+  int status = -1;
+  const auto still = m.dir / "still.png";
+  const std::string out = test::runCommand(
+      kBin + " replay " + (m.dir / "match.log").string() + " --physics --video " + still.string() +
+          " --from 20",
+      status);
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("every state hash equal"), std::string::npos) << out;
+  EXPECT_TRUE(std::filesystem::exists(still));
+  // A part of the log as a video: 2 s at 25 fps.
+  const auto part = m.dir / "part.mp4";
+  test::runCommand(kBin + " replay " + (m.dir / "match.log").string() + " --video " +
+                       part.string() + " --from 10 --to 12",
+                   status);
+  ASSERT_EQ(status, 0);
+  cv::VideoCapture video(part.string());
+  EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), 50.0, 1.0);
+}
+
+TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
+  const auto dir = tempDir("match_kill");
+  int status = -1;
+  std::string out;
+  std::thread run([&] {
+    out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                               " --half 10 --no-video --domain 133 --out " + dir.string(),
+                           status);
+  });
+  // Once the game runs (the log has grown), kill team 1's player 2.
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (std::filesystem::exists(dir / "match.log") &&
+        std::filesystem::file_size(dir / "match.log") > 200000)
+      break;
+  }
+  int kill_status = 0;
+  test::runCommand("pkill -f '^[^ ]*simsoccer-agent --team 1 --player 2 --domain 133 '", kill_status);
+  run.join();
+  ASSERT_EQ(status, 0) << out;
+  const std::string summary = readFile(dir / "summary.json");
+  EXPECT_NE(jsonValue(summary, "agent_restarts"), "[]") << summary;
+  EXPECT_NE(summary.find("\"team\": 1, \"player\": 2, \"exit_status\""), std::string::npos);
+  EXPECT_NE(summary.find("end of the second half"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
+  const auto dir = tempDir("match_int");
+  int status = -1;
+  std::string out;
+  std::thread run([&] {
+    out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                               " --no-video --domain 134 --out " + dir.string(),
+                           status);
+  });
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (std::filesystem::exists(dir / "match.log") &&
+        std::filesystem::file_size(dir / "match.log") > 100000)
+      break;
+  }
+  int s = 0;
+  test::runCommand("pkill -INT -f '^" + kBin + " match .*--domain 134 '", s);
+  run.join();
+  EXPECT_EQ(WEXITSTATUS(status), 130) << out;
+  const std::string summary = readFile(dir / "summary.json");
+  EXPECT_EQ(jsonValue(summary, "interrupted"), "true") << summary;
+  world::MatchLogReader log(dir / "match.log");
+  world::LogFrame f;
+  int frames = 0;
+  while (log.next(f)) ++frames;
+  EXPECT_GT(frames, 100);
+  EXPECT_EQ(std::to_string(frames), jsonValue(summary, "log_frames"));
+  // No agent is left behind.
+  int ps = 0;
+  const std::string left = test::runCommand("pgrep -f '^[^ ]*simsoccer-agent .*--domain 134 '", ps);
+  EXPECT_TRUE(left.empty()) << left;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
+  const auto dir = tempDir("match_bad");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bad.yaml") << "match: bad\nscenario: nowhere.yaml\nrules: rules/spl.yaml\n";
+  int status = 0;
+  std::string out = test::runCommand(kBin + " match " + (dir / "bad.yaml").string(), status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("bad.yaml"), std::string::npos) << out;
+  EXPECT_NE(out.find("scenario"), std::string::npos) << out;
+  out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                             " --out /proc/simsoccer_no",
+                         status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("/proc/simsoccer_no"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
+  const auto dir = tempDir("penalty");
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " penalty " + (test::sourceDir() / "configs/penalty.yaml").string() +
+          " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.string(),
+      status);
+  ASSERT_EQ(status, 0) << out;
+  const std::string json = readFile(dir / "penalty.json");
+  EXPECT_EQ(jsonValue(json, "kicks"), "5");
+  const std::regex outcome("\"(goal|saved|missed|timeout)\"");
+  const std::string list = json.substr(json.find("\"outcomes\""));
+  EXPECT_EQ(std::distance(std::sregex_iterator(list.begin(), list.end(), outcome), std::sregex_iterator()), 5);
+  const double rate = std::stod(jsonValue(json, "scoring_rate"));
+  EXPECT_GE(rate, 0.0);
+  EXPECT_LE(rate, 1.0);
+  EXPECT_NE(out.find("95% CI"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "kick_1.mp4"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
+  const auto dir = tempDir("scaling");
+  std::filesystem::create_directories(dir);
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " bench scaling --robots 1,2 --seconds 2 --domain 136 --csv " +
+          (dir / "scaling.csv").string() + " --png " + (dir / "scaling.png").string(),
+      status);
+  ASSERT_EQ(status, 0) << out;
+  const auto lines = test::readLines(dir / "scaling.csv");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].rfind("robots,steps_per_s,fps,rtf", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("1,", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("2,", 0), 0u);
+  EXPECT_GT(std::filesystem::file_size(dir / "scaling.png"), 1000u);
+  std::filesystem::remove_all(dir);
+}
