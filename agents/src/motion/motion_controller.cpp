@@ -133,9 +133,11 @@ void MotionController::update(double dt, const MotionSensors& sensors,
         still_for_ += dt;
       else
         still_for_ = 0.0;
-      if (state_ == MotionState::Falling && tilt_ < fall_.upright_tilt && rate < fall_.lying_rate &&
-          state_time_ > 0.5) {
-        restart_ = true;  // caught itself: back to the stance
+      if (tilt_ < fall_.upright_tilt && rate < fall_.lying_rate &&
+          (state_ == MotionState::Lying || state_time_ > 0.5)) {
+        // Upright again: it caught itself, or it was picked up and put back
+        // on its feet (a referee's placement): back to the stance.
+        restart_ = true;
         break;
       }
       if (still_for_ >= fall_.lying_time && fall_.get_up) {

@@ -1,0 +1,328 @@
+// The agents' behaviour layer and what it stands on: team message codec,
+// behaviour config errors, role assignment by team messages, GameState
+// obedience, the striker lining up and kicking; keyframe motions and the
+// motion controller's fall detector; the match log format.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+#include "simsoccer/agents/motion/motion_controller.hpp"
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/world/match_log.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+using agents::MotionRequest;
+using agents::Role;
+using engine::Vec3;
+
+namespace {
+
+agents::BehaviourConfig soccerConfig() {
+  return agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer.yaml");
+}
+fields::FieldModel field() {
+  return fields::loadFieldModel(test::splField());
+}
+
+// A perception with the robot at (x, y, yaw) and the ball at field (bx, by), seen.
+agents::PerceptionIn seeing(double x, double y, double yaw, double bx, double by, double t) {
+  agents::PerceptionIn p;
+  p.sim_time = t;
+  p.self_pose = {static_cast<float>(x), static_cast<float>(y), static_cast<float>(yaw)};
+  const double dx = bx - x, dy = by - y, c = std::cos(yaw), s = std::sin(yaw);
+  p.ball.in_view = true;
+  p.ball.last_seen = t;
+  p.ball.x = static_cast<float>(c * dx + s * dy);
+  p.ball.y = static_cast<float>(-s * dx + c * dy);
+  return p;
+}
+
+simsoccer_msg_GameState gameState(int state, int team0_number = 1) {
+  simsoccer_msg_GameState g{};
+  g.state = static_cast<uint8_t>(state);
+  g.players_per_team = 5;
+  g.first_half = 1;
+  g.kicking_team = 255;
+  g.secs_remaining = 600;
+  g.teams[0].team_number = static_cast<uint8_t>(team0_number);
+  g.teams[1].team_number = static_cast<uint8_t>(team0_number == 1 ? 2 : 1);
+  for (auto& t : g.teams) {
+    t.goalkeeper = 1;
+    t.message_budget = 1200;
+  }
+  return g;
+}
+
+}  // namespace
+
+TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
+  agents::TeamMessageData d;
+  d.player = 4;
+  d.role = Role::Defender;
+  d.fallen = true;
+  d.ball_seen = true;
+  d.x = -2.345;
+  d.y = 1.5;
+  d.yaw = -3.0;
+  d.ball_x = 4.4;
+  d.ball_y = -2.9;
+  d.ball_age = 1.3;
+  d.cost = 2.71;
+  const auto bytes = agents::encodeTeamMessage(d);
+  EXPECT_EQ(bytes.size(), 20u);
+  EXPECT_LE(bytes.size(), 128u);  // SPL limit
+  const auto back = agents::decodeTeamMessage(bytes);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->player, 4);
+  EXPECT_EQ(back->role, Role::Defender);
+  EXPECT_TRUE(back->fallen && back->ball_seen);
+  EXPECT_NEAR(back->x, d.x, 1e-3);
+  EXPECT_NEAR(back->yaw, d.yaw, 1e-3);
+  EXPECT_NEAR(back->ball_y, d.ball_y, 1e-3);
+  EXPECT_NEAR(back->ball_age, 1.3, 0.05);
+  EXPECT_NEAR(back->cost, 2.71, 0.01);
+  // Other teams' formats and garbage are ignored, not misread.
+  auto bad = bytes;
+  bad[0] = 'X';
+  EXPECT_FALSE(agents::decodeTeamMessage(bad));
+  EXPECT_FALSE(agents::decodeTeamMessage({1, 2, 3}));
+}
+
+TEST(BehaviourConfig, ErrorsNameFileAndKey) {
+  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_behaviour_cfg";
+  std::filesystem::create_directories(dir);
+  const auto f = dir / "bad.yaml";
+  std::ofstream(f) << "behaviour: soccer\nready_positions: [[0, 0, 0]]\nmax_forward: -1\n";
+  try {
+    agents::loadBehaviourConfig(f);
+    FAIL() << "accepted a negative speed";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("max_forward"), std::string::npos);
+  }
+  std::ofstream(f) << "behaviour: soccer\nready_positions: [[0, 0]]\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\nmax_fowrard: 1\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);  // a typo
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  // Player 3 of team 0 at (-1, 0), the ball at (0, 0); teammates 2 (nearer) and 4 (farther).
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
+  const auto game = gameState(3);
+  auto mate = [](int player, double x, double y, double cost) {
+    agents::TeamMessageData d;
+    d.player = player;
+    d.x = x;
+    d.y = y;
+    d.cost = cost;
+    agents::TeamMessageIn m;
+    m.from_player = player;
+    m.data = agents::encodeTeamMessage(d);
+    return m;
+  };
+  b.receive(mate(2, -0.4, 0.0, 0.4), 0.0);
+  b.receive(mate(4, -3.0, 1.0, 3.2), 0.0);
+  auto p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.01);
+  agents::SoccerBehaviour::Input in;
+  in.time = 0.01;
+  in.perception = &p;
+  in.game = &game;
+  b.update(in);
+  EXPECT_EQ(b.role(), Role::Supporter);  // 2 strikes; 4 is nearest the own goal: defender
+  // Player 2 falls behind: now player 3 is the nearest.
+  b.receive(mate(2, -0.4, 0.0, 2.4), 0.5);
+  in.time = 0.5;
+  p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
+  b.update(in);
+  EXPECT_EQ(b.role(), Role::Striker);
+  // Player 1 is the goalkeeper whatever the distances.
+  agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
+  keeper.update(in);
+  EXPECT_EQ(keeper.role(), Role::Goalkeeper);
+}
+
+TEST(SoccerBehaviour, ObeysTheGameState) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 4, Role::Striker, 1);
+  auto p = seeing(-3.0, 1.0, 0.0, 0.0, 0.0, 0.0);
+  agents::SoccerBehaviour::Input in;
+  in.perception = &p;
+  for (int s : {0, 2, 4, 5}) {  // Initial, Set, Finished, Standby: stand
+    const auto g = gameState(s);
+    in.game = &g;
+    EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand) << s;
+  }
+  // Ready: walks to its kick-off place (player 4: (-0.35, -0.55) of the half-sizes).
+  auto g = gameState(1);
+  in.game = &g;
+  const MotionRequest r = b.update(in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
+  EXPECT_LT(r.turn, 0.0);  // the place is to its right
+  // Penalised: stands.
+  g = gameState(3);
+  g.teams[0].players[3].penalty = 1;
+  EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand);
+  EXPECT_TRUE(b.takeMotionRestart());  // it will be moved
+  // In the second half (the team on the right), it attacks -x: a ball
+  // behind it (at x -4) is in front of the goal it now attacks.
+  g = gameState(3, 2);
+  p = seeing(-3.0, 0.0, M_PI, -3.5, 0.0, 1.0);
+  in.time = 1.0;
+  const MotionRequest r2 = b.update(in);
+  EXPECT_EQ(r2.kind, MotionRequest::Kind::Walk);
+  EXPECT_GT(r2.forward, 0.0);  // towards the ball, no turning round
+}
+
+TEST(SoccerBehaviour, TheStrikerKicksWhenTheBallIsInFrontOfAFootAndAimedAtTheGoal) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+  agents::SoccerBehaviour::Input in;
+  // The ball 0.17 m ahead, 0.05 m to the left; the goal straight ahead.
+  auto p = seeing(2.0, -0.05, 0.0, 2.17, 0.0, 0.1);
+  in.time = 0.1;
+  in.perception = &p;
+  MotionRequest r = b.update(in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Kick);
+  EXPECT_EQ(r.kick_foot, agents::Leg::Left);
+  // Turned 0.5 rad away from the goal: no kick, it turns back.
+  agents::SoccerBehaviour c(cfg, f, 0, 1, 2, Role::Striker, 1);
+  p = seeing(2.0, -0.05, 0.5, 2.0 + 0.17 * std::cos(0.5) - 0.05 * std::sin(0.5),
+             -0.05 + 0.17 * std::sin(0.5) + 0.05 * std::cos(0.5), 0.1);
+  r = c.update(in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
+  EXPECT_LT(r.turn, 0.0);
+  // Head: towards the ball it sees.
+  EXPECT_NEAR(r.head_yaw, std::atan2(0.05, 0.17), 0.01);
+}
+
+TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const auto m = agents::loadKeyframeMotion(test::sourceDir() / "configs/motions/get_up_front.yaml", model);
+  EXPECT_GT(m.frames.size(), 3u);
+  EXPECT_GT(m.duration(), 2.0);
+  EXPECT_LT(m.duration(), 8.0);
+  // The last frame is the stand pose.
+  EXPECT_EQ(m.frames.back().position, model.pose("stand"));
+  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_keyframes";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bad.yaml") << "motion: bad\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 3.0}}\n";
+  try {
+    agents::loadKeyframeMotion(dir / "bad.yaml", model);
+    FAIL();
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("LKneePitch"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("limits"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "bad.yaml") << "motion: bad\nframes:\n  - {duration: 0.5, joints: {RHipYawPitch: 0.1}}\n";
+  EXPECT_THROW(agents::loadKeyframeMotion(dir / "bad.yaml", model), engine::ConfigError);  // a mimic joint
+  // The player interpolates from the measured angles to the frames.
+  agents::KeyframePlayer player;
+  const std::vector<double> start(model.body->joints.size(), 0.0);
+  player.start(m, start);
+  std::vector<double> q(start.size());
+  double k = 0;
+  player.update(1e-3, q, k);
+  EXPECT_NEAR(q[static_cast<size_t>(model.body->jointIndex("LKneePitch"))], 0.0, 1e-3);
+  for (int i = 0; i < 10000 && player.active(); ++i) player.update(0.01, q, k);
+  EXPECT_FALSE(player.active());
+  EXPECT_EQ(q, model.pose("stand"));
+}
+
+TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGetUp) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const auto dir = test::sourceDir() / "configs/motions";
+  agents::FallDetectorParameters fall;
+  fall.get_up = false;
+  agents::MotionController mc(model, agents::loadKeyframeMotion(dir / "get_up_front.yaml", model),
+                              agents::loadKeyframeMotion(dir / "get_up_back.yaml", model), {}, {},
+                              fall);
+  std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
+  const auto& stand = model.pose("stand");
+  for (size_t a = 0; a < model.actuators.size(); ++a)
+    if (model.actuators[a].kind == robots::Actuator::Kind::Joint)
+      joints[a] = static_cast<float>(stand[static_cast<size_t>(model.actuators[a].index)]);
+  agents::MotionSensors s;
+  s.position = joints;
+  MotionRequest stand_still;
+  for (int i = 0; i < 100; ++i) mc.update(0.01, s, stand_still, position, stiffness);
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_FLOAT_EQ(stiffness[static_cast<size_t>(model.actuatorIndex("LKneePitch"))], 1.0f);
+  // Tipping forward: up (the accelerometer) leans towards -x in the torso frame.
+  for (int i = 0; i < 30; ++i) {
+    const double a = std::min(1.5, 0.05 * i);
+    s.accel = Vec3(-9.81 * std::sin(a), 0, 9.81 * std::cos(a));
+    s.gyro = Vec3(0, 2.0, 0);
+    mc.update(0.01, s, stand_still, position, stiffness);
+  }
+  EXPECT_EQ(mc.counters().falls, 1);
+  EXPECT_LT(stiffness[static_cast<size_t>(model.actuatorIndex("LKneePitch"))], 0.3f);
+  // Lying still: stays down (get-up off), soft.
+  s.gyro = Vec3::Zero();
+  for (int i = 0; i < 100; ++i) mc.update(0.01, s, stand_still, position, stiffness);
+  EXPECT_EQ(mc.state(), agents::MotionState::Lying);
+  EXPECT_EQ(mc.counters().get_ups, 0);
+}
+
+TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
+  world::World w(test::scenario(2));
+  const auto file = std::filesystem::temp_directory_path() / "simsoccer_test.log";
+  world::MatchLogHeader h;
+  h.values["scenario"] = "x.yaml";
+  h.values["seed"] = "9";
+  for (world::RobotId r = 0; r < w.robotCount(); ++r)
+    h.robots.push_back({w.robot(r).team, w.robot(r).number,
+                        static_cast<int>(w.robot(r).model->body->joints.size())});
+  std::vector<world::LogFrame> written;
+  {
+    world::MatchLogWriter log(file, h);
+    std::vector<std::array<double, 25>> pos(w.robotCount()), stiff(w.robotCount());
+    for (int i = 0; i < 250; ++i) {
+      for (auto& p : pos) p[3] = world::quantizeCommand(0.001 * i);
+      for (auto& k : stiff) k[3] = world::quantizeStiffness(0.5);
+      w.stepControlPeriod();
+      world::LogFrame f = world::captureFrame(w, static_cast<uint64_t>(i + 1), pos, stiff,
+                                              std::vector<bool>(w.robotCount(), i % 2 == 0));
+      if (i == 7) f.events.push_back({0.08, "goal", 1, 3, "0:1"});
+      f.game = {1, 2, 3};
+      log.write(f);
+      written.push_back(f);
+    }
+  }
+  world::MatchLogReader in(file);
+  EXPECT_EQ(in.header().values.at("seed"), "9");
+  ASSERT_EQ(in.header().robots.size(), w.robotCount());
+  world::LogFrame f;
+  size_t n = 0;
+  while (in.next(f)) {
+    const auto& o = written[n];
+    EXPECT_EQ(f.tick, o.tick);
+    EXPECT_EQ(f.state_hash, o.state_hash);
+    EXPECT_EQ(f.game, o.game);
+    EXPECT_NEAR((f.robots[0].torso.translation() - o.robots[0].torso.translation()).norm(), 0, 1e-6);
+    EXPECT_NEAR(f.robots[1].joints[5], o.robots[1].joints[5], 1e-4);
+    EXPECT_EQ(f.robots[0].command_position[3], o.robots[0].command_position[3]);  // exact
+    EXPECT_EQ(f.robots[0].command_stiffness[3], o.robots[0].command_stiffness[3]);
+    EXPECT_EQ(f.robots[0].commanded, o.robots[0].commanded);
+    EXPECT_EQ(f.events.size(), o.events.size());
+    ++n;
+  }
+  EXPECT_EQ(n, written.size());
+  // Cut the file in the last block: the complete blocks still read.
+  std::filesystem::resize_file(file, std::filesystem::file_size(file) - 100);
+  world::MatchLogReader cut(file);
+  n = 0;
+  while (cut.next(f)) ++n;
+  EXPECT_EQ(n, 200u);
+  // Not a log: a clear error.
+  std::ofstream(file) << "hello";
+  EXPECT_THROW(world::MatchLogReader{file}, std::runtime_error);
+  std::filesystem::remove(file);
+}
