@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# README quick start, command 1: set up, build, run the main job.
-# Until the match runner lands, the main job is the physics scaling benchmark.
+# README quick start, command 1: set up, build, run the main job: a 5 v 5 match with the
+# built-in agents (one simsoccer-agent process per robot over DDS, lockstep), 2 x 2 min halves.
+# Writes runs/latest/ (summary.json, match.log, match.mp4, heatmap.png). Extra arguments go
+# to `simsoccer match` (e.g. --half 600 for full halves, --seed N, --no-video).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
-./build/apps/simsoccer bench physics --csv build/bench_physics.csv "$@"
+./build/apps/simsoccer match configs/match_5v5.yaml --half 120 --out runs/latest "$@"

@@ -529,3 +529,34 @@ TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
   EXPECT_NEAR(p.ball.y, 0.0, 0.05);
   EXPECT_NEAR(p.self_pose[0], -2.0, 0.05);
 }
+
+TEST(NetKick, AStrikerAgentKicksTheBallTwoMetres) {
+  // Lockstep over DDS: simsoccer-agent --role striker sees the ball through
+  // its Perception, lines up behind it and kicks (joint targets only).
+  const uint32_t domain = 117;
+  world::Scenario s = teams(1);
+  s.robots[0].x = 0.0;
+  s.robots[0].y = 0.0;
+  s.ball_position = {0.4, 0.05, -1.0};  // ahead, towards the +x goal
+  s.perception.enabled = true;
+  world::World w(s);
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess agent(domain, 0, 1, {"--role", "striker"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const engine::Vec3 start = w.ballState().pose.translation();
+  double travelled = 0.0;
+  bool fell = false;
+  for (int i = 0; i < 2500 && travelled < 2.0; ++i) {  // up to 25 s
+    server.runPeriod();
+    fell = fell || !w.isStanding(0);
+    travelled = (w.ballState().pose.translation() - start).head<2>().norm();
+  }
+  // Let the ball roll out.
+  for (int i = 0; i < 400; ++i) server.runPeriod();
+  travelled = (w.ballState().pose.translation() - start).head<2>().norm();
+  const engine::Vec3 d = w.ballState().pose.translation() - start;
+  std::printf("ball travelled %.2f m (%.2f, %.2f); robot fell %d\n", travelled, d.x(), d.y(), fell);
+  EXPECT_GE(travelled, 2.0);
+  EXPECT_GT(d.x(), 1.5);  // towards the goal it attacks
+  EXPECT_FALSE(fell);
+}
