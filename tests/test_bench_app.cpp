@@ -123,7 +123,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   std::filesystem::remove(csv);
   int status = -1;
   const std::string out =
-      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --random-minutes 1 --get-up-trials 1 --csv " +
+      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1 --csv " +
                      csv.string() + " 2>&1",
                  status);
   std::printf("%s", out.c_str());
@@ -140,7 +140,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
     ASSERT_EQ(cells.size(), 8u) << line;
     rows[cells[1]] = cells;
   }
-  ASSERT_EQ(rows.size(), 8u);
+  ASSERT_EQ(rows.size(), 10u);
   // The figures: >= 0.25 m/s forward over 5 m, >= 0.10 m/s sideways,
   // >= 45 deg/s turning, paths within 10 %, no falls.
   EXPECT_GE(std::stod(rows["walk_forward"][3]), 0.245);

@@ -50,28 +50,27 @@ std::filesystem::path tempDir(const std::string& name) {
   return d;
 }
 
-// One short 2 v 2 game (2 x 15 s halves), shared by the tests below.
+// One short 2 v 2 game (2 x 15 s halves). ctest runs each test in its own
+// process, maybe side by side: each plays its own, in its own folder and DDS domain.
 struct ShortMatch {
   std::filesystem::path dir;
   std::string out;
   int status = -1;
 };
-const ShortMatch& shortMatch() {
-  static ShortMatch m = [] {
-    ShortMatch r;
-    r.dir = tempDir("match_a");
-    r.out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                                 " --half 15 --domain 131 --out " + r.dir.string(),
-                             r.status);
-    return r;
-  }();
-  return m;
+ShortMatch shortMatch(const std::string& name, int domain, const std::string& extra = "") {
+  ShortMatch r;
+  r.dir = tempDir(name);
+  r.out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                               " --half 15 --domain " + std::to_string(domain) + " --out " +
+                               r.dir.string() + " " + extra,
+                           r.status);
+  return r;
 }
 
 }  // namespace
 
 TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
-  const ShortMatch& m = shortMatch();
+  const ShortMatch m = shortMatch("match_a", 131);
   ASSERT_EQ(m.status, 0) << m.out;
   const std::string summary = readFile(m.dir / "summary.json");
   ASSERT_FALSE(summary.empty());
@@ -113,26 +112,24 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   const double expected = std::ceil(last * 25.0 - 1e-6);
   EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), expected, 2.0);
   EXPECT_GT(std::filesystem::file_size(m.dir / "heatmap.png"), 1000u);
+  std::filesystem::remove_all(m.dir);
 }
 
 TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
-  const ShortMatch& a = shortMatch();
+  const ShortMatch a = shortMatch("match_b1", 132, "--no-video");
   ASSERT_EQ(a.status, 0) << a.out;
-  const auto dir = tempDir("match_b");
-  int status = -1;
-  const std::string out = test::runCommand(
-      kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-          " --half 15 --no-video --domain 132 --out " + dir.string(),
-      status);
-  ASSERT_EQ(status, 0) << out;
+  const ShortMatch b = shortMatch("match_b2", 137, "--no-video");
+  ASSERT_EQ(b.status, 0) << b.out;
+  const auto dir = b.dir;
   const std::string one = readFile(a.dir / "summary.json"), two = readFile(dir / "summary.json");
   EXPECT_EQ(jsonValue(one, "final_state_hash"), jsonValue(two, "final_state_hash"));
   EXPECT_EQ(withoutWallTimes(one), withoutWallTimes(two));
   std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(a.dir);
 }
 
 TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
-  const ShortMatch& m = shortMatch();
+  const ShortMatch m = shortMatch("match_c", 138, "--no-video");
   ASSERT_EQ(m.status, 0) << m.out;
   int status = -1;
   const auto still = m.dir / "still.png";
@@ -151,6 +148,7 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
   ASSERT_EQ(status, 0);
   cv::VideoCapture video(part.string());
   EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), 50.0, 1.0);
+  std::filesystem::remove_all(m.dir);
 }
 
 TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {

@@ -1,5 +1,6 @@
 // simsoccer bench motion: the agents' motion (walk) on an empty field, in
 // this process on the real physics, commands exactly as an agent sends them.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,7 +38,9 @@ const char* kHelp =
     "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
     "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
+    "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
+    "  --striker-trials N, --penalty-trials N  trials in the table (default 20, 50)\n"
     "  --csv FILE    also write the table as CSV\n";
 
 struct WalkResult {
@@ -484,6 +487,39 @@ int benchMotion(int argc, char** argv, int first) {
     }
   }
   {
+    // The striker alone: N seeded trials from random spots, 60 s each to score.
+    const int trials = static_cast<int>(opt.number("striker-trials", 20));
+    int scored = 0, falls = 0;
+    std::vector<double> times;
+    for (int i = 0; i < trials; ++i) {
+      const StrikerResult s = strikerTrial(seed + 300 + static_cast<uint64_t>(i), 60.0, false);
+      scored += s.scored;
+      falls += s.falls;
+      if (s.scored) times.push_back(s.seconds);
+    }
+    std::sort(times.begin(), times.end());
+    const double median = times.empty() ? 0.0 : times[times.size() / 2];
+    row("striker_scores", 0.8, scored / std::max(1.0, double(trials)), "share", median, falls,
+        trials * 60.0);
+  }
+  {
+    // Penalty kicks against the behaviour goalkeeper: N seeded trials.
+    const int trials = static_cast<int>(opt.number("penalty-trials", 50));
+    int goals = 0, saved = 0, missed = 0, timeouts = 0;
+    for (int i = 0; i < trials; ++i) {
+      switch (penaltyTrial(seed + 500 + static_cast<uint64_t>(i), 30.0, false)) {
+        case PenaltyOutcome::Goal: ++goals; break;
+        case PenaltyOutcome::Saved: ++saved; break;
+        case PenaltyOutcome::Missed: ++missed; break;
+        case PenaltyOutcome::Timeout: ++timeouts; break;
+      }
+    }
+    std::fprintf(stderr, "  penalties: %d goals, %d saved, %d missed, %d timeouts\n", goals, saved,
+                 missed, timeouts);
+    row("penalty_scoring", 0, goals / std::max(1.0, double(trials)), "share",
+        100.0 * saved / std::max(1.0, double(trials)), 0, trials * 30.0);
+  }
+  {
     // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
     // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
     std::mt19937_64 rng(seed);
@@ -509,6 +545,10 @@ int benchMotion(int argc, char** argv, int first) {
       "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; get_up_front / "
       "get_up_back: share of trials (robot dropped on its front / back, seeded) standing in the "
       "stance within 8 s, deviation column = the slowest trial's seconds (12: failed); "
+      "striker_scores: share of trials (robot and ball at seeded random spots, the striker "
+      "behaviour alone) that score within 60 s, deviation column = the median seconds to score; "
+      "penalty_scoring: share of penalty kicks (kicker behaviour against the goalkeeper "
+      "behaviour, seeded) that score, deviation column = % saved; "
       "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
       "after each).",
