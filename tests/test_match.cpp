@@ -67,6 +67,32 @@ ShortMatch shortMatch(const std::string& name, int domain, const std::string& ex
   return r;
 }
 
+// A match of match_2v2.yaml run on a thread while the test acts on it; the
+// test's action waits for the game to be under way (the log has grown).
+struct BackgroundMatch {
+  std::filesystem::path dir;
+  int status = -1;
+  std::string out;
+  std::thread thread;
+  BackgroundMatch(const std::string& name, const std::string& options) : dir(tempDir(name)) {
+    thread = std::thread([this, options] {
+      out = test::runCommand(kBin + " match " +
+                                 (test::sourceDir() / "configs/match_2v2.yaml").string() + " " +
+                                 options + " --out " + dir.string(),
+                             status);
+    });
+  }
+  void waitForLog(uintmax_t bytes) const {
+    for (int i = 0; i < 600; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (std::filesystem::exists(dir / "match.log") &&
+          std::filesystem::file_size(dir / "match.log") > bytes)
+        return;
+    }
+  }
+  void join() { thread.join(); }
+};
+
 }  // namespace
 
 TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
@@ -152,25 +178,13 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
 }
 
 TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
-  const auto dir = tempDir("match_kill");
-  int status = -1;
-  std::string out;
-  std::thread run([&] {
-    out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                               " --half 10 --no-video --domain 133 --out " + dir.string(),
-                           status);
-  });
-  // Once the game runs (the log has grown), kill team 1's player 2.
-  for (int i = 0; i < 600; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (std::filesystem::exists(dir / "match.log") &&
-        std::filesystem::file_size(dir / "match.log") > 200000)
-      break;
-  }
+  BackgroundMatch m("match_kill", "--half 10 --no-video --domain 133");
+  m.waitForLog(200000);  // the game runs: kill team 1's player 2
   int kill_status = 0;
   test::runCommand("pkill -f '^[^ ]*simsoccer-agent --team 1 --player 2 --domain 133 '", kill_status);
-  run.join();
-  ASSERT_EQ(status, 0) << out;
+  m.join();
+  const auto& dir = m.dir;
+  ASSERT_EQ(m.status, 0) << m.out;
   const std::string summary = readFile(dir / "summary.json");
   EXPECT_NE(jsonValue(summary, "agent_restarts"), "[]") << summary;
   EXPECT_NE(summary.find("\"team\": 1, \"player\": 2, \"exit_status\""), std::string::npos);
@@ -179,24 +193,13 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
 }
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
-  const auto dir = tempDir("match_int");
-  int status = -1;
-  std::string out;
-  std::thread run([&] {
-    out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                               " --no-video --domain 134 --out " + dir.string(),
-                           status);
-  });
-  for (int i = 0; i < 600; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (std::filesystem::exists(dir / "match.log") &&
-        std::filesystem::file_size(dir / "match.log") > 100000)
-      break;
-  }
+  BackgroundMatch m("match_int", "--no-video --domain 134");
+  m.waitForLog(100000);
   int s = 0;
   test::runCommand("pkill -INT -f '^" + kBin + " match .*--domain 134 '", s);
-  run.join();
-  EXPECT_EQ(WEXITSTATUS(status), 130) << out;
+  m.join();
+  const auto& dir = m.dir;
+  EXPECT_EQ(WEXITSTATUS(m.status), 130) << m.out;
   const std::string summary = readFile(dir / "summary.json");
   EXPECT_EQ(jsonValue(summary, "interrupted"), "true") << summary;
   world::MatchLogReader log(dir / "match.log");

@@ -335,7 +335,9 @@ PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
     const Vec3 b = ball.pose.translation();
     if (!kicked && std::hypot(b.x() - mark, b.y()) > 0.05) kicked = true;
     if (!kicked) continue;
-    if (b.x() > f.halfLength() || std::abs(b.y()) > f.halfWidth()) return PenaltyOutcome::Missed;
+    // Wholly over the goal line outside the goal, or over the touchline: missed.
+    if (b.x() > f.halfLength() + f.ball.radius || std::abs(b.y()) > f.halfWidth())
+      return PenaltyOutcome::Missed;
     still = ball.linear_velocity.norm() < 0.02 ? still + dt : 0.0;
     if (still > 0.5) {
       // Stopped in play: the keeper's (touched, or it came to rest before the line).

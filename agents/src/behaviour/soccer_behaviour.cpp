@@ -135,8 +135,10 @@ SoccerBehaviour::SoccerBehaviour(const BehaviourConfig& config, const fields::Fi
       seed_(seed) {
   attack_sign_ = team == 0 ? 1 : -1;  // without a GameState: team 0 defends -x
   role_ = role == Role::Auto ? (player == 1 ? Role::Goalkeeper : Role::Striker) : role;
-  // The penalty kicker's corner: from the seed (deterministic, varies by trial).
-  penalty_side_ = ((seed * 0x9E3779B97F4A7C15ull) >> 63) ? 1 : -1;
+  // The penalty kicker's aim across the goal, as a share of the half-width
+  // between the posts: from the seed (deterministic, varies by trial), spread
+  // evenly so that some kicks go at the keeper.
+  penalty_aim_ = 2.0 * static_cast<double>((seed * 0x9E3779B97F4A7C15ull) >> 11) * 0x1.0p-53 - 1.0;
 }
 
 SoccerBehaviour::Vec2 SoccerBehaviour::toOwn(double fx, double fy) const {
@@ -444,7 +446,7 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       break;
     case Role::PenaltyKicker:
       if (!ball_known) return MotionRequest{};
-      r = striker(penalty_side_ * (0.5 * field_.goal.inner_width - 0.25), true);
+      r = striker(penalty_aim_ * (0.5 * field_.goal.inner_width - 0.15), true);
       break;
     case Role::Striker:
       if (!ball_known) {

@@ -155,7 +155,7 @@ class SoccerBehaviour {
   // A kick once decided is kept asked for (the walk stops first) until the
   // motion layer is seen kicking, or this time passes.
   double kick_commit_until_ = -1.0;
-  int penalty_side_ = 1;
+  double penalty_aim_ = 0.5;  // -1..1: right post .. left post
   Pose2 target_;
   bool arrived_ = false;  // at the walk target: standing
   double head_phase_ = 0.0;
