@@ -460,7 +460,7 @@ world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o) {
 
 const char* kMatchHelp =
     "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
-    "                       [--no-video] [--half S] [--domain D] [--quiet]\n"
+    "                       [--no-video] [--half S] [--max-seconds S] [--domain D] [--quiet]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -476,6 +476,7 @@ const char* kMatchHelp =
     "  match.mp4     the spectator camera rendered from the log, score and clock on top\n"
     "  heatmap.png   ball and team positions over the game\n"
     "  --half S            half duration in s (overrides the config)\n"
+    "  --max-seconds S     stop after S simulated seconds (a partial game, for trials)\n"
     "  --external-agents   start no agents: wait for agents started elsewhere (same domain)\n"
     "  --no-video          skip the video\n"
     "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
