@@ -28,7 +28,7 @@ const char* kHelp =
     "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready.\n"
     "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
     "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
-    "real-time factor and the time per control period split into physics (with sensors),\n"
+    "real-time factor and the time per control period split into physics, sensors,\n"
     "messaging (perception and frames out, commands in), referee and rendering; writes the\n"
     "CSV and a plot (default scaling.png): real-time factor and frames per second against\n"
     "robots, log scale, beside USARSim's published 110, 55, 30, 10 fps for 1-4 Naos.\n";
@@ -38,7 +38,7 @@ using Clock = std::chrono::steady_clock;
 struct Row {
   int robots = 0;
   double steps_per_s = 0, fps = 0, rtf = 0;
-  double physics_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
+  double physics_ms = 0, sensors_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
   uint64_t missed = 0;
 };
 
@@ -105,6 +105,8 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
   const double period = s.physics.control_period;
   const auto periods = static_cast<long>(seconds / period);
   const net::ServerTimes before = server.times();
+  w.sensors().resetTimes();
+  w.sensors().enableTimers(true);
   double referee_s = 0.0;
   std::optional<referee::ControlData> published;
   const auto t0 = Clock::now();
@@ -130,7 +132,10 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
   row.fps = periods / wall;
   row.rtf = periods * period / wall;
   const double per = 1e3 / static_cast<double>(periods);
-  row.physics_ms = (t.physics_s - before.physics_s) * per;
+  const world::SensorTimes& st = w.sensors().times();
+  row.sensors_ms = (st.sonar_s + st.other_s) * per;
+  // The server times the whole world step; the sensors' part is taken out.
+  row.physics_ms = (t.physics_s - before.physics_s) * per - row.sensors_ms;
   row.messaging_ms = (t.publish_s - before.publish_s + t.wait_s - before.wait_s) * per;
   row.referee_ms = referee_s * per;
   row.render_ms = (t.camera_s - before.camera_s) * per;
@@ -203,20 +208,21 @@ int benchScaling(int argc, char** argv, int first) {
       cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots",     "steps_per_s",  "fps",        "rtf",       "physics_ms",
-                  "messaging_ms", "referee_ms", "render_ms", "missed"};
+  table.header = {"robots",     "steps_per_s", "fps",        "rtf",       "physics_ms",
+                  "sensors_ms", "messaging_ms", "referee_ms", "render_ms", "missed"};
   std::vector<Row> rows;
   for (int n : counts) {
     const Row r = runRow(n, seconds, cameras, domain);
     rows.push_back(r);
     table.rows.push_back({std::to_string(n), fmt(r.steps_per_s, 0), fmt(r.fps, 0), fmt(r.rtf, 2),
-                          fmt(r.physics_ms, 2), fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
+                          fmt(r.physics_ms, 2), fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2),
+                          fmt(r.referee_ms, 3),
                           fmt(r.render_ms, 2), std::to_string(r.missed)});
     std::fprintf(stderr, "  %d robots done\n", n);
   }
   table.finish(
       "fps: control periods (frames) per wall second, 100 per simulated second; rtf: simulated / "
-      "wall time; ms per control period: physics (with sensors), messaging (perception and "
+      "wall time; ms per control period: physics, sensors, messaging (perception and "
       "frames out, waiting for and applying the agents' commands), referee, render (cameras); "
       "missed: lockstep periods an agent did not answer in time. USARSim (published): 1 Nao "
       "110 fps, 2: 55, 3: 30, 4: 10.",
