@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
-#include "simsoccer/agents/motion/motion_controller.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/world/match_log.hpp"
 #include "test_support.hpp"
@@ -241,9 +241,7 @@ TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGet
   const auto dir = test::sourceDir() / "configs/motions";
   agents::FallDetectorParameters fall;
   fall.get_up = false;
-  agents::MotionController mc(model, agents::loadKeyframeMotion(dir / "get_up_front.yaml", model),
-                              agents::loadKeyframeMotion(dir / "get_up_back.yaml", model), {}, {},
-                              fall);
+  agents::MotionController mc = agents::loadMotionController(model, dir, fall);
   std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
   const auto& stand = model.pose("stand");
   for (size_t a = 0; a < model.actuators.size(); ++a)

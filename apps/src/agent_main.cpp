@@ -15,8 +15,7 @@
 
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
-#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
-#include "simsoccer/agents/motion/motion_controller.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
@@ -76,29 +75,26 @@ int main(int argc, char** argv) {
 
     // Soccer (--role): behaviour and motion, loaded before claiming so a bad
     // file stops here.
-    std::unique_ptr<agents::SoccerBehaviour> behaviour;
-    std::unique_ptr<agents::MotionController> motion;
+    std::unique_ptr<agents::SoccerAgent> soccer;
     if (opt.has("role")) {
       const auto role = agents::roleFromName(opt.get("role", ""));
       if (!role)
         throw apps::UsageError(
             "--role must be auto, striker, supporter, defender, goalkeeper, penalty-kicker or "
             "penalty-goalkeeper");
-      const auto config = agents::loadBehaviourConfig(
-          apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml"));
-      const auto field =
-          fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml"));
-      const int number = static_cast<int>(opt.number("team-number", team + 1));
-      behaviour = std::make_unique<agents::SoccerBehaviour>(
-          config, field, team, number, player, *role,
-          static_cast<uint64_t>(opt.number("seed", 1)));
-      const std::string motions = apps::findConfig("", "configs/motions").string();
-      agents::FallDetectorParameters fall;
-      fall.get_up = opt.flag("get-up");
-      motion = std::make_unique<agents::MotionController>(
-          model, agents::loadKeyframeMotion(motions + "/get_up_front.yaml", model),
-          agents::loadKeyframeMotion(motions + "/get_up_back.yaml", model),
-          agents::WalkParameters{}, agents::KickParameters{}, fall);
+      agents::SoccerAgentSetup setup;
+      setup.team = team;
+      setup.team_number = static_cast<int>(opt.number("team-number", team + 1));
+      setup.player = player;
+      setup.role = *role;
+      setup.seed = static_cast<uint64_t>(opt.number("seed", 1));
+      setup.get_up = opt.flag("get-up");
+      soccer = std::make_unique<agents::SoccerAgent>(
+          model,
+          agents::loadBehaviourConfig(
+              apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml")),
+          fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml")),
+          apps::findConfig("", "configs/motions"), setup);
     }
     const bool verbose = opt.flag("verbose");
     const auto& stand = model.pose("stand");
@@ -142,7 +138,7 @@ int main(int argc, char** argv) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;
       if (max_ticks >= 0 && answered >= max_ticks) return;
-      if (behaviour) {
+      if (soccer) {
         // The soccer agent: this tick's perception (published before the
         // frame), the game, teammates' messages, then behaviour and motion.
         const double dt = last_time > 0 ? frame.sim_time - last_time : 0.01;
@@ -153,23 +149,16 @@ int main(int argc, char** argv) {
           have_seen = true;
         }
         if (client.gameState(game)) have_game = true;
-        for (const auto& m : client.receiveTeamMessages()) behaviour->receive(m, frame.sim_time);
-        agents::SoccerBehaviour::Input in;
-        in.time = frame.sim_time;
-        in.perception = have_seen && seen.tick == frame.tick ? &seen : nullptr;
-        in.game = have_game ? &game : nullptr;
-        in.motion = motion->state();
-        in.fallen = motion->state() == agents::MotionState::Falling ||
-                    motion->state() == agents::MotionState::Lying ||
-                    motion->state() == agents::MotionState::GettingUp;
-        const agents::MotionRequest request = behaviour->update(in);
-        if (behaviour->takeMotionRestart()) motion->restart();
-        if (auto out = behaviour->outgoing(in)) client.sendTeamMessage(*out);
-        motion->update(dt > 0 ? dt : 0.01, agents::motionSensors(frame), request, position,
-                       stiffness);
+        for (const auto& m : client.receiveTeamMessages()) soccer->receive(m, frame.sim_time);
+        if (auto out = soccer->step(frame.sim_time, dt > 0 ? dt : 0.01,
+                                    agents::motionSensors(frame),
+                                    have_seen && seen.tick == frame.tick ? &seen : nullptr,
+                                    have_game ? &game : nullptr, position, stiffness))
+          client.sendTeamMessage(*out);
         if (verbose && frame.tick % 100 == 0)
           std::fprintf(stderr, "agent %d/%d t %.1f %s %s\n", team, player, frame.sim_time,
-                       agents::motionStateName(motion->state()), behaviour->status().c_str());
+                       agents::motionStateName(soccer->motion().state()),
+                       soccer->behaviour().status().c_str());
         client.send(frame.tick, position, stiffness);
         ++answered;
         return;

@@ -15,7 +15,7 @@
 #include "inprocess_agents.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
-#include "simsoccer/agents/motion/motion_controller.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -205,9 +205,7 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
                        .toRotationMatrix();
   torso.translation() = Vec3(-3.0 + 0.5 * u(rng), 0.5 * u(rng), 0.16);
   w.placeRobot(0, torso, "stand");
-  agents::MotionController motion(model,
-                                  agents::loadKeyframeMotion(motions_dir + "/get_up_front.yaml", model),
-                                  agents::loadKeyframeMotion(motions_dir + "/get_up_back.yaml", model));
+  agents::MotionController motion = agents::loadMotionController(model, motions_dir);
   std::vector<float> position(25), stiffness(25);
   const auto& joints = model.body->joints;
   const double dt = w.scenario().physics.control_period;

@@ -1,14 +1,13 @@
 // The built-in agents run inside a bench process, without DDS: per robot the
-// same MotionController and SoccerBehaviour an agent process runs, fed the
-// same inputs (its SensorFrame and Perception, the GameState, teammates'
-// messages one period late) and answering with joint targets only.
+// same agents::SoccerAgent an agent process runs, fed the same inputs (its
+// SensorFrame and Perception, the GameState, teammates' messages one period
+// late) and answering with joint targets only.
 #pragma once
 
 #include <memory>
-#include <string>
 #include <vector>
 
-#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/world/perception.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -24,18 +23,15 @@ class InProcessAgents {
   // One control period's agent work: perception, behaviour, motion, the
   // commands set on the world. Call before World::stepControlPeriod().
   void period(const simsoccer_msg_GameState* game = nullptr);
-  agents::MotionController& motion(world::RobotId r) { return *agents_[r].motion; }
-  agents::SoccerBehaviour& behaviour(world::RobotId r) { return *agents_[r].behaviour; }
+  const agents::MotionController& motion(world::RobotId r) const { return agents_[r]->motion(); }
+  const agents::SoccerBehaviour& behaviour(world::RobotId r) const {
+    return agents_[r]->behaviour();
+  }
 
  private:
-  struct Agent {
-    std::unique_ptr<agents::MotionController> motion;
-    std::unique_ptr<agents::SoccerBehaviour> behaviour;
-    bool restarted = false;
-  };
   world::World& world_;
   std::unique_ptr<world::PerceptionSystem> perception_;
-  std::vector<Agent> agents_;
+  std::vector<std::unique_ptr<agents::SoccerAgent>> agents_;
   std::vector<std::pair<int, agents::TeamMessageIn>> outbox_;  // (team, message)
   std::vector<simsoccer_msg_PerceivedObject> scratch_;
 };

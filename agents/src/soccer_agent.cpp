@@ -1,0 +1,48 @@
+#include "simsoccer/agents/soccer_agent.hpp"
+
+namespace simsoccer::agents {
+
+MotionController loadMotionController(const robots::RobotModel& model,
+                                      const std::filesystem::path& motions_dir,
+                                      const FallDetectorParameters& fall) {
+  return MotionController(model, loadKeyframeMotion(motions_dir / "get_up_front.yaml", model),
+                          loadKeyframeMotion(motions_dir / "get_up_back.yaml", model),
+                          WalkParameters{}, KickParameters{}, fall);
+}
+
+namespace {
+FallDetectorParameters fallParameters(bool get_up) {
+  FallDetectorParameters f;
+  f.get_up = get_up;
+  return f;
+}
+}  // namespace
+
+SoccerAgent::SoccerAgent(const robots::RobotModel& model, const BehaviourConfig& config,
+                         const fields::FieldModel& field, const std::filesystem::path& motions_dir,
+                         const SoccerAgentSetup& setup)
+    : behaviour_(config, field, setup.team, setup.team_number, setup.player, setup.role,
+                 setup.seed),
+      motion_(loadMotionController(model, motions_dir, fallParameters(setup.get_up))) {}
+
+std::optional<std::vector<uint8_t>> SoccerAgent::step(double time, double dt,
+                                                      const MotionSensors& sensors,
+                                                      const PerceptionIn* perception,
+                                                      const simsoccer_msg_GameState* game,
+                                                      std::span<float> position,
+                                                      std::span<float> stiffness) {
+  SoccerBehaviour::Input in;
+  in.time = time;
+  in.perception = perception;
+  in.game = game;
+  in.motion = motion_.state();
+  in.fallen = motion_.state() == MotionState::Falling || motion_.state() == MotionState::Lying ||
+              motion_.state() == MotionState::GettingUp;
+  const MotionRequest request = behaviour_.update(in);
+  if (behaviour_.takeMotionRestart()) motion_.restart();
+  auto message = behaviour_.outgoing(in);
+  motion_.update(dt, sensors, request, position, stiffness);
+  return message;
+}
+
+}  // namespace simsoccer::agents
