@@ -108,19 +108,12 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
   w.sensors().resetTimes();
   w.sensors().enableTimers(true);
   double referee_s = 0.0;
-  std::optional<referee::ControlData> published;
   const auto t0 = Clock::now();
   for (long i = 0; i < periods; ++i) {
     server.runPeriod();
     const auto r0 = Clock::now();
     ref.update();
-    const referee::ControlData d = ref.game().packet(0);
-    if (!published || !(d == *published)) {
-      simsoccer_msg_GameState m{};
-      net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
-      server.setGameState(m);
-      published = d;
-    }
+    server.publishGameState(ref.game().packet(0), ref.game().leftTeam());
     referee_s += std::chrono::duration<double>(Clock::now() - r0).count();
   }
   server.flushCameras();

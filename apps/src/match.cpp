@@ -276,23 +276,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     }
     agents.push_back(std::move(a));
   }
-  std::optional<referee::ControlData> published;
-  auto publishGame = [&] {
-    referee::ControlData d = session.controlData();
-    const int left = session.game().leftTeam();
-    for (int side = 0; side < 2; ++side) {
-      const int team = side == 0 ? left : 1 - left;
-      const int used = static_cast<int>(server.teamMessagesRelayed(team));
-      d.teams[static_cast<size_t>(side)].message_budget =
-          static_cast<uint16_t>(std::max(0, d.teams[static_cast<size_t>(side)].message_budget - used));
-    }
-    if (!published || !(d == *published)) {
-      simsoccer_msg_GameState m{};
-      net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
-      server.setGameState(m);
-      published = d;
-    }
-  };
+  auto publishGame = [&] { server.publishGameState(session.controlData(), session.game().leftTeam()); };
   publishGame();
   const auto t_wait = Clock::now();
   while (!g_interrupted && !server.waitForOwners(w.robotCount(), 0.5)) {

@@ -86,7 +86,6 @@ int serve(int argc, char** argv, int first) {
   } else if (opt.has("gc-address")) {
     throw UsageError("--gc-address needs --rules (the referee makes the packets)");
   }
-  std::optional<referee::ControlData> published;
   auto refereePeriod = [&] {
     if (!ref) return;
     // The operator's part: each half starts (Standby, Ready) as soon as it can.
@@ -97,13 +96,7 @@ int serve(int argc, char** argv, int first) {
       game.ready();
     }
     ref->update();
-    const referee::ControlData d = ref->game().packet(0);
-    if (!published || !(d == *published)) {  // every change; SimServer repeats it at 2 Hz
-      simsoccer_msg_GameState m{};
-      net::toMessage(d, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), m);
-      server.setGameState(m);
-      published = d;
-    }
+    server.publishGameState(ref->game().packet(0), ref->game().leftTeam());
     if (gc_link) gc_link->update(ref->game());
   };
   refereePeriod();

@@ -178,6 +178,7 @@ struct SimServer::Impl {
   std::vector<simsoccer_msg_RobotTruth> truth_robots;  // reused every period
   simsoccer_msg_GameState game_state{};
   double game_state_published_at = -1e9;
+  bool game_state_set = false;  // a referee has set one (then it repeats at 2 Hz)
   simsoccer_msg_SensorFrame frame_msg{};
 
   explicit Impl(const ServerConfig& c, uint64_t seed)
@@ -260,9 +261,7 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
         });
     cameras_->capture(world_);  // the images of tick 0
   }
-  impl_->game_state.kicking_team = 255;
-  impl_->game_state.first_half = 1;
-  setGameState(impl_->game_state);
+  // No GameState until a referee sets one: agents without one play freely.
   // Commands are taken as they arrive, in the DDS receive thread: the main
   // thread wakes once, when the last owned robot has answered.
   dds_listener_t* l = dds_create_listener(this);
@@ -314,10 +313,25 @@ size_t SimServer::ownedCount() const {
 
 void SimServer::setGameState(const simsoccer_msg_GameState& state) {
   impl_->game_state = state;
+  impl_->game_state_set = true;
   impl_->game_state.tick =
       world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
   impl_->game.write(impl_->game_state);
   impl_->game_state_published_at = world_.time();
+}
+
+void SimServer::publishGameState(referee::ControlData data, int left_team) {
+  for (int side = 0; side < 2; ++side) {
+    const int team = side == 0 ? left_team : 1 - left_team;
+    auto& budget = data.teams[static_cast<size_t>(side)].message_budget;
+    budget = static_cast<uint16_t>(
+        std::max<int64_t>(0, static_cast<int64_t>(budget) - static_cast<int64_t>(teamMessagesRelayed(team))));
+  }
+  if (published_game_ && data == *published_game_) return;  // SimServer repeats it at 2 Hz
+  simsoccer_msg_GameState m{};
+  toMessage(data, world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod()), m);
+  setGameState(m);
+  published_game_ = data;
 }
 
 void SimServer::publishStatus(world::RobotId r) {
@@ -539,7 +553,8 @@ void SimServer::runPeriod() {
   }
   simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
   impl_->clock.write(clock);
-  if (world_.time() - impl_->game_state_published_at >= 0.5 - 1e-9) setGameState(impl_->game_state);
+  if (impl_->game_state_set && world_.time() - impl_->game_state_published_at >= 0.5 - 1e-9)
+    setGameState(impl_->game_state);
   if (impl_->truth) {
     simsoccer_msg_WorldTruth t{};
     t.tick = tick;

@@ -156,9 +156,6 @@ SoccerBehaviour::Vec2 SoccerBehaviour::toRobot(const Vec2& p) const {
 void SoccerBehaviour::readGame(const Input& in) {
   if (!in.game) return;
   const simsoccer_msg_GameState& g = *in.game;
-  // A simulator without a referee publishes a GameState without team
-  // numbers: free play (as without any GameState).
-  if (g.teams[0].team_number == 0 && g.teams[1].team_number == 0) return;
   have_game_ = true;
   state_ = g.state;
   set_play_ = g.set_play;

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -97,12 +98,18 @@ class SimServer {
   const world::CameraSystem* cameras() const { return cameras_.get(); }
   // Delivers every image captured so far (the end of a run).
   void flushCameras();
-  // The GameState published at every change and every 0.5 s (2 Hz).
+  // The GameState published at every change and every 0.5 s (2 Hz); none is
+  // published until one is set (a simulator without a referee).
   void setGameState(const simsoccer_msg_GameState& state);
+  // The referee's state, published when it changed (and at 2 Hz), with each
+  // team's message budget less the team messages relayed for it so far.
+  // `left_team`: the team index that teams[0] describes (Game::leftTeam()).
+  void publishGameState(referee::ControlData data, int left_team);
 
  private:
   struct Impl;
   std::array<uint64_t, 2> team_messages_{};
+  std::optional<referee::ControlData> published_game_;
   struct RobotSlot {
     int team = 0, player = 0;
     RobotNetStats stats;

@@ -15,7 +15,7 @@
 // The GameState rules: stand in Initial, Standby, Set and Finished and while
 // penalised; walk to the kick-off formation in Ready; play in Playing,
 // keeping clear of the ball while the opponents take a kick-off or set play.
-// Without a GameState (or one without team numbers: no referee) it plays.
+// Without a GameState (a simulator without a referee publishes none) it plays.
 //
 // Frames: "own" is the field frame turned so that this team attacks +x.
 #pragma once
