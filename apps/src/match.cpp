@@ -234,7 +234,8 @@ struct RunResult {
   uint64_t log_bytes = 0;
 };
 
-std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o, int team, int number,
+std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o,
+                                   const std::filesystem::path& field, int team, int number,
                                    uint64_t seed) {
   std::vector<std::string> a{agentProgram().string(), "--team", std::to_string(team), "--player",
                              std::to_string(number), "--domain", std::to_string(o.domain),
@@ -245,9 +246,8 @@ std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o, in
     a.push_back("--config");
     a.push_back(c.agent_config.string());
   }
-  const world::Scenario s = world::loadScenario(c.scenario);
   a.push_back("--field");
-  a.push_back(s.field_file.string());
+  a.push_back(field.string());
   if (c.get_up) a.push_back("--get-up");
   return a;
 }
@@ -271,7 +271,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     a.team = w.robot(r).team;
     a.number = w.robot(r).number;
     if (!o.external) {
-      a.process = std::make_unique<ChildProcess>(agentArgs(c, o, a.team, a.number, o.seed));
+      a.process = std::make_unique<ChildProcess>(agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
       if (!a.process->started()) throw std::runtime_error("cannot start " + agentProgram().string());
     }
     agents.push_back(std::move(a));
@@ -332,7 +332,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
                       num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
                       a.restarts);
         result.agent_events.push_back(buf);
-        a.process = std::make_unique<ChildProcess>(agentArgs(c, o, a.team, a.number, o.seed));
+        a.process = std::make_unique<ChildProcess>(agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
       }
       if (result.aborted) break;
     }
