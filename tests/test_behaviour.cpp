@@ -205,7 +205,8 @@ TEST(SoccerBehaviour, TheStrikerKicksWhenTheBallIsInFrontOfAFootAndAimedAtTheGoa
 
 TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   const auto model = robots::loadRobotModel(test::naoH25());
-  const auto m = agents::loadKeyframeMotion(test::sourceDir() / "configs/motions/get_up_front.yaml", model);
+  const auto m =
+      agents::loadKeyframeMotion(test::sourceDir() / "configs/motions/get_up_front.yaml", model);
   EXPECT_GT(m.frames.size(), 3u);
   EXPECT_GT(m.duration(), 2.0);
   EXPECT_LT(m.duration(), 8.0);
@@ -213,7 +214,8 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   EXPECT_EQ(m.frames.back().position, model.pose("stand"));
   const auto dir = std::filesystem::temp_directory_path() / "simsoccer_keyframes";
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "bad.yaml") << "motion: bad\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 3.0}}\n";
+  std::ofstream(dir / "bad.yaml")
+      << "motion: bad\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 3.0}}\n";
   try {
     agents::loadKeyframeMotion(dir / "bad.yaml", model);
     FAIL();
@@ -221,8 +223,10 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
     EXPECT_NE(std::string(e.what()).find("LKneePitch"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("limits"), std::string::npos) << e.what();
   }
-  std::ofstream(dir / "bad.yaml") << "motion: bad\nframes:\n  - {duration: 0.5, joints: {RHipYawPitch: 0.1}}\n";
-  EXPECT_THROW(agents::loadKeyframeMotion(dir / "bad.yaml", model), engine::ConfigError);  // a mimic joint
+  std::ofstream(dir / "bad.yaml")
+      << "motion: bad\nframes:\n  - {duration: 0.5, joints: {RHipYawPitch: 0.1}}\n";
+  EXPECT_THROW(agents::loadKeyframeMotion(dir / "bad.yaml", model),
+               engine::ConfigError);  // a mimic joint
   // The player interpolates from the measured angles to the frames.
   agents::KeyframePlayer player;
   const std::vector<double> start(model.body->joints.size(), 0.0);
@@ -304,7 +308,8 @@ TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
     EXPECT_EQ(f.tick, o.tick);
     EXPECT_EQ(f.state_hash, o.state_hash);
     EXPECT_EQ(f.game, o.game);
-    EXPECT_NEAR((f.robots[0].torso.translation() - o.robots[0].torso.translation()).norm(), 0, 1e-6);
+    EXPECT_NEAR((f.robots[0].torso.translation() - o.robots[0].torso.translation()).norm(), 0,
+                1e-6);
     EXPECT_NEAR(f.robots[1].joints[5], o.robots[1].joints[5], 1e-4);
     EXPECT_EQ(f.robots[0].command_position[3], o.robots[0].command_position[3]);  // exact
     EXPECT_EQ(f.robots[0].command_stiffness[3], o.robots[0].command_stiffness[3]);

@@ -13,18 +13,13 @@ using simsoccer::test::runCommand;
 namespace test = simsoccer::test;
 
 TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
-  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_test.csv";
-  std::filesystem::remove(csv);
-  int status = -1;
-  const std::string out =
-      runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 1,2 --seconds 0.5 --csv " +
-                     csv.string(),
-                 status);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(status, 0) << out;
+  const test::BenchRun run =
+      test::runBench(SIMSOCCER_BIN, "bench physics --robots 1,2 --seconds 0.5");
+  const std::string& out = run.out;
+  ASSERT_EQ(run.status, 0) << out;
   EXPECT_NE(out.find("steps_per_s"), std::string::npos);
   EXPECT_NE(out.find("real_time_factor"), std::string::npos);
-  const std::vector<std::string> lines = test::readLines(csv);
+  const std::vector<std::string>& lines = run.lines;
   ASSERT_GE(lines.size(), 3u);
   const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,", 0), 0u) << header;
@@ -33,7 +28,6 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   EXPECT_FALSE(lines.size() > 3 && !lines[3].empty());  // no further rows
   // Both robots of the pair still stand: "2/2" in the standing column.
   EXPECT_NE(row2.find(",2/2,"), std::string::npos) << row2;
-  std::filesystem::remove(csv);
 }
 
 TEST(BenchPhysicsApp, RejectsBadOptions) {
@@ -68,17 +62,11 @@ TEST(CheckApp, ValidScenarioAndConfigError) {
 }
 
 TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
-  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_sensors_test.csv";
-  std::filesystem::remove(csv);
-  int status = -1;
-  const std::string out = runCommand(std::string(SIMSOCCER_BIN) +
-                                         " bench sensors --robots 1,2 --rays 9,32 --seconds 0.2 "
-                                         "--csv " +
-                                         csv.string(),
-                                     status);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(status, 0) << out;
-  const std::vector<std::string> lines = test::readLines(csv);
+  const test::BenchRun run =
+      test::runBench(SIMSOCCER_BIN, "bench sensors --robots 1,2 --rays 9,32 --seconds 0.2");
+  const std::string& out = run.out;
+  ASSERT_EQ(run.status, 0) << out;
+  const std::vector<std::string>& lines = run.lines;
   ASSERT_GE(lines.size(), 3u);
   const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,batched_us_rays9,reference_us_rays9,speedup_rays9", 0), 0u)
@@ -87,21 +75,15 @@ TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
   EXPECT_NE(header.find("sensor_share_pct"), std::string::npos);
   EXPECT_EQ(row1.rfind("1,", 0), 0u) << row1;
   EXPECT_EQ(row2.rfind("2,", 0), 0u) << row2;
-  std::filesystem::remove(csv);
 }
 
 TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
-  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_cameras_test.csv";
-  std::filesystem::remove(csv);
-  int status = -1;
-  const std::string out =
-      runCommand(std::string(SIMSOCCER_BIN) + " bench cameras --robots 1,2 --seconds 0.5 --csv " +
-                     csv.string() + " 2>&1",
-                 status);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(status, 0) << out;
+  const test::BenchRun run =
+      test::runBench(SIMSOCCER_BIN, "bench cameras --robots 1,2 --seconds 0.5");
+  const std::string& out = run.out;
+  ASSERT_EQ(run.status, 0) << out;
   EXPECT_NE(out.find("llvmpipe"), std::string::npos) << "the renderer is named";
-  const std::vector<std::string> lines = test::readLines(csv);
+  const std::vector<std::string>& lines = run.lines;
   ASSERT_GE(lines.size(), 3u);
   const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header,
@@ -111,7 +93,7 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
   EXPECT_EQ(row1.rfind("1,30,", 0), 0u) << row1;
   EXPECT_EQ(row2.rfind("2,60,", 0), 0u) << row2;
   EXPECT_EQ(row2.substr(row2.rfind(',')), ",0");  // lockstep policy: nothing dropped
-  std::filesystem::remove(csv);
+  int status = -1;
   EXPECT_NE(runCommand(std::string(SIMSOCCER_BIN) + " bench cameras --encoding png 2>&1", status)
                 .find("--encoding"),
             std::string::npos);
@@ -119,16 +101,12 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
 }
 
 TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
-  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_motion_test.csv";
-  std::filesystem::remove(csv);
-  int status = -1;
-  const std::string out =
-      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1 --csv " +
-                     csv.string() + " 2>&1",
-                 status);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(status, 0) << out;
-  const std::vector<std::string> lines = test::readLines(csv);
+  const test::BenchRun run = test::runBench(
+      SIMSOCCER_BIN,
+      "bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1");
+  const std::string& out = run.out;
+  ASSERT_EQ(run.status, 0) << out;
+  const std::vector<std::string>& lines = run.lines;
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0], "robots,test,commanded,achieved,unit,deviation_pct,falls,sim_seconds");
   std::map<std::string, std::vector<std::string>> rows;
@@ -156,5 +134,4 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   EXPECT_EQ(rows["kick_distance"][6], "0");
   EXPECT_GT(std::stod(rows["kick_distance"][3]), 1.5);
   EXPECT_LT(std::stod(rows["kick_distance"][5]), 15.0);
-  std::filesystem::remove(csv);
 }

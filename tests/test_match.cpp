@@ -60,10 +60,11 @@ struct ShortMatch {
 ShortMatch shortMatch(const std::string& name, int domain, const std::string& extra = "") {
   ShortMatch r;
   r.dir = tempDir(name);
-  r.out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                               " --half 15 --domain " + std::to_string(domain) + " --out " +
-                               r.dir.string() + " " + extra,
-                           r.status);
+  r.out =
+      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --half 15 --domain " + std::to_string(domain) + " --out " +
+                           r.dir.string() + " " + extra,
+                       r.status);
   return r;
 }
 
@@ -129,7 +130,8 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   std::snprintf(score, sizeof score, "[%d, %d]", goals[0], goals[1]);
   EXPECT_EQ(jsonValue(summary, "final_score"), score);
   // A few MB per minute at most.
-  const double mb_per_minute = std::filesystem::file_size(m.dir / "match.log") / 1e6 / (last / 60.0);
+  const double mb_per_minute =
+      std::filesystem::file_size(m.dir / "match.log") / 1e6 / (last / 60.0);
   EXPECT_LT(mb_per_minute, 5.0);
 
   // The video: 25 frames per simulated second of the log.
@@ -159,10 +161,10 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
   ASSERT_EQ(m.status, 0) << m.out;
   int status = -1;
   const auto still = m.dir / "still.png";
-  const std::string out = test::runCommand(
-      kBin + " replay " + (m.dir / "match.log").string() + " --physics --video " + still.string() +
-          " --from 20",
-      status);
+  const std::string out =
+      test::runCommand(kBin + " replay " + (m.dir / "match.log").string() + " --physics --video " +
+                           still.string() + " --from 20",
+                       status);
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("every state hash equal"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::exists(still));
@@ -181,7 +183,8 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
   BackgroundMatch m("match_kill", "--half 10 --no-video --domain 133");
   m.waitForLog(200000);  // the game runs: kill team 1's player 2
   int kill_status = 0;
-  test::runCommand("pkill -f '^[^ ]*simsoccer-agent --team 1 --player 2 --domain 133 '", kill_status);
+  test::runCommand("pkill -f '^[^ ]*simsoccer-agent --team 1 --player 2 --domain 133 '",
+                   kill_status);
   m.join();
   const auto& dir = m.dir;
   ASSERT_EQ(m.status, 0) << m.out;
@@ -224,9 +227,10 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("bad.yaml"), std::string::npos) << out;
   EXPECT_NE(out.find("scenario"), std::string::npos) << out;
-  out = test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                             " --out /proc/simsoccer_no",
-                         status);
+  out =
+      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --out /proc/simsoccer_no",
+                       status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("/proc/simsoccer_no"), std::string::npos) << out;
   std::filesystem::remove_all(dir);
@@ -235,17 +239,18 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
 TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
   const auto dir = tempDir("penalty");
   int status = -1;
-  const std::string out = test::runCommand(
-      kBin + " penalty " + (test::sourceDir() / "configs/penalty.yaml").string() +
-          " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.string(),
-      status);
+  const std::string out =
+      test::runCommand(kBin + " penalty " + (test::sourceDir() / "configs/penalty.yaml").string() +
+                           " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.string(),
+                       status);
   ASSERT_EQ(status, 0) << out;
   const std::string json = readFile(dir / "penalty.json");
   EXPECT_EQ(jsonValue(json, "kicks"), "5");
   const std::regex outcome("\"(goal|saved|missed|timeout)\"");
   const std::string list = json.substr(json.find("\"outcomes\""));
   int kicks = 0, goals = 0;
-  for (auto it = std::sregex_iterator(list.begin(), list.end(), outcome); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(list.begin(), list.end(), outcome);
+       it != std::sregex_iterator(); ++it) {
     ++kicks;
     goals += (*it)[1] == "goal";
   }

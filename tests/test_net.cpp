@@ -283,23 +283,17 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
 }
 
 TEST(NetApps, BenchNetWritesItsTable) {
-  const auto csv = std::filesystem::temp_directory_path() / "simsoccer_bench_net_test.csv";
-  std::filesystem::remove(csv);
-  int status = -1;
-  const std::string out =
-      runCommand(std::string(SIMSOCCER_BIN) +
-                     " bench net --robots 1,2 --seconds 1 --domain 109 --csv " + csv.string(),
-                 status);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(status, 0) << out;
-  const std::vector<std::string> lines = test::readLines(csv);
+  const test::BenchRun run =
+      test::runBench(SIMSOCCER_BIN, "bench net --robots 1,2 --seconds 1 --domain 109");
+  const std::string& out = run.out;
+  ASSERT_EQ(run.status, 0) << out;
+  const std::vector<std::string>& lines = run.lines;
   ASSERT_GE(lines.size(), 3u);
   const std::string &header = lines[0], &row1 = lines[1], &row2 = lines[2];
   EXPECT_EQ(header.rfind("robots,overhead_ms_per_period", 0), 0u) << header;
   EXPECT_NE(header.find("bytes_per_tick"), std::string::npos);
   EXPECT_EQ(row1.rfind("1,", 0), 0u);
   EXPECT_EQ(row2.rfind("2,", 0), 0u);
-  std::filesystem::remove(csv);
 }
 
 TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {

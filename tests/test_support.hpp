@@ -2,6 +2,8 @@
 // small scenarios built in code.
 #pragma once
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -71,6 +73,28 @@ inline std::vector<std::string> readLines(const std::filesystem::path& file) {
   std::vector<std::string> lines;
   for (std::string line; std::getline(f, line);) lines.push_back(line);
   return lines;
+}
+
+// A bench run: `simsoccer ARGS --csv FILE` (the program's path: `bin`); its
+// output, exit status (as pclose gives it) and the CSV's lines (header first),
+// the file removed afterwards.
+struct BenchRun {
+  std::string out;
+  int status = -1;
+  std::vector<std::string> lines;
+};
+inline BenchRun runBench(const std::string& bin, const std::string& args) {
+  static int serial = 0;
+  const auto csv =
+      std::filesystem::temp_directory_path() /
+      ("simsoccer_bench_" + std::to_string(::getpid()) + "_" + std::to_string(serial++) + ".csv");
+  std::filesystem::remove(csv);
+  BenchRun r;
+  r.out = runCommand(bin + " " + args + " --csv " + csv.string(), r.status);
+  std::printf("%s", r.out.c_str());
+  r.lines = readLines(csv);
+  std::filesystem::remove(csv);
+  return r;
 }
 
 }  // namespace simsoccer::test

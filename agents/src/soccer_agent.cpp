@@ -25,12 +25,9 @@ SoccerAgent::SoccerAgent(const robots::RobotModel& model, const BehaviourConfig&
                  setup.seed),
       motion_(loadMotionController(model, motions_dir, fallParameters(setup.get_up))) {}
 
-std::optional<std::vector<uint8_t>> SoccerAgent::step(double time, double dt,
-                                                      const MotionSensors& sensors,
-                                                      const PerceptionIn* perception,
-                                                      const simsoccer_msg_GameState* game,
-                                                      std::span<float> position,
-                                                      std::span<float> stiffness) {
+std::optional<std::vector<uint8_t>> SoccerAgent::step(
+    double time, double dt, const MotionSensors& sensors, const PerceptionIn* perception,
+    const simsoccer_msg_GameState* game, std::span<float> position, std::span<float> stiffness) {
   SoccerBehaviour::Input in;
   in.time = time;
   in.perception = perception;

@@ -15,8 +15,8 @@
 
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
-#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
 namespace {
@@ -51,10 +51,10 @@ const char* kHelp =
 int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
-    const apps::Options opt(argc, argv, 1, {"help", "get-up", "verbose"},
-                            {"team", "player", "domain", "dds-config", "robot", "mode",
-                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
-                             "config", "field", "team-number", "seed"});
+    const apps::Options opt(
+        argc, argv, 1, {"help", "get-up", "verbose"},
+        {"team", "player", "domain", "dds-config", "robot", "mode", "stall-after", "ticks",
+         "claim-timeout", "vx", "vy", "turn", "role", "config", "field", "team-number", "seed"});
     if (opt.help(kHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -150,10 +150,10 @@ int main(int argc, char** argv) {
         }
         if (client.gameState(game)) have_game = true;
         for (const auto& m : client.receiveTeamMessages()) soccer->receive(m, frame.sim_time);
-        if (auto out = soccer->step(frame.sim_time, dt > 0 ? dt : 0.01,
-                                    agents::motionSensors(frame),
-                                    have_seen && seen.tick == frame.tick ? &seen : nullptr,
-                                    have_game ? &game : nullptr, position, stiffness))
+        if (auto out =
+                soccer->step(frame.sim_time, dt > 0 ? dt : 0.01, agents::motionSensors(frame),
+                             have_seen && seen.tick == frame.tick ? &seen : nullptr,
+                             have_game ? &game : nullptr, position, stiffness))
           client.sendTeamMessage(*out);
         if (verbose && frame.tick % 100 == 0)
           std::fprintf(stderr, "agent %d/%d t %.1f %s %s\n", team, player, frame.sim_time,

@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "bench_scene.hpp"
-#include "inprocess_agents.hpp"
 #include "cli.hpp"
+#include "inprocess_agents.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
-#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/world/world.hpp"
 
 namespace simsoccer::apps {
@@ -369,9 +369,10 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-lift", &kp.lift},
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation}};
-  std::vector<std::string> valued{"seconds",        "csv",  "vx",   "vy",         "turn",
-                                  "random-minutes", "seed", "foot", "ball-offset", "get-up", "get-up-trials", "striker-trials",
-                                  "penalty-trials"};
+  std::vector<std::string> valued{
+      "seconds",       "csv",  "vx",          "vy",     "turn",          "random-minutes",
+      "seed",          "foot", "ball-offset", "get-up", "get-up-trials", "striker-trials",
+      "penalty-trials"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first, {"help", "verbose", "kick", "striker", "penalty"}, valued);
   if (opt.help(kHelp)) return 0;
@@ -478,12 +479,13 @@ int benchMotion(int argc, char** argv, int first) {
       int ok = 0;
       double worst = 0.0;
       for (int i = 0; i < trials; ++i) {
-        const GetUpResult g = getUp(front, seed + 200 + static_cast<uint64_t>(i), motions_dir, false);
+        const GetUpResult g =
+            getUp(front, seed + 200 + static_cast<uint64_t>(i), motions_dir, false);
         ok += g.success && g.seconds < 8.0;
         worst = std::max(worst, g.success ? g.seconds : 12.0);
       }
-      row(front ? "get_up_front" : "get_up_back", 0.95, ok / std::max(1.0, double(trials)),
-          "share", worst, 0, trials * 13.0);
+      row(front ? "get_up_front" : "get_up_back", 0.95, ok / std::max(1.0, double(trials)), "share",
+          worst, 0, trials * 13.0);
     }
   }
   {
@@ -508,10 +510,18 @@ int benchMotion(int argc, char** argv, int first) {
     int goals = 0, saved = 0, missed = 0, timeouts = 0;
     for (int i = 0; i < trials; ++i) {
       switch (penaltyTrial(seed + 500 + static_cast<uint64_t>(i), 30.0, false)) {
-        case PenaltyOutcome::Goal: ++goals; break;
-        case PenaltyOutcome::Saved: ++saved; break;
-        case PenaltyOutcome::Missed: ++missed; break;
-        case PenaltyOutcome::Timeout: ++timeouts; break;
+        case PenaltyOutcome::Goal:
+          ++goals;
+          break;
+        case PenaltyOutcome::Saved:
+          ++saved;
+          break;
+        case PenaltyOutcome::Missed:
+          ++missed;
+          break;
+        case PenaltyOutcome::Timeout:
+          ++timeouts;
+          break;
       }
     }
     std::fprintf(stderr, "  penalties: %d goals, %d saved, %d missed, %d timeouts\n", goals, saved,

@@ -81,7 +81,8 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
   sc.lockstep = true;
   sc.command_timeout = 2.0;
   net::SimServer server(w, sc);
-  const referee::RuleBook rules = referee::loadRuleBook(findConfig("", "configs/rules/simleague.yaml"));
+  const referee::RuleBook rules =
+      referee::loadRuleBook(findConfig("", "configs/rules/simleague.yaml"));
   std::array<referee::TeamSetup, 2> teams;
   for (size_t t = 0; t < 2; ++t) {
     teams[t].number = static_cast<uint8_t>(t + 1);
@@ -140,16 +141,19 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
 void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
   const int W = 900, H = 560, L = 80, R = 30, T = 50, B = 70;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
-  const double xmin = std::log10(1.0), xmax = std::log10(24.0), ymin = -1.0, ymax = 4.0;  // 0.1 .. 10^4
+  const double xmin = std::log10(1.0), xmax = std::log10(24.0), ymin = -1.0,
+               ymax = 4.0;  // 0.1 .. 10^4
   auto px = [&](double robots, double value) {
     const double x = L + (std::log10(robots) - xmin) / (xmax - xmin) * (W - L - R);
-    const double y = H - B - (std::log10(std::max(value, 0.1)) - ymin) / (ymax - ymin) * (H - T - B);
+    const double y =
+        H - B - (std::log10(std::max(value, 0.1)) - ymin) / (ymax - ymin) * (H - T - B);
     return cv::Point(static_cast<int>(x), static_cast<int>(y));
   };
   for (int e = -1; e <= 4; ++e) {
     cv::line(img, px(1, std::pow(10, e)), px(24, std::pow(10, e)), cv::Scalar(225, 225, 225), 1);
-    cv::putText(img, fmt(std::pow(10, e), e < 0 ? 1 : 0), px(1, std::pow(10, e)) + cv::Point(-60, 5),
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
+    cv::putText(img, fmt(std::pow(10, e), e < 0 ? 1 : 0),
+                px(1, std::pow(10, e)) + cv::Point(-60, 5), cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
   }
   for (int n : {1, 2, 4, 8, 11, 22}) {
     cv::line(img, px(n, 0.1), px(n, 1e4), cv::Scalar(235, 235, 235), 1);
@@ -161,7 +165,9 @@ void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
   auto series = [&](const std::vector<std::pair<double, double>>& pts, const cv::Scalar& colour) {
     for (size_t i = 0; i < pts.size(); ++i) {
       cv::circle(img, px(pts[i].first, pts[i].second), 5, colour, cv::FILLED, cv::LINE_AA);
-      if (i) cv::line(img, px(pts[i - 1].first, pts[i - 1].second), px(pts[i].first, pts[i].second), colour, 2, cv::LINE_AA);
+      if (i)
+        cv::line(img, px(pts[i - 1].first, pts[i - 1].second), px(pts[i].first, pts[i].second),
+                 colour, 2, cv::LINE_AA);
     }
   };
   std::vector<std::pair<double, double>> fps, rtf;
@@ -178,13 +184,15 @@ void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
               0.5, cv::Scalar(30, 150, 30), 1, cv::LINE_AA);
   cv::putText(img, "USARSim fps (published, 1-4 Naos)", cv::Point(L + 450, T - 25),
               cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
-  if (!cv::imwrite(file.string(), img)) throw std::runtime_error(file.string() + ": cannot write the plot");
+  if (!cv::imwrite(file.string(), img))
+    throw std::runtime_error(file.string() + ": cannot write the plot");
 }
 
 }  // namespace
 
 int benchScaling(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "cameras"}, {"robots", "seconds", "csv", "png", "domain"});
+  const Options opt(argc, argv, first, {"help", "cameras"},
+                    {"robots", "seconds", "csv", "png", "domain"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
@@ -201,7 +209,7 @@ int benchScaling(int argc, char** argv, int first) {
       cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots",     "steps_per_s", "fps",        "rtf",       "physics_ms",
+  table.header = {"robots",     "steps_per_s",  "fps",        "rtf",       "physics_ms",
                   "sensors_ms", "messaging_ms", "referee_ms", "render_ms", "missed"};
   std::vector<Row> rows;
   for (int n : counts) {
@@ -209,8 +217,7 @@ int benchScaling(int argc, char** argv, int first) {
     rows.push_back(r);
     table.rows.push_back({std::to_string(n), fmt(r.steps_per_s, 0), fmt(r.fps, 0), fmt(r.rtf, 2),
                           fmt(r.physics_ms, 2), fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2),
-                          fmt(r.referee_ms, 3),
-                          fmt(r.render_ms, 2), std::to_string(r.missed)});
+                          fmt(r.referee_ms, 3), fmt(r.render_ms, 2), std::to_string(r.missed)});
     std::fprintf(stderr, "  %d robots done\n", n);
   }
   table.finish(

@@ -52,10 +52,10 @@ int main(int argc, char** argv) {
       if (sub == "cameras") return benchCameras(argc, argv, 3);
       if (sub == "motion") return benchMotion(argc, argv, 3);
       if (sub == "scaling") return benchScaling(argc, argv, 3);
-      std::fprintf(
-          stderr,
-          "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, cameras, motion, scaling)\n",
-          sub.c_str());
+      std::fprintf(stderr,
+                   "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, "
+                   "cameras, motion, scaling)\n",
+                   sub.c_str());
       return 2;
     }
     std::fprintf(stderr, "simsoccer: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);

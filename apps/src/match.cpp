@@ -71,7 +71,9 @@ std::filesystem::path defaultOut() {
 void prepareOut(const std::filesystem::path& out) {
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
-  if (ec) throw std::runtime_error(out.string() + ": cannot create the output folder (" + ec.message() + ")");
+  if (ec)
+    throw std::runtime_error(out.string() + ": cannot create the output folder (" + ec.message() +
+                             ")");
   const auto probe = out / ".write_test";
   std::ofstream f(probe);
   if (!f) throw std::runtime_error(out.string() + ": the output folder is not writable");
@@ -97,7 +99,8 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
                         const VideoSettings& v, double from, double to) {
   world::MatchLogReader log(log_file);
   const auto& h = log.header().values;
-  if (!h.count("scenario")) throw std::runtime_error(log_file.string() + ": no scenario in the header");
+  if (!h.count("scenario"))
+    throw std::runtime_error(log_file.string() + ": no scenario in the header");
   world::World w(world::loadScenario(h.at("scenario")));
   engine::OffscreenRenderer renderer;
   const double vfov = 2 * std::atan(std::tan(0.5 * v.horizontal_fov) * v.height / v.width);
@@ -109,10 +112,10 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
   const bool png = out.extension() == ".png";  // one still: the first frame at `from`
   const bool avi = out.extension() == ".avi";
   if (!png) {
-    writer.open(out.string(),
-                cv::VideoWriter::fourcc(avi ? 'M' : 'm', avi ? 'J' : 'p', avi ? 'P' : '4',
-                                        avi ? 'G' : 'v'),
-                v.fps, cv::Size(v.width, v.height));
+    writer.open(
+        out.string(),
+        cv::VideoWriter::fourcc(avi ? 'M' : 'm', avi ? 'J' : 'p', avi ? 'P' : '4', avi ? 'G' : 'v'),
+        v.fps, cv::Size(v.width, v.height));
     if (!writer.isOpened())
       throw std::runtime_error(out.string() + ": OpenCV cannot write this video");
   }
@@ -135,11 +138,10 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
     if (f.game.size() == referee::kControlSize) {
       const referee::ControlData d = referee::decodeControl(f.game);
       char buf[160];
-      std::snprintf(buf, sizeof buf, "%d  %d : %d  %d   %s %02d:%02d  %s",
-                    d.teams[0].team_number, d.teams[0].score, d.teams[1].score,
-                    d.teams[1].team_number, d.first_half ? "1st" : "2nd",
-                    std::max(0, (int)d.secs_remaining) / 60, std::max(0, (int)d.secs_remaining) % 60,
-                    stateLabel(d.state));
+      std::snprintf(buf, sizeof buf, "%d  %d : %d  %d   %s %02d:%02d  %s", d.teams[0].team_number,
+                    d.teams[0].score, d.teams[1].score, d.teams[1].team_number,
+                    d.first_half ? "1st" : "2nd", std::max(0, (int)d.secs_remaining) / 60,
+                    std::max(0, (int)d.secs_remaining) % 60, stateLabel(d.state));
       text = buf;
     }
     cv::rectangle(bgr, cv::Point(0, 0), cv::Point(v.width, 26), cv::Scalar(0, 0, 0), cv::FILLED);
@@ -147,7 +149,8 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
                 cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
     ++result.frames;
     if (png) {
-      if (!cv::imwrite(out.string(), bgr)) throw std::runtime_error(out.string() + ": cannot write");
+      if (!cv::imwrite(out.string(), bgr))
+        throw std::runtime_error(out.string() + ": cannot write");
       break;
     }
     writer.write(bgr);
@@ -173,7 +176,8 @@ void writeHeatmap(const std::filesystem::path& log_file, const std::filesystem::
   while (log.next(fr)) {
     auto add = [&](cv::Mat& m, double x, double y) {
       const cv::Point2d p = px(x, y);
-      if (p.x >= 0 && p.y >= 0 && p.x < W && p.y < H) m.at<float>(static_cast<int>(p.y), static_cast<int>(p.x)) += 1.0f;
+      if (p.x >= 0 && p.y >= 0 && p.x < W && p.y < H)
+        m.at<float>(static_cast<int>(p.y), static_cast<int>(p.x)) += 1.0f;
     };
     add(density[2], fr.ball.translation().x(), fr.ball.translation().y());
     for (size_t r = 0; r < fr.robots.size() && r < robots.size(); ++r)
@@ -182,10 +186,13 @@ void writeHeatmap(const std::filesystem::path& log_file, const std::filesystem::
   }
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(40, 120, 30));
   for (const auto& l : f.lines)
-    cv::line(img, px(l.a.x(), l.a.y()), px(l.b.x(), l.b.y()), cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+    cv::line(img, px(l.a.x(), l.a.y()), px(l.b.x(), l.b.y()), cv::Scalar(255, 255, 255), 2,
+             cv::LINE_AA);
   for (const auto& c : f.circles)
-    cv::circle(img, px(c.centre.x(), c.centre.y()), static_cast<int>(c.radius * ppm), cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
-  const cv::Scalar colours[3] = {cv::Scalar(255, 80, 30), cv::Scalar(30, 40, 240), cv::Scalar(255, 255, 255)};
+    cv::circle(img, px(c.centre.x(), c.centre.y()), static_cast<int>(c.radius * ppm),
+               cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+  const cv::Scalar colours[3] = {cv::Scalar(255, 80, 30), cv::Scalar(30, 40, 240),
+                                 cv::Scalar(255, 255, 255)};
   for (size_t k = 0; k < 3; ++k) {
     cv::Mat blurred;
     cv::GaussianBlur(density[k], blurred, cv::Size(0, 0), 0.25 * ppm);
@@ -204,7 +211,8 @@ void writeHeatmap(const std::filesystem::path& log_file, const std::filesystem::
   cv::putText(img, "team 0", cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.7, colours[0], 2);
   cv::putText(img, "team 1", cv::Point(110, 24), cv::FONT_HERSHEY_SIMPLEX, 0.7, colours[1], 2);
   cv::putText(img, "ball", cv::Point(210, 24), cv::FONT_HERSHEY_SIMPLEX, 0.7, colours[2], 2);
-  if (!cv::imwrite(out.string(), img)) throw std::runtime_error(out.string() + ": cannot write the heatmap");
+  if (!cv::imwrite(out.string(), img))
+    throw std::runtime_error(out.string() + ": cannot write the heatmap");
 }
 
 // --- the live run -----------------------------------------------------------------------------
@@ -237,11 +245,20 @@ struct RunResult {
 std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o,
                                    const std::filesystem::path& field, int team, int number,
                                    uint64_t seed) {
-  std::vector<std::string> a{agentProgram().string(), "--team", std::to_string(team), "--player",
-                             std::to_string(number), "--domain", std::to_string(o.domain),
-                             "--role", c.role, "--team-number",
-                             std::to_string(c.team_numbers[static_cast<size_t>(team)]), "--seed",
-                             std::to_string(seed * 1000 + static_cast<uint64_t>(team * 100 + number))};
+  std::vector<std::string> a{
+      agentProgram().string(),
+      "--team",
+      std::to_string(team),
+      "--player",
+      std::to_string(number),
+      "--domain",
+      std::to_string(o.domain),
+      "--role",
+      c.role,
+      "--team-number",
+      std::to_string(c.team_numbers[static_cast<size_t>(team)]),
+      "--seed",
+      std::to_string(seed * 1000 + static_cast<uint64_t>(team * 100 + number))};
   if (!c.agent_config.empty()) {
     a.push_back("--config");
     a.push_back(c.agent_config.string());
@@ -271,12 +288,16 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     a.team = w.robot(r).team;
     a.number = w.robot(r).number;
     if (!o.external) {
-      a.process = std::make_unique<ChildProcess>(agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
-      if (!a.process->started()) throw std::runtime_error("cannot start " + agentProgram().string());
+      a.process = std::make_unique<ChildProcess>(
+          agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
+      if (!a.process->started())
+        throw std::runtime_error("cannot start " + agentProgram().string());
     }
     agents.push_back(std::move(a));
   }
-  auto publishGame = [&] { server.publishGameState(session.controlData(), session.game().leftTeam()); };
+  auto publishGame = [&] {
+    server.publishGameState(session.controlData(), session.game().leftTeam());
+  };
   publishGame();
   const auto t_wait = Clock::now();
   while (!g_interrupted && !server.waitForOwners(w.robotCount(), 0.5)) {
@@ -304,9 +325,9 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       positions[r] = server.commandPosition(r);
       stiffness[r] = server.commandStiffness(r);
     }
-    world::LogFrame frame = world::captureFrame(
-        w, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()), positions, stiffness,
-        commanded);
+    world::LogFrame frame =
+        world::captureFrame(w, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()),
+                            positions, stiffness, commanded);
     frame.game = session.packet();
     frame.events = events;
     log.write(frame);
@@ -332,7 +353,8 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
                       num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
                       a.restarts);
         result.agent_events.push_back(buf);
-        a.process = std::make_unique<ChildProcess>(agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
+        a.process = std::make_unique<ChildProcess>(
+            agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
       }
       if (result.aborted) break;
     }
@@ -344,9 +366,12 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       const double left_sim =
           std::max(0.0, g.secondsRemaining() + (g.half() == referee::Half::First ? half : 0.0));
       std::printf("\r  %s half  %02d:%02d  %-8s  %d:%d   sim %6.1f s  RTF %4.2f  ETA %4.0f s   ",
-                  g.half() == referee::Half::First ? "1st" : (g.half() == referee::Half::Second ? "2nd" : "pso"),
-                  static_cast<int>(g.secondsRemaining()) / 60, static_cast<int>(g.secondsRemaining()) % 60,
-                  referee::stateName(g.state()), g.score(0), g.score(1), w.time(), rtf, left_sim / std::max(rtf, 1e-3));
+                  g.half() == referee::Half::First
+                      ? "1st"
+                      : (g.half() == referee::Half::Second ? "2nd" : "pso"),
+                  static_cast<int>(g.secondsRemaining()) / 60,
+                  static_cast<int>(g.secondsRemaining()) % 60, referee::stateName(g.state()),
+                  g.score(0), g.score(1), w.time(), rtf, left_sim / std::max(rtf, 1e-3));
       std::fflush(stdout);
     }
   }
@@ -373,7 +398,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"seed\": " << o.seed << ",\n";
   out << "  \"teams\": [";
   for (int t = 0; t < 2; ++t)
-    out << (t ? ", " : "") << "{\"index\": " << t << ", \"number\": " << s.config().team_numbers[static_cast<size_t>(t)]
+    out << (t ? ", " : "") << "{\"index\": " << t
+        << ", \"number\": " << s.config().team_numbers[static_cast<size_t>(t)]
         << ", \"score\": " << g.score(t) << "}";
   out << "],\n";
   out << "  \"final_score\": [" << g.score(0) << ", " << g.score(1) << "],\n";
@@ -382,7 +408,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   for (size_t i = 0; i < s.goals().size(); ++i) {
     const auto& goal = s.goals()[i];
     out << (i ? ", " : "") << "{\"time\": " << num(goal.time, 2) << ", \"team\": " << goal.team
-        << ", \"scorer\": " << goal.scorer << ", \"own_goal\": " << (goal.own_goal ? "true" : "false") << "}";
+        << ", \"scorer\": " << goal.scorer
+        << ", \"own_goal\": " << (goal.own_goal ? "true" : "false") << "}";
   }
   out << "],\n";
   out << "  \"referee_events\": [\n";
@@ -390,7 +417,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
     const auto& e = r.events[i];
     out << "    {\"time\": " << num(e.time, 2) << ", \"type\": " << jsonString(e.type)
         << ", \"team\": " << e.team << ", \"player\": " << e.player
-        << ", \"detail\": " << jsonString(e.detail) << "}" << (i + 1 < r.events.size() ? "," : "") << "\n";
+        << ", \"detail\": " << jsonString(e.detail) << "}" << (i + 1 < r.events.size() ? "," : "")
+        << "\n";
   }
   out << "  ],\n";
   out << "  \"penalties\": [";
@@ -405,8 +433,9 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"robots\": [\n";
   for (size_t i = 0; i < s.robots().size(); ++i) {
     const auto& rec = s.robots()[i];
-    out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number << ", \"falls\": " << rec.falls
-        << ", \"distance_walked\": " << num(rec.distance, 2) << "}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
+    out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number
+        << ", \"falls\": " << rec.falls << ", \"distance_walked\": " << num(rec.distance, 2) << "}"
+        << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }
   out << "  ],\n";
   const auto p = s.possession();
@@ -479,7 +508,8 @@ const char* kPenaltyHelp =
 const char* kReplayHelp =
     "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics] [--events]\n"
     "\n"
-    "Reads a match log: prints what it holds (--events: every referee event); --video renders the spectator camera over\n"
+    "Reads a match log: prints what it holds (--events: every referee event); --video renders the "
+    "spectator camera over\n"
     "[--from, --to] s (default the whole log) to FILE (.mp4 or .avi; .png: one still at\n"
     "--from); --physics re-runs the\n"
     "game through the physics and the referee with the recorded commands and checks every\n"
@@ -502,7 +532,8 @@ int match(int argc, char** argv, int first) {
   if (opt.help(kMatchHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match config file");
   MatchConfig config = loadMatchConfig(opt.positional()[0]);
-  if (config.penalty_kicks > 0) throw UsageError(config.file + " is a penalty config: use `simsoccer penalty`");
+  if (config.penalty_kicks > 0)
+    throw UsageError(config.file + " is a penalty config: use `simsoccer penalty`");
   if (opt.has("half")) {
     const double h = opt.number("half", 0);
     if (!(h > 0)) throw UsageError("--half must be > 0 s");
@@ -533,7 +564,8 @@ int match(int argc, char** argv, int first) {
   const auto& g = session.game();
   std::printf("%s: %d:%d after %.1f simulated s in %.1f s (real-time factor %.2f); log %.1f MB\n",
               r.interrupted ? "interrupted" : (r.aborted ? "stopped" : "final"), g.score(0),
-              g.score(1), session.world().time(), r.wall, session.world().time() / std::max(r.wall, 1e-9),
+              g.score(1), session.world().time(), r.wall,
+              session.world().time() / std::max(r.wall, 1e-9),
               static_cast<double>(r.log_bytes) / 1e6);
   if (r.aborted) std::printf("stopped: %s\n", r.abort_reason.c_str());
   for (const auto& goal : session.goals())
@@ -556,7 +588,8 @@ int penalty(int argc, char** argv, int first) {
   if (opt.help(kPenaltyHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one penalty config file");
   MatchConfig config = loadMatchConfig(opt.positional()[0]);
-  if (config.penalty_kicks == 0) throw UsageError(config.file + " is not a penalty config (`penalty: NAME`)");
+  if (config.penalty_kicks == 0)
+    throw UsageError(config.file + " is not a penalty config (`penalty: NAME`)");
   const int kicks = static_cast<int>(opt.number("kicks", config.penalty_kicks));
   if (kicks < 1) throw UsageError("--kicks must be >= 1");
   const int video_kicks = static_cast<int>(opt.number("video-kicks", 3));
@@ -582,28 +615,44 @@ int penalty(int argc, char** argv, int first) {
     std::string outcome = "timeout";
     if (!shots.empty()) {
       switch (shots[0]) {
-        case referee::ShotOutcome::Goal: outcome = "goal"; break;
-        case referee::ShotOutcome::Saved: outcome = "saved"; break;
-        case referee::ShotOutcome::NoKick: outcome = "timeout"; break;
-        default: outcome = "missed"; break;
+        case referee::ShotOutcome::Goal:
+          outcome = "goal";
+          break;
+        case referee::ShotOutcome::Saved:
+          outcome = "saved";
+          break;
+        case referee::ShotOutcome::NoKick:
+          outcome = "timeout";
+          break;
+        default:
+          outcome = "missed";
+          break;
       }
     }
     ++counts[outcome];
     outcomes.push_back(outcome);
-    std::printf("  kick %2d (seed %llu): %s\n", k + 1, static_cast<unsigned long long>(ko.seed), outcome.c_str());
+    std::printf("  kick %2d (seed %llu): %s\n", k + 1, static_cast<unsigned long long>(ko.seed),
+                outcome.c_str());
     std::fflush(stdout);
-    if (k < video_kicks) logs.push_back(log_file);
-    else std::filesystem::remove(log_file);
+    if (k < video_kicks)
+      logs.push_back(log_file);
+    else
+      std::filesystem::remove(log_file);
   }
   const int n = static_cast<int>(outcomes.size());
   const double goals = counts["goal"], p = n ? goals / n : 0.0, z = 1.96;
   // Wilson score interval.
   const double denom = 1 + z * z / std::max(n, 1);
   const double centre = (p + z * z / (2.0 * std::max(n, 1))) / denom;
-  const double half = z * std::sqrt(p * (1 - p) / std::max(n, 1) + z * z / (4.0 * std::max(n, 1) * std::max(n, 1))) / denom;
-  std::printf("penalties: %d kicks, %d goals: scoring rate %.2f (95%% CI %.2f..%.2f); saved %d, missed %d, timeout %d\n",
-              n, counts["goal"], p, std::max(0.0, centre - half), std::min(1.0, centre + half),
-              counts["saved"], counts["missed"], counts["timeout"]);
+  const double half =
+      z *
+      std::sqrt(p * (1 - p) / std::max(n, 1) + z * z / (4.0 * std::max(n, 1) * std::max(n, 1))) /
+      denom;
+  std::printf(
+      "penalties: %d kicks, %d goals: scoring rate %.2f (95%% CI %.2f..%.2f); saved %d, missed %d, "
+      "timeout %d\n",
+      n, counts["goal"], p, std::max(0.0, centre - half), std::min(1.0, centre + half),
+      counts["saved"], counts["missed"], counts["timeout"]);
   std::ofstream out(o.out / "penalty.json");
   out << "{\n  \"config\": " << jsonString(config.file) << ",\n  \"seed\": " << base
       << ",\n  \"kicks\": " << n << ",\n  \"scoring_rate\": " << num(p) << ",\n  \"ci95\": ["
@@ -614,7 +663,8 @@ int penalty(int argc, char** argv, int first) {
   for (size_t i = 0; i < outcomes.size(); ++i) out << (i ? ", " : "") << jsonString(outcomes[i]);
   out << "]\n}\n";
   for (size_t i = 0; i < logs.size(); ++i) {
-    const auto v = renderVideo(logs[i], o.out / ("kick_" + std::to_string(i + 1) + ".mp4"), config.video, 0, 1e12);
+    const auto v = renderVideo(logs[i], o.out / ("kick_" + std::to_string(i + 1) + ".mp4"),
+                               config.video, 0, 1e12);
     std::printf("video: %s, %d frames\n", v.file.string().c_str(), v.frames);
   }
   std::printf("wrote %s\n", (o.out / "penalty.json").string().c_str());
@@ -681,7 +731,8 @@ int replay(int argc, char** argv, int first) {
       }
       ++checked;
     }
-    if (status == 0) std::printf("physics replay: %d of %d periods, every state hash equal\n", checked, frames);
+    if (status == 0)
+      std::printf("physics replay: %d of %d periods, every state hash equal\n", checked, frames);
   }
   if (opt.has("video")) {
     VideoSettings v;

@@ -51,7 +51,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
         root["teams"].fail("GameController team numbers are whole numbers 0..254");
       c.team_numbers[i] = static_cast<int>(t[i]);
     }
-    if (c.team_numbers[0] == c.team_numbers[1]) root["teams"].fail("the two teams need different numbers");
+    if (c.team_numbers[0] == c.team_numbers[1])
+      root["teams"].fail("the two teams need different numbers");
   }
   if (auto a = root.optional("agents")) {
     a->allowOnly({"config", "role", "get_up", "restart_limit"});

@@ -21,7 +21,7 @@ struct VideoSettings {
   double fps = 25.0;
   int width = 640, height = 360;
   engine::Vec3 position{0.0, -7.0, 5.0}, look_at{0.0, 0.0, 0.0};  // m, field frame
-  double horizontal_fov = 1.1;                                      // rad
+  double horizontal_fov = 1.1;                                    // rad
 };
 
 struct MatchConfig {

@@ -35,7 +35,6 @@ Vec3 linkAngularVelocity(const World& world, RobotId r, int link) {
   return omega;
 }
 
-
 }  // namespace
 
 bool CameraSystem::due(uint64_t tick, double control_period, double rate) {
@@ -150,8 +149,8 @@ void CameraSystem::capture(const World& world) {
     const double vertical_fov =
         2 * std::atan(std::tan(0.5 * sp.horizontal_fov) * sp.height / sp.width);
     job.views.push_back({CameraId::Spectator, 0, 0, 0,
-                         engine::pinholeView(lookAtPose(sp.position, sp.look_at), sp.width, sp.height,
-                                             sp.horizontal_fov, vertical_fov),
+                         engine::pinholeView(lookAtPose(sp.position, sp.look_at), sp.width,
+                                             sp.height, sp.horizontal_fov, vertical_fov),
                          Vec3::Zero()});
   }
   {

@@ -70,7 +70,8 @@ MatchLogWriter::MatchLogWriter(const std::filesystem::path& file, const MatchLog
   if (!out_) throw std::runtime_error(file.string() + ": cannot write the match log");
   std::ostringstream h;
   for (const auto& [k, v] : header.values) h << k << '=' << v << '\n';
-  for (const auto& r : header.robots) h << "robot=" << r.team << ',' << r.number << ',' << r.joints << '\n';
+  for (const auto& r : header.robots)
+    h << "robot=" << r.team << ',' << r.number << ',' << r.joints << '\n';
   const std::string text = h.str();
   out_.write(kMagic, 8);
   const uint32_t version = kMatchLogVersion, length = static_cast<uint32_t>(text.size());
@@ -134,9 +135,7 @@ void MatchLogWriter::flush() {
 
 MatchLogReader::MatchLogReader(const std::filesystem::path& file)
     : file_(file), in_(file, std::ios::binary) {
-  auto fail = [&](const std::string& why) {
-    throw std::runtime_error(file.string() + ": " + why);
-  };
+  auto fail = [&](const std::string& why) { throw std::runtime_error(file.string() + ": " + why); };
   if (!in_) fail("cannot open the match log");
   char magic[8];
   uint32_t version = 0, length = 0;
@@ -188,7 +187,8 @@ bool MatchLogReader::next(LogFrame& f) {
   f.state_hash = in.raw<uint64_t>();
   const auto g = in.raw<uint16_t>();
   if (pos_ + g > block_.size()) throw std::runtime_error(file_.string() + ": bad frame");
-  f.game.assign(block_.begin() + static_cast<long>(pos_), block_.begin() + static_cast<long>(pos_ + g));
+  f.game.assign(block_.begin() + static_cast<long>(pos_),
+                block_.begin() + static_cast<long>(pos_ + g));
   pos_ += g;
   f.ball = getPose(in);
   const auto n = in.raw<uint16_t>();

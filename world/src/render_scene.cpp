@@ -106,8 +106,8 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
   add(items, Primitive::Quad, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 1.0),
       c.carpet);
   p.translation() = Vec3(0, 0, -0.01);
-  add(items, Primitive::Quad, p, Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 1.0),
-      c.floor);
+  add(items, Primitive::Quad, p,
+      Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 1.0), c.floor);
 }
 
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,

@@ -38,13 +38,20 @@ int get16u(const std::vector<uint8_t>& b, size_t i) {
 
 const char* roleName(Role r) {
   switch (r) {
-    case Role::Auto: return "auto";
-    case Role::Striker: return "striker";
-    case Role::Supporter: return "supporter";
-    case Role::Defender: return "defender";
-    case Role::Goalkeeper: return "goalkeeper";
-    case Role::PenaltyKicker: return "penalty-kicker";
-    case Role::PenaltyGoalkeeper: return "penalty-goalkeeper";
+    case Role::Auto:
+      return "auto";
+    case Role::Striker:
+      return "striker";
+    case Role::Supporter:
+      return "supporter";
+    case Role::Defender:
+      return "defender";
+    case Role::Goalkeeper:
+      return "goalkeeper";
+    case Role::PenaltyKicker:
+      return "penalty-kicker";
+    case Role::PenaltyGoalkeeper:
+      return "penalty-goalkeeper";
   }
   return "?";
 }
@@ -59,8 +66,8 @@ std::optional<Role> roleFromName(const std::string& name) {
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   root.allowOnly({"behaviour", "ready_positions", "kick_off_position", "max_forward", "max_side",
-                  "max_turn", "kick_ball", "kick_tolerance", "approach_distance",
-                  "ball_lost_time", "team_ball_time", "keep_clear", "message_interval"});
+                  "max_turn", "kick_ball", "kick_tolerance", "approach_distance", "ball_lost_time",
+                  "team_ball_time", "keep_clear", "message_interval"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -87,14 +94,17 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
   c.keep_clear = root.number("keep_clear", c.keep_clear);
   c.message_interval = root.number("message_interval", c.message_interval);
-  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance",
-                        "message_interval"})
+  for (const char* k :
+       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
   return c;
 }
 
 std::vector<uint8_t> encodeTeamMessage(const TeamMessageData& d) {
-  std::vector<uint8_t> b{'S', 'S', 1, static_cast<uint8_t>(d.player),
+  std::vector<uint8_t> b{'S',
+                         'S',
+                         1,
+                         static_cast<uint8_t>(d.player),
                          static_cast<uint8_t>(d.role),
                          static_cast<uint8_t>((d.fallen ? 1 : 0) | (d.ball_seen ? 2 : 0))};
   put16(b, static_cast<int>(std::lround(d.x * 1000)));
@@ -252,7 +262,8 @@ void SoccerBehaviour::receive(const TeamMessageIn& message, double time) {
 }
 
 Role SoccerBehaviour::chooseRole(const Input& in) {
-  if (phase_ == kPhasePenaltyShoot) return our_kick_ ? Role::PenaltyKicker : Role::PenaltyGoalkeeper;
+  if (phase_ == kPhasePenaltyShoot)
+    return our_kick_ ? Role::PenaltyKicker : Role::PenaltyGoalkeeper;
   if (fixed_role_ != Role::Auto) return fixed_role_;
   if (player_ == goalkeeper_number_) return Role::Goalkeeper;
   // Field players still in the game (teammates heard from recently), with
@@ -262,11 +273,11 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
     int player;
     double cost, x;
   };
-  const double my_cost =
-      std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
+  const double my_cost = std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
   std::vector<Bid> bids{{player_, my_cost, self_.x}};
   for (const Teammate& m : mates_) {
-    if (m.data.player == goalkeeper_number_ || in.time - m.received > 3.0 * config_.message_interval + 6.0)
+    if (m.data.player == goalkeeper_number_ ||
+        in.time - m.received > 3.0 * config_.message_interval + 6.0)
       continue;
     bids.push_back({m.data.player, m.data.cost, toOwn(m.data.x, m.data.y).x});
   }
@@ -278,8 +289,9 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   });
   if (bids.front().player == player_) return Role::Striker;
   std::vector<Bid> rest(bids.begin() + 1, bids.end());
-  std::sort(rest.begin(), rest.end(),
-            [](const Bid& a, const Bid& b) { return a.x != b.x ? a.x < b.x : a.player < b.player; });
+  std::sort(rest.begin(), rest.end(), [](const Bid& a, const Bid& b) {
+    return a.x != b.x ? a.x < b.x : a.player < b.player;
+  });
   const size_t defenders = (rest.size() + 1) / 2;
   for (size_t i = 0; i < rest.size(); ++i)
     if (rest[i].player == player_) return i < defenders ? Role::Defender : Role::Supporter;
@@ -365,8 +377,8 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
   const double across = -(self_.x - ball_.x) * dir.y + (self_.y - ball_.y) * dir.x;
   const bool behind = along < -0.1 && std::abs(across) < std::max(0.25, -0.8 * along);
   if (to_ball > config_.approach_distance + 0.2 || !behind) {
-    Pose2 t{ball_.x - dir.x * config_.approach_distance, ball_.y - dir.y * config_.approach_distance,
-            aim};
+    Pose2 t{ball_.x - dir.x * config_.approach_distance,
+            ball_.y - dir.y * config_.approach_distance, aim};
     if (!behind && along > -0.2) {
       // In front of or beside the ball: go round it on the near side.
       const double side = across >= 0 ? 1.0 : -1.0;
@@ -411,9 +423,9 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
     y = std::clamp(ball_.y + ball_velocity_.y * t, -half_goal - 0.1, half_goal + 0.1);
   }
   const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
-  const bool area =
-      field_.penalty_area && ball_.x < -field_.halfLength() + field_.penalty_area->length &&
-      std::abs(ball_.y) < 0.5 * field_.penalty_area->width;
+  const bool area = field_.penalty_area &&
+                    ball_.x < -field_.halfLength() + field_.penalty_area->length &&
+                    std::abs(ball_.y) < 0.5 * field_.penalty_area->width;
   if (!shootout && area && to_ball < 1.0 && std::hypot(ball_velocity_.x, ball_velocity_.y) < 0.3)
     return striker(0.0, false);  // clear it
   return walkTo({line, y, 0.0}, false);
@@ -430,7 +442,8 @@ MotionRequest SoccerBehaviour::ready() {
 }
 
 MotionRequest SoccerBehaviour::play(const Input& in) {
-  const bool ball_known = in.time - ball_known_at_ < config_.ball_lost_time + config_.team_ball_time;
+  const bool ball_known =
+      in.time - ball_known_at_ < config_.ball_lost_time + config_.team_ball_time;
   // The opponents' kick-off or set play: keep clear of the ball.
   const bool theirs = have_game_ && !our_kick_ && (kick_pending_ || set_play_ != 0);
   MotionRequest r;
@@ -465,8 +478,8 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
     }
     case Role::Defender: {
       const Vec2 own_goal{-field_.halfLength(), 0.0};
-      Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x), own_goal.y + 0.45 * (ball_.y - own_goal.y),
-              0.0};
+      Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x),
+              own_goal.y + 0.45 * (ball_.y - own_goal.y), 0.0};
       t.x = std::clamp(std::min(t.x, ball_.x - 0.8), -field_.halfLength() + 0.8, 0.0);
       r = walkTo(t, true);
       break;
@@ -509,8 +522,8 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
   readGame(in);
   updateBall(in);
   MotionRequest r;
-  if (have_game_ && (penalised_ || state_ == kInitial || state_ == kStandby ||
-                     state_ == kFinished)) {
+  if (have_game_ &&
+      (penalised_ || state_ == kInitial || state_ == kStandby || state_ == kFinished)) {
     head(r, in);
     r.head_yaw = 0.0;
     return r;
@@ -528,9 +541,9 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
 
 std::string SoccerBehaviour::status() const {
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%s state %d self (%.2f %.2f %.2f) ball (%.2f %.2f) target (%.2f %.2f)",
-                roleName(role_), state_, self_.x, self_.y, self_.yaw, ball_.x, ball_.y, target_.x,
-                target_.y);
+  std::snprintf(
+      buf, sizeof buf, "%s state %d self (%.2f %.2f %.2f) ball (%.2f %.2f) target (%.2f %.2f)",
+      roleName(role_), state_, self_.x, self_.y, self_.yaw, ball_.x, ball_.y, target_.x, target_.y);
   return buf;
 }
 

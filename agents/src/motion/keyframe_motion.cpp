@@ -25,8 +25,7 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
     Keyframe f;
     f.duration = item["duration"].positive();
     f.stiffness = item.number("stiffness", 1.0);
-    if (f.stiffness < 0.0 || f.stiffness > 1.0)
-      item["stiffness"].fail("must be within 0..1");
+    if (f.stiffness < 0.0 || f.stiffness > 1.0) item["stiffness"].fail("must be within 0..1");
     if (auto pose = item.optional("pose")) {
       const std::string name = pose->string();
       if (!model.poses.count(name))
@@ -36,9 +35,11 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
     if (auto set = item.optional("joints")) {
       for (const auto& [name, value] : set->entries()) {
         const int j = model.body->jointIndex(name);
-        if (j < 0) set->failKey(name, "robot model '" + model.name + "' has no joint '" + name + "'");
+        if (j < 0)
+          set->failKey(name, "robot model '" + model.name + "' has no joint '" + name + "'");
         const auto& joint = joints[static_cast<size_t>(j)];
-        if (joint.mimic_of >= 0) set->failKey(name, "a mimic joint follows its master: set that one");
+        if (joint.mimic_of >= 0)
+          set->failKey(name, "a mimic joint follows its master: set that one");
         const double v = value.number();
         if (v < joint.lower - 1e-6 || v > joint.upper + 1e-6)
           set->failKey(name, "beyond the joint's limits [" + engine::formatNumber(joint.lower) +

@@ -7,13 +7,20 @@ namespace simsoccer::agents {
 
 const char* motionStateName(MotionState s) {
   switch (s) {
-    case MotionState::Easing: return "easing";
-    case MotionState::Stance: return "stance";
-    case MotionState::Walking: return "walking";
-    case MotionState::Kicking: return "kicking";
-    case MotionState::Falling: return "falling";
-    case MotionState::Lying: return "lying";
-    case MotionState::GettingUp: return "getting_up";
+    case MotionState::Easing:
+      return "easing";
+    case MotionState::Stance:
+      return "stance";
+    case MotionState::Walking:
+      return "walking";
+    case MotionState::Kicking:
+      return "kicking";
+    case MotionState::Falling:
+      return "falling";
+    case MotionState::Lying:
+      return "lying";
+    case MotionState::GettingUp:
+      return "getting_up";
   }
   return "?";
 }
@@ -66,9 +73,8 @@ void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<
       q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
 }
 
-void MotionController::update(double dt, const MotionSensors& sensors,
-                              const MotionRequest& request, std::span<float> position,
-                              std::span<float> stiffness) {
+void MotionController::update(double dt, const MotionSensors& sensors, const MotionRequest& request,
+                              std::span<float> position, std::span<float> stiffness) {
   // The direction of "up" in the torso frame from the accelerometer, low-passed
   // (steps and kicks shake it; a fall takes ~0.5 s).
   gravity_ = 0.8 * gravity_ + 0.2 * sensors.accel;
@@ -188,8 +194,8 @@ void MotionController::update(double dt, const MotionSensors& sensors,
     const int j = act.index;
     position[a] = static_cast<float>(targets_[static_cast<size_t>(j)]);
     const bool head = j == head_yaw_ || j == head_pitch_;
-    stiffness[a] = static_cast<float>(head && !soft ? std::min(stiffness_, fall_.head_stiffness)
-                                                    : stiffness_);
+    stiffness[a] =
+        static_cast<float>(head && !soft ? std::min(stiffness_, fall_.head_stiffness) : stiffness_);
   }
 }
 

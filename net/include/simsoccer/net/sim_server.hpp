@@ -17,12 +17,12 @@
 #pragma once
 
 #include <array>
-#include <optional>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
@@ -146,7 +146,7 @@ class SimServer {
   std::vector<RobotSlot> robots_;
   ServerTimes times_;
   std::unique_ptr<world::PerceptionSystem> perception_;  // null unless the scenario turns it on
-  std::unique_ptr<world::CameraSystem> cameras_;  // declared last: stopped first
+  std::unique_ptr<world::CameraSystem> cameras_;         // declared last: stopped first
 };
 
 // The referee's GameController packet as the DDS GameState message.

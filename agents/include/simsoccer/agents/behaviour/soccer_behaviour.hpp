@@ -53,16 +53,16 @@ struct BehaviourConfig {
   std::vector<Pose2> ready_positions;
   Pose2 kick_off_position{-0.25, 0.0, 0.0};  // the kicking team's striker in Ready
   double max_forward = 0.25, max_side = 0.10, max_turn = 0.8;  // m/s, m/s, rad/s
-  double kick_ball_x = 0.17;       // m ahead of the torso: the ball where a kick meets it
-  double kick_ball_y = 0.05;       // m sideways: in front of the kicking foot
-  double kick_tolerance_x = 0.03;  // m
-  double kick_tolerance_y = 0.025;  // m
+  double kick_ball_x = 0.17;           // m ahead of the torso: the ball where a kick meets it
+  double kick_ball_y = 0.05;           // m sideways: in front of the kicking foot
+  double kick_tolerance_x = 0.03;      // m
+  double kick_tolerance_y = 0.025;     // m
   double kick_tolerance_angle = 0.15;  // rad off the aim
-  double approach_distance = 0.35;  // m behind the ball before lining up
-  double ball_lost_time = 3.0;      // s: after this, the own sighting is stale
-  double team_ball_time = 4.0;      // s: a teammate's sighting counts this long
-  double keep_clear = 0.8;          // m from the ball at the opponents' kick-off / set play
-  double message_interval = 1.0;    // s, the fastest; slower when the budget asks
+  double approach_distance = 0.35;     // m behind the ball before lining up
+  double ball_lost_time = 3.0;         // s: after this, the own sighting is stale
+  double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
+  double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
+  double message_interval = 1.0;       // s, the fastest; slower when the budget asks
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
@@ -72,10 +72,10 @@ struct TeamMessageData {
   int player = 0;
   Role role = Role::Auto;
   bool fallen = false, ball_seen = false;
-  double x = 0, y = 0, yaw = 0;      // m, m, rad
-  double ball_x = 0, ball_y = 0;     // m
-  double ball_age = 0;               // s since seen
-  double cost = 0;                   // the striker bid: lower is better (m)
+  double x = 0, y = 0, yaw = 0;   // m, m, rad
+  double ball_x = 0, ball_y = 0;  // m
+  double ball_age = 0;            // s since seen
+  double cost = 0;                // the striker bid: lower is better (m)
 };
 std::vector<uint8_t> encodeTeamMessage(const TeamMessageData& d);
 std::optional<TeamMessageData> decodeTeamMessage(const std::vector<uint8_t>& bytes);

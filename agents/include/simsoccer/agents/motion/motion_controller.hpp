@@ -36,13 +36,13 @@ struct MotionSensors {
 };
 
 struct FallDetectorParameters {
-  double falling_tilt = 0.65;     // rad from upright: the robot is falling
-  double lying_tilt = 1.0;        // rad: it lies ...
-  double lying_rate = 0.6;        // rad/s: ... once it turns slower than this ...
-  double lying_time = 0.3;        // s ... for this long
-  double upright_tilt = 0.35;     // rad: a get-up that ends within this succeeded
-  double safe_stiffness = 0.15;   // while falling and lying
-  double head_stiffness = 0.6;    // the head's stiffness in normal motion
+  double falling_tilt = 0.65;    // rad from upright: the robot is falling
+  double lying_tilt = 1.0;       // rad: it lies ...
+  double lying_rate = 0.6;       // rad/s: ... once it turns slower than this ...
+  double lying_time = 0.3;       // s ... for this long
+  double upright_tilt = 0.35;    // rad: a get-up that ends within this succeeded
+  double safe_stiffness = 0.15;  // while falling and lying
+  double head_stiffness = 0.6;   // the head's stiffness in normal motion
   // Try to get up once lying still. Off: the robot stays down, soft (the
   // referee takes it out as an inactive player). See the README: the get-up
   // motions do not succeed yet, and with the robot off its feet the leg
