@@ -230,7 +230,6 @@ void SoccerBehaviour::updateBall(const Input& in) {
       }
       ball_ = b;
       ball_known_at_ = ball_seen_at_;
-      ball_from_team_ = false;
     }
   }
   // A teammate's fresher sighting replaces a stale own one.
@@ -241,7 +240,6 @@ void SoccerBehaviour::updateBall(const Input& in) {
       if (in.time - seen < config_.team_ball_time && seen > ball_known_at_) {
         ball_ = toOwn(m.data.ball_x, m.data.ball_y);
         ball_known_at_ = seen;
-        ball_from_team_ = true;
       }
     }
   }
@@ -510,8 +508,7 @@ void SoccerBehaviour::head(MotionRequest& r, const Input& in) {
     r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
   } else {
     // Scan: side to side, 4 s a sweep.
-    head_phase_ += 0.01;
-    r.head_yaw = 1.2 * std::sin(2 * kPi * head_phase_ / 4.0);
+    r.head_yaw = 1.2 * std::sin(2 * kPi * in.time / 4.0);
     r.head_pitch = 0.2;
   }
 }

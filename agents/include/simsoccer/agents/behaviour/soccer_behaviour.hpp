@@ -145,7 +145,6 @@ class SoccerBehaviour {
   bool self_known_ = false;
   Vec2 ball_, ball_robot_;  // own frame; robot frame (own sighting)
   double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
-  bool ball_from_team_ = false;
   Vec2 ball_velocity_;
   Vec2 last_ball_;
   double last_ball_time_ = -1e9;
@@ -158,7 +157,6 @@ class SoccerBehaviour {
   double penalty_aim_ = 0.5;  // -1..1: right post .. left post
   Pose2 target_;
   bool arrived_ = false;  // at the walk target: standing
-  double head_phase_ = 0.0;
 };
 
 }  // namespace simsoccer::agents
