@@ -87,6 +87,8 @@ CameraSystem::CameraSystem(const World& world, const CameraSettings& settings, B
     thread_.join();
     throw engine::RenderError(start_error_);
   }
+  lock.unlock();
+  convert_thread_ = std::thread([this] { convert(); });
 }
 
 CameraSystem::~CameraSystem() {
@@ -96,6 +98,7 @@ CameraSystem::~CameraSystem() {
   }
   changed_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (convert_thread_.joinable()) convert_thread_.join();
 }
 
 void CameraSystem::capture(const World& world) {
@@ -187,36 +190,65 @@ void CameraSystem::run() {
     started_ = true;
   }
   changed_.notify_all();
+  std::vector<engine::RenderView> views;
   for (;;) {
     Job* job = nullptr;
     {
       std::unique_lock lock(mutex_);
-      changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping, everything delivered
-      job = &queue_.front();       // stays queued (counted as in flight) until delivered
+      changed_.wait(lock, [&] { return stopping_ || rendered_ < queue_.size(); });
+      if (rendered_ == queue_.size()) {  // stopping, everything rendered
+        render_done_ = true;
+        changed_.notify_all();
+        return;
+      }
+      job = &queue_[rendered_];  // stays queued (counted as in flight) until delivered
     }
-    process(*renderer, *job);
+    views.clear();
+    for (const ViewJob& v : job->views) views.push_back(v.view);
+    renderer->render(job->scene, views);
+    Rendered rendered{job, {}, renderer->lastTiming()};
+    for (size_t i = 0; i < views.size(); ++i) rendered.rgba.push_back(renderer->image(i));
     {
-      std::lock_guard lock(mutex_);
-      queue_.pop_front();
+      // The previous capture must be converted before this one is handed
+      // over: the render after this one reuses that capture's readback buffer.
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return !converting_.has_value(); });
+      converting_ = std::move(rendered);
+      ++rendered_;
     }
     changed_.notify_all();
   }
 }
 
-void CameraSystem::process(engine::OffscreenRenderer& renderer, Job& job) {
-  std::vector<engine::RenderView> views;
-  views.reserve(job.views.size());
-  for (const ViewJob& v : job.views) views.push_back(v.view);
-  renderer.render(job.scene, views);
-  const engine::RenderTiming& timing = renderer.lastTiming();
+void CameraSystem::convert() {
+  for (;;) {
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return converting_.has_value() || render_done_; });
+      if (!converting_) return;  // the render thread has stopped and everything is delivered
+    }
+    // Only this thread touches converting_ while it holds a capture.
+    process(*converting_);
+    {
+      std::lock_guard lock(mutex_);
+      converting_.reset();
+      queue_.pop_front();
+      --rendered_;
+    }
+    changed_.notify_all();
+  }
+}
+
+void CameraSystem::process(Rendered& rendered) {
+  const Job& job = *rendered.job;
+  const engine::RenderTiming& timing = rendered.timing;
   double convert_ms = 0.0, deliver_ms = 0.0;
   uint64_t pixels = 0;
   CameraImage image;
   for (size_t i = 0; i < job.views.size(); ++i) {
     const ViewJob& v = job.views[i];
     const auto t0 = Clock::now();
-    cv::Mat rgba = renderer.image(i);
+    cv::Mat rgba = rendered.rgba[i];
     pixels += rgba.total();
     image.camera = v.camera;
     image.robot = v.robot;

@@ -18,7 +18,17 @@ Eigen::Matrix4f toMatrix(const engine::Pose& pose, const Vec3& scale) {
 
 void add(std::vector<DrawItem>& items, Primitive shape, const engine::Pose& pose, const Vec3& scale,
          const Eigen::Vector3f& colour, bool pattern = false) {
-  items.push_back({shape, toMatrix(pose, scale), colour, pattern});
+  items.push_back({shape, toMatrix(pose, scale), colour, pattern, false, 0.0f});
+}
+
+// Paint on the ground: a quad in the plane z = 0 (the renderer draws these in order).
+void addGround(std::vector<DrawItem>& items, const Vec3& centre, double yaw, double length,
+               double width, const Eigen::Vector3f& colour) {
+  engine::Pose p = engine::Pose::Identity();
+  p.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+  p.translation() = centre;
+  items.push_back(
+      {Primitive::Quad, toMatrix(p, Vec3(length, width, 1.0)), colour, false, true, 0.0f});
 }
 
 // A collision primitive as render instances (a capsule: cylinder + 2 spheres).
@@ -37,46 +47,37 @@ void addShape(std::vector<DrawItem>& items, const engine::Shape& s, const engine
       break;
     case engine::ShapeType::Capsule: {
       const double half = 0.5 * s.length - s.radius;  // between the cap centres, halved
-      add(items, Primitive::Cylinder, p, Vec3(s.radius, s.radius, 2 * half), colour);
-      for (double z : {-half, half}) {
-        engine::Pose cap = p;
-        cap.translation() = p * Vec3(0, 0, z);
-        add(items, Primitive::CoarseSphere, cap, Vec3::Constant(s.radius), colour);
-      }
+      add(items, Primitive::Capsule, p, Vec3::Constant(s.radius), colour);
+      items.back().stretch = static_cast<float>(half / s.radius);
       break;
     }
   }
 }
 
-// A painted line: a quad just above the carpet.
+// A painted line from a to b, its ends squared off half a width beyond them.
 void addLine(std::vector<DrawItem>& items, const fields::Vec2& a, const fields::Vec2& b,
              double width, const Eigen::Vector3f& colour) {
   const fields::Vec2 d = b - a;
-  engine::Pose p = engine::Pose::Identity();
-  p.rotate(Eigen::AngleAxisd(std::atan2(d.y(), d.x()), Vec3::UnitZ()));
-  p.translation() = Vec3(0.5 * (a.x() + b.x()), 0.5 * (a.y() + b.y()), 0.001);
-  add(items, Primitive::Quad, p, Vec3(d.norm() + (d.norm() > 0 ? width : 0), width, 1.0), colour);
+  addGround(items, Vec3(0.5 * (a.x() + b.x()), 0.5 * (a.y() + b.y()), 0.0),
+            std::atan2(d.y(), d.x()), d.norm() + (d.norm() > 0 ? width : 0), width, colour);
 }
 
 }  // namespace
 
 void buildRenderScene(const World& world, std::vector<DrawItem>& items, const SceneColours& c) {
-  // Nearest things first, the ground last: the renderer keeps this order, and
-  // ground hidden behind robots then fails the early depth test.
-  // Robots from their collision primitives; the torso in the jersey colour.
-  for (RobotId r = 0; r < world.robotCount(); ++r) {
-    const auto& info = world.robot(r);
-    const auto& links = info.model->body->links;
-    const Eigen::Vector3f jersey =
-        c.jerseys.empty() ? c.robot : c.jerseys[static_cast<size_t>(info.team) % c.jerseys.size()];
-    for (size_t l = 0; l < links.size(); ++l) {
-      if (links[l].shapes.empty()) continue;
-      const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
-      for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
-    }
-  }
   const auto& f = world.field();
-  // The lines, then the carpet, then the floor around it.
+  // The ground in painter's order (the renderer draws it first, later paint
+  // over earlier, no depth test): the floor as a 10 m ring around the carpet
+  // (not a quad under it, which would be shaded twice), the carpet, the lines.
+  const double carpet_length = f.length + 2 * f.border, carpet_width = f.width + 2 * f.border;
+  const double ring = 10.0;
+  for (int side : {-1, 1}) {
+    addGround(items, Vec3(side * 0.5 * (carpet_length + ring), 0, 0), 0.0, ring,
+              carpet_width + 2 * ring, c.floor);
+    addGround(items, Vec3(0, side * 0.5 * (carpet_width + ring), 0), 0.0, carpet_length, ring,
+              c.floor);
+  }
+  addGround(items, Vec3::Zero(), 0.0, carpet_length, carpet_width, c.carpet);
   for (const auto& l : f.lines) addLine(items, l.a, l.b, f.line_width, c.line);
   for (const auto& circle : f.circles) {
     const int segments = 24;  // few triangles: llvmpipe pays per triangle
@@ -92,6 +93,18 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
     addLine(items, m - fields::Vec2(h, 0), m + fields::Vec2(h, 0), f.line_width, c.line);
     addLine(items, m - fields::Vec2(0, h), m + fields::Vec2(0, h), f.line_width, c.line);
   }
+  // Robots from their collision primitives; the torso in the jersey colour.
+  for (RobotId r = 0; r < world.robotCount(); ++r) {
+    const auto& info = world.robot(r);
+    const auto& links = info.model->body->links;
+    const Eigen::Vector3f jersey =
+        c.jerseys.empty() ? c.robot : c.jerseys[static_cast<size_t>(info.team) % c.jerseys.size()];
+    for (size_t l = 0; l < links.size(); ++l) {
+      if (links[l].shapes.empty()) continue;
+      const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
+      for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
+    }
+  }
   // The ball.
   const engine::RigidBodyState ball = world.ballState();
   add(items, Primitive::Sphere, ball.pose, Vec3::Constant(f.ball.radius), c.ball, true);
@@ -101,13 +114,6 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
     for (size_t i = 0; i < shapes.size(); ++i)
       addShape(items, shapes[i], engine::Pose::Identity(), i < 3 ? c.goal : c.net);
   }
-  // The carpet (its surface at z = 0) and the floor around it, 1 cm lower.
-  engine::Pose p = engine::Pose::Identity();
-  add(items, Primitive::Quad, p, Vec3(f.length + 2 * f.border, f.width + 2 * f.border, 1.0),
-      c.carpet);
-  p.translation() = Vec3(0, 0, -0.01);
-  add(items, Primitive::Quad, p,
-      Vec3(f.length + 2 * f.border + 20, f.width + 2 * f.border + 20, 1.0), c.floor);
 }
 
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,

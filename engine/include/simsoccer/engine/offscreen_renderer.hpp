@@ -25,8 +25,11 @@ class RenderError : public std::runtime_error {
 // (192 triangles, for the ball); a coarse sphere (an icosahedron, 20
 // triangles, for robot parts); cylinder of radius 1 and length 1 along z,
 // centred (24 triangles); a quad -0.5..0.5 in x and y facing +z (2 triangles,
-// for paint on the ground).
-enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder, Quad };
+// for paint on the ground); a capsule of radius 1 along z whose end caps are
+// centred at z = +-DrawItem::stretch (a hexagonal prism with hexagonal pyramid
+// ends, 24 triangles: one instance where a cylinder and two spheres took 64,
+// and llvmpipe pays per triangle).
+enum class Primitive : uint8_t { Box, Sphere, CoarseSphere, Cylinder, Quad, Capsule };
 
 // One instance of a unit mesh in the world frame.
 struct DrawItem {
@@ -34,6 +37,13 @@ struct DrawItem {
   Eigen::Matrix4f transform = Eigen::Matrix4f::Identity();  // world from unit mesh (with scale)
   Eigen::Vector3f colour = Eigen::Vector3f::Ones();         // linear RGB, 0..1
   bool ball_pattern = false;                                // black patches on white (the SPL ball)
+  // Paint on the ground (carpet, floor, lines: flat, nothing lies under it):
+  // drawn before everything else, in the scene's order, without the depth
+  // test, later paint over earlier. It covers most of every robot camera's
+  // image, and without depth reads and writes llvmpipe shades it about 5
+  // times faster. Only Quad.
+  bool ground = false;
+  float stretch = 0.0f;  // Capsule: half the distance between the cap centres, in radii
 };
 
 // A pinhole camera. `pose` is the camera frame in the world: x forward
@@ -75,7 +85,9 @@ class OffscreenRenderer {
   // Must be called on the thread that created the renderer.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views);
   // View i of the last render as 8-bit RGBA (CV_8UC4, R first, top row
-  // first): a region of the readback, valid until the next render.
+  // first): a region of the readback. Two readback buffers alternate, so the
+  // pixels stay valid until the second render after this one: one frame's
+  // images can be converted on another thread while the next is drawn.
   cv::Mat image(size_t view) const;
   // The same, with `images[i]` an RGB copy (CV_8UC3) of view i.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views,

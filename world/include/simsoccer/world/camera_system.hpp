@@ -18,6 +18,7 @@
 #include <functional>
 #include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -70,14 +71,16 @@ void applyCameraEffects(cv::Mat& image, const CameraEffects& effects,
 
 class CameraSystem {
  public:
-  // Called on the render thread, in capture order, once per image.
+  // Called on the conversion thread, in capture order, once per image.
   using Sink = std::function<void(const CameraImage&)>;
 
-  // Starts the render thread and its EGL context; throws engine::RenderError
+  // Starts the render thread (with its EGL context) and the conversion
+  // thread, which converts and delivers one capture's images while the next
+  // capture is drawn; throws engine::RenderError
   // if the context cannot be made, engine::ConfigError if the settings name a
   // robot that is not in the world.
   CameraSystem(const World& world, const CameraSettings& settings, BehindPolicy policy, Sink sink);
-  ~CameraSystem();  // delivers what is queued, then stops the thread
+  ~CameraSystem();  // delivers what is queued, then stops the threads
   CameraSystem(const CameraSystem&) = delete;
   CameraSystem& operator=(const CameraSystem&) = delete;
 
@@ -107,8 +110,17 @@ class CameraSystem {
     std::vector<ViewJob> views;
   };
 
-  void run();
-  void process(engine::OffscreenRenderer& renderer, Job& job);
+  // A rendered capture on its way to conversion: its views' RGBA pixels
+  // (regions of one of the renderer's two readback buffers) and timings.
+  struct Rendered {
+    Job* job = nullptr;
+    std::vector<cv::Mat> rgba;
+    engine::RenderTiming timing;
+  };
+
+  void run();      // render thread
+  void convert();  // conversion thread
+  void process(Rendered& rendered);
 
   CameraSettings settings_;
   BehindPolicy policy_;
@@ -120,13 +132,18 @@ class CameraSystem {
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<Job> queue_;  // waiting and in flight (front is being rendered)
+  // Waiting and in flight: the first `rendered_` have been rendered (at most
+  // one is being converted, one more may be rendered and waiting for it).
+  std::deque<Job> queue_;
+  size_t rendered_ = 0;
+  std::optional<Rendered> converting_;  // handed to the conversion thread
+  bool render_done_ = false;            // the render thread has returned
   bool stopping_ = false;
   std::string start_error_;
   bool started_ = false;
   CameraStats stats_;
   std::string gl_renderer_;
-  std::thread thread_;
+  std::thread thread_, convert_thread_;
 };
 
 }  // namespace simsoccer::world
