@@ -182,6 +182,75 @@ TEST(Camera, SameStateSameBytesAndOneBatchForAllViews) {
   EXPECT_GT(cv::norm(a[0], a[4], cv::NORM_L1), 0.0);
 }
 
+TEST(Camera, AViewInABatchOf44RendersAsItDoesAlone) {
+  // 22 robots' 44 views packed into one framebuffer: each comes out as when
+  // it is drawn alone (no view bleeds into another, culling and level of
+  // detail are per view) but for a few edge pixels rasterised at another
+  // offset in the framebuffer, and the packing leaves little unused.
+  world::World w(test::scenario(22));
+  std::vector<engine::RenderView> views;
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    views.push_back(world::robotCameraView(w, r, "CameraTop", 640, 480));
+    views.push_back(world::robotCameraView(w, r, "CameraBottom", 320, 240));
+  }
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  std::vector<cv::Mat> batch;
+  renderer().render(scene, views, batch);
+  const auto t = renderer().lastTiming();
+  double used = 0;
+  for (const auto& v : views) used += static_cast<double>(v.width) * v.height;
+  const double fill = used / (static_cast<double>(t.atlas_width) * t.atlas_height);
+  std::printf("44 views in %dx%d (%.0f %% used), %zu triangles per view, draw %.1f ms\n",
+              t.atlas_width, t.atlas_height, 100 * fill, t.triangles_per_view, t.draw_ms);
+  EXPECT_GT(fill, 0.9);
+  for (size_t i : {size_t{0}, size_t{1}, size_t{20}, size_t{31}, size_t{43}}) {
+    std::vector<cv::Mat> alone;
+    const engine::RenderView one[1] = {views[i]};
+    renderer().render(scene, one, alone);
+    cv::Mat diff;
+    cv::absdiff(alone[0], batch[i], diff);
+    cv::cvtColor(diff, diff, cv::COLOR_RGB2GRAY);
+    std::printf("view %zu: %d pixels differ\n", i, cv::countNonZero(diff));
+    EXPECT_LE(cv::countNonZero(diff), static_cast<int>(diff.total() / 10000)) << "view " << i;
+  }
+}
+
+TEST(Camera, CapsuleAndItsCoarseStandInWherePredicted) {
+  // A capsule (radius 5 cm, 40 cm long) lying across the view at 2 m and at
+  // 8 m, where it is drawn with three sides: its extent in the image is the
+  // pinhole model's, within the polygons' deviation from a circle.
+  engine::Pose eye = engine::Pose::Identity();
+  eye.translation() = Vec3(0.0, 0.0, 0.5);
+  const engine::RenderView view = engine::pinholeView(eye, 640, 480, 0.98, 0.76);
+  for (double distance : {2.0, 8.0}) {
+    engine::DrawItem capsule;
+    capsule.shape = engine::Primitive::Capsule;
+    capsule.stretch = (0.2f - 0.05f) / 0.05f;
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.block<3, 3>(0, 0) =
+        Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()).toRotationMatrix() * 0.05;  // z -> -y
+    m.block<3, 1>(0, 3) = Vec3(distance, 0.0, 0.5);
+    capsule.transform = m.cast<float>();
+    std::vector<cv::Mat> images;
+    const engine::RenderView views[1] = {view};
+    const engine::DrawItem scene[1] = {capsule};
+    renderer().render(scene, views, images);
+    cv::Mat grey, mask;
+    cv::cvtColor(images[0], grey, cv::COLOR_RGB2GRAY);
+    mask = grey > 120;  // a white capsule (lit at least 0.6) on the hall's grey (0.35)
+    const cv::Rect box = cv::boundingRect(mask);
+    const double length = 0.4 * view.fx / distance, thickness = 0.1 * view.fy / distance;
+    std::printf("capsule at %.0f m: %d x %d px, predicted %.1f x %.1f\n", distance, box.width,
+                box.height, length, thickness);
+    EXPECT_NEAR(box.x + 0.5 * box.width, view.cx, 1.0);
+    EXPECT_NEAR(box.y + 0.5 * box.height, view.cy, 1.0);
+    // The caps' tips are exact; a bit nearer than the centre, so a little wider.
+    EXPECT_NEAR(box.width, length, 0.05 * length + 1.0);
+    EXPECT_NEAR(box.height, thickness, (distance < 5 ? 0.1 : 0.35) * thickness + 1.0);
+  }
+}
+
 TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
   cv::Mat rgb(480, 640, CV_8UC3);
   cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
