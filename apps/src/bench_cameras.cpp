@@ -21,7 +21,8 @@ const char* kHelp =
     "robot's top (640x480) and bottom (320x240) camera on at 30 Hz, or the scenario's own\n"
     "`cameras:` block if it has one. Runs S simulated seconds per N: the simulation thread\n"
     "steps the physics and queues each due capture; the render thread (EGL, one batched\n"
-    "framebuffer per capture) draws, reads back and converts every view. Lockstep policy: the\n"
+    "framebuffer per capture) draws and reads back every view, the conversion thread converts\n"
+    "them while the next capture is drawn. Lockstep policy: the\n"
     "simulation waits when two captures are queued, so nothing is dropped.\n"
     "Prints per N: views, views per wall second, ms per batched frame (draw), ms readback and\n"
     "ms conversion per frame, the real-time factor with cameras on and with them off (same\n"
@@ -107,7 +108,7 @@ int benchCameras(int argc, char** argv, int first) {
       motion.command(w);
       w.stepControlPeriod();
     }
-    uint64_t bytes = 0;  // touched on the render thread only, read after flush()
+    uint64_t bytes = 0;  // touched on the conversion thread only, read after flush()
     world::CameraSystem system(
         w, cameras, world::BehindPolicy::Wait,
         [&](const world::CameraImage& image) { bytes += image.data.size(); });

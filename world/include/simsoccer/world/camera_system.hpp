@@ -2,8 +2,9 @@
 // thread. At each control period the simulation thread calls capture(): if a
 // camera is due, it copies the scene and the due views (a few kB) into a job
 // on a bounded queue; the render thread, which owns the EGL context, draws all
-// views of a job in one batch, applies the image effects, converts each view
-// (YUYV or JPEG; BGR for the spectator) and hands it to the sink.
+// views of a job in one batch and reads them back; the conversion thread
+// applies the image effects, converts each view (YUYV or JPEG; BGR for the
+// spectator) and hands it to the sink while the next job is drawn.
 //
 // When rendering falls behind (the queue holds `queue` captures):
 //   Wait  - capture() blocks until there is room (lockstep: nothing is lost,
