@@ -66,6 +66,16 @@ Blob ballBlob(world::World& w, const engine::RenderView& view) {
   return b;
 }
 
+// Every robot's top (640x480) and bottom (320x240) view, robot by robot.
+std::vector<engine::RenderView> bothCamerasOfEveryRobot(const world::World& w) {
+  std::vector<engine::RenderView> views;
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    views.push_back(world::robotCameraView(w, r, "CameraTop", 640, 480));
+    views.push_back(world::robotCameraView(w, r, "CameraBottom", 320, 240));
+  }
+  return views;
+}
+
 bool isGreen(const cv::Vec3b& p) {
   return p[1] > p[0] + 40 && p[1] > p[2] + 40;
 }
@@ -157,11 +167,7 @@ TEST(Camera, TurningTheHeadShiftsTheImageAsPredicted) {
 
 TEST(Camera, SameStateSameBytesAndOneBatchForAllViews) {
   world::World w(test::scenario(4));
-  std::vector<engine::RenderView> views;
-  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-    views.push_back(world::robotCameraView(w, r, "CameraTop", 640, 480));
-    views.push_back(world::robotCameraView(w, r, "CameraBottom", 320, 240));
-  }
+  const std::vector<engine::RenderView> views = bothCamerasOfEveryRobot(w);
   std::vector<engine::DrawItem> scene;
   world::buildRenderScene(w, scene);
   std::vector<cv::Mat> a, b;
@@ -188,11 +194,7 @@ TEST(Camera, AViewInABatchOf44RendersAsItDoesAlone) {
   // detail are per view) but for a few edge pixels rasterised at another
   // offset in the framebuffer, and the packing leaves little unused.
   world::World w(test::scenario(22));
-  std::vector<engine::RenderView> views;
-  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-    views.push_back(world::robotCameraView(w, r, "CameraTop", 640, 480));
-    views.push_back(world::robotCameraView(w, r, "CameraBottom", 320, 240));
-  }
+  const std::vector<engine::RenderView> views = bothCamerasOfEveryRobot(w);
   std::vector<engine::DrawItem> scene;
   world::buildRenderScene(w, scene);
   std::vector<cv::Mat> batch;
