@@ -280,6 +280,27 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   EXPECT_EQ(got_b[0].from_player, 1);
   EXPECT_EQ(got_b[0].data, hello);
   EXPECT_TRUE(got_c.empty());  // the other team hears nothing
+
+  // A message carries the tick of the frame its sender last received, and
+  // arrives 0.05 s (5 periods) of simulated time after that tick, whenever
+  // it reached the simulator.
+  simsoccer_msg_SensorFrame frame{};
+  ASSERT_TRUE(b.receive(frame, 2.0));
+  while (b.receive(frame, 0.05)) {
+  }
+  b.sendTeamMessage(hello);
+  std::vector<std::pair<uint64_t, agents::TeamMessageIn>> got_a;  // (simulator tick, message)
+  for (int i = 0; i < 20; ++i) {
+    const uint64_t now = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+    server.runPeriod();
+    dds_sleepfor(DDS_MSECS(2));
+    for (auto& m : a.receiveTeamMessages()) got_a.emplace_back(now, m);
+  }
+  ASSERT_EQ(got_a.size(), 1u);
+  EXPECT_EQ(got_a[0].second.from_player, 2);
+  EXPECT_EQ(got_a[0].second.tick, frame.tick);
+  EXPECT_GE(got_a[0].first, frame.tick + 5);  // relayed in the period of tick sent + 5
+                                              // (seen here then, or a little later)
 }
 
 TEST(NetApps, BenchNetWritesItsTable) {

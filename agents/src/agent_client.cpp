@@ -1,6 +1,7 @@
 #include "simsoccer/agents/agent_client.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -26,6 +27,10 @@ struct AgentClient::Impl {
   net::Entity image_waitset, image_condition;
   bool have_game = false;
   simsoccer_msg_GameState game_state{};
+  // The tick of the last SensorFrame handed to the agent: team messages carry
+  // it, so the simulator relays them by when they were sent, not by when they
+  // arrived (which varies with the machine's load).
+  std::atomic<uint64_t> frame_tick{0};
 
   Impl(const net::DomainConfig& dds, int team, int player)
       : participant(dds),
@@ -64,8 +69,10 @@ AgentClient::~AgentClient() {
 void AgentClient::onFrameData(dds_entity_t, void* self) {
   auto* client = static_cast<AgentClient*>(self);
   client->impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t&) {
-    if (f.team == client->team_ && f.player == client->player_ && client->handler_)
+    if (f.team == client->team_ && f.player == client->player_ && client->handler_) {
+      client->impl_->frame_tick = f.tick;
       client->handler_(f);
+    }
   });
 }
 
@@ -127,6 +134,7 @@ bool AgentClient::receive(simsoccer_msg_SensorFrame& frame, double timeout_secon
                      static_cast<dds_duration_t>(timeout_seconds * 1e9));
     grab();
   }
+  if (got) impl_->frame_tick = frame.tick;
   readStatus();
   return got;
 }
@@ -166,6 +174,7 @@ void AgentClient::sendTeamMessage(std::span<const uint8_t> data) {
   m.team = static_cast<uint8_t>(team_);
   m.to_player = 0;
   m.from_player = static_cast<uint8_t>(player_);
+  m.tick = impl_->frame_tick;
   m.data._buffer = const_cast<uint8_t*>(data.data());
   m.data._length = m.data._maximum = static_cast<uint32_t>(data.size());
   impl_->team_send.write(m);

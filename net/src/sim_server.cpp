@@ -6,6 +6,7 @@
 #include <cstring>
 #include <deque>
 #include <random>
+#include <tuple>
 
 #include "simsoccer/world/match_log.hpp"
 
@@ -167,7 +168,7 @@ struct SimServer::Impl {
   // Publication handle -> participant GUID of writers seen on the command
   // and team-message readers (cached: looked up once per writer).
   std::vector<std::pair<dds_instance_handle_t, dds_guid_t>> publishers;
-  // Team messages waiting for their delivery tick.
+  // Team messages waiting for their delivery tick (one per message sent).
   struct Pending {
     uint64_t due;
     simsoccer_msg_TeamMessage msg;
@@ -448,8 +449,14 @@ void SimServer::handleCommands() {
 }
 
 void SimServer::relayTeamMessages(uint64_t tick) {
+  // Messages go by the tick their sender stamped (the frame it was answering;
+  // never later than now), not by when they arrived, and at least one period
+  // later: a message written while answering tick t is relayed with tick
+  // t + 1, when in lockstep every command of t, written after it, is in. So
+  // the load of the machine does not change who hears what when.
   const double period = world_.scenario().physics.control_period;
-  const auto delay = static_cast<uint64_t>(std::lround(config_.team_message_delay / period));
+  const auto delay = std::max<uint64_t>(
+      1, static_cast<uint64_t>(std::lround(config_.team_message_delay / period)));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   impl_->team_send.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t& info) {
     const int ri = robotIndex(m.team, m.from_player);
@@ -462,25 +469,35 @@ void SimServer::relayTeamMessages(uint64_t tick) {
       ++sender.stats.refused;
       return;
     }
-    ++team_messages_[m.team == 0 ? 0 : 1];
+    const uint64_t sent = std::min<uint64_t>(m.tick, tick);
+    Impl::Pending p{sent + delay, m, {}};
+    std::memcpy(p.data.data(), m.data._buffer, m.data._length);
+    p.msg.tick = sent;
+    impl_->pending.push_back(p);
+  });
+  // The due ones by delivery tick, team and sender (one sender's in the order
+  // it wrote them): the count and the loss draws do not depend on arrival.
+  auto& pending = impl_->pending;
+  const auto due_end = std::stable_partition(pending.begin(), pending.end(),
+                                             [&](const Impl::Pending& p) { return p.due <= tick; });
+  std::stable_sort(pending.begin(), due_end, [](const Impl::Pending& a, const Impl::Pending& b) {
+    return std::tie(a.due, a.msg.team, a.msg.from_player) <
+           std::tie(b.due, b.msg.team, b.msg.from_player);
+  });
+  for (auto it = pending.begin(); it != due_end; ++it) {
+    simsoccer_msg_TeamMessage msg = it->msg;
+    msg.data._buffer = it->data.data();
+    msg.data._release = false;
+    ++team_messages_[msg.team == 0 ? 0 : 1];
     for (const RobotSlot& to : robots_) {
-      if (to.team != m.team || to.player == m.from_player) continue;
+      if (to.team != msg.team || to.player == msg.from_player) continue;
       if (config_.team_message_loss > 0.0 && unit(impl_->loss_rng) < config_.team_message_loss)
         continue;
-      Impl::Pending p{tick + delay, m, {}};
-      std::memcpy(p.data.data(), m.data._buffer, m.data._length);
-      p.msg.to_player = static_cast<uint8_t>(to.player);
-      p.msg.tick = tick;
-      impl_->pending.push_back(p);
+      msg.to_player = static_cast<uint8_t>(to.player);
+      impl_->team_deliver.write(msg);
     }
-  });
-  while (!impl_->pending.empty() && impl_->pending.front().due <= tick) {
-    Impl::Pending& p = impl_->pending.front();
-    p.msg.data._buffer = p.data.data();
-    p.msg.data._release = false;
-    impl_->team_deliver.write(p.msg);
-    impl_->pending.pop_front();
   }
+  pending.erase(pending.begin(), due_end);
 }
 
 void SimServer::poll(double wait_seconds) {

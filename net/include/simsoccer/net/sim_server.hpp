@@ -39,7 +39,7 @@ struct ServerConfig {
   bool lockstep = true;
   double command_timeout = 0.5;     // s of wall time to wait per lockstep period
   bool hold_on_release = true;      // a released robot holds its pose (false: goes limp)
-  double team_message_delay = 0.0;  // s of simulated time
+  double team_message_delay = 0.0;  // s of simulated time (at least one control period)
   double team_message_loss = 0.0;   // probability a copy is lost
   bool world_truth = false;
   double position_margin = 0.5;  // rad beyond a joint's limits before a target is rejected
