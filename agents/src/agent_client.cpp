@@ -102,10 +102,20 @@ bool AgentClient::ownsRobot() const {
 }
 
 bool AgentClient::claim(double timeout_seconds) {
-  simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
-  impl_->join.write(j);
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(timeout_seconds));
+  // Claim once the simulator's readers of our commands and team messages are
+  // matched: a command written before would be lost, and the first ticks
+  // would then go differently from run to run.
+  const auto matched = [](dds_entity_t writer) {
+    dds_publication_matched_status_t st{};
+    return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK &&
+           st.current_count > 0;
+  };
+  while (Clock::now() < end && !(matched(impl_->command.get()) && matched(impl_->team_send.get())))
+    dds_sleepfor(DDS_MSECS(5));
+  simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
+  impl_->join.write(j);
   while (Clock::now() < end) {
     readStatus();
     if (status_.owned) {

@@ -518,18 +518,33 @@ void SimServer::poll(double wait_seconds) {
 bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(timeout_seconds));
+  // Owned, and every path between the simulator and the agents matched:
+  // a frame, perception or team message sent before its reader is matched is
+  // lost, and an agent that misses the first ones plays another game (the
+  // same seed would no longer give the same match under load).
+  const auto writer_matched = [](dds_entity_t writer, uint32_t n) {
+    dds_publication_matched_status_t st{};
+    return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK &&
+           st.current_count >= n;
+  };
+  const auto reader_matched = [](dds_entity_t reader, uint32_t n) {
+    dds_subscription_matched_status_t st{};
+    return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK &&
+           st.current_count >= n;
+  };
   auto ready = [&] {
     std::lock_guard lock(mutex_);
-    size_t owned = 0;
+    uint32_t owned = 0;
     for (size_t r = 0; r < robots_.size(); ++r) {
       if (!robots_[r].stats.owned) continue;
       ++owned;
-      dds_publication_matched_status_t st{};
-      if (dds_get_publication_matched_status(impl_->frames[r]->get(), &st) != DDS_RETCODE_OK ||
-          st.current_count == 0)
+      if (!writer_matched(impl_->frames[r]->get(), 1)) return false;
+      if (!impl_->perceptions.empty() && !writer_matched(impl_->perceptions[r]->get(), 1))
         return false;
     }
-    return owned >= count;
+    return owned >= count && reader_matched(impl_->commands.get(), owned) &&
+           writer_matched(impl_->team_deliver.get(), owned) &&
+           reader_matched(impl_->team_send.get(), owned);
   };
   while (!ready() && Clock::now() < end) poll(0.02);
   return ready();
