@@ -89,14 +89,25 @@ constexpr size_t kOctahedronMesh = 6, kThinCapsuleMesh = 7, kMeshCount = 8;
 constexpr size_t meshOf(Primitive p) {
   return static_cast<size_t>(p);
 }
-constexpr std::array<size_t, 10> kBatchMesh{
+enum Batch : size_t {
+  kGroundBatch,  // drawn first, without the depth test
+  kCoarseSphereBatch,
+  kOctahedronBatch,
+  kCapsuleBatch,
+  kThinCapsuleBatch,
+  kCylinderBatch,
+  kSphereBatch,
+  kPatternBatch,  // the ball: the sphere with the pattern program
+  kBoxBatch,
+  kQuadBatch,
+  kBatchCount
+};
+constexpr std::array<size_t, kBatchCount> kBatchMesh{
     meshOf(Primitive::Quad),   meshOf(Primitive::CoarseSphere),
     kOctahedronMesh,           meshOf(Primitive::Capsule),
     kThinCapsuleMesh,          meshOf(Primitive::Cylinder),
     meshOf(Primitive::Sphere), meshOf(Primitive::Sphere),
     meshOf(Primitive::Box),    meshOf(Primitive::Quad)};
-constexpr size_t kGroundBatch = 0;
-constexpr size_t kPatternBatch = 7;
 // A sphere or capsule whose radius spans fewer pixels than this in a view is
 // drawn there with its coarse stand-in: the octahedron's outline strays 0.16
 // radii further from the circle than the icosahedron's, the three-sided
@@ -107,8 +118,8 @@ constexpr float kCoarseSpherePixels = 10.0f, kThinCapsulePixels = 6.0f;
 // The batch of the coarse stand-in for an instance of `radius_px` pixels
 // (its radius times the focal length over its distance), or `batch` itself.
 constexpr size_t levelOfDetail(size_t batch, float radius_px) {
-  if (batch == 1 && radius_px < kCoarseSpherePixels) return 2;
-  if (batch == 3 && radius_px < kThinCapsulePixels) return 4;
+  if (batch == kCoarseSphereBatch && radius_px < kCoarseSpherePixels) return kOctahedronBatch;
+  if (batch == kCapsuleBatch && radius_px < kThinCapsulePixels) return kThinCapsuleBatch;
   return batch;
 }
 
@@ -119,19 +130,19 @@ size_t batchOf(const DrawItem& d) {
   if (d.ball_pattern) return kPatternBatch;
   switch (d.shape) {
     case Primitive::CoarseSphere:
-      return 1;
+      return kCoarseSphereBatch;
     case Primitive::Capsule:
-      return 3;
+      return kCapsuleBatch;
     case Primitive::Cylinder:
-      return 5;
+      return kCylinderBatch;
     case Primitive::Sphere:
-      return 6;
+      return kSphereBatch;
     case Primitive::Box:
-      return 8;
+      return kBoxBatch;
     case Primitive::Quad:
-      return 9;
+      return kQuadBatch;
   }
-  return 8;
+  return kBoxBatch;
 }
 
 // Radius of the unit mesh's bounding sphere (box corners at sqrt(3)/2; the
@@ -240,23 +251,20 @@ void unitCapsule(std::vector<Vertex>& v, std::vector<uint32_t>& idx, int slices)
     return Eigen::Vector3f(static_cast<float>(scale * std::cos(ph)),
                            static_cast<float>(scale * std::sin(ph)), 0);
   };
-  const auto triangle = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b,
-                            const Eigen::Vector3f& c,
-                            const Eigen::Vector3f& n) { addFace(v, idx, a, b, c, n); };
   for (int j = 0; j < slices; ++j) {
     const Eigen::Vector3f a = corner(j), b = corner(j + 1);
     const Eigen::Vector3f side = (a + b).normalized();
     const Eigen::Vector3f up(0, 0, rim), down(0, 0, -rim);
     // Side: counter-clockwise seen from outside.
-    triangle(a + down, b + down, b + up, side);
-    triangle(a + down, b + up, a + up, side);
+    addFace(v, idx, a + down, b + down, b + up, side);
+    addFace(v, idx, a + down, b + up, a + up, side);
     for (float end : {1.0f, -1.0f}) {
       const Eigen::Vector3f tip(0, 0, end), base_a = a + end * up, base_b = b + end * up;
       const Eigen::Vector3f n = ((base_b - base_a).cross(tip - base_a) * end).normalized();
       if (end > 0)
-        triangle(base_a, base_b, tip, n);
+        addFace(v, idx, base_a, base_b, tip, n);
       else
-        triangle(base_b, base_a, tip, n);
+        addFace(v, idx, base_b, base_a, tip, n);
     }
   }
 }
