@@ -165,7 +165,9 @@ TEST(SoccerBehaviour, ObeysTheGameState) {
   const MotionRequest r = b.update(in);
   EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
   EXPECT_LT(r.turn, 0.0);  // the place is to its right
-  // Penalised: stands.
+  // Penalised: stands, and its motion restarts (the flag the earlier states
+  // raised is taken first, so only the penalty can raise it again).
+  b.takeMotionRestart();
   g = gameState(3);
   g.teams[0].players[3].penalty = 1;
   EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <map>
 #include <opencv2/videoio.hpp>
@@ -264,6 +265,12 @@ TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
   EXPECT_LE(lo, rate);
   EXPECT_GE(hi, rate);
   EXPECT_LT(lo, hi);
+  // Wilson's interval for `goals` of 5 (z = 1.96), to the printed precision.
+  const double z = 1.96, n = 5.0, denom = 1 + z * z / n;
+  const double centre = (rate + z * z / (2 * n)) / denom;
+  const double half = z * std::sqrt(rate * (1 - rate) / n + z * z / (4 * n * n)) / denom;
+  EXPECT_NEAR(lo, std::max(0.0, centre - half), 0.006) << ci;
+  EXPECT_NEAR(hi, std::min(1.0, centre + half), 0.006) << ci;
   EXPECT_NE(out.find("95% CI"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "kick_1.mp4"));
   std::filesystem::remove_all(dir);

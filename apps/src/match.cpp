@@ -81,11 +81,6 @@ void prepareOut(const std::filesystem::path& out) {
   std::filesystem::remove(probe, ec);
 }
 
-const char* stateLabel(uint8_t s) {
-  static const char* names[] = {"INITIAL", "READY", "SET", "PLAYING", "FINISHED", "STANDBY"};
-  return s < 6 ? names[s] : "?";
-}
-
 // --- video and heatmap from the log ---------------------------------------------------------
 
 struct VideoResult {
@@ -141,7 +136,8 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
       std::snprintf(buf, sizeof buf, "%d  %d : %d  %d   %s %02d:%02d  %s", d.teams[0].team_number,
                     d.teams[0].score, d.teams[1].score, d.teams[1].team_number,
                     d.first_half ? "1st" : "2nd", std::max(0, (int)d.secs_remaining) / 60,
-                    std::max(0, (int)d.secs_remaining) % 60, stateLabel(d.state));
+                    std::max(0, (int)d.secs_remaining) % 60,
+                    referee::stateName(static_cast<referee::gc::State>(d.state)));
       text = buf;
     }
     cv::rectangle(bgr, cv::Point(0, 0), cv::Point(v.width, 26), cv::Scalar(0, 0, 0), cv::FILLED);

@@ -194,9 +194,6 @@ void MatchSession::record() {
   // Possession: the team with a robot nearest the ball, within 0.5 m.
   const int team = nearest[0] <= nearest[1] ? 0 : 1;
   if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
-  if (const auto& touch = world_->lastBallTouch())
-    last_touch_player_[static_cast<size_t>(world_->robot(touch->robot).team)] =
-        world_->robot(touch->robot).number;
 }
 
 void MatchSession::afterStep(std::vector<world::LogEvent>& events) {

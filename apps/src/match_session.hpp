@@ -26,7 +26,7 @@ struct VideoSettings {
 
 struct MatchConfig {
   std::string file, name;
-  std::filesystem::path scenario, rules, agent_config, field;
+  std::filesystem::path scenario, rules, agent_config;
   std::optional<double> half_duration, half_time_break;
   std::array<int, 2> team_numbers{1, 2};
   std::string role = "auto";
@@ -58,7 +58,6 @@ class MatchSession {
   MatchSession(const MatchConfig& config, uint64_t seed);
 
   world::World& world() { return *world_; }
-  referee::Referee& referee() { return *referee_; }
   const referee::Game& game() const { return referee_->game(); }
   const MatchConfig& config() const { return config_; }
 
@@ -92,7 +91,6 @@ class MatchSession {
   std::vector<Goal> goals_;
   size_t events_seen_ = 0;
   int next_striker_[2] = {0, 0};
-  std::array<int, 2> last_touch_player_{};
 };
 
 }  // namespace simsoccer::apps

@@ -138,11 +138,9 @@ SoccerBehaviour::SoccerBehaviour(const BehaviourConfig& config, const fields::Fi
                                  int team, int team_number, int player, Role role, uint64_t seed)
     : config_(config),
       field_(field),
-      team_(team),
       team_number_(team_number),
       player_(player),
-      fixed_role_(role),
-      seed_(seed) {
+      fixed_role_(role) {
   attack_sign_ = team == 0 ? 1 : -1;  // without a GameState: team 0 defends -x
   role_ = role == Role::Auto ? (player == 1 ? Role::Goalkeeper : Role::Striker) : role;
   // The penalty kicker's aim across the goal, as a share of the half-width

@@ -127,9 +127,8 @@ class SoccerBehaviour {
 
   BehaviourConfig config_;
   fields::FieldModel field_;
-  int team_, team_number_, player_;
+  int team_number_, player_;
   Role fixed_role_, role_ = Role::Striker;
-  uint64_t seed_;
   // Game.
   bool have_game_ = false;
   int state_ = 3;  // gc::State numbering; Playing without a GameState
