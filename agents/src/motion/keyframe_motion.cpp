@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "simsoccer/engine/config.hpp"
+#include "smoothstep.hpp"
 
 namespace simsoccer::agents {
 
@@ -70,8 +71,7 @@ void KeyframePlayer::update(double dt, std::vector<double>& targets, double& sti
   const std::vector<double>* prev = &from_;
   for (const Keyframe& f : motion_->frames) {
     if (t_ < begin + f.duration) {
-      const double s = std::clamp((t_ - begin) / f.duration, 0.0, 1.0);
-      const double w = s * s * (3.0 - 2.0 * s);
+      const double w = smoothstep((t_ - begin) / f.duration);
       for (size_t j = 0; j < targets.size() && j < f.position.size(); ++j)
         targets[j] = (*prev)[j] + w * (f.position[j] - (*prev)[j]);
       stiffness = f.stiffness;

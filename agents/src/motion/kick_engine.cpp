@@ -4,13 +4,10 @@
 #include <array>
 #include <cmath>
 
+#include "smoothstep.hpp"
+
 namespace simsoccer::agents {
 namespace {
-
-double smoothstep(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
 
 // One keyframe: torso shift (fraction of the full shift), the kicking foot
 // forward (m) and up (m), and the time to reach it.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "smoothstep.hpp"
+
 namespace simsoccer::agents {
 namespace {
 
@@ -13,10 +15,6 @@ Pose2 compose(const Pose2& a, double dx, double dy, double dyaw) {
 
 Pose2 lerp(const Pose2& a, const Pose2& b, double t) {
   return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.yaw + (b.yaw - a.yaw) * t};
-}
-
-double smoothstep(double t) {
-  return t * t * (3.0 - 2.0 * t);
 }
 
 }  // namespace
