@@ -112,7 +112,9 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
 MatchSession::MatchSession(const MatchConfig& config, uint64_t seed) : config_(config) {
   world::Scenario s = world::loadScenario(config.scenario);
   s.seed = seed;
-  s.perception.enabled = true;
+  if (!s.perception.enabled)  // not switched on behind the scenario's back
+    throw engine::ConfigError(config.scenario.string(), "perception",
+                              "a match's agents see through perception: turn it on");
   world_ = std::make_unique<world::World>(s);
   referee::RuleBook rules = referee::loadRuleBook(config.rules);
   if (config.half_duration) rules.half_duration = *config.half_duration;
