@@ -291,10 +291,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     }
     agents.push_back(std::move(a));
   }
-  auto publishGame = [&] {
-    server.publishGameState(session.controlData(), session.game().leftTeam());
-  };
-  publishGame();
+  server.publishGameState(session.controlData(), session.game().leftTeam());
   const auto t_wait = Clock::now();
   while (!g_interrupted && !server.waitForOwners(w.robotCount(), 0.5)) {
     if (secondsSince(t_wait) > 60.0)
@@ -315,7 +312,8 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     server.runPeriod();
     std::vector<world::LogEvent> events;
     session.afterStep(events);
-    publishGame();
+    const referee::ControlData game = session.controlData();  // once: to the agents and the log
+    server.publishGameState(game, session.game().leftTeam());
     for (world::RobotId r = 0; r < w.robotCount(); ++r) {
       commanded[r] = server.commandApplied(r);
       positions[r] = server.commandPosition(r);
@@ -324,10 +322,11 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     world::LogFrame frame =
         world::captureFrame(w, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()),
                             positions, stiffness, commanded);
-    frame.game = session.packet();
-    frame.events = events;
-    log.write(frame);
+    const auto packet = referee::encode(game);
+    frame.game.assign(packet.begin(), packet.end());
     result.events.insert(result.events.end(), events.begin(), events.end());
+    frame.events = std::move(events);
+    log.write(frame);
     ++result.frames;
     ++i;
     // Agents that died are restarted (up to the limit); past it the match stops.

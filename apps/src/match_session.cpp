@@ -231,9 +231,4 @@ referee::ControlData MatchSession::controlData() const {
   return referee_->game().packet(0);
 }
 
-std::vector<uint8_t> MatchSession::packet() const {
-  const auto bytes = referee::encode(controlData());
-  return {bytes.begin(), bytes.end()};
-}
-
 }  // namespace simsoccer::apps

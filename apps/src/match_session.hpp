@@ -75,8 +75,6 @@ class MatchSession {
     bool own_goal;
   };
   const std::vector<Goal>& goals() const { return goals_; }
-  // The GameController packet for now (bytes, for the log).
-  std::vector<uint8_t> packet() const;
   referee::ControlData controlData() const;
 
  private:
