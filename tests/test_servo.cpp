@@ -14,70 +14,113 @@ using namespace simsoccer;
 namespace {
 
 // A 2 N m, 5 rad/s motor with a stiff P gain.
-engine::Motor testMotor(double kp) {
+engine::Motor testMotor(double kp, bool implicit) {
   engine::Motor m;
   m.stall_torque = 2.0;
   m.no_load_speed = 5.0;
   m.kp = kp;
   m.kd = 0.0;
+  m.implicit_servo = implicit;
   return m;
+}
+
+// One step of servo 0 of `batch` on a joint alone: the motor torque.
+double stepAlone(engine::JointServoBatch& batch, double q, double qd, double inertia, double dt) {
+  batch.prepare(std::vector<double>{q}, std::vector<double>{qd}, dt);
+  const double tau = batch.solveAlone(0, q, qd, inertia);
+  if (batch.implicit(0)) batch.setRowImpulse(0, (tau - batch.row(0).feedforward) * dt);
+  return tau;
 }
 
 }  // namespace
 
 TEST(JointServoBatch, TorqueEnvelope) {
-  // A huge inertia bound: the predicted speed is the current one (explicit envelope).
-  engine::JointServoBatch batch;
-  batch.add(testMotor(100.0), 0.0, -1.0, 1.0, 1e12);
-  std::vector<double> tau(1);
-  const double dt = 0.005;
-  auto torque = [&](double q, double qd) {
-    batch.resetHistory(0);
-    batch.computeTorques(std::vector<double>{q}, std::vector<double>{qd}, tau, dt);
-    return tau[0];
-  };
-  batch.setTarget(0, 0.5, 1.0);
-  EXPECT_NEAR(torque(0.0, 0.0), 2.0, 1e-9);   // saturates at stall torque
-  EXPECT_NEAR(torque(0.0, 2.5), 1.0, 1e-9);   // half the no-load speed: half the torque left
-  EXPECT_NEAR(torque(0.0, 5.0), 0.0, 1e-9);   // no torque at no-load speed
-  EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9);  // unsaturated: plain P
-  batch.setTarget(0, 0.5, 0.25);
-  EXPECT_NEAR(torque(0.0, 0.0), 0.5, 1e-9);  // stiffness scales the available torque
-  batch.setTarget(0, 0.5, 0.0);
-  EXPECT_EQ(torque(0.0, 0.0), 0.0);  // limp
-  batch.setTarget(0, 3.0, 1.0);
-  EXPECT_DOUBLE_EQ(batch.target(0), 1.0);  // targets clamp to the limits
+  for (const bool implicit : {false, true}) {
+    SCOPED_TRACE(implicit ? "implicit" : "explicit");
+    // A huge inertia bound: the predicted speed is the current one (explicit envelope).
+    engine::JointServoBatch batch;
+    batch.add(testMotor(100.0, implicit), 0.0, -1.0, 1.0, 1e12);
+    const double dt = 0.005;
+    auto torque = [&](double q, double qd) {
+      batch.resetHistory(0);
+      return stepAlone(batch, q, qd, 1e12, dt);
+    };
+    batch.setTarget(0, 0.5, 1.0);
+    EXPECT_NEAR(torque(0.0, 0.0), 2.0, 1e-9);   // saturates at stall torque
+    EXPECT_NEAR(torque(0.0, 2.5), 1.0, 1e-9);   // half the no-load speed: half the torque left
+    EXPECT_NEAR(torque(0.0, 5.0), 0.0, 1e-9);   // no torque at no-load speed
+    EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9);  // unsaturated: plain P
+    // Unsaturated and moving: kd = 0 here, but backward Euler damps with at least dt kp.
+    EXPECT_NEAR(torque(0.49, 0.2), 1.0 - (implicit ? 0.2 * dt * 100.0 : 0.0), 1e-9);
+    batch.setTarget(0, 0.5, 0.25);
+    EXPECT_NEAR(torque(0.0, 0.0), 0.5, 1e-9);  // stiffness scales the available torque
+    batch.setTarget(0, 0.5, 0.0);
+    EXPECT_EQ(torque(0.0, 0.0), 0.0);  // limp
+    batch.setTarget(0, 3.0, 1.0);
+    EXPECT_DOUBLE_EQ(batch.target(0), 1.0);  // targets clamp to the limits
+  }
 }
 
 TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
   // A free joint of inertia I driven from rest: integrating with the torques
   // the batch returns, the speed approaches but never passes the no-load speed,
   // even though one step of stall torque alone would overshoot it.
-  engine::JointServoBatch batch;
-  const double inertia = 1e-3, dt = 0.005;  // stall * dt / I = 10 rad/s > 5 rad/s
-  batch.add(testMotor(1000.0), 0.0, -10.0, 10.0, inertia);
-  batch.setTarget(0, 9.0, 1.0);
-  std::vector<double> q{0.0}, qd{0.0}, tau(1);
-  double peak = 0.0;
-  for (int i = 0; i < 200; ++i) {
-    batch.computeTorques(q, qd, tau, dt);
-    qd[0] += tau[0] / inertia * dt;
-    q[0] += qd[0] * dt;
-    peak = std::max(peak, qd[0]);
+  for (const bool implicit : {false, true}) {
+    SCOPED_TRACE(implicit ? "implicit" : "explicit");
+    engine::JointServoBatch batch;
+    const double inertia = 1e-3, dt = 0.005;  // stall * dt / I = 10 rad/s > 5 rad/s
+    batch.add(testMotor(1000.0, implicit), 0.0, -10.0, 10.0, inertia);
+    batch.setTarget(0, 9.0, 1.0);
+    double q = 0.0, qd = 0.0, peak = 0.0;
+    for (int i = 0; i < 200; ++i) {
+      const double tau = stepAlone(batch, q, qd, inertia, dt);
+      qd += tau / inertia * dt;
+      q += qd * dt;
+      peak = std::max(peak, qd);
+    }
+    EXPECT_LE(peak, 5.0 + 1e-9);
+    EXPECT_GT(peak, 4.5);
   }
-  EXPECT_LE(peak, 5.0 + 1e-9);
-  EXPECT_GT(peak, 4.5);
 }
 
 TEST(JointServoBatch, LoadedJointGetsFullStallTorque) {
-  // Held against a constant load at rest, the torque converges to stall.
-  engine::JointServoBatch batch;
-  batch.add(testMotor(1000.0), 0.0, -1.0, 1.0, 1e-3);
-  batch.setTarget(0, 0.5, 1.0);
-  std::vector<double> tau(1);
-  for (int i = 0; i < 400; ++i)
-    batch.computeTorques(std::vector<double>{0.0}, std::vector<double>{0.0}, tau, 0.005);
-  EXPECT_NEAR(tau[0], 2.0, 1e-3);
+  // Held against a constant load at rest (the load cancels the torque: the
+  // joint stays at rest), the torque converges to stall.
+  for (const bool implicit : {false, true}) {
+    SCOPED_TRACE(implicit ? "implicit" : "explicit");
+    engine::JointServoBatch batch;
+    batch.add(testMotor(1000.0, implicit), 0.0, -1.0, 1.0, 1e-3);
+    batch.setTarget(0, 0.5, 1.0);
+    double tau = 0.0;
+    for (int i = 0; i < 400; ++i) tau = stepAlone(batch, 0.0, 0.0, 1e-3, 0.005);
+    EXPECT_NEAR(tau, 2.0, 1e-3);
+  }
+}
+
+TEST(JointServoBatch, ImplicitServoIsStableWhereTheExplicitOneDiverges) {
+  // A stiff servo on a joint far lighter than its gains allow at 5 ms
+  // (dt kd / I = 5): the explicit servo's swing grows, the implicit one settles.
+  for (const bool implicit : {false, true}) {
+    engine::Motor m = testMotor(60.0, implicit);
+    m.kd = 0.3;
+    m.stall_torque = 1e3;  // the envelope never binds: the PD alone
+    m.no_load_speed = 1e6;
+    engine::JointServoBatch batch;
+    const double inertia = 3e-4, dt = 0.005;
+    batch.add(m, 0.0, -10.0, 10.0, inertia);
+    batch.setTarget(0, 0.1, 1.0);
+    double q = 0.0, qd = 0.0, late = 0.0;
+    for (int i = 0; i < 60; ++i) {  // short: the explicit swing grows 4-fold per step
+      const double tau = stepAlone(batch, q, qd, inertia, dt);
+      qd += tau / inertia * dt;
+      q += qd * dt;
+      if (i >= 40) late = std::max(late, std::abs(q - 0.1));
+    }
+    if (implicit)
+      EXPECT_LT(late, 1e-6);
+    else
+      EXPECT_GT(late, 1.0);
+  }
 }
 
 namespace {

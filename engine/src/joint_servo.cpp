@@ -13,6 +13,8 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
                             double min_inertia) {
   if (!(motor.no_load_speed > 0.0)) throw std::invalid_argument("motor no_load_speed must be > 0");
   if (!(min_inertia > 0.0)) throw std::invalid_argument("servo min_inertia must be > 0");
+  if (!(motor.kp >= 0.0) || !(motor.kd >= 0.0) || !(motor.kp + motor.kd > 0.0))
+    throw std::invalid_argument("motor kp and kd must be >= 0 and not both 0");
   target_.push_back(std::clamp(0.0, lower, upper));
   stiffness_.push_back(0.0);
   kp_.push_back(motor.kp);
@@ -26,8 +28,13 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
   prev_qdot_.push_back(0.0);
   prev_tau_.push_back(0.0);
   has_history_.push_back(0);
+  implicit_.push_back(motor.implicit_servo ? 1 : 0);
   load_.push_back(0.0);
   motor_tau_.push_back(0.0);
+  passive_tau_.push_back(0.0);
+  feedforward_.push_back(0.0);
+  lo_.push_back(0.0);
+  hi_.push_back(0.0);
   return target_.size() - 1;
 }
 
@@ -37,7 +44,7 @@ void JointServoBatch::setTarget(size_t i, double target_rad, double stiffness) {
 }
 
 void JointServoBatch::appendState(std::vector<double>& out) const {
-  for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &prev_tau_, &load_})
+  for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &prev_tau_, &load_, &motor_tau_})
     out.insert(out.end(), v->begin(), v->end());
   for (unsigned char h : has_history_) out.push_back(h);
 }
@@ -45,16 +52,16 @@ void JointServoBatch::appendState(std::vector<double>& out) const {
 void JointServoBatch::resetHistory(size_t i) {
   has_history_[i] = 0;
   load_[i] = 0.0;
+  motor_tau_[i] = 0.0;
 }
 
-void JointServoBatch::computeTorques(std::span<const double> q, std::span<const double> qdot,
-                                     std::span<double> tau, double dt) {
+void JointServoBatch::prepare(std::span<const double> q, std::span<const double> qdot, double dt) {
+  dt_ = dt;
   const size_t n = target_.size();
   for (size_t i = 0; i < n; ++i) {
     const double w = qdot[i];
-    const double pd = kp_[i] * (target_[i] - q[i]) - kd_[i] * w;
     const double drive = stiffness_[i] * stall_[i];
-    double motor = 0.0;
+    double lo = 0.0, hi = 0.0;
     if (drive > 0.0) {
       // Everything but our torque that accelerated the joint last step,
       // low-pass filtered: static loads (gravity, a push) change slowly, and
@@ -66,16 +73,57 @@ void JointServoBatch::computeTorques(std::span<const double> q, std::span<const 
       const double load = load_[i];
       const double k = drive * inv_no_load_[i] * dt / min_inertia_[i];
       const double inv = 1.0 / (1.0 + k);
-      const double hi = (drive * (1.0 - w * inv_no_load_[i]) - k * load) * inv;
-      const double lo = (-drive * (1.0 + w * inv_no_load_[i]) - k * load) * inv;
-      motor = std::min(std::max(pd, lo), hi);
+      hi = (drive * (1.0 - w * inv_no_load_[i]) - k * load) * inv;
+      lo = (-drive * (1.0 + w * inv_no_load_[i]) - k * load) * inv;
     }
-    motor_tau_[i] = motor;
-    tau[i] = motor - damping_[i] * w;
+    lo_[i] = lo;
+    hi_[i] = hi;
+    passive_tau_[i] = -damping_[i] * w;
+    if (implicit_[i]) {
+      feedforward_[i] = drive > 0.0 ? std::clamp(motor_tau_[i], lo, hi) : 0.0;
+    } else {
+      const double pd = kp_[i] * (target_[i] - q[i]) - kd_[i] * w;
+      feedforward_[i] = motor_tau_[i] = drive > 0.0 ? std::clamp(pd, lo, hi) : 0.0;
+      prev_tau_[i] = motor_tau_[i] + passive_tau_[i];
+    }
     prev_qdot_[i] = w;
-    prev_tau_[i] = tau[i];
     has_history_[i] = 1;
   }
+}
+
+JointServoBatch::Row JointServoBatch::row(size_t i) const {
+  Row r;
+  if (!implicit_[i] || !(stiffness_[i] > 0.0) || !(dt_ > 0.0)) return r;
+  // Backward Euler of tau = kp (target - q') - kd' qdot' with q' = q + dt qdot'
+  // and the impulse p = dt tau: qdot' = beta / dt (target - q) - gamma p, where
+  // c = kd' + dt kp. For a heavy joint (qdot' ~ qdot) that is
+  // tau = kp (target - q) - c qdot: the explicit servo's torque when
+  // kd' = kd - dt kp, so the servo damps as its kd says (backward Euler's own
+  // damping dt kp included; at least that much).
+  const double c = std::max(kd_[i], dt_ * kp_[i]);
+  r.active = true;
+  r.target = target_[i];
+  r.beta = dt_ * kp_[i] / c;
+  r.gamma = 1.0 / (dt_ * c);
+  r.feedforward = feedforward_[i];
+  r.lower = lo_[i];
+  r.upper = hi_[i];
+  return r;
+}
+
+void JointServoBatch::setRowImpulse(size_t i, double impulse) {
+  motor_tau_[i] = feedforward_[i] + impulse / dt_;
+  prev_tau_[i] = motor_tau_[i] + passive_tau_[i];
+}
+
+double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inertia) const {
+  if (!implicit_[i]) return motor_tau_[i];  // computed in prepare
+  const Row r = row(i);
+  if (!r.active) return 0.0;
+  // qdot' = qdot + P / I  and  qdot' = beta / dt (target - q) - gamma P, with P
+  // the whole impulse (feedforward included).
+  const double p = (r.beta / dt_ * (r.target - q) - qdot) / (1.0 / inertia + r.gamma);
+  return std::clamp(p / dt_, r.lower, r.upper);
 }
 
 }  // namespace simsoccer::engine

@@ -6,6 +6,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <btBulletDynamicsCommon.h>
 
@@ -135,6 +136,98 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   }
 };
 
+// One joint servo as a row of Bullet's constraint solver: a joint-velocity
+// row (as Bullet's btMultiBodyJointMotor, whose island and finalize code it
+// reuses) made soft with the servo's compliance gamma, so that the solver
+// applies the implicit spring-damper of JointServoBatch with the real
+// articulated inertia, its impulse bounded by the motor envelope. No row
+// while the servo is limp. The row is filled here rather than by Bullet's
+// fillMultiBodyConstraint, which runs a second articulated-body pass for the
+// parent side: its Jacobian is zero for a joint row, so its response is too,
+// and that pass was half the cost of the servos.
+class ServoConstraint : public btMultiBodyJointMotor {
+ public:
+  ServoConstraint(btMultiBody* body, int link, const JointServoBatch& batch, size_t servo)
+      : btMultiBodyJointMotor(body, link, 0, 1), batch_(batch), servo_(servo) {}
+
+  // The impulse applied in the last step (0 without a row), N m s.
+  btScalar impulse() { return row_made_ ? getAppliedImpulse(0) : btScalar(0); }
+  void startStep() { row_made_ = false; }
+
+  void createConstraintRows(btMultiBodyConstraintArray& rows, btMultiBodyJacobianData& data,
+                            const btContactSolverInfo& info) override {
+    const JointServoBatch::Row r = batch_.row(servo_);
+    if (!r.active) return;
+    if (m_numDofsFinalized != m_jacSizeBoth) finalizeMultiDof();
+    btMultiBody* mb = m_bodyA;
+    const int ndof = mb->getNumDofs() + 6;
+    btMultiBodySolverConstraint& row = rows.expandNonInitializing();
+    row.m_multiBodyA = mb;
+    row.m_multiBodyB = mb;
+    row.m_linkA = m_linkA;
+    row.m_linkB = m_linkB;
+    row.m_solverBodyIdA = row.m_solverBodyIdB = data.m_fixedBodyId;
+    row.m_orgConstraint = this;
+    row.m_orgDofIndex = 0;
+    // Both sides share the articulation's delta-velocity block.
+    int block = mb->getCompanionId();
+    if (block < 0) {
+      block = data.m_deltaVelocities.size();
+      mb->setCompanionId(block);
+      data.m_deltaVelocities.resize(block + ndof);
+    }
+    row.m_deltaVelAindex = row.m_deltaVelBindex = block;
+    // Jacobians: 1 at the joint's coordinate (side A), zero (side B).
+    row.m_jacAindex = data.m_jacobians.size();
+    row.m_jacBindex = row.m_jacAindex + ndof;
+    data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
+    data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
+    btScalar* jac = &data.m_jacobians[row.m_jacAindex];
+    btScalar* response = &data.m_deltaVelocitiesUnitImpulse[row.m_jacAindex];
+    const btScalar* own = jacobianA(0);
+    for (int i = 0; i < ndof; ++i) {
+      jac[i] = own[i];
+      jac[ndof + i] = 0;
+      response[ndof + i] = 0;
+    }
+    mb->calcAccelerationDeltasMultiDof(jac, response, data.scratch_r, data.scratch_v);
+    const int coordinate = 6 + mb->getLink(m_linkA).m_dofOffset;
+    const btScalar inv_mass = response[coordinate];  // J M^-1 J^T
+    const btScalar velocity = mb->getJointVel(m_linkA);
+    // Soft row: qdot' = beta / dt (target - q) - gamma (dt feedforward + p).
+    const btScalar h = info.m_timeStep;
+    const btScalar gamma = static_cast<btScalar>(r.gamma);
+    const btScalar goal = static_cast<btScalar>(r.beta / h * (r.target - mb->getJointPos(m_linkA)) -
+                                                r.gamma * h * r.feedforward);
+    const btScalar soft = btScalar(1) / (inv_mass + gamma);
+    row.m_jacDiagABInv = soft;
+    row.m_rhs = (goal - velocity) * soft;
+    row.m_cfm = gamma * soft;
+    row.m_rhsPenetration = 0;
+    row.m_lowerLimit = static_cast<btScalar>((r.lower - r.feedforward) * h);
+    row.m_upperLimit = static_cast<btScalar>((r.upper - r.feedforward) * h);
+    row.m_friction = 0;
+    row.m_appliedImpulse = 0;
+    row.m_appliedPushImpulse = 0;
+    // As Bullet's motor: the impulse acts as a torque about the joint axis on
+    // the child link and its reaction on the parent.
+    const btVector3 axis = quatRotate(mb->getLink(m_linkA).m_cachedWorldTransform.getRotation(),
+                                      mb->getLink(m_linkA).m_axes[0].m_topVec);
+    row.m_contactNormal1.setZero();
+    row.m_contactNormal2.setZero();
+    row.m_relpos1CrossNormal = axis;
+    row.m_relpos2CrossNormal = -axis;
+    row.m_angularComponentA.setZero();
+    row.m_angularComponentB.setZero();
+    row_made_ = true;
+  }
+
+ private:
+  const JointServoBatch& batch_;
+  size_t servo_;
+  bool row_made_ = false;
+};
+
 struct Articulation {
   std::shared_ptr<const ArticulatedModel> model;
   btMultiBody* body = nullptr;
@@ -207,7 +300,8 @@ struct PhysicsWorld::Impl {
   JointServoBatch servos;
   std::vector<btMultiBody*> servo_body;
   std::vector<int> servo_link;
-  std::vector<double> q, qdot, tau;
+  std::vector<ServoConstraint*> servo_rows;  // owned by `constraints`; null: explicit servo
+  std::vector<double> q, qdot;
 
   StageTimes times;
 
@@ -458,15 +552,22 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
           link.inertia +
           link.mass * (link.com.squaredNorm() * Mat3::Identity() - link.com * link.com.transpose());
       const double min_inertia = motor.armature + a.dot(about_joint * a);
-      art.servo[static_cast<size_t>(j)] = static_cast<int>(
-          m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia));
+      const size_t s = m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia);
+      art.servo[static_cast<size_t>(j)] = static_cast<int>(s);
       m.servo_body.push_back(raw);
       m.servo_link.push_back(j);
+      if (motor.implicit_servo) {
+        auto row = std::make_unique<ServoConstraint>(raw, j, m.servos, s);
+        m.servo_rows.push_back(row.get());
+        m.world->addMultiBodyConstraint(row.get());
+        m.constraints.push_back(std::move(row));
+      } else {
+        m.servo_rows.push_back(nullptr);
+      }
     }
   }
   m.q.resize(m.servos.size());
   m.qdot.resize(m.servos.size());
-  m.tau.resize(m.servos.size());
 
   m.articulations.push_back(std::move(art));
   const auto id = static_cast<ArticulationId>(m.articulations.size() - 1);
@@ -534,20 +635,28 @@ void PhysicsWorld::step() {
   const auto t0 = timers_on_ ? Clock::now() : Clock::time_point{};
   m.world->times = timers_on_ ? &m.times : nullptr;
 
-  // Stage 1: joint servos (gather, compute over the batch, scatter).
+  // Stage 1: joint servos (gather, the batch's rows and passive torques, scatter).
   const size_t n = m.servos.size();
   for (size_t i = 0; i < n; ++i) {
     m.q[i] = m.servo_body[i]->getJointPos(m.servo_link[i]);
     m.qdot[i] = m.servo_body[i]->getJointVel(m.servo_link[i]);
   }
-  m.servos.computeTorques(m.q, m.qdot, m.tau, settings_.dt);
-  for (size_t i = 0; i < n; ++i)
-    m.servo_body[i]->addJointTorque(m.servo_link[i], static_cast<btScalar>(m.tau[i]));
+  m.servos.prepare(m.q, m.qdot, settings_.dt);
+  for (size_t i = 0; i < n; ++i) {
+    m.servo_body[i]->addJointTorque(m.servo_link[i],
+                                    static_cast<btScalar>(m.servos.appliedTorque(i)));
+    if (m.servo_rows[i]) m.servo_rows[i]->startStep();
+  }
   if (timers_on_) m.times.servo_s += std::chrono::duration<double>(Clock::now() - t0).count();
 
-  // Stage 2: Bullet (collision, dynamics, solve, integrate); exactly one dt.
+  // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
+  // integrate); exactly one dt.
   const auto dt = static_cast<btScalar>(settings_.dt);
   m.world->stepSimulation(dt, 0, dt);
+
+  // Stage 3: the motor torques the solver applied.
+  for (size_t i = 0; i < n; ++i)
+    if (m.servo_rows[i]) m.servos.setRowImpulse(i, m.servo_rows[i]->impulse());
   for (Articulation& art : m.articulations) art.kinematics_stale = true;
   ++step_count_;
   if (timers_on_) {
@@ -607,7 +716,7 @@ double PhysicsWorld::jointVelocity(ArticulationId a, int joint) const {
 }
 double PhysicsWorld::jointTorque(ArticulationId a, int joint) const {
   const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));
-  return s >= 0 ? impl_->tau[static_cast<size_t>(s)] : 0.0;
+  return s >= 0 ? impl_->servos.torque(static_cast<size_t>(s)) : 0.0;
 }
 double PhysicsWorld::jointMotorTorque(ArticulationId a, int joint) const {
   const int s = impl_->articulations.at(a).servo.at(static_cast<size_t>(joint));

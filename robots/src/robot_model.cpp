@@ -171,7 +171,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   for (const auto& [name, n] : root["motors"].entries()) {
     n.allowOnly({"motor_type", "gear_ratio", "stall_torque", "no_load_speed", "armature", "kp",
                  "kd", "damping", "torque_constant", "resistance", "no_load_current",
-                 "thermal_resistance", "thermal_time_constant"});
+                 "thermal_resistance", "thermal_time_constant", "servo"});
     engine::Motor m;
     m.name = name;
     m.stall_torque = n["stall_torque"].positive();
@@ -179,6 +179,12 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     m.armature = n["armature"].nonNegative();
     m.kp = n["kp"].nonNegative();
     m.kd = n["kd"].nonNegative();
+    if (n.has("servo")) {
+      const std::string servo = n["servo"].string();
+      if (servo != "implicit" && servo != "explicit")
+        n["servo"].fail("must be implicit or explicit, not '" + servo + "'");
+      m.implicit_servo = servo == "implicit";
+    }
     m.gear_ratio = n["gear_ratio"].positive();
     m.torque_constant = n["torque_constant"].positive();
     m.resistance = n["resistance"].positive();

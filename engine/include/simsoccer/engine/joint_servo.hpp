@@ -1,18 +1,30 @@
 // Position servos for every actuated joint of every robot, as one structure
 // of arrays: the hot loop is a straight pass over contiguous doubles.
 //
-// Model (per joint, evaluated every physics step):
-//   tau_pd = kp (target - q) - kd qdot                      (the position servo)
+// Model (per joint and physics step of h seconds):
+//   tau_pd = kp (target - q) - kd qdot              (the position servo)
 //   DC motor envelope with the stiffness s in [0, 1] scaling the drive D = s stall:
 //     D (-1 - w/w0) <= tau_motor <= D (1 - w/w0)
-//   tau = clamp(tau_pd, envelope) - damping qdot
-// The envelope's speed w is the joint speed at the END of the step, predicted
-// (semi-implicitly) from a lower bound of the joint's inertia and the load
-// seen in the previous steps (low-pass filtered). Evaluated at the current speed instead, the
-// envelope's slope D / w0 (2.9 N m s/rad on a Nao leg) is an explicit damper
-// that is unstable on a free-swinging leg at 5 ms and lets a head reach more
-// than its no-load speed in one step; predicted, a loaded joint still gets
-// its full stall torque and no joint drives itself past its no-load speed.
+//   tau = clamp(tau_pd, envelope) - damping qdot    (the passive damping explicit: it is small)
+// Each motor's servo is evaluated one of two ways (the robot YAML's `servo`):
+// - explicit: tau_pd from q and qdot at the start of the step, applied as a
+//   joint torque. Cheap; stable while h kd / I and h^2 kp / I stay well below
+//   2 for every inertia I the joint can move.
+// - implicit: backward Euler, tau_pd = kp (target - q') - kd' qdot' at the END
+//   of the step, with kd' = max(kd - h kp, 0) so that on a heavy joint it is
+//   the explicit torque above. Bullet's constraint solver finds it with the real
+//   articulated inertia, contacts included: one soft constraint row per servo
+//   (its CFM the spring-damper's compliance, Catto's soft constraints), its
+//   impulse bounded by the envelope. Needed for the Nao's legs: with the
+//   armature on the links, some joint-space modes of a leg in the air (hip,
+//   knee and ankle pitch together) are so light that the explicit kd of
+//   0.3 N m s/rad at 5 ms diverged, and a robot getting up flew away.
+// The envelope's speed w is the joint speed at the end of the step, predicted
+// from a lower bound of the joint's inertia and the load seen in the previous
+// steps (low-pass filtered): evaluated at the current speed instead, its slope
+// D / w0 (2.9 N m s/rad on a Nao leg) is an explicit damper that is unstable on
+// a free-swinging leg at 5 ms and lets a head pass its no-load speed in one
+// step; predicted, a loaded joint still gets its full stall torque.
 // s = 0 leaves only passive damping (a limp joint), as on the real Nao.
 #pragma once
 
@@ -35,23 +47,60 @@ class JointServoBatch {
   void setTarget(size_t i, double target_rad, double stiffness);
   double target(size_t i) const { return target_[i]; }
   double stiffness(size_t i) const { return stiffness_[i]; }
-  // Motor part of the last computed torque (without passive damping), N m.
+  // Motor part of the last step's torque (without passive damping), N m.
   double motorTorque(size_t i) const { return motor_tau_[i]; }
+  // The whole torque of the last step: motor plus passive damping, N m.
+  double torque(size_t i) const { return motor_tau_[i] + passive_tau_[i]; }
   // Appends every servo's target, stiffness and the state it carries between
   // steps (for state hashes).
   void appendState(std::vector<double>& out) const;
   // Forget the load history of one servo (after a teleport).
   void resetHistory(size_t i);
 
-  // tau[i] for every servo from the joint positions and velocities, for a
-  // step of dt seconds; remembers speed and torque for the next step.
-  void computeTorques(std::span<const double> q, std::span<const double> qdot,
-                      std::span<double> tau, double dt);
+  bool implicit(size_t i) const { return implicit_[i] != 0; }
+
+  // Stage 1, before the solver, from the joint positions and speeds at the
+  // start of a step of dt seconds: every explicit servo's torque, every
+  // implicit servo's constraint row, and the torque the caller applies as a
+  // joint torque before the solver (appliedTorque): the passive damping plus
+  // the explicit servo's torque or the implicit row's feedforward.
+  void prepare(std::span<const double> q, std::span<const double> qdot, double dt);
+  double appliedTorque(size_t i) const { return passive_tau_[i] + feedforward_[i]; }
+
+  // One servo's soft constraint row for the step prepared: the motor's impulse
+  // over the step is dt * feedforward + p, and the solver finds p (N m s) with
+  //   qdot' = beta / dt (target - q) - gamma (dt * feedforward + p),
+  //   lower <= feedforward + p / dt <= upper.
+  // The feedforward (last step's motor torque, within the bounds) is applied
+  // as a joint torque before the solver: Bullet starts joint rows from zero
+  // impulse, and with 10 iterations a stance would then sag; this way the
+  // solver starts from the last answer (a warm start) and finds the change.
+  // active false: limp or explicit, no row.
+  struct Row {
+    bool active = false;
+    double target = 0.0;              // rad
+    double beta = 0.0;                // share of the position error removed in one step
+    double gamma = 0.0;               // compliance, rad/s per N m s
+    double feedforward = 0.0;         // N m
+    double lower = 0.0, upper = 0.0;  // motor torque bounds, N m
+  };
+  Row row(size_t i) const;
+
+  // Stage 3, after the solver: the impulse p the solver applied with
+  // implicit servo i's row (N m s; 0 without a row).
+  void setRowImpulse(size_t i, double impulse);
+
+  // The motor torque of servo i when its joint is alone (for an implicit
+  // servo, what the solver finds):
+  // inertia `inertia` (kg m^2), no other force, the step prepared. For tests
+  // and for reading the model above in one place.
+  double solveAlone(size_t i, double q, double qdot, double inertia) const;
 
  private:
   std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_, upper_,
-      min_inertia_, prev_qdot_, prev_tau_, load_, motor_tau_;
-  std::vector<unsigned char> has_history_;
+      min_inertia_, prev_qdot_, prev_tau_, load_, motor_tau_, passive_tau_, feedforward_, lo_, hi_;
+  std::vector<unsigned char> has_history_, implicit_;
+  double dt_ = 0.0;
 };
 
 }  // namespace simsoccer::engine

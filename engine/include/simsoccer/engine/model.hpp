@@ -56,6 +56,9 @@ struct Motor {
   double armature = 0.0;       // reflected rotor inertia, kg m^2
   double kp = 0.0;             // N m/rad, servo proportional gain
   double kd = 0.0;             // N m s/rad, servo derivative gain
+  // The servo's PD solved implicitly, by Bullet's constraint solver (stable
+  // for any inertia, costs a solver row), or explicitly (a joint torque).
+  bool implicit_servo = false;
   // Electrical and thermal model (sensors: current, temperature).
   double gear_ratio = 1.0;
   double torque_constant = 0.0;        // N m/A at the motor shaft
