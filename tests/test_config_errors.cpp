@@ -191,3 +191,8 @@ TEST_F(ConfigErrors, DirectoryInsteadOfFile) {
   const engine::ConfigError e = load();
   EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
 }
+
+TEST_F(ConfigErrors, UnknownServoIntegration) {
+  replace(robot_, "leg_pitch: {servo: implicit,", "leg_pitch: {servo: semi,");
+  expectError("robot.yaml", "motors.leg_pitch.servo", "must be implicit or explicit, not 'semi'");
+}
