@@ -226,8 +226,11 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
     w.stepControlPeriod();
     if (verbose && i % 10 == 0) {
       const engine::Pose t = w.torsoPose(0);
-      std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f\n", i * dt,
-                   agents::motionStateName(motion.state()), motion.tilt(), t.translation().z());
+      // The torso's x axis (forward) and z axis (up), world z components:
+      // forward > 0 leans back, up < 0 is upside down.
+      std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f forward %.2f up %.2f\n", i * dt,
+                   agents::motionStateName(motion.state()), motion.tilt(), t.translation().z(),
+                   t.linear()(2, 0), t.linear()(2, 2));
     }
     const bool stance = motion.state() == agents::MotionState::Stance;
     standing_for = stance && w.isStanding(0) ? standing_for + dt : 0.0;
