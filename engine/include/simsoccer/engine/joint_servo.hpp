@@ -73,8 +73,9 @@ class JointServoBatch {
   //   lower <= feedforward + p / dt <= upper.
   // The feedforward (last step's motor torque, within the bounds) is applied
   // as a joint torque before the solver: Bullet starts joint rows from zero
-  // impulse, and with 10 iterations a stance would then sag; this way the
-  // solver starts from the last answer (a warm start) and finds the change.
+  // impulse, and this way its 10 iterations start from the last answer (a
+  // warm start) and look for the change. (Measured without it: the stance,
+  // sway and walk figures were the same; kept as the cheaper starting point.)
   // active false: limp or explicit, no row.
   struct Row {
     bool active = false;
