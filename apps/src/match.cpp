@@ -233,6 +233,9 @@ struct RunResult {
   double wall = 0.0;
   uint64_t final_hash = 0;
   std::vector<std::string> agent_events;  // restarts
+  // Per robot (world order): lockstep periods its agent did not answer within
+  // the timeout (the robot kept its last command: a cause for a changed game).
+  std::vector<uint64_t> missed_commands;
   std::vector<world::LogEvent> events;
   int frames = 0;
   uint64_t log_bytes = 0;
@@ -374,6 +377,8 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   result.interrupted = g_interrupted != 0;
   result.wall = secondsSince(t0);
   result.final_hash = w.stateHash();
+  for (world::RobotId r = 0; r < w.robotCount(); ++r)
+    result.missed_commands.push_back(server.stats(r).missed);
   for (AgentSlot& a : agents)
     if (a.process) a.process->stop();
   log.flush();
@@ -429,8 +434,9 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   for (size_t i = 0; i < s.robots().size(); ++i) {
     const auto& rec = s.robots()[i];
     out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number
-        << ", \"falls\": " << rec.falls << ", \"distance_walked\": " << num(rec.distance, 2) << "}"
-        << (i + 1 < s.robots().size() ? "," : "") << "\n";
+        << ", \"falls\": " << rec.falls << ", \"distance_walked\": " << num(rec.distance, 2)
+        << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
+        << "}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }
   out << "  ],\n";
   const auto p = s.possession();
@@ -485,6 +491,9 @@ const char* kMatchHelp =
     "  heatmap.png   ball and team positions over the game\n"
     "  --half S            half duration in s (overrides the config)\n"
     "  --max-seconds S     stop after S simulated seconds (a partial game, for trials)\n"
+    "  --lockstep-timeout S  wall seconds a period waits for the agents (overrides the\n"
+    "                config's lockstep.timeout; a missed answer changes the game, and\n"
+    "                summary.json counts them per robot: raise it on a loaded machine)\n"
     "  --external-agents   start no agents: wait for agents started elsewhere (same domain)\n"
     "  --no-video          skip the video\n"
     "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
@@ -523,7 +532,7 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
 
 int match(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
-                    {"out", "seed", "half", "domain", "max-seconds"});
+                    {"out", "seed", "half", "domain", "max-seconds", "lockstep-timeout"});
   if (opt.help(kMatchHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match config file");
   MatchConfig config = loadMatchConfig(opt.positional()[0]);
@@ -533,6 +542,11 @@ int match(int argc, char** argv, int first) {
     const double h = opt.number("half", 0);
     if (!(h > 0)) throw UsageError("--half must be > 0 s");
     config.half_duration = h;
+  }
+  if (opt.has("lockstep-timeout")) {
+    const double t = opt.number("lockstep-timeout", 0);
+    if (!(t > 0)) throw UsageError("--lockstep-timeout must be > 0 s");
+    config.command_timeout = t;
   }
   RunOptions o = runOptions(opt, config);
   o.realtime = opt.flag("realtime");
