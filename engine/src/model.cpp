@@ -14,6 +14,12 @@ int ArticulatedModel::jointIndex(const std::string& joint_name) const {
   return -1;
 }
 
+void ArticulatedModel::applyMimic(std::span<double> q) const {
+  for (size_t j = 0; j < q.size() && j < joints.size(); ++j)
+    if (joints[j].mimic_of >= 0)
+      q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+}
+
 double ArticulatedModel::totalMass() const {
   double m = 0.0;
   for (const Link& l : links) m += l.mass;

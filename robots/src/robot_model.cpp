@@ -398,10 +398,9 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
         if (j < 0) v.fail("unknown joint '" + joint_name + "'");
         q[static_cast<size_t>(j)] = v.number();
       }
+      body->applyMimic(q);
       for (size_t j = 0; j < q.size(); ++j) {
         const Joint& joint = body->joints[j];
-        if (joint.mimic_of >= 0)
-          q[j] = joint.mimic_multiplier * q[static_cast<size_t>(joint.mimic_of)];
         if (q[j] < joint.lower - 1e-9 || q[j] > joint.upper + 1e-9)
           n.failKey(joint.name,
                     "angle " + engine::formatNumber(q[j]) + " is outside the joint limits");

@@ -113,9 +113,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
         if (joints[j].mimic_of < 0)
           q[j] = std::clamp(q[j] + scenario_.noise.joints * normal(), joints[j].lower,
                             joints[j].upper);
-      for (size_t j = 0; j < q.size(); ++j)
-        if (joints[j].mimic_of >= 0)
-          q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+      model->body->applyMimic(q);
     }
     if (!field_->onCarpet(x, y))
       scenarioError(

@@ -48,9 +48,7 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
         q[static_cast<size_t>(j)] = v;
       }
     }
-    for (size_t j = 0; j < q.size(); ++j)
-      if (joints[j].mimic_of >= 0)
-        q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+    model.body->applyMimic(q);
     f.position = q;
     m.frames.push_back(std::move(f));
   }

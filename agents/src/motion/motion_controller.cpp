@@ -68,9 +68,7 @@ void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<
   for (size_t a = 0; a < model_.actuators.size() && a < sensors.position.size(); ++a)
     if (model_.actuators[a].kind == robots::Actuator::Kind::Joint)
       q[static_cast<size_t>(model_.actuators[a].index)] = sensors.position[a];
-  for (size_t j = 0; j < q.size(); ++j)
-    if (joints[j].mimic_of >= 0)
-      q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
+  model_.body->applyMimic(q);
 }
 
 void MotionController::update(double dt, const MotionSensors& sensors, const MotionRequest& request,

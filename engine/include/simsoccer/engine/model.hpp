@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,8 @@ struct ArticulatedModel {
   // Joint-frame pose of every link relative to the root at the given joint
   // angles (forward kinematics on the model data alone, no physics).
   std::vector<Pose> linkFramesAt(const std::vector<double>& joint_positions) const;
+  // Sets every mimic joint's angle from its master's (one angle per joint).
+  void applyMimic(std::span<double> joint_positions) const;
 };
 
 }  // namespace simsoccer::engine
