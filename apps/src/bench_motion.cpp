@@ -1,6 +1,7 @@
 // simsoccer bench motion: the agents' motion (walk) on an empty field, in
 // this process on the real physics, commands exactly as an agent sends them.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
+#include "simsoccer/fields/field_model.hpp"
 #include "simsoccer/world/world.hpp"
 
 namespace simsoccer::apps {
@@ -166,10 +168,11 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
   const Vec3 start = b.pose.translation();
   engine.start(foot);
   KickResult r;
-  for (int i = 0; i < 600; ++i) {
+  const double dt = w.scenario().physics.control_period;
+  for (int i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
     const auto& fr = w.sensorFrame(0);
     if (engine.active()) {
-      engine.update(0.01, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
+      engine.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
       send(w, targets);
     }
     w.stepControlPeriod();
@@ -268,8 +271,8 @@ StrikerResult strikerTrial(uint64_t seed, double limit, bool verbose) {
   s.seed = seed;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
-  world::World probe(s);
-  const double hl = probe.field().halfLength() - 0.5, hw = probe.field().halfWidth() - 0.5;
+  const fields::FieldModel field = fields::loadFieldModel(s.field_file);
+  const double hl = field.halfLength() - 0.5, hw = field.halfWidth() - 0.5;
   s.robots[0].x = hl * u(rng);
   s.robots[0].y = hw * u(rng);
   s.robots[0].yaw = M_PI * u(rng);
@@ -301,6 +304,7 @@ StrikerResult strikerTrial(uint64_t seed, double limit, bool verbose) {
 }
 
 enum class PenaltyOutcome { Goal, Saved, Missed, Timeout };
+constexpr std::array<const char*, 4> kPenaltyOutcomeNames{"goal", "saved", "missed", "timeout"};
 
 // One penalty: kicker (team 0) behind the ball on the +x penalty mark,
 // keeper (team 1) on that goal line; ends on a goal, the ball out or stopped
@@ -308,8 +312,7 @@ enum class PenaltyOutcome { Goal, Saved, Missed, Timeout };
 PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
   world::Scenario s = emptyField();
   s.seed = seed;
-  world::World probe(s);
-  const auto& f = probe.field();
+  const fields::FieldModel f = fields::loadFieldModel(s.field_file);
   const double mark = f.halfLength() - f.penalty_mark_distance.value_or(1.3);
   s.robots[0].x = mark - 0.5;
   s.robots[0].y = 0.0;
@@ -401,8 +404,7 @@ int benchMotion(int argc, char** argv, int first) {
   if (opt.flag("penalty")) {  // one penalty, for tuning
     const PenaltyOutcome o =
         penaltyTrial(static_cast<uint64_t>(opt.number("seed", 1)), 30.0, opt.flag("verbose"));
-    const char* names[] = {"goal", "saved", "missed", "timeout"};
-    std::printf("penalty: %s\n", names[static_cast<int>(o)]);
+    std::printf("penalty: %s\n", kPenaltyOutcomeNames[static_cast<size_t>(o)]);
     return 0;
   }
   if (opt.flag("kick")) {  // one kick, for tuning
@@ -510,27 +512,19 @@ int benchMotion(int argc, char** argv, int first) {
   {
     // Penalty kicks against the behaviour goalkeeper: N seeded trials.
     const int trials = static_cast<int>(opt.number("penalty-trials", 50));
-    int goals = 0, saved = 0, missed = 0, timeouts = 0;
-    for (int i = 0; i < trials; ++i) {
-      switch (penaltyTrial(seed + 500 + static_cast<uint64_t>(i), 30.0, false)) {
-        case PenaltyOutcome::Goal:
-          ++goals;
-          break;
-        case PenaltyOutcome::Saved:
-          ++saved;
-          break;
-        case PenaltyOutcome::Missed:
-          ++missed;
-          break;
-        case PenaltyOutcome::Timeout:
-          ++timeouts;
-          break;
-      }
-    }
-    std::fprintf(stderr, "  penalties: %d goals, %d saved, %d missed, %d timeouts\n", goals, saved,
-                 missed, timeouts);
-    row("penalty_scoring", 0, goals / std::max(1.0, double(trials)), "share",
-        100.0 * saved / std::max(1.0, double(trials)), 0, trials * 30.0);
+    std::array<int, kPenaltyOutcomeNames.size()> count{};
+    for (int i = 0; i < trials; ++i)
+      ++count[static_cast<size_t>(
+          penaltyTrial(seed + 500 + static_cast<uint64_t>(i), 30.0, false))];
+    std::fprintf(stderr, "  penalties:");
+    for (size_t k = 0; k < count.size(); ++k)
+      std::fprintf(stderr, " %d %s", count[k], kPenaltyOutcomeNames[k]);
+    std::fprintf(stderr, "\n");
+    const auto share = [&](PenaltyOutcome o) {
+      return count[static_cast<size_t>(o)] / std::max(1.0, double(trials));
+    };
+    row("penalty_scoring", 0, share(PenaltyOutcome::Goal), "share",
+        100.0 * share(PenaltyOutcome::Saved), 0, trials * 30.0);
   }
   {
     // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
