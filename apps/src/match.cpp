@@ -23,6 +23,7 @@
 #include "match_session.hpp"
 #include "process.hpp"
 #include "simsoccer/engine/offscreen_renderer.hpp"
+#include "simsoccer/fields/field_model.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/world/render_scene.hpp"
@@ -157,8 +158,8 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
 // Ball (white) and team (blue, red) positions over the game on a drawing of the field.
 void writeHeatmap(const std::filesystem::path& log_file, const std::filesystem::path& out) {
   world::MatchLogReader log(log_file);
-  world::World w(world::loadScenario(log.header().values.at("scenario")));
-  const auto& f = w.field();
+  const fields::FieldModel f =
+      fields::loadFieldModel(world::loadScenario(log.header().values.at("scenario")).field_file);
   const double ppm = 60.0, margin = f.border;
   const int W = static_cast<int>((f.length + 2 * margin) * ppm),
             H = static_cast<int>((f.width + 2 * margin) * ppm);
@@ -388,7 +389,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
 void writeSummary(const std::filesystem::path& file, const MatchSession& s, const RunResult& r,
                   const RunOptions& o, const std::string& extra) {
   const referee::Game& g = s.game();
-  const world::World& w = const_cast<MatchSession&>(s).world();
+  const world::World& w = s.world();
   std::ofstream out(file);
   if (!out) throw std::runtime_error(file.string() + ": cannot write the summary");
   out << "{\n";
@@ -459,7 +460,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
 
 world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o) {
   world::MatchLogHeader h;
-  world::World& w = const_cast<MatchSession&>(s).world();
+  const world::World& w = s.world();
   h.values["config"] = std::filesystem::absolute(s.config().file).string();
   h.values["config_hash"] = s.config().hash;
   h.values["scenario"] = std::filesystem::absolute(s.config().scenario).string();

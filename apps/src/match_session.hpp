@@ -58,6 +58,7 @@ class MatchSession {
   MatchSession(const MatchConfig& config, uint64_t seed);
 
   world::World& world() { return *world_; }
+  const world::World& world() const { return *world_; }
   const referee::Game& game() const { return referee_->game(); }
   const MatchConfig& config() const { return config_; }
 
