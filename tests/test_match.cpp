@@ -84,13 +84,16 @@ struct BackgroundMatch {
                              status);
     });
   }
-  void waitForLog(uintmax_t bytes) const {
+  // True once the log has grown past `bytes` (the game is under way); false
+  // after 60 s without.
+  bool waitForLog(uintmax_t bytes) const {
     for (int i = 0; i < 600; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       if (std::filesystem::exists(dir / "match.log") &&
           std::filesystem::file_size(dir / "match.log") > bytes)
-        return;
+        return true;
     }
+    return false;
   }
   void join() { thread.join(); }
 };
@@ -196,7 +199,7 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
 
 TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
   BackgroundMatch m("match_kill", "--half 10 --no-video --domain 133");
-  m.waitForLog(200000);  // the game runs: kill team 1's player 2
+  EXPECT_TRUE(m.waitForLog(200000)) << "the game did not start";  // kill team 1's player 2
   int kill_status = 0;
   test::runCommand("pkill -f '^[^ ]*simsoccer-agent --team 1 --player 2 --domain 133 '",
                    kill_status);
@@ -212,7 +215,7 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
   BackgroundMatch m("match_int", "--no-video --domain 134");
-  m.waitForLog(100000);
+  EXPECT_TRUE(m.waitForLog(100000)) << "the game did not start";
   int s = 0;
   test::runCommand("pkill -INT -f '^" + kBin + " match .*--domain 134 '", s);
   m.join();
