@@ -182,8 +182,7 @@ void SoccerBehaviour::readGame(const Input& in) {
   penalised_ = player_ >= 1 && player_ <= 20 && t.players[player_ - 1].penalty != 0;
   // A state change that moves robots (Set: placement; leaving a penalty: the
   // robot re-enters elsewhere) restarts the motion from the stance.
-  if (was_penalised_ && !penalised_) restart_motion_ = true;
-  if (penalised_ && !was_penalised_) restart_motion_ = true;
+  if (penalised_ != was_penalised_) restart_motion_ = true;
   if (state_ != last_state_ && (state_ == kSet || state_ == kInitial)) restart_motion_ = true;
   was_penalised_ = penalised_;
   last_state_ = state_;
