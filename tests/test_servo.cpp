@@ -27,8 +27,9 @@ engine::Motor testMotor(double kp, bool implicit) {
 // One step of servo 0 of `batch` on a joint alone: the motor torque.
 double stepAlone(engine::JointServoBatch& batch, double q, double qd, double inertia, double dt) {
   batch.prepare(std::vector<double>{q}, std::vector<double>{qd}, dt);
+  if (!batch.implicit(0)) return batch.motorTorque(0);
   const double tau = batch.solveAlone(0, q, qd, inertia);
-  if (batch.implicit(0)) batch.setRowImpulse(0, (tau - batch.row(0).feedforward) * dt);
+  batch.setRowImpulse(0, (tau - batch.row(0).feedforward) * dt);
   return tau;
 }
 

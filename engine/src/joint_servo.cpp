@@ -117,7 +117,6 @@ void JointServoBatch::setRowImpulse(size_t i, double impulse) {
 }
 
 double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inertia) const {
-  if (!implicit_[i]) return motor_tau_[i];  // computed in prepare
   const Row r = row(i);
   if (!r.active) return 0.0;
   // qdot' = qdot + P / I  and  qdot' = beta / dt (target - q) - gamma P, with P

@@ -91,8 +91,8 @@ class JointServoBatch {
   // implicit servo i's row (N m s; 0 without a row).
   void setRowImpulse(size_t i, double impulse);
 
-  // The motor torque of servo i when its joint is alone (for an implicit
-  // servo, what the solver finds):
+  // The motor torque the solver finds for implicit servo i (0 for an explicit
+  // one: its torque is motorTorque after prepare) when its joint is alone:
   // inertia `inertia` (kg m^2), no other force, the step prepared. For tests
   // and for reading the model above in one place.
   double solveAlone(size_t i, double q, double qdot, double inertia) const;
