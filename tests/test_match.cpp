@@ -151,9 +151,8 @@ TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
   // Same config, seed and agent programs => same game, as long as every agent
   // answers every period: a 5 s lockstep timeout (a miss keeps the robot's
   // last command). Each summary counts the misses; both must be 0.
-  // Known flake under ctest -j2 (2026-11-21): the games can still differ with
-  // 0 misses; suspected cause: an agent answering a frame before that tick's
-  // Perception / GameState (other topics) has arrived.
+  // (With 0 misses the games still differed under load until the agents
+  // waited for the referee's GameState before claiming their robots.)
   const ShortMatch a = shortMatch("match_b1", 132, "--no-video --lockstep-timeout 5");
   ASSERT_EQ(a.status, 0) << a.out;
   const ShortMatch b = shortMatch("match_b2", 137, "--no-video --lockstep-timeout 5");

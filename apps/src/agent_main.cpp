@@ -27,6 +27,7 @@ const char* kHelp =
     "                        [--team-number N] [--seed N] [--get-up] [--verbose]]\n"
     "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
     "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
+    "                       [--game-state-wait S]\n"
     "\n"
     "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
     "  --role ROLE      play soccer: auto (the GameState's goalkeeper keeps goal, the field\n"
@@ -44,6 +45,8 @@ const char* kHelp =
     "                   sizes, stale and future ticks, stiffness out of range)\n"
     "  --mode stall     answers --stall-after ticks, then keeps running without answering\n"
     "  --ticks N        exit after answering N frames (default: run until the simulator is gone)\n"
+    "  --game-state-wait S  with --role: wait up to S s (default 0) for the referee's GameState\n"
+    "                   before claiming the robot (the match starts its agents so)\n"
     "Exit status: 0 done, 3 the claim was refused or not answered, 4 the simulator went away.\n";
 
 }  // namespace
@@ -51,10 +54,10 @@ const char* kHelp =
 int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
-    const apps::Options opt(
-        argc, argv, 1, {"help", "get-up", "verbose"},
-        {"team", "player", "domain", "dds-config", "robot", "mode", "stall-after", "ticks",
-         "claim-timeout", "vx", "vy", "turn", "role", "config", "field", "team-number", "seed"});
+    const apps::Options opt(argc, argv, 1, {"help", "get-up", "verbose"},
+                            {"team", "player", "domain", "dds-config", "robot", "mode",
+                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
+                             "config", "field", "team-number", "seed", "game-state-wait"});
     if (opt.help(kHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -115,6 +118,18 @@ int main(int argc, char** argv) {
     double start_time = -1.0, last_time = 0.0;
 
     agents::AgentClient client(dds, team, player);
+    simsoccer_msg_GameState game{};
+    bool have_game = false;
+    if (soccer) {
+      // The referee's state (durable) before claiming: the simulator starts
+      // once every robot is claimed, so the first frame is answered with it
+      // however late it would have arrived (otherwise the first periods may
+      // be played without it, and the same seed gives another game).
+      const auto until = std::chrono::steady_clock::now() +
+                         std::chrono::duration<double>(opt.number("game-state-wait", 0.0));
+      while (!(have_game = client.gameState(game)) && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     if (!client.claim(opt.number("claim-timeout", 10.0))) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
       return 3;
@@ -132,8 +147,6 @@ int main(int argc, char** argv) {
     last_frame_ns = now_ns();
     agents::PerceptionIn seen;
     bool have_seen = false;
-    simsoccer_msg_GameState game{};
-    bool have_game = false;
     client.onFrame([&](const simsoccer_msg_SensorFrame& frame) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;

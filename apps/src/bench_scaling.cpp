@@ -97,8 +97,9 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
     agents.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
         agentProgram().string(), "--team", std::to_string(info.team), "--player",
         std::to_string(info.number), "--domain", std::to_string(domain), "--role", "auto",
-        "--field", s.field_file.string()}));
+        "--field", s.field_file.string(), "--game-state-wait", "10"}));
   }
+  server.publishGameState(ref.game().packet(0), ref.game().leftTeam());  // before they claim
   const auto t_wait = Clock::now();
   while (!server.waitForOwners(w.robotCount(), 0.5))
     if (std::chrono::duration<double>(Clock::now() - t_wait).count() > 60)

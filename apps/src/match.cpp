@@ -258,7 +258,9 @@ std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o,
       "--team-number",
       std::to_string(c.team_numbers[static_cast<size_t>(team)]),
       "--seed",
-      std::to_string(seed * 1000 + static_cast<uint64_t>(team * 100 + number))};
+      std::to_string(seed * 1000 + static_cast<uint64_t>(team * 100 + number)),
+      "--game-state-wait",  // the referee's state is published before the agents start
+      "10"};
   if (!c.agent_config.empty()) {
     a.push_back("--config");
     a.push_back(c.agent_config.string());
