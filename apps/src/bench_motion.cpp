@@ -7,7 +7,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +24,7 @@
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/fields/field_model.hpp"
+#include "simsoccer/world/render_scene.hpp"
 #include "simsoccer/world/world.hpp"
 
 namespace simsoccer::apps {
@@ -42,6 +48,8 @@ const char* kHelp =
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
+    "  --motions DIR get-up motions from DIR (default configs/motions; for tuning them)\n"
+    "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s, tiled\n"
     "  --striker-trials N, --penalty-trials N  trials in the table (default 20, 50)\n"
     "  --csv FILE    also write the table as CSV\n";
 
@@ -190,11 +198,64 @@ struct GetUpResult {
   int attempts = 0;
 };
 
+// For tuning motions by hand: where the robot's centre of mass is over its
+// ground contacts, and which joints lag their targets. Printed per line:
+// the CoM height, each link on the ground with its contact's offset from the
+// CoM along the robot's heading (x: the torso's x axis on the ground; a
+// posture is statically stable when the CoM lies among the contacts), and
+// every joint more than 0.1 rad from its target.
+void traceSupport(const world::World& w, std::span<const float> targets) {
+  const auto& model = *w.robot(0).model;
+  const auto& links = model.body->links;
+  Vec3 com = Vec3::Zero();
+  double mass = 0.0;
+  for (size_t l = 0; l < links.size(); ++l) {
+    com += links[l].mass * (w.linkPose(0, static_cast<int>(l)) * links[l].com);
+    mass += links[l].mass;
+  }
+  com /= mass;
+  const engine::Pose t = w.torsoPose(0);
+  // Heading: the torso's x axis, or when it points at the ground, its z axis.
+  Vec3 ahead(t.linear()(0, 0), t.linear()(1, 0), 0.0);
+  if (ahead.norm() < 0.5) ahead = Vec3(t.linear()(0, 2), t.linear()(1, 2), 0.0);
+  ahead.normalize();
+  const Vec3 left = Vec3::UnitZ().cross(ahead);
+  std::fprintf(stderr, "    com z %.3f  ground:", com.z());
+  // Per link on the ground: the span of its contacts ahead of the CoM, and their mean sideways.
+  std::vector<int> order;
+  std::vector<std::array<double, 4>> span(links.size(), {1e9, -1e9, 0.0, 0.0});
+  for (const engine::LinkContact& c : w.contacts()) {
+    if (c.articulation != w.robot(0).body || c.with_articulation || c.other_body >= 0) continue;
+    auto& sp = span[static_cast<size_t>(c.link)];
+    if (sp[3] == 0.0) order.push_back(c.link);
+    const Vec3 d = c.position - com;
+    sp[0] = std::min(sp[0], d.dot(ahead));
+    sp[1] = std::max(sp[1], d.dot(ahead));
+    sp[2] += d.dot(left);
+    sp[3] += 1.0;
+  }
+  for (int l : order) {
+    const auto& sp = span[static_cast<size_t>(l)];
+    std::fprintf(stderr, " %s(%+.2f..%+.2f,%+.2f)", links[static_cast<size_t>(l)].name.c_str(),
+                 sp[0], sp[1], sp[2] / sp[3]);
+  }
+  std::fprintf(stderr, "\n    lag:");
+  for (size_t a = 0; a < model.actuators.size() && a < targets.size(); ++a) {
+    if (model.actuators[a].kind != robots::Actuator::Kind::Joint) continue;
+    const int j = model.actuators[a].index;
+    const double e = targets[a] - w.jointPosition(0, j);
+    if (std::abs(e) > 0.1)
+      std::fprintf(stderr, " %s %+.2f", model.body->joints[static_cast<size_t>(j)].name.c_str(), e);
+  }
+  std::fprintf(stderr, "\n");
+}
+
 // One get-up trial: the robot dropped on its front or back (seeded heading,
 // spot and joint jitter), the motion controller (fall detector, get-up,
 // stance) given 12 s with a "stand" request. Success: standing (world truth)
 // in the controller's stance within the time.
-GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, bool verbose) {
+GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, bool verbose,
+                  const std::string& snapshots = "") {
   world::Scenario s = emptyField();
   s.seed = seed;
   world::World w(s);
@@ -221,6 +282,11 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
   }
   GetUpResult r;
   double standing_for = 0.0;
+  // --snapshots: the robot from its side every 0.2 s from 0.2 s, tiled into one image.
+  std::unique_ptr<engine::OffscreenRenderer> renderer;
+  std::vector<cv::Mat> tiles;
+  if (!snapshots.empty()) renderer = std::make_unique<engine::OffscreenRenderer>();
+  const Vec3 heading(std::cos(yaw), std::sin(yaw), 0.0), side(-std::sin(yaw), std::cos(yaw), 0.0);
   for (int i = 0; i < 1200; ++i) {
     agents::MotionRequest stand;
     motion.update(dt, agents::motionSensors(w.sensorFrame(0)), stand, position, stiffness);
@@ -234,6 +300,21 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
       std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f forward %.2f up %.2f\n", i * dt,
                    agents::motionStateName(motion.state()), motion.tilt(), t.translation().z(),
                    t.linear()(2, 0), t.linear()(2, 2));
+      traceSupport(w, position);
+    }
+    if (renderer && i % 20 == 0 && i >= 20 && tiles.size() < 36) {
+      const Vec3 c = w.torsoPose(0).translation();
+      const Vec3 at(c.x(), c.y(), 0.2);
+      const engine::RenderView view =
+          engine::pinholeView(world::lookAtPose(at + 0.9 * side, at), 320, 240, 0.75, 0.57);
+      std::vector<engine::DrawItem> scene;
+      world::buildRenderScene(w, scene);
+      renderer->render(scene, std::span<const engine::RenderView>(&view, 1));
+      cv::Mat bgr;
+      cv::cvtColor(renderer->image(0), bgr, cv::COLOR_RGBA2BGR);
+      cv::putText(bgr, std::to_string(i * dt).substr(0, 4) + " " + motionStateName(motion.state()),
+                  cv::Point(4, 14), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1);
+      tiles.push_back(bgr);
     }
     const bool stance = motion.state() == agents::MotionState::Stance;
     standing_for = stance && w.isStanding(0) ? standing_for + dt : 0.0;
@@ -244,6 +325,18 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
     }
   }
   r.attempts = motion.counters().get_ups + motion.counters().failed_get_ups;
+  if (renderer && !tiles.empty()) {
+    while (tiles.size() % 6) tiles.push_back(cv::Mat::zeros(tiles[0].size(), tiles[0].type()));
+    std::vector<cv::Mat> rows;
+    for (size_t k = 0; k < tiles.size(); k += 6) {
+      cv::Mat row;
+      cv::hconcat(std::vector<cv::Mat>(tiles.begin() + k, tiles.begin() + k + 6), row);
+      rows.push_back(row);
+    }
+    cv::Mat all;
+    cv::vconcat(rows, all);
+    if (!cv::imwrite(snapshots, all)) throw std::runtime_error(snapshots + ": cannot write");
+  }
   return r;
 }
 
@@ -376,20 +469,22 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation}};
   std::vector<std::string> valued{
-      "seconds",       "csv",  "vx",          "vy",     "turn",          "random-minutes",
-      "seed",          "foot", "ball-offset", "get-up", "get-up-trials", "striker-trials",
-      "penalty-trials"};
+      "seconds",        "csv",     "vx",          "vy",     "turn",          "random-minutes",
+      "seed",           "foot",    "ball-offset", "get-up", "get-up-trials", "striker-trials",
+      "penalty-trials", "motions", "snapshots"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first, {"help", "verbose", "kick", "striker", "penalty"}, valued);
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
-  const std::string motions_dir = findConfig("", "configs/motions").string();
+  // Another motions folder (same file names) for tuning get-up motions.
+  const std::string motions_dir =
+      opt.has("motions") ? opt.get("motions", "") : findConfig("", "configs/motions").string();
   if (opt.has("get-up")) {  // one get-up, for tuning
     const std::string side = opt.get("get-up", "");
     if (side != "front" && side != "back") throw UsageError("--get-up must be front or back");
     const GetUpResult r = getUp(side == "front", static_cast<uint64_t>(opt.number("seed", 1)),
-                                motions_dir, opt.flag("verbose"));
+                                motions_dir, opt.flag("verbose"), opt.get("snapshots", ""));
     std::printf("get-up from the %s: %s in %.2f s, %d attempts\n", side.c_str(),
                 r.success ? "standing" : "FAILED", r.seconds, r.attempts);
     return 0;
