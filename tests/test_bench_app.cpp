@@ -1,9 +1,13 @@
 // End to end: the real `simsoccer bench physics` program, its table and CSV.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 
@@ -134,4 +138,45 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   EXPECT_EQ(rows["kick_distance"][6], "0");
   EXPECT_GT(std::stod(rows["kick_distance"][3]), 1.5);
   EXPECT_LT(std::stod(rows["kick_distance"][5]), 15.0);
+}
+
+// The get-up tuning aids: another motions folder, the side-view snapshots
+// (real EGL rendering, tiled), the support trace; a bad motion file is named.
+TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("simsoccer_motions_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"get_up_front.yaml", "get_up_back.yaml"})
+    std::filesystem::copy_file(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs/motions" / f,
+                               dir / f, std::filesystem::copy_options::overwrite_existing);
+  const std::filesystem::path png = dir / "snapshots.png";
+  int status = 0;
+  const std::string out =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --get-up back --seed 3 --motions " +
+                     dir.string() + " --snapshots " + png.string() + " --verbose 2>&1",
+                 status);
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("get-up from the back:"), std::string::npos) << out;
+  EXPECT_NE(out.find("com z 0."), std::string::npos);
+  EXPECT_NE(out.find("ground: Torso("), std::string::npos);  // lying on its back at first
+  const cv::Mat image = cv::imread(png.string());
+  ASSERT_FALSE(image.empty());
+  EXPECT_EQ(image.cols, 6 * 320);
+  EXPECT_EQ(image.rows % 240, 0);
+  cv::Scalar mean, spread;
+  cv::meanStdDev(image, mean, spread);
+  EXPECT_GT(spread[1], 10.0);  // a scene, not a blank image
+  // A motion with a joint beyond its limits: refused, the file and joint named.
+  {
+    std::ofstream bad(dir / "get_up_back.yaml");
+    bad << "motion: get_up_back\nframes:\n  - duration: 0.5\n    joints: {LKneePitch: 3.0}\n";
+  }
+  const std::string err =
+      runCommand(std::string(SIMSOCCER_BIN) + " bench motion --get-up back --motions " +
+                     dir.string() + " 2>&1",
+                 status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(err.find("get_up_back.yaml"), std::string::npos) << err;
+  EXPECT_NE(err.find("LKneePitch"), std::string::npos) << err;
+  std::filesystem::remove_all(dir);
 }
