@@ -2,6 +2,7 @@
 // odometry, stopping. (Walking on the physics: bench motion and the DDS test.)
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 #include <utility>
@@ -110,7 +111,11 @@ SupportMargins walkSupport(const robots::RobotModel& model,
                            const std::vector<std::pair<engine::Vec3, double>>& plan,
                            double skip_seconds = 0.0) {
   const engine::ArticulatedModel& body = *model.body;
-  agents::WalkEngine e(model);
+  // The support hip's sag compensation bends the support leg on purpose
+  // (the physical servo gives as much back): left out of the pure geometry.
+  agents::WalkParameters parameters;
+  parameters.hip_roll_compensation = 0.0;
+  agents::WalkEngine e(model, parameters);
   std::vector<double> q = model.pose("stand");
   const int feet[2] = {body.linkIndex("LFoot"), body.linkIndex("RFoot")};
   const std::vector<engine::Vec3> soles[2] = {soleCorners(body, feet[0]),
@@ -120,14 +125,19 @@ SupportMargins walkSupport(const robots::RobotModel& model,
   SupportMargins m;
   engine::Pose ground_support = engine::Pose::Identity();  // the support foot in the ground frame
   int support = 1;
+  double yaw = 0.0;  // the plan's torso yaw, fed back as the IMU's (heading hold)
   std::vector<engine::Vec3> com_track;
   std::vector<std::vector<cv::Point2f>> polygons;  // per tick, ground frame (mm)
   double zmp_sum = 0.0;
   int zmp_count = 0;
+  const long skip_ticks = std::lround(skip_seconds / dt);
   for (const auto& [v, seconds] : plan) {
-    e.setVelocity(v.x(), v.y(), v.z());
-    for (int i = 0; i < static_cast<int>(seconds / dt); ++i) {
-      e.update(dt, engine::Vec3::Zero(), 0.0, q);
+    if (v.isZero())
+      e.stop();  // a zero command: finish the step and stand
+    else
+      e.setVelocity(v.x(), v.y(), v.z());
+    for (int i = 0; i < static_cast<int>(std::lround(seconds / dt)); ++i) {
+      e.update(dt, engine::Vec3::Zero(), yaw, q);
       body.applyMimic(q);
       const std::vector<engine::Pose> frames = body.linkFramesAt(q);  // torso frame
       const int now = e.supportLeg() == Leg::Left ? 0 : 1;
@@ -138,6 +148,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
       }
       const engine::Pose ground_torso =
           ground_support * frames[static_cast<size_t>(feet[support])].inverse();
+      yaw = std::atan2(ground_torso.linear()(1, 0), ground_torso.linear()(0, 0));
       engine::Vec3 com = engine::Vec3::Zero();
       for (size_t l = 0; l < body.links.size(); ++l)
         com += body.links[l].mass * (frames[l] * body.links[l].com);
@@ -164,8 +175,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
       cv::convexHull(points, hull);
       polygons.push_back(hull);
       const engine::Vec3& c = com_track.back();
-      const bool measured = static_cast<double>(com_track.size()) * dt > skip_seconds + dt;
-      if (!measured) continue;
+      if (static_cast<long>(com_track.size()) <= skip_ticks + 1) continue;  // the ramp
       m.com = std::min(m.com,
                        0.001 * cv::pointPolygonTest(hull,
                                                     cv::Point2f(static_cast<float>(1000 * c.x()),
@@ -202,15 +212,15 @@ SupportMargins walkSupport(const robots::RobotModel& model,
 // sequence"), checked on the plan itself: forward kinematics of the commanded
 // joint angles with the model's masses, no physics.
 //  - Walking forward at full speed (after the 2 s ramp): the ZMP stays over
-//    the support sole / both soles; it comes within 5 mm of the polygon's edge
-//    at lift-off (the generator has no double-support phase: the ZMP must jump
-//    from one foot to the other, measured 2-4 mm past the sole's inner rear
-//    edge for one 10 ms tick).
+//    the support sole / both soles except at lift-off, where it may be up to
+//    5 mm outside (the generator has no double-support phase: the ZMP must
+//    jump from one foot to the other; measured up to 4.4 mm past the sole's inner
+//    rear edge for one 10 ms tick).
 //  - Known limits, measured and printed, not asserted: the plan's body changes
 //    velocity at once at a step boundary (ramps, the sideways and turning
 //    steps that open on one step and close on the next), an impulse that
-//    puts the cart-table ZMP up to 0.3 m outside for one tick; and the CoM
-//    itself leaves the sole during single support by up to 53 mm (a dynamic
+//    puts the cart-table ZMP up to 0.35 m outside for one tick; and the CoM
+//    itself leaves the sole during single support by up to 54 mm (a dynamic
 //    walk: it is the ZMP that has to stay in). Both are mean-inside.
 TEST(WalkEngine, PlannedZmpStaysOverTheSupportPolygon) {
   const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
@@ -228,7 +238,7 @@ TEST(WalkEngine, PlannedZmpStaysOverTheSupportPolygon) {
     std::vector<std::pair<engine::Vec3, double>> plan;
   };
   const std::vector<Case> cases{
-      {"start, forward, stop", {{{0.3, 0.0, 0.0}, 4.0}, {{0.0, 0.0, 0.0}, 1.0}}},
+      {"start, forward, stop", {{{0.3, 0.0, 0.0}, 4.0}, {{0.0, 0.0, 0.0}, 1.5}}},
       {"sideways", {{{0.0, 0.1, 0.0}, 3.0}, {{0.0, -0.1, 0.0}, 3.0}}},
       {"turning", {{{0.0, 0.0, 0.8}, 3.0}, {{0.0, 0.0, -0.8}, 3.0}}},
       {"combined", {{{0.15, 0.05, 0.4}, 3.0}, {{-0.1, -0.05, -0.3}, 3.0}}}};
