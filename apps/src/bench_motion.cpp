@@ -49,7 +49,8 @@ const char* kHelp =
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
     "  --motions DIR get-up motions from DIR (default configs/motions; for tuning them)\n"
-    "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s, tiled\n"
+    "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
+    "                7.2 s), tiled\n"
     "  --striker-trials N, --penalty-trials N  trials in the table (default 20, 50)\n"
     "  --csv FILE    also write the table as CSV\n";
 
@@ -215,7 +216,7 @@ void traceSupport(const world::World& w, std::span<const float> targets) {
   }
   com /= mass;
   const engine::Pose t = w.torsoPose(0);
-  // Heading: the torso's x axis, or when it points at the ground, its z axis.
+  // Heading: the torso's x axis, or when that is vertical (lying), its z axis.
   Vec3 ahead(t.linear()(0, 0), t.linear()(1, 0), 0.0);
   if (ahead.norm() < 0.5) ahead = Vec3(t.linear()(0, 2), t.linear()(1, 2), 0.0);
   ahead.normalize();
@@ -286,7 +287,7 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
   std::unique_ptr<engine::OffscreenRenderer> renderer;
   std::vector<cv::Mat> tiles;
   if (!snapshots.empty()) renderer = std::make_unique<engine::OffscreenRenderer>();
-  const Vec3 heading(std::cos(yaw), std::sin(yaw), 0.0), side(-std::sin(yaw), std::cos(yaw), 0.0);
+  const Vec3 side(-std::sin(yaw), std::cos(yaw), 0.0);
   for (int i = 0; i < 1200; ++i) {
     agents::MotionRequest stand;
     motion.update(dt, agents::motionSensors(w.sensorFrame(0)), stand, position, stiffness);
