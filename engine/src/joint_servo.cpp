@@ -26,7 +26,6 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
   upper_.push_back(upper);
   min_inertia_.push_back(min_inertia);
   prev_qdot_.push_back(0.0);
-  prev_tau_.push_back(0.0);
   has_history_.push_back(0);
   implicit_.push_back(motor.implicit_servo ? 1 : 0);
   load_.push_back(0.0);
@@ -44,7 +43,7 @@ void JointServoBatch::setTarget(size_t i, double target_rad, double stiffness) {
 }
 
 void JointServoBatch::appendState(std::vector<double>& out) const {
-  for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &prev_tau_, &load_, &motor_tau_})
+  for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &load_, &motor_tau_})
     out.insert(out.end(), v->begin(), v->end());
   for (unsigned char h : has_history_) out.push_back(h);
 }
@@ -67,7 +66,8 @@ void JointServoBatch::prepare(std::span<const double> q, std::span<const double>
       // low-pass filtered: static loads (gravity, a push) change slowly, and
       // following contact impulses step by step makes the loop unstable.
       if (has_history_[i]) {
-        const double seen = min_inertia_[i] * (w - prev_qdot_[i]) / dt - prev_tau_[i];
+        // (motor and passive torques still those of last step: torque(i))
+        const double seen = min_inertia_[i] * (w - prev_qdot_[i]) / dt - torque(i);
         load_[i] += kLoadFilter * (seen - load_[i]);
       }
       const double load = load_[i];
@@ -84,7 +84,6 @@ void JointServoBatch::prepare(std::span<const double> q, std::span<const double>
     } else {
       const double pd = kp_[i] * (target_[i] - q[i]) - kd_[i] * w;
       feedforward_[i] = motor_tau_[i] = drive > 0.0 ? std::clamp(pd, lo, hi) : 0.0;
-      prev_tau_[i] = motor_tau_[i] + passive_tau_[i];
     }
     prev_qdot_[i] = w;
     has_history_[i] = 1;
@@ -113,7 +112,6 @@ JointServoBatch::Row JointServoBatch::row(size_t i) const {
 
 void JointServoBatch::setRowImpulse(size_t i, double impulse) {
   motor_tau_[i] = feedforward_[i] + impulse / dt_;
-  prev_tau_[i] = motor_tau_[i] + passive_tau_[i];
 }
 
 double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inertia) const {

@@ -356,6 +356,7 @@ struct OffscreenRenderer::Impl {
   std::vector<std::array<float, 4>> bounds;  // their bounding spheres (x, y, z, r)
   std::vector<float> radius;                 // their meshes' scale (a sphere's, a capsule's radius)
   std::vector<size_t> batch_of;
+  std::vector<size_t> view_order;  // views by height, for the atlas layout
   std::array<std::vector<uint32_t>, kBatchMesh.size()> visible;  // one view's, by batch
   std::vector<Instance> uploaded;  // per view, per batch, the visible instances
   std::vector<std::array<std::array<size_t, 2>, kBatchMesh.size()>> ranges;  // [view][batch]
@@ -588,7 +589,8 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
   // rows of their own).
   const int max_row = 4096;
   m.rects.resize(views.size());
-  std::vector<size_t> order(views.size());
+  std::vector<size_t>& order = m.view_order;
+  order.resize(views.size());
   for (size_t i = 0; i < order.size(); ++i) {
     const RenderView& v = views[i];
     if (v.width <= 0 || v.height <= 0 || v.width > max_row)

@@ -300,7 +300,8 @@ struct PhysicsWorld::Impl {
   JointServoBatch servos;
   std::vector<btMultiBody*> servo_body;
   std::vector<int> servo_link;
-  std::vector<ServoConstraint*> servo_rows;  // owned by `constraints`; null: explicit servo
+  // The implicit servos' rows (owned by `constraints`), with their servo index.
+  std::vector<std::pair<size_t, ServoConstraint*>> servo_rows;
   std::vector<double> q, qdot;
 
   StageTimes times;
@@ -558,11 +559,9 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       m.servo_link.push_back(j);
       if (motor.implicit_servo) {
         auto row = std::make_unique<ServoConstraint>(raw, j, m.servos, s);
-        m.servo_rows.push_back(row.get());
+        m.servo_rows.emplace_back(s, row.get());
         m.world->addMultiBodyConstraint(row.get());
         m.constraints.push_back(std::move(row));
-      } else {
-        m.servo_rows.push_back(nullptr);
       }
     }
   }
@@ -642,11 +641,10 @@ void PhysicsWorld::step() {
     m.qdot[i] = m.servo_body[i]->getJointVel(m.servo_link[i]);
   }
   m.servos.prepare(m.q, m.qdot, settings_.dt);
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < n; ++i)
     m.servo_body[i]->addJointTorque(m.servo_link[i],
                                     static_cast<btScalar>(m.servos.appliedTorque(i)));
-    if (m.servo_rows[i]) m.servo_rows[i]->startStep();
-  }
+  for (auto& [servo, row] : m.servo_rows) row->startStep();
   if (timers_on_) m.times.servo_s += std::chrono::duration<double>(Clock::now() - t0).count();
 
   // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
@@ -655,8 +653,7 @@ void PhysicsWorld::step() {
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
-  for (size_t i = 0; i < n; ++i)
-    if (m.servo_rows[i]) m.servos.setRowImpulse(i, m.servo_rows[i]->impulse());
+  for (auto& [servo, row] : m.servo_rows) m.servos.setRowImpulse(servo, row->impulse());
   for (Articulation& art : m.articulations) art.kinematics_stale = true;
   ++step_count_;
   if (timers_on_) {

@@ -73,9 +73,9 @@ class JointServoBatch {
   //   lower <= feedforward + p / dt <= upper.
   // The feedforward (last step's motor torque, within the bounds) is applied
   // as a joint torque before the solver: Bullet starts joint rows from zero
-  // impulse, and this way its 10 iterations start from the last answer (a
-  // warm start) and look for the change. (Measured without it: the stance,
-  // sway and walk figures were the same; kept as the cheaper starting point.)
+  // impulse, and this way its iterations (solver_iterations, a fixed number)
+  // start from the last answer (a warm start) and look for the change.
+  // (Measured without it: the stance, sway and walk figures were the same.)
   // active false: limp or explicit, no row.
   struct Row {
     bool active = false;
@@ -99,7 +99,7 @@ class JointServoBatch {
 
  private:
   std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_, upper_,
-      min_inertia_, prev_qdot_, prev_tau_, load_, motor_tau_, passive_tau_, feedforward_, lo_, hi_;
+      min_inertia_, prev_qdot_, load_, motor_tau_, passive_tau_, feedforward_, lo_, hi_;
   std::vector<unsigned char> has_history_, implicit_;
   double dt_ = 0.0;
 };
