@@ -91,15 +91,16 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
   referee::Referee ref(w, rules, teams, 0);
   ref.game().standby();
   ref.game().ready();
+  server.publishGameState(ref.game().packet(0), ref.game().leftTeam());  // before they start
   std::vector<std::unique_ptr<ChildProcess>> agents;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-    const auto& info = w.robot(r);
-    agents.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
-        agentProgram().string(), "--team", std::to_string(info.team), "--player",
-        std::to_string(info.number), "--domain", std::to_string(domain), "--role", "auto",
-        "--field", s.field_file.string(), "--game-state-wait", "10"}));
+    SoccerAgentOptions ao;
+    ao.team = w.robot(r).team;
+    ao.player = w.robot(r).number;
+    ao.domain = domain;
+    ao.field = s.field_file;
+    agents.push_back(std::make_unique<ChildProcess>(soccerAgentCommand(ao)));
   }
-  server.publishGameState(ref.game().packet(0), ref.game().leftTeam());  // before they claim
   const auto t_wait = Clock::now();
   while (!server.waitForOwners(w.robotCount(), 0.5))
     if (std::chrono::duration<double>(Clock::now() - t_wait).count() > 60)

@@ -242,35 +242,6 @@ struct RunResult {
   uint64_t log_bytes = 0;
 };
 
-std::vector<std::string> agentArgs(const MatchConfig& c, const RunOptions& o,
-                                   const std::filesystem::path& field, int team, int number,
-                                   uint64_t seed) {
-  std::vector<std::string> a{
-      agentProgram().string(),
-      "--team",
-      std::to_string(team),
-      "--player",
-      std::to_string(number),
-      "--domain",
-      std::to_string(o.domain),
-      "--role",
-      c.role,
-      "--team-number",
-      std::to_string(c.team_numbers[static_cast<size_t>(team)]),
-      "--seed",
-      std::to_string(seed * 1000 + static_cast<uint64_t>(team * 100 + number)),
-      "--game-state-wait",  // the referee's state is published before the agents start
-      "10"};
-  if (!c.agent_config.empty()) {
-    a.push_back("--config");
-    a.push_back(c.agent_config.string());
-  }
-  a.push_back("--field");
-  a.push_back(field.string());
-  if (c.get_up) a.push_back("--get-up");
-  return a;
-}
-
 // Plays one session (a game, or one penalty kick) with agents, logging to `log`.
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
@@ -284,20 +255,32 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.team_message_delay = c.message_delay;
   sc.team_message_loss = c.message_loss;
   net::SimServer server(w, sc);
+  server.publishGameState(session.controlData(), session.game().leftTeam());
+  auto agentCommand = [&](int team, int number) {  // the same for a restart
+    SoccerAgentOptions ao;
+    ao.team = team;
+    ao.player = number;
+    ao.domain = o.domain;
+    ao.role = c.role;
+    ao.field = w.scenario().field_file;
+    ao.config = c.agent_config;
+    ao.team_number = c.team_numbers[static_cast<size_t>(team)];
+    ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);
+    ao.get_up = c.get_up;
+    return soccerAgentCommand(ao);
+  };
   std::vector<AgentSlot> agents;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
     AgentSlot a;
     a.team = w.robot(r).team;
     a.number = w.robot(r).number;
     if (!o.external) {
-      a.process = std::make_unique<ChildProcess>(
-          agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
+      a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
       if (!a.process->started())
         throw std::runtime_error("cannot start " + agentProgram().string());
     }
     agents.push_back(std::move(a));
   }
-  server.publishGameState(session.controlData(), session.game().leftTeam());
   const auto t_wait = Clock::now();
   while (!g_interrupted && !server.waitForOwners(w.robotCount(), 0.5)) {
     if (secondsSince(t_wait) > 60.0)
@@ -354,8 +337,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
                       num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
                       a.restarts);
         result.agent_events.push_back(buf);
-        a.process = std::make_unique<ChildProcess>(
-            agentArgs(c, o, w.scenario().field_file, a.team, a.number, o.seed));
+        a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
       }
       if (result.aborted) break;
     }

@@ -50,6 +50,27 @@ std::filesystem::path agentProgram() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path() / "simsoccer-agent";
 }
 
+std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
+  std::vector<std::string> a{agentProgram().string(),
+                             "--team",
+                             std::to_string(o.team),
+                             "--player",
+                             std::to_string(o.player),
+                             "--domain",
+                             std::to_string(o.domain),
+                             "--role",
+                             o.role,
+                             "--field",
+                             o.field.string(),
+                             "--game-state-wait",
+                             std::to_string(o.game_state_wait)};
+  if (o.team_number) a.insert(a.end(), {"--team-number", std::to_string(*o.team_number)});
+  if (o.seed) a.insert(a.end(), {"--seed", std::to_string(*o.seed)});
+  if (!o.config.empty()) a.insert(a.end(), {"--config", o.config.string()});
+  if (o.get_up) a.push_back("--get-up");
+  return a;
+}
+
 long long loopbackBytes() {
   std::ifstream f("/proc/net/dev");
   std::string line;

@@ -6,7 +6,9 @@
 #include <sys/types.h>
 #include <sys/wait.h>
 
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,21 @@ class ChildProcess {
 
 // The simsoccer-agent program beside the running executable.
 std::filesystem::path agentProgram();
+
+// One soccer agent process as a match or bench scaling starts it. It waits
+// for the referee's GameState (published before the agents start) before it
+// claims its robot, so its first answers already know the game's state.
+struct SoccerAgentOptions {
+  int team = 0, player = 0, domain = 0;
+  std::string role = "auto";
+  std::filesystem::path field;
+  std::filesystem::path config;    // empty: the agent's default
+  std::optional<int> team_number;  // GameController team number
+  std::optional<uint64_t> seed;    // the agent's own random numbers
+  bool get_up = false;
+  double game_state_wait = 10.0;  // s
+};
+std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o);
 
 // Bytes sent on the loopback interface so far (/proc/net/dev), or -1.
 long long loopbackBytes();
