@@ -178,6 +178,17 @@ bool AgentClient::gameState(simsoccer_msg_GameState& out) {
   return impl_->have_game;
 }
 
+bool AgentClient::waitForGameState(double timeout_seconds) {
+  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(timeout_seconds));
+  simsoccer_msg_GameState g;
+  while (!gameState(g)) {
+    if (Clock::now() >= end) return false;
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  return true;
+}
+
 void AgentClient::sendTeamMessage(std::span<const uint8_t> data) {
   if (data.size() > 128) throw std::invalid_argument("team messages are at most 128 bytes");
   simsoccer_msg_TeamMessage m{};

@@ -119,17 +119,11 @@ int main(int argc, char** argv) {
 
     agents::AgentClient client(dds, team, player);
     simsoccer_msg_GameState game{};
-    bool have_game = false;
-    if (soccer) {
-      // The referee's state (durable) before claiming: the simulator starts
-      // once every robot is claimed, so the first frame is answered with it
-      // however late it would have arrived (otherwise the first periods may
-      // be played without it, and the same seed gives another game).
-      const auto until = std::chrono::steady_clock::now() +
-                         std::chrono::duration<double>(opt.number("game-state-wait", 0.0));
-      while (!(have_game = client.gameState(game)) && std::chrono::steady_clock::now() < until)
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    // The referee's state before claiming: the simulator starts once every
+    // robot is claimed, so the first frame is answered with it however late
+    // it would have arrived (otherwise the first periods may be played
+    // without it, and the same seed gives another game).
+    if (soccer) client.waitForGameState(opt.number("game-state-wait", 0.0));
     if (!client.claim(opt.number("claim-timeout", 10.0))) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
       return 3;
@@ -161,7 +155,7 @@ int main(int argc, char** argv) {
           seen = std::move(p);
           have_seen = true;
         }
-        if (client.gameState(game)) have_game = true;
+        const bool have_game = client.gameState(game);
         for (const auto& m : client.receiveTeamMessages()) soccer->receive(m, frame.sim_time);
         if (auto out =
                 soccer->step(frame.sim_time, dt > 0 ? dt : 0.01, agents::motionSensors(frame),

@@ -85,6 +85,9 @@ class AgentClient {
 
   // The latest GameState (false until one arrived).
   bool gameState(simsoccer_msg_GameState& out);
+  // Waits until a GameState has arrived (the topic is durable: the last one
+  // published reaches a late joiner); false on timeout.
+  bool waitForGameState(double timeout_seconds);
   // Team communication: at most 128 bytes, delivered by the simulator to
   // this robot's teammates.
   void sendTeamMessage(std::span<const uint8_t> data);
