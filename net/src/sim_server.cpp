@@ -473,17 +473,22 @@ void SimServer::relayTeamMessages(uint64_t tick) {
     Impl::Pending p{sent + delay, m, {}};
     std::memcpy(p.data.data(), m.data._buffer, m.data._length);
     p.msg.tick = sent;
-    impl_->pending.push_back(p);
+    // Kept in order of delivery tick, team and sender (one sender's in the
+    // order it wrote them): the count and the loss draws do not depend on
+    // which sender's message arrived first.
+    auto& pending = impl_->pending;
+    const auto key = [](const Impl::Pending& x) {
+      return std::tie(x.due, x.msg.team, x.msg.from_player);
+    };
+    pending.insert(std::upper_bound(pending.begin(), pending.end(), p,
+                                    [&](const Impl::Pending& a, const Impl::Pending& b) {
+                                      return key(a) < key(b);
+                                    }),
+                   p);
   });
-  // The due ones by delivery tick, team and sender (one sender's in the order
-  // it wrote them): the count and the loss draws do not depend on arrival.
   auto& pending = impl_->pending;
-  const auto due_end = std::stable_partition(pending.begin(), pending.end(),
-                                             [&](const Impl::Pending& p) { return p.due <= tick; });
-  std::stable_sort(pending.begin(), due_end, [](const Impl::Pending& a, const Impl::Pending& b) {
-    return std::tie(a.due, a.msg.team, a.msg.from_player) <
-           std::tie(b.due, b.msg.team, b.msg.from_player);
-  });
+  const auto due_end = std::partition_point(pending.begin(), pending.end(),
+                                            [&](const Impl::Pending& p) { return p.due <= tick; });
   for (auto it = pending.begin(); it != due_end; ++it) {
     simsoccer_msg_TeamMessage msg = it->msg;
     msg.data._buffer = it->data.data();
