@@ -291,8 +291,7 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
   for (int i = 0; i < 1200; ++i) {
     agents::MotionRequest stand;
     motion.update(dt, agents::motionSensors(w.sensorFrame(0)), stand, position, stiffness);
-    std::vector<double> p(position.begin(), position.end()), k(stiffness.begin(), stiffness.end());
-    w.setCommand(0, p, k);
+    w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
     w.stepControlPeriod();
     if (verbose && i % 10 == 0) {
       const engine::Pose t = w.torsoPose(0);

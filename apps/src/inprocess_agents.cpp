@@ -39,8 +39,8 @@ void InProcessAgents::period(const simsoccer_msg_GameState* game) {
       if (world_.robot(r).team == team && world_.robot(r).number != m.from_player)
         agents_[r]->receive(m, now);
   outbox_.clear();
-  std::vector<float> position(25), stiffness(25);
-  std::vector<double> p(25), k(25);
+  position_.resize(25);
+  stiffness_.resize(25);
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
     // The perception as an agent gets it: through the DDS message's conversion.
     simsoccer_msg_Perception msg{};
@@ -48,18 +48,14 @@ void InProcessAgents::period(const simsoccer_msg_GameState* game) {
                    scratch_);
     const agents::PerceptionIn seen = agents::perceptionFromMessage(msg);
     if (auto out = agents_[r]->step(now, dt, agents::motionSensors(world_.sensorFrame(r)), &seen,
-                                    game, position, stiffness)) {
+                                    game, position_, stiffness_)) {
       agents::TeamMessageIn m;
       m.from_player = world_.robot(r).number;
       m.tick = world_.stepCount() / world_.stepsPerControlPeriod();  // the period, as over DDS
       m.data = std::move(*out);
       outbox_.emplace_back(world_.robot(r).team, std::move(m));
     }
-    for (size_t i = 0; i < 25; ++i) {
-      p[i] = position[i];
-      k[i] = stiffness[i];
-    }
-    world_.setCommand(r, p, k);
+    world_.setCommand(r, std::span<const float>(position_), std::span<const float>(stiffness_));
   }
 }
 

@@ -34,6 +34,7 @@ class InProcessAgents {
   std::vector<std::unique_ptr<agents::SoccerAgent>> agents_;
   std::vector<std::pair<int, agents::TeamMessageIn>> outbox_;  // (team, message)
   std::vector<simsoccer_msg_PerceivedObject> scratch_;
+  std::vector<float> position_, stiffness_;  // one robot's command, reused
 };
 
 }  // namespace simsoccer::apps

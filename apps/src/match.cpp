@@ -705,16 +705,11 @@ int replay(int argc, char** argv, int first) {
     world::World& w = session.world();
     world::MatchLogReader again(file);
     int checked = 0;
-    std::vector<double> p(25), k(25);
     while (again.next(f)) {
-      for (world::RobotId r = 0; r < w.robotCount() && r < f.robots.size(); ++r) {
-        if (!f.robots[r].commanded) continue;
-        for (size_t a = 0; a < 25; ++a) {
-          p[a] = f.robots[r].command_position[a];
-          k[a] = f.robots[r].command_stiffness[a];
-        }
-        w.setCommand(r, p, k);
-      }
+      for (world::RobotId r = 0; r < w.robotCount() && r < f.robots.size(); ++r)
+        if (f.robots[r].commanded)
+          w.setCommand(r, std::span<const double>(f.robots[r].command_position),
+                       std::span<const double>(f.robots[r].command_stiffness));
       w.stepControlPeriod();
       std::vector<world::LogEvent> ev;
       session.afterStep(ev);

@@ -148,6 +148,16 @@ void World::initSensors() {
 
 void World::setCommand(RobotId r, std::span<const double> positions,
                        std::span<const double> stiffness) {
+  applyCommand(r, positions, stiffness);
+}
+
+void World::setCommand(RobotId r, std::span<const float> positions,
+                       std::span<const float> stiffness) {
+  applyCommand(r, positions, stiffness);
+}
+
+template <typename T>
+void World::applyCommand(RobotId r, std::span<const T> positions, std::span<const T> stiffness) {
   const RobotInfo& info = robots_.at(r);
   const auto& actuators = info.model->actuators;
   if (positions.size() != actuators.size() || stiffness.size() != actuators.size())

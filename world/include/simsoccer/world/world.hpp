@@ -72,6 +72,8 @@ class World {
   // Targets (rad) and stiffnesses (0..1) in actuator order; sizes must match
   // the robot's actuator count. Non-finite values are rejected (throws).
   void setCommand(RobotId r, std::span<const double> positions, std::span<const double> stiffness);
+  // The same in single precision, as agents and the wire carry it.
+  void setCommand(RobotId r, std::span<const float> positions, std::span<const float> stiffness);
   // One body joint by index (a mimic joint cannot be commanded: its master is).
   void setJointTarget(RobotId r, int joint, double target_rad, double stiffness);
   // A named pose of the robot model at one stiffness for every joint.
@@ -120,6 +122,8 @@ class World {
   const engine::PhysicsWorld& physics() const { return *physics_; }
 
  private:
+  template <typename T>
+  void applyCommand(RobotId r, std::span<const T> positions, std::span<const T> stiffness);
   void holdJoints(RobotId r, const std::vector<double>& q, double stiffness);
   static Pose standingTorso(const robots::RobotModel& model, const std::vector<double>& q, double x,
                             double y, double yaw);
