@@ -195,13 +195,16 @@ void CameraSystem::run() {
     Job* job = nullptr;
     {
       std::unique_lock lock(mutex_);
-      changed_.wait(lock, [&] { return stopping_ || rendered_ < queue_.size(); });
-      if (rendered_ == queue_.size()) {  // stopping, everything rendered
+      // The front job is being converted while converting_ holds it; the
+      // next one is this thread's.
+      const auto rendered = [&] { return converting_ ? size_t{1} : size_t{0}; };
+      changed_.wait(lock, [&] { return stopping_ || rendered() < queue_.size(); });
+      if (rendered() == queue_.size()) {  // stopping, everything rendered
         render_done_ = true;
         changed_.notify_all();
         return;
       }
-      job = &queue_[rendered_];  // stays queued (counted as in flight) until delivered
+      job = &queue_[rendered()];  // stays queued until delivered
     }
     views.clear();
     for (const ViewJob& v : job->views) views.push_back(v.view);
@@ -214,7 +217,6 @@ void CameraSystem::run() {
       std::unique_lock lock(mutex_);
       changed_.wait(lock, [&] { return !converting_.has_value(); });
       converting_ = std::move(rendered);
-      ++rendered_;
     }
     changed_.notify_all();
   }
@@ -233,7 +235,6 @@ void CameraSystem::convert() {
       std::lock_guard lock(mutex_);
       converting_.reset();
       queue_.pop_front();
-      --rendered_;
     }
     changed_.notify_all();
   }

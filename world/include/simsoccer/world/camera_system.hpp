@@ -133,10 +133,9 @@ class CameraSystem {
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  // Waiting and in flight: the first `rendered_` have been rendered (at most
-  // one is being converted, one more may be rendered and waiting for it).
+  // Waiting and in flight, oldest first: while converting_ holds the front
+  // one's capture, the render thread works on the second.
   std::deque<Job> queue_;
-  size_t rendered_ = 0;
   std::optional<Rendered> converting_;  // handed to the conversion thread
   bool render_done_ = false;            // the render thread has returned
   bool stopping_ = false;
