@@ -33,8 +33,6 @@ std::optional<std::vector<uint8_t>> SoccerAgent::step(
   in.perception = perception;
   in.game = game;
   in.motion = motion_.state();
-  in.fallen = motion_.state() == MotionState::Falling || motion_.state() == MotionState::Lying ||
-              motion_.state() == MotionState::GettingUp;
   const MotionRequest request = behaviour_.update(in);
   if (behaviour_.takeMotionRestart()) motion_.restart();
   auto message = behaviour_.outgoing(in);

@@ -268,7 +268,8 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
     int player;
     double cost, x;
   };
-  const double my_cost = std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
+  const double my_cost =
+      std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen() ? 2.0 : 0.0);
   std::vector<Bid> bids{{player_, my_cost, self_.x}};
   for (const Teammate& m : mates_) {
     if (m.data.player == goalkeeper_number_ ||
@@ -309,7 +310,7 @@ std::optional<std::vector<uint8_t>> SoccerBehaviour::outgoing(const Input& in) {
   TeamMessageData d;
   d.player = player_;
   d.role = role_;
-  d.fallen = in.fallen;
+  d.fallen = in.fallen();
   const Vec2 f = fromOwn(self_.x, self_.y);
   d.x = f.x;
   d.y = f.y;
@@ -319,7 +320,7 @@ std::optional<std::vector<uint8_t>> SoccerBehaviour::outgoing(const Input& in) {
   d.ball_x = b.x;
   d.ball_y = b.y;
   d.ball_age = std::max(0.0, in.time - ball_seen_at_);
-  d.cost = std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen ? 2.0 : 0.0);
+  d.cost = std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen() ? 2.0 : 0.0);
   return encodeTeamMessage(d);
 }
 
@@ -512,7 +513,7 @@ void SoccerBehaviour::head(MotionRequest& r, const Input& in) {
 
 MotionRequest SoccerBehaviour::update(const Input& in) {
   now_ = in.time;
-  if (in.motion == MotionState::Kicking || in.fallen) kick_commit_until_ = -1.0;
+  if (in.motion == MotionState::Kicking || in.fallen()) kick_commit_until_ = -1.0;
   readGame(in);
   updateBall(in);
   MotionRequest r;

@@ -90,7 +90,11 @@ class SoccerBehaviour {
     const PerceptionIn* perception = nullptr;       // this period's, if any
     const simsoccer_msg_GameState* game = nullptr;  // the latest, if any
     MotionState motion = MotionState::Stance;
-    bool fallen = false;
+    // Down: falling, lying or getting up (from the motion state).
+    bool fallen() const {
+      return motion == MotionState::Falling || motion == MotionState::Lying ||
+             motion == MotionState::GettingUp;
+    }
   };
   MotionRequest update(const Input& in);
   // Teammates' messages as they arrive (stamped with the period they were sent in).
