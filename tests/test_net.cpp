@@ -169,7 +169,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   pos[0] = 1.5f;  // HeadYaw
   const uint64_t refused_before = server.stats(0).refused;
   for (int i = 0; i < 100; ++i) {
-    const uint64_t tick = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+    const uint64_t tick = w.controlTick();
     intruder.send(tick, pos, stiff);
     server.runPeriod();
   }
@@ -291,7 +291,7 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   b.sendTeamMessage(hello);
   std::vector<std::pair<uint64_t, agents::TeamMessageIn>> got_a;  // (simulator tick, message)
   for (int i = 0; i < 20; ++i) {
-    const uint64_t now = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+    const uint64_t now = w.controlTick();
     server.runPeriod();
     dds_sleepfor(DDS_MSECS(2));
     for (auto& m : a.receiveTeamMessages()) got_a.emplace_back(now, m);
@@ -418,7 +418,7 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
   viewer.subscribeImages();
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   server.poll(0.5);  // the viewer's reader matches the image writer
-  const uint64_t first = w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod());
+  const uint64_t first = w.controlTick();
   const int periods = 100;
   size_t got[2] = {0, 0};
   std::vector<agents::CameraImageIn> images;
@@ -534,7 +534,7 @@ TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
     const auto start = Clock::now();
     while (!viewer.perception(p) && seconds(start) < 1.0)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    if (p.tick == static_cast<uint64_t>(w.stepCount() / w.stepsPerControlPeriod()) - 1) ++received;
+    if (p.tick == w.controlTick() - 1) ++received;
   }
   std::printf("perception received for %d of 50 periods; ball at (%.3f, %.3f), in view %d\n",
               received, p.ball.x, p.ball.y, p.ball.in_view);

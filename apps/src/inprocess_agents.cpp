@@ -51,7 +51,7 @@ void InProcessAgents::period(const simsoccer_msg_GameState* game) {
                                     game, position_, stiffness_)) {
       agents::TeamMessageIn m;
       m.from_player = world_.robot(r).number;
-      m.tick = world_.stepCount() / world_.stepsPerControlPeriod();  // the period, as over DDS
+      m.tick = world_.controlTick();  // the period, as over DDS
       m.data = std::move(*out);
       outbox_.emplace_back(world_.robot(r).team, std::move(m));
     }

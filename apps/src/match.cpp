@@ -309,8 +309,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       stiffness[r] = server.commandStiffness(r);
     }
     world::LogFrame frame =
-        world::captureFrame(w, w.stepCount() / static_cast<uint64_t>(w.stepsPerControlPeriod()),
-                            positions, stiffness, commanded);
+        world::captureFrame(w, w.controlTick(), positions, stiffness, commanded);
     const auto packet = referee::encode(game);
     frame.game.assign(packet.begin(), packet.end());
     result.events.insert(result.events.end(), events.begin(), events.end());

@@ -315,8 +315,7 @@ size_t SimServer::ownedCount() const {
 void SimServer::setGameState(const simsoccer_msg_GameState& state) {
   impl_->game_state = state;
   impl_->game_state_set = true;
-  impl_->game_state.tick =
-      world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
+  impl_->game_state.tick = world_.controlTick();
   impl_->game.write(impl_->game_state);
   impl_->game_state_published_at = world_.time();
 }
@@ -330,7 +329,7 @@ void SimServer::publishGameState(referee::ControlData data, int left_team) {
   }
   if (published_game_ && data == *published_game_) return;  // SimServer repeats it at 2 Hz
   simsoccer_msg_GameState m{};
-  toMessage(data, world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod()), m);
+  toMessage(data, world_.controlTick(), m);
   setGameState(m);
   published_game_ = data;
 }
@@ -557,7 +556,7 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
 
 void SimServer::runPeriod() {
   const auto t0 = Clock::now();
-  const uint64_t tick = world_.stepCount() / static_cast<uint64_t>(world_.stepsPerControlPeriod());
+  const uint64_t tick = world_.controlTick();
   {
     std::lock_guard lock(mutex_);
     handleJoins();

@@ -102,7 +102,7 @@ CameraSystem::~CameraSystem() {
 }
 
 void CameraSystem::capture(const World& world) {
-  const uint64_t tick = world.stepCount() / static_cast<uint64_t>(world.stepsPerControlPeriod());
+  const uint64_t tick = world.controlTick();
   const std::array<const CameraSpec*, 2> specs{&settings_.top, &settings_.bottom};
   std::array<bool, 2> robot_due{};
   for (size_t c = 0; c < 2; ++c)

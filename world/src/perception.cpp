@@ -107,7 +107,7 @@ void PerceptionSystem::observe(const World& world, const Viewpoint& from, const 
 
 void PerceptionSystem::update(const World& world) {
   if (!settings_.enabled) return;
-  const uint64_t tick = world.stepCount() / static_cast<uint64_t>(world.stepsPerControlPeriod());
+  const uint64_t tick = world.controlTick();
   const Vec3 ball = world.ballState().pose.translation();
   torsos_.resize(world.robotCount());
   for (RobotId r = 0; r < world.robotCount(); ++r) torsos_[r] = world.torsoPose(r).translation();

@@ -67,6 +67,8 @@ class World {
   size_t robotCount() const { return robots_.size(); }
   const RobotInfo& robot(RobotId r) const { return robots_.at(r); }
   int stepsPerControlPeriod() const { return steps_per_control_; }
+  // The control period under way (its number: the tick of SensorFrames and commands).
+  uint64_t controlTick() const { return stepCount() / static_cast<uint64_t>(steps_per_control_); }
 
   // --- commands -----------------------------------------------------------------
   // Targets (rad) and stiffnesses (0..1) in actuator order; sizes must match
