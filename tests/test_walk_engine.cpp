@@ -121,7 +121,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
   const std::vector<engine::Vec3> soles[2] = {soleCorners(body, feet[0]),
                                               soleCorners(body, feet[1])};
   EXPECT_EQ(soles[0].size(), 4u);
-  const double mass = body.totalMass(), dt = 0.01, g = 9.81;
+  const double dt = 0.01, g = 9.81;
   SupportMargins m;
   engine::Pose ground_support = engine::Pose::Identity();  // the support foot in the ground frame
   int support = 1;
@@ -149,10 +149,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
       const engine::Pose ground_torso =
           ground_support * frames[static_cast<size_t>(feet[support])].inverse();
       yaw = std::atan2(ground_torso.linear()(1, 0), ground_torso.linear()(0, 0));
-      engine::Vec3 com = engine::Vec3::Zero();
-      for (size_t l = 0; l < body.links.size(); ++l)
-        com += body.links[l].mass * (frames[l] * body.links[l].com);
-      com_track.push_back(ground_torso * (com / mass));
+      com_track.push_back(ground_torso * body.centreOfMass(frames));
       // The swing foot is down when its sole is within 0.5 mm of the ground.
       const engine::Pose ground_swing =
           ground_torso * frames[static_cast<size_t>(feet[1 - support])];

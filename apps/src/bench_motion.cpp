@@ -208,13 +208,9 @@ struct GetUpResult {
 void traceSupport(const world::World& w, std::span<const float> targets) {
   const auto& model = *w.robot(0).model;
   const auto& links = model.body->links;
-  Vec3 com = Vec3::Zero();
-  double mass = 0.0;
-  for (size_t l = 0; l < links.size(); ++l) {
-    com += links[l].mass * (w.linkPose(0, static_cast<int>(l)) * links[l].com);
-    mass += links[l].mass;
-  }
-  com /= mass;
+  std::vector<engine::Pose> frames;
+  for (size_t l = 0; l < links.size(); ++l) frames.push_back(w.linkPose(0, static_cast<int>(l)));
+  const Vec3 com = model.body->centreOfMass(frames);
   const engine::Pose t = w.torsoPose(0);
   // Heading: the torso's x axis, or when that is vertical (lying), its z axis.
   Vec3 ahead(t.linear()(0, 0), t.linear()(1, 0), 0.0);
@@ -223,22 +219,25 @@ void traceSupport(const world::World& w, std::span<const float> targets) {
   const Vec3 left = Vec3::UnitZ().cross(ahead);
   std::fprintf(stderr, "    com z %.3f  ground:", com.z());
   // Per link on the ground: the span of its contacts ahead of the CoM, and their mean sideways.
-  std::vector<int> order;
-  std::vector<std::array<double, 4>> span(links.size(), {1e9, -1e9, 0.0, 0.0});
+  struct Span {
+    double behind = 1e9, ahead = -1e9, sideways = 0.0;  // m
+    int contacts = 0;
+  };
+  std::vector<int> order;  // links in the order they were first seen
+  std::vector<Span> span(links.size());
   for (const engine::LinkContact& c : w.contacts()) {
     if (c.articulation != w.robot(0).body || c.with_articulation || c.other_body >= 0) continue;
-    auto& sp = span[static_cast<size_t>(c.link)];
-    if (sp[3] == 0.0) order.push_back(c.link);
+    Span& sp = span[static_cast<size_t>(c.link)];
+    if (sp.contacts++ == 0) order.push_back(c.link);
     const Vec3 d = c.position - com;
-    sp[0] = std::min(sp[0], d.dot(ahead));
-    sp[1] = std::max(sp[1], d.dot(ahead));
-    sp[2] += d.dot(left);
-    sp[3] += 1.0;
+    sp.behind = std::min(sp.behind, d.dot(ahead));
+    sp.ahead = std::max(sp.ahead, d.dot(ahead));
+    sp.sideways += d.dot(left);
   }
   for (int l : order) {
-    const auto& sp = span[static_cast<size_t>(l)];
+    const Span& sp = span[static_cast<size_t>(l)];
     std::fprintf(stderr, " %s(%+.2f..%+.2f,%+.2f)", links[static_cast<size_t>(l)].name.c_str(),
-                 sp[0], sp[1], sp[2] / sp[3]);
+                 sp.behind, sp.ahead, sp.sideways / sp.contacts);
   }
   std::fprintf(stderr, "\n    lag:");
   for (size_t a = 0; a < model.actuators.size() && a < targets.size(); ++a) {

@@ -26,6 +26,13 @@ double ArticulatedModel::totalMass() const {
   return m;
 }
 
+Vec3 ArticulatedModel::centreOfMass(std::span<const Pose> link_frames) const {
+  Vec3 sum = Vec3::Zero();
+  for (size_t l = 0; l < links.size() && l < link_frames.size(); ++l)
+    sum += links[l].mass * (link_frames[l] * links[l].com);
+  return sum / totalMass();
+}
+
 std::vector<Pose> ArticulatedModel::linkFramesAt(const std::vector<double>& q) const {
   std::vector<Pose> frames(links.size(), Pose::Identity());
   for (size_t j = 0; j < joints.size(); ++j) {

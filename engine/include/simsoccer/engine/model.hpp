@@ -95,6 +95,9 @@ struct ArticulatedModel {
   int linkIndex(const std::string& link_name) const;    // -1 if absent
   int jointIndex(const std::string& joint_name) const;  // -1 if absent
   double totalMass() const;
+  // The whole body's centre of mass, given every link's joint frame (in any
+  // one frame: the result is in it).
+  Vec3 centreOfMass(std::span<const Pose> link_frames) const;
   // Joint-frame pose of every link relative to the root at the given joint
   // angles (forward kinematics on the model data alone, no physics).
   std::vector<Pose> linkFramesAt(const std::vector<double>& joint_positions) const;
