@@ -72,7 +72,9 @@ class MatchSession {
   std::array<double, 2> possession() const;  // share of the time each team had the ball
   struct Goal {
     double time;
-    int team, scorer;  // scorer: player number of the last touch by that team (0: unknown)
+    // scorer: player number of the last robot to touch the ball, of either team (0: unknown);
+    // own_goal: that robot was the other team's.
+    int team, scorer;
     bool own_goal;
   };
   const std::vector<Goal>& goals() const { return goals_; }
