@@ -98,6 +98,7 @@ struct SupportMargins {
   double zmp = 1e9;       // m, the same for the ZMP (negative: outside)
   double zmp_mean = 0.0;  // m, mean ZMP margin
   int ticks = 0, single_support = 0;
+  int zmp_outside = 0;  // ticks with the ZMP more than 5 mm outside
 };
 
 // Runs the walk engine on a planned command sequence (velocity, seconds) at
@@ -194,6 +195,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
                                          true);
         m.zmp = std::min(m.zmp, margin);
         zmp_sum += margin;
+        if (margin < -0.005) ++m.zmp_outside;
         ++zmp_count;
       }
     }
@@ -204,7 +206,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
 
 }  // namespace
 
-// The pattern generator's plan keeps its ZMP over the support polygon
+// The pattern generator's plan, its ZMP against the support polygon
 // (issue: "the ZMP/CoM stays in the support polygon for a planned step
 // sequence"), checked on the plan itself: forward kinematics of the commanded
 // joint angles with the model's masses, no physics.
@@ -213,13 +215,16 @@ SupportMargins walkSupport(const robots::RobotModel& model,
 //    5 mm outside (the generator has no double-support phase: the ZMP must
 //    jump from one foot to the other; measured up to 4.4 mm past the sole's inner
 //    rear edge for one 10 ms tick).
-//  - Known limits, measured and printed, not asserted: the plan's body changes
-//    velocity at once at a step boundary (ramps, the sideways and turning
-//    steps that open on one step and close on the next), an impulse that
-//    puts the cart-table ZMP up to 0.35 m outside for one tick; and the CoM
+//  - Known limits, measured and printed; only bounded (mean inside, at most
+//    a fifth of the ticks more than 5 mm outside): the plan's body changes
+//    velocity at once at a step boundary (ramps, stopping), an impulse that
+//    puts the cart-table ZMP up to 0.35 m outside for one tick; in sideways
+//    steps (open on one step, close on the next) the body moves over the
+//    landing foot before it lands, the ZMP outside for the last fifth of the
+//    opening step (107 of 599 ticks); turning 23, combined 61 ticks. The CoM
 //    itself leaves the sole during single support by up to 54 mm (a dynamic
-//    walk: it is the ZMP that has to stay in). Both are mean-inside.
-TEST(WalkEngine, PlannedZmpStaysOverTheSupportPolygon) {
+//    walk: it is the ZMP that has to stay in).
+TEST(WalkEngine, PlannedZmpAgainstTheSupportPolygon) {
   const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
   const SupportMargins steady = walkSupport(model, {{{0.3, 0.0, 0.0}, 6.0}}, 2.0);
   std::printf(
@@ -243,10 +248,12 @@ TEST(WalkEngine, PlannedZmpStaysOverTheSupportPolygon) {
     SCOPED_TRACE(c.name);
     const SupportMargins m = walkSupport(model, c.plan);
     std::printf(
-        "%-20s ticks %d (single support %d): ZMP margin min %.1f mm, mean %.1f mm; CoM "
-        "margin min %.1f mm\n",
-        c.name, m.ticks, m.single_support, 1000 * m.zmp, 1000 * m.zmp_mean, 1000 * m.com);
+        "%-20s ticks %d (single support %d): ZMP margin min %.1f mm, mean %.1f mm, %d ticks "
+        "> 5 mm outside; CoM margin min %.1f mm\n",
+        c.name, m.ticks, m.single_support, 1000 * m.zmp, 1000 * m.zmp_mean, m.zmp_outside,
+        1000 * m.com);
     EXPECT_GT(m.single_support, m.ticks / 2);
     EXPECT_GT(m.zmp_mean, 0.0);
+    EXPECT_LE(m.zmp_outside, m.ticks / 5);  // measured: 6, 107, 23 and 61 of 549-599 ticks
   }
 }
