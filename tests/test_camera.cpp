@@ -216,6 +216,13 @@ TEST(Camera, AViewInABatchOf44RendersAsItDoesAlone) {
     std::printf("view %zu: %d pixels differ\n", i, cv::countNonZero(diff));
     EXPECT_LE(cv::countNonZero(diff), static_cast<int>(diff.total() / 10000)) << "view " << i;
   }
+  // And they show the scene: blank views would agree too. A bottom camera may
+  // see only carpet; every top camera sees lines, goals or robots.
+  for (size_t i = 0; i < views.size(); i += 2) {
+    cv::Scalar mean, spread;
+    cv::meanStdDev(batch[i], mean, spread);
+    EXPECT_GT(spread[1], 5.0) << "top camera view " << i;
+  }
 }
 
 TEST(Camera, CapsuleAndItsCoarseStandInWherePredicted) {
