@@ -102,6 +102,7 @@ TEST(JointServoBatch, ImplicitServoIsStableWhereTheExplicitOneDiverges) {
   // A stiff servo on a joint far lighter than its gains allow at 5 ms
   // (dt kd / I = 5): the explicit servo's swing grows, the implicit one settles.
   for (const bool implicit : {false, true}) {
+    SCOPED_TRACE(implicit ? "implicit" : "explicit");
     engine::Motor m = testMotor(60.0, implicit);
     m.kd = 0.3;
     m.stall_torque = 1e3;  // the envelope never binds: the PD alone
