@@ -270,7 +270,9 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   a.sendTeamMessage(hello);
   server.poll(0.2);
   std::vector<agents::TeamMessageIn> got_b, got_c;
-  for (int i = 0; i < 40; ++i) {
+  // At least 40 periods; more while the message is on its way on a busy machine.
+  auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  for (int i = 0; i < 40 || (got_b.empty() && std::chrono::steady_clock::now() < until); ++i) {
     server.runPeriod();
     dds_sleepfor(DDS_MSECS(2));
     for (auto& m : b.receiveTeamMessages()) got_b.push_back(m);
@@ -290,7 +292,8 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   }
   b.sendTeamMessage(hello);
   std::vector<std::pair<uint64_t, agents::TeamMessageIn>> got_a;  // (simulator tick, message)
-  for (int i = 0; i < 20; ++i) {
+  until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  for (int i = 0; i < 20 || (got_a.empty() && std::chrono::steady_clock::now() < until); ++i) {
     const uint64_t now = w.controlTick();
     server.runPeriod();
     dds_sleepfor(DDS_MSECS(2));
