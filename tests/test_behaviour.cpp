@@ -214,7 +214,7 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   EXPECT_LT(m.duration(), 8.0);
   // The last frame is the stand pose.
   EXPECT_EQ(m.frames.back().position, model.pose("stand"));
-  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_keyframes";
+  const auto dir = test::freshTempDir("keyframes");
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "bad.yaml")
       << "motion: bad\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 3.0}}\n";

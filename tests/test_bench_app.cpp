@@ -143,8 +143,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
 // The get-up tuning aids: another motions folder, the side-view snapshots
 // (real EGL rendering, tiled), the support trace; a bad motion file is named.
 TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("simsoccer_motions_" + std::to_string(getpid()));
+  const std::filesystem::path dir = test::freshTempDir("motions");
   std::filesystem::create_directories(dir);
   struct RemoveAfter {
     std::filesystem::path dir;

@@ -17,13 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string readFile(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
 class ConfigErrors : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -32,8 +25,8 @@ class ConfigErrors : public ::testing::Test {
             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    robot_ = readFile(test::naoH25());
-    scenario_ = readFile(test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml");
+    robot_ = test::readFile(test::naoH25());
+    scenario_ = test::readFile(test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml");
     // Point the copied scenario at the copied robot file and the real field.
     replace(scenario_, "../../fields/spl.yaml", test::splField().string());
     replace(scenario_, "../../robots/nao_v6_h25.yaml", (dir_ / "robot.yaml").string());
@@ -153,7 +146,7 @@ TEST_F(ConfigErrors, SyntaxError) {
 }
 
 TEST_F(ConfigErrors, BadFieldValue) {
-  std::string field = readFile(test::splField());
+  std::string field = test::readFile(test::splField());
   replace(field, "width: 6.0", "width: -6.0");
   std::ofstream(dir_ / "field.yaml") << field;
   try {

@@ -21,13 +21,6 @@ namespace {
 
 const std::string kBin = SIMSOCCER_BIN;
 
-std::string readFile(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The value of a top-level "key": number or string in our summary's JSON.
 std::string jsonValue(const std::string& json, const std::string& key) {
   const std::regex re("\"" + key + "\": (\"[^\"]*\"|[-0-9.]+|null|true|false|\\[[^\\]]*\\])");
@@ -45,12 +38,6 @@ std::string withoutWallTimes(const std::string& json) {
   return out.str();
 }
 
-std::filesystem::path tempDir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() / ("simsoccer_test_" + name);
-  std::filesystem::remove_all(d);
-  return d;
-}
-
 // One short 2 v 2 game (2 x 15 s halves). ctest runs each test in its own
 // process, maybe side by side: each plays its own, in its own folder and DDS domain.
 struct ShortMatch {
@@ -60,7 +47,7 @@ struct ShortMatch {
 };
 ShortMatch shortMatch(const std::string& name, int domain, const std::string& extra = "") {
   ShortMatch r;
-  r.dir = tempDir(name);
+  r.dir = test::freshTempDir(name);
   r.out =
       test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
                            " --half 15 --domain " + std::to_string(domain) + " --out " +
@@ -76,7 +63,8 @@ struct BackgroundMatch {
   int status = -1;
   std::string out;
   std::thread thread;
-  BackgroundMatch(const std::string& name, const std::string& options) : dir(tempDir(name)) {
+  BackgroundMatch(const std::string& name, const std::string& options)
+      : dir(test::freshTempDir(name)) {
     thread = std::thread([this, options] {
       out = test::runCommand(kBin + " match " +
                                  (test::sourceDir() / "configs/match_2v2.yaml").string() + " " +
@@ -103,7 +91,7 @@ struct BackgroundMatch {
 TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   const ShortMatch m = shortMatch("match_a", 131);
   ASSERT_EQ(m.status, 0) << m.out;
-  const std::string summary = readFile(m.dir / "summary.json");
+  const std::string summary = test::readFile(m.dir / "summary.json");
   ASSERT_FALSE(summary.empty());
   for (const char* key : {"final_score", "goals", "referee_events", "penalties", "robots",
                           "possession", "agent_restarts", "simulated_seconds", "wall_seconds",
@@ -158,7 +146,8 @@ TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
   const ShortMatch b = shortMatch("match_b2", 137, "--no-video --lockstep-timeout 5");
   ASSERT_EQ(b.status, 0) << b.out;
   const auto dir = b.dir;
-  const std::string one = readFile(a.dir / "summary.json"), two = readFile(dir / "summary.json");
+  const std::string one = test::readFile(a.dir / "summary.json"),
+                    two = test::readFile(dir / "summary.json");
   for (const std::string* s : {&one, &two}) {
     const std::regex missed("\"missed_commands\": ([0-9]+)");
     int robots = 0;
@@ -205,7 +194,7 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
   m.join();
   const auto& dir = m.dir;
   ASSERT_EQ(m.status, 0) << m.out;
-  const std::string summary = readFile(dir / "summary.json");
+  const std::string summary = test::readFile(dir / "summary.json");
   EXPECT_NE(jsonValue(summary, "agent_restarts"), "[]") << summary;
   EXPECT_NE(summary.find("\"team\": 1, \"player\": 2, \"exit_status\""), std::string::npos);
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
@@ -220,7 +209,7 @@ TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
   m.join();
   const auto& dir = m.dir;
   EXPECT_EQ(WEXITSTATUS(m.status), 130) << m.out;
-  const std::string summary = readFile(dir / "summary.json");
+  const std::string summary = test::readFile(dir / "summary.json");
   EXPECT_EQ(jsonValue(summary, "interrupted"), "true") << summary;
   world::MatchLogReader log(dir / "match.log");
   world::LogFrame f;
@@ -236,7 +225,7 @@ TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
 }
 
 TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
-  const auto dir = tempDir("match_bad");
+  const auto dir = test::freshTempDir("match_bad");
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "bad.yaml") << "match: bad\nscenario: nowhere.yaml\nrules: rules/spl.yaml\n";
   int status = 0;
@@ -254,14 +243,14 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
 }
 
 TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
-  const auto dir = tempDir("penalty");
+  const auto dir = test::freshTempDir("penalty");
   int status = -1;
   const std::string out =
       test::runCommand(kBin + " penalty " + (test::sourceDir() / "configs/penalty.yaml").string() +
                            " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.string(),
                        status);
   ASSERT_EQ(status, 0) << out;
-  const std::string json = readFile(dir / "penalty.json");
+  const std::string json = test::readFile(dir / "penalty.json");
   EXPECT_EQ(jsonValue(json, "kicks"), "5");
   const std::regex outcome("\"(goal|saved|missed|timeout)\"");
   const std::string list = json.substr(json.find("\"outcomes\""));
@@ -293,7 +282,7 @@ TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
 }
 
 TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
-  const auto dir = tempDir("scaling");
+  const auto dir = test::freshTempDir("scaling");
   std::filesystem::create_directories(dir);
   int status = -1;
   const std::string out = test::runCommand(

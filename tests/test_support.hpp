@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,18 @@ inline std::string runCommand(const std::string& cmd, int& status) {
   while (fgets(buf, sizeof buf, p)) out += buf;
   status = pclose(p);
   return out;
+}
+inline std::string readFile(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+// An empty folder of this test process's own (name and process id: test
+// runs side by side do not share it); removed first if it was left over.
+inline std::filesystem::path freshTempDir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("simsoccer_test_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(d);
+  return d;
 }
 inline std::filesystem::path dataDir() {
   return sourceDir() / "tests" / "data";
