@@ -205,6 +205,123 @@ TEST(SoccerBehaviour, TheStrikerKicksWhenTheBallIsInFrontOfAFootAndAimedAtTheGoa
   EXPECT_NEAR(r.head_yaw, std::atan2(0.05, 0.17), 0.01);
 }
 
+// The goalkeeper against a ball rolled at it (perceived every 0.1 s, its
+// velocity estimated by the behaviour): it blocks one coming at it in time;
+// in the shoot-out it dives, to the ball's side, for one out of the block's
+// reach; a slow ball or one going wide is neither blocked nor dived for.
+TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  struct Outcome {
+    MotionRequest::Kind kind = MotionRequest::Kind::Walk;
+    agents::Leg side = agents::Leg::Left;
+    double ball_x = 0.0;  // where the ball was when the keeper acted
+  };
+  // Ball from (-1.5, y0) at (vx, vy) m/s; the keeper at (x, 0) facing +x.
+  auto roll = [&](Role role, double x, double y0, double vx, double vy) {
+    agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, role, 1);
+    Outcome o;
+    for (int i = 0; i < 40; ++i) {
+      const double t = 0.1 * i, bx = -1.5 + vx * t, by = y0 + vy * t;
+      if (bx < x) break;  // passed it
+      auto p = seeing(x, 0.0, 0.0, bx, by, t);
+      agents::SoccerBehaviour::Input in;
+      in.time = t;
+      in.perception = &p;
+      const MotionRequest r = keeper.update(in);
+      if (r.kind == MotionRequest::Kind::Block || r.kind == MotionRequest::Kind::Dive) {
+        o = {r.kind, r.side, bx};
+        break;
+      }
+    }
+    return o;
+  };
+  const double line = -f.halfLength() + 0.25, shootout_line = -f.halfLength() + 0.05;
+  // Straight at the keeper at 2 m/s: a block, before the ball is there.
+  Outcome o = roll(Role::Goalkeeper, line, 0.1, -2.0, 0.0);
+  EXPECT_EQ(o.kind, MotionRequest::Kind::Block);
+  EXPECT_GT(o.ball_x - line, 0.3);
+  const auto acted = [](const Outcome& x) {
+    return x.kind == MotionRequest::Kind::Block || x.kind == MotionRequest::Kind::Dive;
+  };
+  // 0.6 m to its side: no dive in play (it would end on the ground) ...
+  EXPECT_FALSE(acted(roll(Role::Goalkeeper, line, 0.6, -2.0, 0.0)));
+  // ... but in the shoot-out: to the left for +y, to the right for -y.
+  o = roll(Role::PenaltyGoalkeeper, shootout_line, 0.6, -2.0, 0.0);
+  EXPECT_EQ(o.kind, MotionRequest::Kind::Dive);
+  EXPECT_EQ(o.side, agents::Leg::Left);
+  EXPECT_GT(o.ball_x - shootout_line, 0.5);  // a dive takes longer to reach the ground
+  o = roll(Role::PenaltyGoalkeeper, shootout_line, -0.6, -2.0, 0.0);
+  EXPECT_EQ(o.kind, MotionRequest::Kind::Dive);
+  EXPECT_EQ(o.side, agents::Leg::Right);
+  // Slow (0.3 m/s), or 1.2 m wide of the keeper: neither.
+  EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.3, 0.0)));
+  EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 1.2, -2.0, 0.0)));
+}
+
+// The block and the dive on the real robot (Bullet, joint targets only): the
+// block spreads the feet and lowers the torso without a fall, and the robot is
+// back in its stance after it; the dive puts it on the ground on the side it
+// was asked for, and it is counted as a dive, not as a fall.
+TEST(MotionController, TheBlockStaysUpAndTheDiveLandsOnItsSide) {
+  for (const auto kind : {MotionRequest::Kind::Block, MotionRequest::Kind::Dive}) {
+    for (const auto side : {agents::Leg::Left, agents::Leg::Right}) {
+      if (kind == MotionRequest::Kind::Block && side == agents::Leg::Right) continue;
+      SCOPED_TRACE(kind == MotionRequest::Kind::Block ? "block"
+                   : side == agents::Leg::Left        ? "dive left"
+                                                      : "dive right");
+      world::World w(test::scenario(1));
+      const auto& model = *w.robot(0).model;
+      agents::FallDetectorParameters fall;
+      fall.get_up = false;
+      agents::MotionController mc =
+          agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
+      std::vector<float> position(25), stiffness(25);
+      const double dt = w.scenario().physics.control_period;
+      const int lfoot = model.body->linkIndex("LFoot"), rfoot = model.body->linkIndex("RFoot");
+      auto period = [&](const MotionRequest& r) {
+        mc.update(dt, agents::motionSensors(w.sensorFrame(0)), r, position, stiffness);
+        w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
+        w.stepControlPeriod();
+      };
+      MotionRequest stand, act;
+      for (int i = 0; i < 200; ++i) period(stand);  // into the stance
+      ASSERT_EQ(mc.state(), agents::MotionState::Stance);
+      const Vec3 torso0 = w.torsoPose(0).translation();
+      const double feet0 = (w.linkPose(0, lfoot).translation() - w.linkPose(0, rfoot).translation()).y();
+      act.kind = kind;
+      act.side = side;
+      period(act);
+      double lowest = torso0.z(), widest = feet0;
+      for (int i = 0; i < 80; ++i) {  // 0.8 s: the block held, the dive landed
+        period(stand);
+        lowest = std::min(lowest, w.torsoPose(0).translation().z());
+        widest = std::max(widest, (w.linkPose(0, lfoot).translation() -
+                                   w.linkPose(0, rfoot).translation()).y());
+      }
+      if (kind == MotionRequest::Kind::Block) {
+        EXPECT_EQ(mc.state(), agents::MotionState::Blocking);
+        EXPECT_GT(widest - feet0, 0.08);        // the feet spread sideways (0.103 measured)
+        EXPECT_LT(lowest, torso0.z() - 0.05);   // and the torso goes down (0.073)
+        for (int i = 0; i < 300; ++i) period(stand);
+        EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+        EXPECT_TRUE(w.isStanding(0));
+        EXPECT_EQ(mc.counters().blocks, 1);
+        EXPECT_EQ(mc.counters().falls, 0);
+      } else {
+        for (int i = 0; i < 200; ++i) period(stand);
+        EXPECT_EQ(mc.state(), agents::MotionState::Lying);
+        const Vec3 torso = w.torsoPose(0).translation();
+        EXPECT_LT(torso.z(), 0.15);  // on the ground
+        // Towards the side asked for (the robot faces +x: left is +y).
+        EXPECT_GT((side == agents::Leg::Left ? 1 : -1) * (torso.y() - torso0.y()), 0.15);
+        EXPECT_EQ(mc.counters().dives, 1);
+        EXPECT_EQ(mc.counters().falls, 0);
+      }
+    }
+  }
+}
+
 TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   const auto model = robots::loadRobotModel(test::naoH25());
   const auto m =

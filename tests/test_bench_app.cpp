@@ -108,7 +108,8 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
 TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   const test::BenchRun run = test::runBench(
       SIMSOCCER_BIN,
-      "bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1");
+      "bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1 "
+      "--block-trials 2");
   const std::string& out = run.out;
   ASSERT_EQ(run.status, 0) << out;
   const std::vector<std::string>& lines = run.lines;
@@ -123,7 +124,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
     ASSERT_EQ(cells.size(), 8u) << line;
     rows[cells[1]] = cells;
   }
-  ASSERT_EQ(rows.size(), 10u);
+  ASSERT_EQ(rows.size(), 12u);
   // The figures: >= 0.25 m/s forward over 5 m, >= 0.10 m/s sideways,
   // >= 45 deg/s turning, paths within 10 %, no falls.
   EXPECT_GE(std::stod(rows["walk_forward"][3]), 0.245);
@@ -139,6 +140,8 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   EXPECT_EQ(rows["kick_distance"][6], "0");
   EXPECT_GT(std::stod(rows["kick_distance"][3]), 1.5);
   EXPECT_LT(std::stod(rows["kick_distance"][5]), 15.0);
+  // The goalkeeper's block does not make it fall (dives are not falls).
+  for (const char* t : {"keeper_saves", "shootout_keeper_saves"}) EXPECT_EQ(rows[t][6], "0") << t;
 }
 
 // The get-up tuning aids: another motions folder, the side-view snapshots
@@ -150,7 +153,8 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
     std::filesystem::path dir;
     ~RemoveAfter() { std::filesystem::remove_all(dir); }
   } remove_after{dir};
-  for (const char* f : {"get_up_front.yaml", "get_up_back.yaml"})
+  for (const char* f : {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml",
+                        "dive_right.yaml"})
     std::filesystem::copy_file(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs/motions" / f,
                                dir / f, std::filesystem::copy_options::overwrite_existing);
   const std::filesystem::path png = dir / "snapshots.png";

@@ -7,6 +7,9 @@ MotionController loadMotionController(const robots::RobotModel& model,
                                       const FallDetectorParameters& fall) {
   return MotionController(model, loadKeyframeMotion(motions_dir / "get_up_front.yaml", model),
                           loadKeyframeMotion(motions_dir / "get_up_back.yaml", model),
+                          loadKeyframeMotion(motions_dir / "block.yaml", model),
+                          loadKeyframeMotion(motions_dir / "dive_left.yaml", model),
+                          loadKeyframeMotion(motions_dir / "dive_right.yaml", model),
                           WalkParameters{}, KickParameters{}, fall);
 }
 

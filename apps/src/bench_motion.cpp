@@ -47,11 +47,14 @@ const char* kHelp =
     "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
+    "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
+    "play: it blocks; in the shoot-out: it also dives).\n"
     "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
     "  --motions DIR get-up motions from DIR (default configs/motions; for tuning them)\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
     "                7.2 s), tiled\n"
-    "  --striker-trials N, --penalty-trials N  trials in the table (default 20, 50)\n"
+    "  --striker-trials N, --penalty-trials N, --block-trials N  trials in the table (default\n"
+    "                20, 50, 20)\n"
     "  --csv FILE    also write the table as CSV\n";
 
 struct WalkResult {
@@ -444,6 +447,66 @@ PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
   return PenaltyOutcome::Timeout;
 }
 
+struct BlockResult {
+  bool saved = false, in_reach = false;
+  int blocks = 0, falls = 0;
+};
+
+// The goalkeeper behaviour on its line (team 0, own goal at -x) and a ball
+// rolled at the goal from 2.5 m out (seeded: 1.6-2.4 m/s, at a point of the
+// goal line inside the posts); 4 s to see whether it goes in. Saved: it did
+// not, and the keeper touched it. In reach: aimed within the block's reach
+// of the keeper's middle.
+BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  const fields::FieldModel f = fields::loadFieldModel(s.field_file);
+  // Where SoccerBehaviour's keeper stands (in the shoot-out, on its line).
+  const double line = -f.halfLength() + (shootout ? 0.05 : 0.25);
+  s.robots[0].x = line;
+  s.robots[0].y = 0.0;
+  s.robots[0].yaw = 0.0;
+  s.ball_position = {line + 2.5, 0.0, -1.0};
+  world::World w(s);
+  InProcessAgents agents(w, {shootout ? agents::Role::PenaltyGoalkeeper : agents::Role::Goalkeeper},
+                         seed);
+  const double dt = w.scenario().physics.control_period;
+  for (int i = 0; i < 200; ++i) {  // 2 s to settle into the stance
+    agents.period();
+    w.stepControlPeriod();
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double half_goal = 0.5 * f.goal.inner_width - f.ball.radius;
+  const Vec3 from(line + 2.5, 0.6 * u(rng), f.ball.radius);
+  const Vec3 to(-f.halfLength(), half_goal * u(rng), f.ball.radius);
+  const double speed = 2.0 + 0.4 * u(rng);
+  engine::RigidBodyState b;
+  b.pose.translation() = from;
+  b.linear_velocity = speed * (to - from).normalized();
+  b.angular_velocity = Vec3::UnitZ().cross(b.linear_velocity) / f.ball.radius;  // rolling
+  w.setBallState(b);
+  BlockResult r;
+  // Where the ball would pass the keeper's line, from the keeper's middle.
+  const double y_at = from.y() + (to.y() - from.y()) * (from.x() - line) / (from.x() - to.x());
+  r.in_reach = std::abs(y_at - w.torsoPose(0).translation().y()) < (shootout ? 0.8 : 0.35);
+  for (int i = 0; i < 400; ++i) {
+    agents.period();
+    w.stepControlPeriod();
+    if (verbose && i % 10 == 0)
+      std::fprintf(stderr, "t %.2f %-10s ball %.2f %.2f torso z %.3f\n", i * dt,
+                   agents::motionStateName(agents.motion(0).state()),
+                   w.ballState().pose.translation().x(), w.ballState().pose.translation().y(),
+                   w.torsoPose(0).translation().z());
+    if (goalScored(w) == -1) break;
+  }
+  const auto& touch = w.lastBallTouch();
+  r.saved = goalScored(w) == 0 && touch && touch->robot == 0;
+  r.blocks = agents.motion(0).counters().blocks + agents.motion(0).counters().dives;
+  r.falls = agents.motion(0).counters().falls;
+  return r;
+}
+
 }  // namespace
 
 int benchMotion(int argc, char** argv, int first) {
@@ -468,11 +531,12 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation}};
   std::vector<std::string> valued{
-      "seconds",        "csv",     "vx",          "vy",     "turn",          "random-minutes",
-      "seed",           "foot",    "ball-offset", "get-up", "get-up-trials", "striker-trials",
-      "penalty-trials", "motions", "snapshots"};
+      "seconds",        "csv",     "vx",          "vy",          "turn",          "random-minutes",
+      "seed",           "foot",    "ball-offset", "get-up",      "get-up-trials", "striker-trials",
+      "penalty-trials", "motions", "snapshots",   "block-trials"};
   for (const auto& k : knobs) valued.push_back(k.first);
-  const Options opt(argc, argv, first, {"help", "verbose", "kick", "striker", "penalty"}, valued);
+  const Options opt(argc, argv, first,
+                    {"help", "verbose", "kick", "striker", "penalty", "block", "shootout"}, valued);
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
@@ -493,6 +557,13 @@ int benchMotion(int argc, char** argv, int first) {
         strikerTrial(static_cast<uint64_t>(opt.number("seed", 1)), 60.0, opt.flag("verbose"));
     std::printf("striker: %s in %.1f s, %d falls\n", r.scored ? "scored" : "no goal", r.seconds,
                 r.falls);
+    return 0;
+  }
+  if (opt.flag("block")) {  // one ball at the goalkeeper, for tuning
+    const BlockResult r = blockTrial(static_cast<uint64_t>(opt.number("seed", 1)),
+                                     opt.flag("shootout"), opt.flag("verbose"));
+    std::printf("block: %s (%s), %d blocks, %d falls\n", r.saved ? "saved" : "not saved",
+                r.in_reach ? "in reach" : "out of reach", r.blocks, r.falls);
     return 0;
   }
   if (opt.flag("penalty")) {  // one penalty, for tuning
@@ -621,6 +692,27 @@ int benchMotion(int argc, char** argv, int first) {
         100.0 * share(PenaltyOutcome::Saved), 0, trials * 30.0);
   }
   {
+    // The goalkeeper against balls rolled at its goal (seeded): in play (it
+    // blocks) and in the shoot-out (it also dives); the share kept out.
+    const int trials = static_cast<int>(opt.number("block-trials", 20));
+    for (const bool shootout : {false, true}) {
+      int saved = 0, in_reach = 0, saved_in_reach = 0, blocks = 0, falls = 0;
+      for (int i = 0; i < trials; ++i) {
+        const BlockResult b = blockTrial(seed + 700 + static_cast<uint64_t>(i), shootout, false);
+        saved += b.saved;
+        in_reach += b.in_reach;
+        saved_in_reach += b.saved && b.in_reach;
+        blocks += b.blocks;
+        falls += b.falls;
+      }
+      std::fprintf(stderr, "  %s: %d blocks/dives, %d of %d balls within reach saved\n",
+                   shootout ? "shoot-out keeper" : "keeper", blocks, saved_in_reach, in_reach);
+      row(shootout ? "shootout_keeper_saves" : "keeper_saves", 0,
+          saved / std::max(1.0, double(trials)), "share",
+          100.0 * saved_in_reach / std::max(1, in_reach), falls, trials * 6.0);
+    }
+  }
+  {
     // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
     // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
     std::mt19937_64 rng(seed);
@@ -649,7 +741,11 @@ int benchMotion(int argc, char** argv, int first) {
       "striker_scores: share of trials (robot and ball at seeded random spots, the striker "
       "behaviour alone) that score within 60 s, deviation column = the median seconds to score; "
       "penalty_scoring: share of penalty kicks (kicker behaviour against the goalkeeper "
-      "behaviour, seeded) that score, deviation column = % saved; "
+      "behaviour, seeded) that score, deviation column = % saved; keeper_saves / "
+      "shootout_keeper_saves: share of balls rolled at the goal (seeded, 1.6-2.4 m/s from 2.5 m, "
+      "aimed inside the posts) the goalkeeper behaviour keeps out in play (it blocks) / in the "
+      "shoot-out (it also dives), deviation column = % of those aimed within its reach (0.35 / "
+      "0.8 m of its middle), falls = falls besides dives; "
       "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
       "after each).",

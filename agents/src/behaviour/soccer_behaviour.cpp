@@ -67,7 +67,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   root.allowOnly({"behaviour", "ready_positions", "kick_off_position", "max_forward", "max_side",
                   "max_turn", "kick_ball", "kick_tolerance", "approach_distance", "ball_lost_time",
-                  "team_ball_time", "keep_clear", "message_interval"});
+                  "team_ball_time", "keep_clear", "message_interval", "block_speed", "block_time",
+                  "block_reach", "dive_time", "dive_reach"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -94,8 +95,14 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
   c.keep_clear = root.number("keep_clear", c.keep_clear);
   c.message_interval = root.number("message_interval", c.message_interval);
+  c.block_speed = root.number("block_speed", c.block_speed);
+  c.block_time = root.number("block_time", c.block_time);
+  c.block_reach = root.number("block_reach", c.block_reach);
+  c.dive_time = root.number("dive_time", c.dive_time);
+  c.dive_reach = root.number("dive_reach", c.dive_reach);
   for (const char* k :
-       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval"})
+       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval",
+        "block_speed", "block_time", "block_reach", "dive_time", "dive_reach"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
   return c;
 }
@@ -417,6 +424,25 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   if (ball_velocity_.x < -0.3 && ball_.x > line) {
     const double t = (line - ball_.x) / ball_velocity_.x;
     y = std::clamp(ball_.y + ball_velocity_.y * t, -half_goal - 0.1, half_goal + 0.1);
+  }
+  // A ball that will pass the keeper within reach, soon: block it (a wide
+  // squat: the legs cover the ground on both sides, with no fall to get up
+  // from); in the shoot-out, one further out: dive for it.
+  if (ball_velocity_.x < -config_.block_speed && ball_.x > self_.x) {
+    const double t = (self_.x - ball_.x) / ball_velocity_.x;
+    // Sideways in the keeper's own frame (it faces the field, +x).
+    const double off = ball_.y + ball_velocity_.y * t - self_.y;
+    MotionRequest r;
+    if (t < config_.block_time && std::abs(off) < config_.block_reach) {
+      r.kind = MotionRequest::Kind::Block;
+      return r;
+    }
+    if (shootout && t < config_.dive_time && std::abs(off) < config_.dive_reach &&
+        std::abs(off) >= config_.block_reach) {
+      r.kind = MotionRequest::Kind::Dive;
+      r.side = off > 0 ? Leg::Left : Leg::Right;
+      return r;
+    }
   }
   const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
   const bool area = field_.penalty_area &&

@@ -15,6 +15,10 @@ const char* motionStateName(MotionState s) {
       return "walking";
     case MotionState::Kicking:
       return "kicking";
+    case MotionState::Blocking:
+      return "blocking";
+    case MotionState::Diving:
+      return "diving";
     case MotionState::Falling:
       return "falling";
     case MotionState::Lying:
@@ -26,11 +30,16 @@ const char* motionStateName(MotionState s) {
 }
 
 MotionController::MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
-                                   KeyframeMotion get_up_back, const WalkParameters& walk,
-                                   const KickParameters& kick, const FallDetectorParameters& fall)
+                                   KeyframeMotion get_up_back, KeyframeMotion block,
+                                   KeyframeMotion dive_left, KeyframeMotion dive_right,
+                                   const WalkParameters& walk, const KickParameters& kick,
+                                   const FallDetectorParameters& fall)
     : model_(model),
       get_up_front_(std::move(get_up_front)),
       get_up_back_(std::move(get_up_back)),
+      block_(std::move(block)),
+      dive_left_(std::move(dive_left)),
+      dive_right_(std::move(dive_right)),
       walk_parameters_(walk),
       kick_parameters_(kick),
       fall_(fall),
@@ -94,7 +103,8 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     enter(MotionState::Easing);
   }
   const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
-                      state_ == MotionState::Walking || state_ == MotionState::Kicking;
+                      state_ == MotionState::Walking || state_ == MotionState::Kicking ||
+                      state_ == MotionState::Blocking;
   if (normal && tilt_ > fall_.falling_tilt) {
     ++counters_.falls;
     enter(MotionState::Falling);
@@ -109,6 +119,22 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Stance:
     case MotionState::Walking:
       stiffness_ = 1.0;
+      if (request.kind == MotionRequest::Kind::Block) {
+        // No time to stop the walk first: the block starts from the joints as
+        // they are (its first frame is short and low, which steadies the robot).
+        ++counters_.blocks;
+        enter(MotionState::Blocking);
+        player_.start(block_, measured);
+        player_.update(dt, targets_, stiffness_);
+        break;
+      }
+      if (request.kind == MotionRequest::Kind::Dive) {
+        ++counters_.dives;
+        enter(MotionState::Diving);
+        player_.start(request.side == Leg::Left ? dive_left_ : dive_right_, measured);
+        player_.update(dt, targets_, stiffness_);
+        break;
+      }
       if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
           !walk_.walking()) {
         kick_.start(request.kick_foot);
@@ -127,6 +153,20 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Kicking:
       kick_.update(dt, sensors.gyro, targets_);
       if (!kick_.active()) enter(MotionState::Stance);
+      break;
+    case MotionState::Diving:
+      // Meant to end on the ground: not a fall. Lying afterwards, the fall
+      // detector's rules apply (soft, then the get-up if it is on).
+      player_.update(dt, targets_, stiffness_);
+      if (!player_.active()) enter(MotionState::Lying);
+      break;
+    case MotionState::Blocking:
+      player_.update(dt, targets_, stiffness_);
+      if (!player_.active()) {  // back up: ease into the walk's stance
+        ease_from_ = targets_;
+        walk_ = WalkEngine(model_, walk_parameters_);
+        enter(MotionState::Easing);
+      }
       break;
     case MotionState::Falling:
     case MotionState::Lying:

@@ -63,6 +63,17 @@ struct BehaviourConfig {
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
+  // The goalkeeper blocks (MotionRequest::Kind::Block) a ball coming at its
+  // goal faster than block_speed that will pass it within block_time, no
+  // further sideways than block_reach from its feet.
+  double block_speed = 0.4;   // m/s
+  double block_time = 0.6;    // s
+  double block_reach = 0.35;  // m
+  // The penalty goalkeeper dives (MotionRequest::Kind::Dive) at a ball out of
+  // the block's reach but within dive_reach, passing within dive_time. (Only
+  // in the shoot-out: a dive ends on the ground, and one shot is all there is.)
+  double dive_time = 0.9;   // s
+  double dive_reach = 0.8;  // m
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);

@@ -1,9 +1,9 @@
 // The motion layer of an agent: takes what the behaviour wants (stand, walk
 // at a velocity, kick with a foot, where the head looks) and the robot's
 // sensors, and produces the joint targets and stiffnesses for one control
-// period. It owns the walk, the kick and the get-up motions, switches
-// between them only where that is safe (a kick from a standing stance, the
-// walk stopped first), and runs the fall detector: while the robot falls its
+// period. It owns the walk, the kick, the goalkeeper's block and the get-up
+// motions, switches between them only where that is safe (a kick from a
+// standing stance, the walk stopped first), and runs the fall detector: while the robot falls its
 // joints go soft (safe stiffness), once it lies still it gets up from the
 // front or the back (keyframe motions), and then eases back into the stance.
 #pragma once
@@ -20,10 +20,15 @@
 namespace simsoccer::agents {
 
 struct MotionRequest {
-  enum class Kind { Stand, Walk, Kick };
+  // Block: the goalkeeper's block (a keyframe motion down into a wide squat
+  // and back up). Dive: the goalkeeper throws itself to the side of `side`
+  // (a keyframe motion; it ends lying, then the fall detector's get-up
+  // applies). Both start at once from standing or walking.
+  enum class Kind { Stand, Walk, Kick, Block, Dive };
   Kind kind = Kind::Stand;
   double forward = 0.0, left = 0.0, turn = 0.0;  // m/s, m/s, rad/s (robot frame)
   Leg kick_foot = Leg::Right;
+  Leg side = Leg::Left;                     // a dive's side
   double head_yaw = 0.0, head_pitch = 0.0;  // rad
 };
 
@@ -50,17 +55,28 @@ struct FallDetectorParameters {
   bool get_up = true;
 };
 
-enum class MotionState { Easing, Stance, Walking, Kicking, Falling, Lying, GettingUp };
+enum class MotionState {
+  Easing,
+  Stance,
+  Walking,
+  Kicking,
+  Blocking,
+  Diving,
+  Falling,
+  Lying,
+  GettingUp
+};
 const char* motionStateName(MotionState s);
 
 struct MotionCounters {
-  int falls = 0, get_ups = 0, failed_get_ups = 0, kicks = 0;
+  int falls = 0, get_ups = 0, failed_get_ups = 0, kicks = 0, blocks = 0, dives = 0;
 };
 
 class MotionController {
  public:
   MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
-                   KeyframeMotion get_up_back, const WalkParameters& walk = {},
+                   KeyframeMotion get_up_back, KeyframeMotion block, KeyframeMotion dive_left,
+                   KeyframeMotion dive_right, const WalkParameters& walk = {},
                    const KickParameters& kick = {}, const FallDetectorParameters& fall = {});
 
   // One control period: writes 25 targets (rad) and stiffnesses (0..1) in
@@ -84,7 +100,7 @@ class MotionController {
   void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
 
   const robots::RobotModel& model_;
-  KeyframeMotion get_up_front_, get_up_back_;
+  KeyframeMotion get_up_front_, get_up_back_, block_, dive_left_, dive_right_;
   WalkParameters walk_parameters_;
   KickParameters kick_parameters_;
   FallDetectorParameters fall_;
