@@ -217,12 +217,12 @@ TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
     agents::Leg side = agents::Leg::Left;
     double ball_x = 0.0;  // where the ball was when the keeper acted
   };
-  // Ball from (-1.5, y0) at (vx, vy) m/s; the keeper at (x, 0) facing +x.
-  auto roll = [&](Role role, double x, double y0, double vx, double vy) {
+  // Ball from (x0, y0) at (vx, vy) m/s; the keeper at (x, 0) facing +x.
+  auto roll = [&](Role role, double x, double y0, double vx, double vy, double x0 = -1.5) {
     agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, role, 1);
     Outcome o;
     for (int i = 0; i < 40; ++i) {
-      const double t = 0.1 * i, bx = -1.5 + vx * t, by = y0 + vy * t;
+      const double t = 0.1 * i, bx = x0 + vx * t, by = y0 + vy * t;
       if (bx < x) break;  // passed it
       auto p = seeing(x, 0.0, 0.0, bx, by, t);
       agents::SoccerBehaviour::Input in;
@@ -254,8 +254,12 @@ TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
   o = roll(Role::PenaltyGoalkeeper, shootout_line, -0.6, -2.0, 0.0);
   EXPECT_EQ(o.kind, MotionRequest::Kind::Dive);
   EXPECT_EQ(o.side, agents::Leg::Right);
-  // Slow (0.3 m/s), or 1.2 m wide of the keeper: neither.
-  EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.3, 0.0)));
+  // Slow (0.3 m/s, from 0.5 m: it passes within the block's time), or 1.2 m
+  // wide of the keeper: neither. (At 0.6 m/s the same ball is blocked.)
+  EXPECT_FALSE(
+      acted(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.3, 0.0, shootout_line + 0.5)));
+  EXPECT_EQ(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.6, 0.0, shootout_line + 0.9).kind,
+            MotionRequest::Kind::Block);
   EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 1.2, -2.0, 0.0)));
 }
 

@@ -50,7 +50,8 @@ const char* kHelp =
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
     "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
-    "  --motions DIR get-up motions from DIR (default configs/motions; for tuning them)\n"
+    "  --motions DIR the motions (get-up, block, dives) from DIR (default configs/motions; for\n"
+    "                tuning them)\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
     "                7.2 s), tiled\n"
     "  --striker-trials N, --penalty-trials N, --block-trials N  trials in the table (default\n"
@@ -433,6 +434,8 @@ PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
     if (goalScored(w) == 1) return PenaltyOutcome::Goal;
     const Vec3 b = ball.pose.translation();
     if (!kicked && std::hypot(b.x() - mark, b.y()) > 0.05) kicked = true;
+    // The keeper down before the kick: a goal (the referee's shoot-out rule).
+    if (!kicked && !w.isStanding(1)) return PenaltyOutcome::Goal;
     if (!kicked) continue;
     // Wholly over the goal line outside the goal, or over the touchline: missed.
     if (b.x() > f.halfLength() + f.ball.radius || std::abs(b.y()) > f.halfWidth())

@@ -221,7 +221,13 @@ void SoccerBehaviour::updateBall(const Input& in) {
       const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
       const Vec2 b{self_.x + c * p.ball.x - s * p.ball.y, self_.y + s * p.ball.x + c * p.ball.y};
       if (p.ball.in_view) {
-        if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.05) {
+        if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.5) {
+          // Not seen for a while (lost, or the robots were placed): the old
+          // velocity says nothing about the ball now. Start over.
+          ball_velocity_ = {0.0, 0.0};
+          last_ball_ = b;
+          last_ball_time_ = in.time;
+        } else if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.05) {
           const double dt = in.time - last_ball_time_;
           const Vec2 v{(b.x - last_ball_.x) / dt, (b.y - last_ball_.y) / dt};
           ball_velocity_ = {0.7 * ball_velocity_.x + 0.3 * v.x, 0.7 * ball_velocity_.y + 0.3 * v.y};
@@ -425,20 +431,23 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
     const double t = (line - ball_.x) / ball_velocity_.x;
     y = std::clamp(ball_.y + ball_velocity_.y * t, -half_goal - 0.1, half_goal + 0.1);
   }
-  // A ball that will pass the keeper within reach, soon: block it (a wide
-  // squat: the legs cover the ground on both sides, with no fall to get up
-  // from); in the shoot-out, one further out: dive for it.
-  if (ball_velocity_.x < -config_.block_speed && ball_.x > self_.x) {
+  // A ball the keeper sees now (not a teammate's or an old sighting) that
+  // will pass it within reach, soon: block it (a wide squat: the legs cover
+  // the ground on both sides, with no fall to get up from); in the shoot-out,
+  // one further out: dive for it, if the keeper faces the field (its left is
+  // then +y; turned further, a dive would go partly forwards or backwards).
+  const bool fresh = now_ - ball_seen_at_ < 0.2 && ball_known_at_ == ball_seen_at_;
+  if (fresh && ball_velocity_.x < -config_.block_speed && ball_.x > self_.x) {
     const double t = (self_.x - ball_.x) / ball_velocity_.x;
-    // Sideways in the keeper's own frame (it faces the field, +x).
+    // Where it passes, sideways of the keeper's middle (team frame).
     const double off = ball_.y + ball_velocity_.y * t - self_.y;
     MotionRequest r;
     if (t < config_.block_time && std::abs(off) < config_.block_reach) {
       r.kind = MotionRequest::Kind::Block;
       return r;
     }
-    if (shootout && t < config_.dive_time && std::abs(off) < config_.dive_reach &&
-        std::abs(off) >= config_.block_reach) {
+    if (shootout && std::abs(self_.yaw) < 0.5 && t < config_.dive_time &&
+        std::abs(off) < config_.dive_reach && std::abs(off) >= config_.block_reach) {
       r.kind = MotionRequest::Kind::Dive;
       r.side = off > 0 ? Leg::Left : Leg::Right;
       return r;

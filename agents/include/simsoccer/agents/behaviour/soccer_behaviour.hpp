@@ -65,7 +65,7 @@ struct BehaviourConfig {
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
   // The goalkeeper blocks (MotionRequest::Kind::Block) a ball coming at its
   // goal faster than block_speed that will pass it within block_time, no
-  // further sideways than block_reach from its feet.
+  // further sideways than block_reach from its middle.
   double block_speed = 0.4;   // m/s
   double block_time = 0.6;    // s
   double block_reach = 0.35;  // m
@@ -104,7 +104,7 @@ class SoccerBehaviour {
     // Down: falling, lying or getting up (from the motion state).
     bool fallen() const {
       return motion == MotionState::Falling || motion == MotionState::Lying ||
-             motion == MotionState::GettingUp;
+             motion == MotionState::GettingUp || motion == MotionState::Diving;
     }
   };
   MotionRequest update(const Input& in);

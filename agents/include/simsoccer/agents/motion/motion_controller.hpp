@@ -1,11 +1,12 @@
 // The motion layer of an agent: takes what the behaviour wants (stand, walk
 // at a velocity, kick with a foot, where the head looks) and the robot's
 // sensors, and produces the joint targets and stiffnesses for one control
-// period. It owns the walk, the kick, the goalkeeper's block and the get-up
-// motions, switches between them only where that is safe (a kick from a
-// standing stance, the walk stopped first), and runs the fall detector: while the robot falls its
-// joints go soft (safe stiffness), once it lies still it gets up from the
-// front or the back (keyframe motions), and then eases back into the stance.
+// period. It owns the walk, the kick, the goalkeeper's block and dive and the
+// get-up motions, switches between them only where that is safe (a kick from
+// a standing stance, the walk stopped first; the block and the dive, which
+// cannot wait, at once from standing or walking), and runs the fall detector: while the robot falls
+// its joints go soft (safe stiffness), once it lies still it gets up from the front or the back
+// (keyframe motions), and then eases back into the stance.
 #pragma once
 
 #include <array>
