@@ -305,8 +305,12 @@ TEST(MotionController, TheBlockStaysUpAndTheDiveLandsOnItsSide) {
       }
       if (kind == MotionRequest::Kind::Block) {
         EXPECT_EQ(mc.state(), agents::MotionState::Blocking);
-        EXPECT_GT(widest - feet0, 0.08);        // the feet spread sideways (0.103 measured)
-        EXPECT_LT(lowest, torso0.z() - 0.05);   // and the torso goes down (0.073)
+        EXPECT_GT(widest - feet0, 0.1);        // the feet spread sideways (0.146 measured)
+        EXPECT_LT(lowest, torso0.z() - 0.03);  // and the torso goes down (0.044) ...
+        // ... but not below World::isStanding's 0.22 m: to the referee (a
+        // shoot-out keeper must stay on its feet) and the match summary's fall
+        // count a block is not a fall.
+        EXPECT_GT(lowest, 0.23);
         for (int i = 0; i < 300; ++i) period(stand);
         EXPECT_EQ(mc.state(), agents::MotionState::Stance);
         EXPECT_TRUE(w.isStanding(0));
