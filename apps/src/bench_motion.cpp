@@ -20,6 +20,7 @@
 #include "bench_scene.hpp"
 #include "cli.hpp"
 #include "inprocess_agents.hpp"
+#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
@@ -490,9 +491,12 @@ BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
   b.angular_velocity = Vec3::UnitZ().cross(b.linear_velocity) / f.ball.radius;  // rolling
   w.setBallState(b);
   BlockResult r;
-  // Where the ball would pass the keeper's line, from the keeper's middle.
+  // Where the ball would pass the keeper's line, from the keeper's middle;
+  // its reach: the behaviour's (block, or in the shoot-out dive).
   const double y_at = from.y() + (to.y() - from.y()) * (from.x() - line) / (from.x() - to.x());
-  r.in_reach = std::abs(y_at - w.torsoPose(0).translation().y()) < (shootout ? 0.8 : 0.35);
+  const auto config = agents::loadBehaviourConfig(findConfig("", "configs/agents/soccer.yaml"));
+  r.in_reach = std::abs(y_at - w.torsoPose(0).translation().y()) <
+               (shootout ? config.dive_reach : config.block_reach);
   for (int i = 0; i < 400; ++i) {
     agents.period();
     w.stepControlPeriod();
@@ -747,8 +751,9 @@ int benchMotion(int argc, char** argv, int first) {
       "behaviour, seeded) that score, deviation column = % saved; keeper_saves / "
       "shootout_keeper_saves: share of balls rolled at the goal (seeded, 1.6-2.4 m/s from 2.5 m, "
       "aimed inside the posts) the goalkeeper behaviour keeps out in play (it blocks) / in the "
-      "shoot-out (it also dives), deviation column = % of those aimed within its reach (0.35 / "
-      "0.8 m of its middle), falls = falls besides dives; "
+      "shoot-out (it also dives), deviation column = % of those aimed within its reach "
+      "(block_reach / dive_reach of configs/agents/soccer.yaml from its middle), falls = falls "
+      "besides dives; "
       "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
       "after each).",

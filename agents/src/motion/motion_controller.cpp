@@ -64,6 +64,19 @@ void MotionController::enter(MotionState s) {
   still_for_ = 0.0;
 }
 
+void MotionController::startKeyframes(MotionState s, const KeyframeMotion& motion,
+                                      const std::vector<double>& measured, double dt) {
+  enter(s);
+  player_.start(motion, measured);
+  player_.update(dt, targets_, stiffness_);
+}
+
+void MotionController::easeIntoStance() {
+  ease_from_ = targets_;
+  walk_ = WalkEngine(model_, walk_parameters_);
+  enter(MotionState::Easing);
+}
+
 void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const {
   const auto& joints = model_.body->joints;
   // A frame from before the first control period carries no joint angles
@@ -123,16 +136,13 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         // No time to stop the walk first: the block starts from the joints as
         // they are (its first frame is short and low, which steadies the robot).
         ++counters_.blocks;
-        enter(MotionState::Blocking);
-        player_.start(block_, measured);
-        player_.update(dt, targets_, stiffness_);
+        startKeyframes(MotionState::Blocking, block_, measured, dt);
         break;
       }
       if (request.kind == MotionRequest::Kind::Dive) {
         ++counters_.dives;
-        enter(MotionState::Diving);
-        player_.start(request.side == Leg::Left ? dive_left_ : dive_right_, measured);
-        player_.update(dt, targets_, stiffness_);
+        startKeyframes(MotionState::Diving, request.side == Leg::Left ? dive_left_ : dive_right_,
+                       measured, dt);
         break;
       }
       if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
@@ -162,11 +172,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       break;
     case MotionState::Blocking:
       player_.update(dt, targets_, stiffness_);
-      if (!player_.active()) {  // back up: ease into the walk's stance
-        ease_from_ = targets_;
-        walk_ = WalkEngine(model_, walk_parameters_);
-        enter(MotionState::Easing);
-      }
+      if (!player_.active()) easeIntoStance();  // back up
       break;
     case MotionState::Falling:
     case MotionState::Lying:
@@ -187,8 +193,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       if (still_for_ >= fall_.lying_time && fall_.get_up) {
         // Up in the torso frame: -x lying on the front (chest down), +x on the back.
         const bool front = gravity_.x() < 0.0;
-        enter(MotionState::GettingUp);
-        player_.start(front ? get_up_front_ : get_up_back_, measured);
+        startKeyframes(MotionState::GettingUp, front ? get_up_front_ : get_up_back_, measured, dt);
       } else if (state_ == MotionState::Falling && tilt_ > fall_.lying_tilt) {
         state_ = MotionState::Lying;
       }
@@ -198,9 +203,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       if (!player_.active()) {
         if (upright()) {
           ++counters_.get_ups;
-          ease_from_ = targets_;
-          walk_ = WalkEngine(model_, walk_parameters_);
-          enter(MotionState::Easing);
+          easeIntoStance();
         } else {
           ++counters_.failed_get_ups;
           enter(MotionState::Falling);

@@ -98,6 +98,12 @@ class MotionController {
 
  private:
   void enter(MotionState s);
+  // Enters `s` playing `motion` from the measured joints (its first period
+  // included): the get-up, the block and the dive.
+  void startKeyframes(MotionState s, const KeyframeMotion& motion,
+                      const std::vector<double>& measured, double dt);
+  // After a keyframe motion that ends on the feet: ease into a fresh walk's stance.
+  void easeIntoStance();
   void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
 
   const robots::RobotModel& model_;
