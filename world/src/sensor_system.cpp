@@ -138,13 +138,7 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
                                   : r.link_cluster[static_cast<size_t>(joint.parent_link)];
     }
     r.temperature.fill(model.sensor_spec.ambient_temperature);
-    for (size_t a = 0; a < kActuators; ++a) {
-      const auto& act = model.actuators[a];
-      if (act.kind == robots::Actuator::Kind::Joint)
-        r.last_position[a] = physics.jointPosition(r.body, act.index);
-    }
-    const Pose torso = physics.linkPose(r.body, 0);
-    r.last_accel_point_velocity = physics.rootPointVelocity(r.body, torso * r.accel_point);
+    restartDifferences(physics, r);
     r.noise = engine::NormalSampler(seed ^ (0x9E3779B97F4A7C15ull * (robots_.size() + 1)));
     // This robot's sonar cone (its model's angle) in the sonar frame.
     const double cone_half = 0.5 * model.sensor_spec.sonar_cone_angle;
@@ -188,6 +182,20 @@ void SensorSystem::commandHand(size_t robot, size_t hand, double target, double 
   const auto& h = r.model->hands.at(hand);
   r.hand_target.at(hand) = std::clamp(target, h.lower, h.upper);
   r.hand_stiffness.at(hand) = std::clamp(stiffness, 0.0, 1.0);
+}
+
+void SensorSystem::restartDifferences(const engine::PhysicsWorld& physics, Robot& r) {
+  for (size_t a = 0; a < kActuators; ++a) {
+    const auto& act = r.model->actuators[a];
+    if (act.kind == robots::Actuator::Kind::Joint)
+      r.last_position[a] = physics.jointPosition(r.body, act.index);
+  }
+  const Pose torso = physics.linkPose(r.body, 0);
+  r.last_accel_point_velocity = physics.rootPointVelocity(r.body, torso * r.accel_point);
+}
+
+void SensorSystem::robotPlaced(const engine::PhysicsWorld& physics, size_t robot) {
+  restartDifferences(physics, robots_.at(robot));
 }
 
 void SensorSystem::afterStep(const engine::PhysicsWorld& physics,

@@ -238,6 +238,7 @@ void World::placeRobot(RobotId r, double x, double y, double yaw, const std::str
   const std::vector<double>& q = info.model->pose(posture);
   physics_->resetArticulation(info.body, standingTorso(*info.model, q, x, y, yaw), q);
   holdJoints(r, q, 1.0);
+  if (sensors_) sensors_->robotPlaced(*physics_, r);
 }
 
 void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture) {
@@ -245,6 +246,7 @@ void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture)
   const std::vector<double>& q = info.model->pose(posture);
   physics_->resetArticulation(info.body, torso, q);
   holdJoints(r, q, 1.0);
+  if (sensors_) sensors_->robotPlaced(*physics_, r);
 }
 
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {

@@ -45,6 +45,10 @@ class SensorSystem {
                  const std::vector<engine::LinkContact>& contacts);
   // At the end of every control period.
   void finishPeriod(const engine::PhysicsWorld& physics, uint64_t tick, double time);
+  // A robot put somewhere else (World::placeRobot): the next period's joint
+  // velocities and accelerometer start from there, not from a jump of metres
+  // and radians in one period (the referee's hands are not that fast).
+  void robotPlaced(const engine::PhysicsWorld& physics, size_t robot);
 
   const SensorFrame& frame(size_t robot) const { return frames_.at(robot); }
   void setTouch(size_t robot, Touch sensor, bool pressed);
@@ -100,6 +104,7 @@ class SensorSystem {
   };
 
   void updateSonar(const engine::PhysicsWorld& physics);
+  void restartDifferences(const engine::PhysicsWorld& physics, Robot& r);
   void buildScene(const engine::PhysicsWorld& physics);
 
   SensorSettings settings_;
