@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Cross-entropy search over symmetric get-up keyframes, each candidate scored in the
+simulator (`simsoccer bench motion --get-up SIDE --verbose`, seeded trials): how high and
+upright the torso gets while the motion plays and 1.5 s after, +2 for standing.
+How configs/motions/get_up_front.yaml was found (README, "Get up").
+
+  python3 scripts/tune_get_up.py SIDE START.yaml OUTDIR [generations] [population]
+
+SIDE: front or back. START.yaml: a get-up motion file to start from (its frames up to
+the first `pose:` frame are searched; unnamed joints start from the stand pose).
+Writes OUTDIR/get_up_SIDE.yaml (the best so far). SQUAT_TAIL=1: every candidate ends in
+a fixed deep squat and the stand. Needs python3-yaml; runs two trials at a time."""
+import math, os, random, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SIM = os.environ.get("SIM", os.path.join(ROOT, "build/apps/simsoccer"))
+MOTIONS = os.path.join(ROOT, "configs/motions")
+EVAL = tempfile.mkdtemp(prefix="tune_get_up.")
+STAND = {"HeadPitch": 0.0, "LShoulderPitch": 1.5, "LShoulderRoll": 0.15, "LElbowYaw": -1.2,
+         "LElbowRoll": -0.5, "LHipYawPitch": 0.0, "LHipRoll": 0.0, "LHipPitch": -0.45,
+         "LKneePitch": 0.9, "LAnklePitch": -0.45, "LAnkleRoll": 0.0}
+JOINTS = ["HeadPitch", "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LHipYawPitch",
+          "LHipRoll", "LHipPitch", "LKneePitch", "LAnklePitch", "LAnkleRoll"]
+LIMITS = {"HeadPitch": (-0.67, 0.51), "LShoulderPitch": (-2.08, 2.08), "LShoulderRoll": (-0.31, 1.32),
+          "LElbowYaw": (-2.08, 2.08), "LElbowRoll": (-1.54, -0.035), "LHipYawPitch": (-1.145, 0.74),
+          "LHipRoll": (-0.379, 0.79), "LHipPitch": (-1.535, 0.483), "LKneePitch": (-0.092, 2.112),
+          "LAnklePitch": (-1.186, 0.922), "LAnkleRoll": (-0.397, 0.768)}
+MIRROR = {"LShoulderPitch": ("RShoulderPitch", 1), "LShoulderRoll": ("RShoulderRoll", -1),
+          "LElbowYaw": ("RElbowYaw", -1), "LElbowRoll": ("RElbowRoll", -1), "LHipRoll": ("RHipRoll", -1),
+          "LHipPitch": ("RHipPitch", 1), "LKneePitch": ("RKneePitch", 1), "LAnklePitch": ("RAnklePitch", 1),
+          "LAnkleRoll": ("RAnkleRoll", -1)}
+LINE = re.compile(r"^t (\S+) (\S+)\s+tilt \S+ torso z (\S+) forward \S+ up (\S+)")
+
+def to_vec(frames):
+    v = []
+    for f in frames:
+        v.append(f["duration"])
+        v += [f["joints"][j] for j in JOINTS]
+    return v
+
+def to_frames(v):
+    frames, k = [], 0
+    while k < len(v):
+        d = min(max(v[k], 0.05), 1.2)
+        js = {j: min(max(v[k + 1 + i], LIMITS[j][0]), LIMITS[j][1]) for i, j in enumerate(JOINTS)}
+        frames.append({"duration": d, "joints": js})
+        k += 1 + len(JOINTS)
+    return frames
+
+def write_yaml(side, frames, path, tail):
+    out = [f"motion: get_up_{side}", "frames:"]
+    for f in frames:
+        js = dict(HeadYaw=0.0)
+        for j, x in f["joints"].items():
+            js[j] = x
+            if j in MIRROR:
+                js[MIRROR[j][0]] = MIRROR[j][1] * x
+        body = ", ".join(f"{j}: {x:.3f}" for j, x in js.items())
+        out.append(f"  - duration: {f['duration']:.3f}")
+        out.append(f"    joints: {{{body}}}")
+    out += tail
+    with open(path, "w") as fh:
+        fh.write("\n".join(out) + "\n")
+
+TAIL = ["  - duration: 1.0", "    pose: stand"]
+if os.environ.get("SQUAT_TAIL"):
+    TAIL = ["  - duration: 0.5",
+            "    joints: {HeadYaw: 0.0, HeadPitch: 0.0, LShoulderPitch: 0.6, RShoulderPitch: 0.6, LShoulderRoll: 0.1, RShoulderRoll: -0.1,",
+            "             LElbowYaw: 0.0, RElbowYaw: 0.0, LElbowRoll: -0.04, RElbowRoll: 0.04, LHipYawPitch: 0.0, LHipRoll: 0.0, RHipRoll: 0.0,",
+            "             LHipPitch: -1.53, RHipPitch: -1.53, LKneePitch: 2.1, RKneePitch: 2.1, LAnklePitch: -1.1, RAnklePitch: -1.1,",
+            "             LAnkleRoll: 0.0, RAnkleRoll: 0.0}",
+            "  - duration: 0.6",
+            "    joints: {LHipPitch: -1.0, RHipPitch: -1.0, LShoulderPitch: 0.5, RShoulderPitch: 0.5}",
+            "  - duration: 1.0", "    pose: stand"]
+
+def run(side, motions_dir, seed):
+    p = subprocess.run([SIM, "bench", "motion", "--get-up", side, "--seed", str(seed), "--motions",
+                        motions_dir, "--verbose"], capture_output=True, text=True)
+    rows = []
+    for line in p.stderr.splitlines():
+        m = LINE.match(line)
+        if m:
+            rows.append((float(m.group(1)), m.group(2), float(m.group(3)), float(m.group(4))))
+    ok = re.search(r"standing in (\S+) s", p.stdout)
+    start = next((i for i, r in enumerate(rows) if r[1] == "getting_up"), None)
+    if start is None:
+        return 0.0, False
+    end = next((i for i in range(start, len(rows)) if rows[i][1] != "getting_up"), len(rows))
+    window = rows[start:min(len(rows), end + 15)]
+    h = [min(r[2], 0.33) / 0.33 * (0.4 + 0.6 * max(r[3], 0.0)) for r in window]
+    last = h[-10:]
+    score = 0.5 * max(h) + 0.5 * sum(last) / len(last)
+    success = bool(ok) and float(ok.group(1)) < 8.0
+    return score + (2.0 if success else 0.0), success
+
+def evaluate(args):
+    side, v, seeds, tag = args
+    d = os.path.join(EVAL, tag)
+    os.makedirs(d, exist_ok=True)
+    for f in os.listdir(MOTIONS):
+        if not os.path.exists(os.path.join(d, f)):
+            shutil.copy(os.path.join(MOTIONS, f), d)
+    write_yaml(side, to_frames(v), os.path.join(d, f"get_up_{side}.yaml"), TAIL)
+    res = [run(side, d, s) for s in seeds]
+    return sum(r[0] for r in res) / len(res), sum(r[1] for r in res)
+
+def main():
+    side, init, outdir = sys.argv[1], sys.argv[2], sys.argv[3]
+    gens = int(sys.argv[4]) if len(sys.argv) > 4 else 25
+    pop = int(sys.argv[5]) if len(sys.argv) > 5 else 24
+    q, frames = dict(STAND), []
+    for f in yaml.safe_load(open(init))["frames"]:
+        if "pose" in f:
+            break
+        q.update({j: x for j, x in (f.get("joints") or {}).items() if j in q})
+        frames.append({"duration": f["duration"], "joints": dict(q)})
+    mean = to_vec(frames)
+    n = len(mean)
+    sig = [0.08 if (i % (1 + len(JOINTS))) == 0 else 0.25 for i in range(n)]
+    rng = random.Random(1)
+    os.makedirs(outdir, exist_ok=True)
+    best = (-1, None)
+    with cf.ProcessPoolExecutor(2) as ex:
+        for g in range(gens):
+            seeds = [1000 + 3 * g, 1001 + 3 * g, 1002 + 3 * g, 1500 + g]
+            cands = [mean] + [[m + s * rng.gauss(0, 1) for m, s in zip(mean, sig)] for _ in range(pop - 1)]
+            cands = [to_vec(to_frames(c)) for c in cands]
+            scores = list(ex.map(evaluate, [(side, c, seeds, f"{side}{i}") for i, c in enumerate(cands)]))
+            order = sorted(range(pop), key=lambda i: -scores[i][0])
+            elite = [cands[i] for i in order[: max(2, pop // 4)]]
+            if scores[order[0]][0] > best[0]:
+                best = (scores[order[0]][0], cands[order[0]])
+                write_yaml(side, to_frames(best[1]), os.path.join(outdir, f"get_up_{side}.yaml"), TAIL)
+            mean = [sum(e[i] for e in elite) / len(elite) for i in range(n)]
+            sig = [max(0.02, 0.7 * s + 0.3 * math.sqrt(sum((e[i] - mean[i]) ** 2 for e in elite) / len(elite)))
+                   for i, s in enumerate(sig)]
+            print(f"gen {g}: best {scores[order[0]][0]:.3f} ({scores[order[0]][1]}/4 up) mean-cand "
+                  f"{scores[0][0]:.3f} overall {best[0]:.3f}", flush=True)
+    write_yaml(side, to_frames(mean), os.path.join(outdir, f"get_up_{side}_mean.yaml"), TAIL)
+
+if __name__ == "__main__":
+    main()
