@@ -55,6 +55,22 @@ simsoccer_msg_GameState gameState(int state, int team0_number = 1) {
   return g;
 }
 
+// The motion controller with the get-up off, as the agents run it.
+agents::MotionController controllerWithoutGetUp(const robots::RobotModel& model) {
+  agents::FallDetectorParameters fall;
+  fall.get_up = false;
+  return agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
+}
+
+// One control period of robot 0 driven by `mc`.
+void controlPeriod(world::World& w, agents::MotionController& mc, const MotionRequest& request,
+                   std::vector<float>& position, std::vector<float>& stiffness) {
+  mc.update(w.scenario().physics.control_period, agents::motionSensors(w.sensorFrame(0)), request,
+            position, stiffness);
+  w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
+  w.stepControlPeriod();
+}
+
 }  // namespace
 
 TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
@@ -276,18 +292,10 @@ TEST(MotionController, TheBlockStaysUpAndTheDiveLandsOnItsSide) {
                                                       : "dive right");
       world::World w(test::scenario(1));
       const auto& model = *w.robot(0).model;
-      agents::FallDetectorParameters fall;
-      fall.get_up = false;
-      agents::MotionController mc =
-          agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
+      agents::MotionController mc = controllerWithoutGetUp(model);
       std::vector<float> position(25), stiffness(25);
-      const double dt = w.scenario().physics.control_period;
       const int lfoot = model.body->linkIndex("LFoot"), rfoot = model.body->linkIndex("RFoot");
-      auto period = [&](const MotionRequest& r) {
-        mc.update(dt, agents::motionSensors(w.sensorFrame(0)), r, position, stiffness);
-        w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
-        w.stepControlPeriod();
-      };
+      auto period = [&](const MotionRequest& r) { controlPeriod(w, mc, r, position, stiffness); };
       MotionRequest stand, act;
       for (int i = 0; i < 200; ++i) period(stand);  // into the stance
       ASSERT_EQ(mc.state(), agents::MotionState::Stance);
@@ -339,19 +347,10 @@ TEST(MotionController, TheBlockStaysUpAndTheDiveLandsOnItsSide) {
 // heading hold. Neither sinks below World::isStanding's height.
 TEST(MotionController, ARobotPutDownByTheRefereeStaysUpAndKeepsItsNewHeading) {
   world::World w(test::scenario(1));
-  const auto& model = *w.robot(0).model;
-  agents::FallDetectorParameters fall;
-  fall.get_up = false;
-  agents::MotionController mc =
-      agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
+  agents::MotionController mc = controllerWithoutGetUp(*w.robot(0).model);
   std::vector<float> position(25), stiffness(25);
-  const double dt = w.scenario().physics.control_period;
   MotionRequest stand;
-  auto period = [&] {
-    mc.update(dt, agents::motionSensors(w.sensorFrame(0)), stand, position, stiffness);
-    w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
-    w.stepControlPeriod();
-  };
+  auto period = [&] { controlPeriod(w, mc, stand, position, stiffness); };
   for (int i = 0; i < 100; ++i) period();
   engine::Pose lying = engine::Pose::Identity();
   lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();
