@@ -234,11 +234,8 @@ void World::setBallState(const engine::RigidBodyState& state) {
 }
 
 void World::placeRobot(RobotId r, double x, double y, double yaw, const std::string& posture) {
-  const RobotInfo& info = robots_.at(r);
-  const std::vector<double>& q = info.model->pose(posture);
-  physics_->resetArticulation(info.body, standingTorso(*info.model, q, x, y, yaw), q);
-  holdJoints(r, q, 1.0);
-  if (sensors_) sensors_->robotPlaced(*physics_, r);
+  const robots::RobotModel& model = *robots_.at(r).model;
+  placeRobot(r, standingTorso(model, model.pose(posture), x, y, yaw), posture);
 }
 
 void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture) {
@@ -246,7 +243,7 @@ void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture)
   const std::vector<double>& q = info.model->pose(posture);
   physics_->resetArticulation(info.body, torso, q);
   holdJoints(r, q, 1.0);
-  if (sensors_) sensors_->robotPlaced(*physics_, r);
+  sensors_->robotPlaced(*physics_, r);
 }
 
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {
