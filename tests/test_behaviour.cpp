@@ -343,8 +343,9 @@ TEST(MotionController, TheBlockStaysUpAndTheDiveLandsOnItsSide) {
 // One lying soft (get-up off) is in the stance again at once; one put down
 // while walking, facing the other way, neither reads the jump as a fall (the
 // accelerometer's finite difference spanned it: it went soft and fell, as a
-// shoot-out keeper did in the README match) nor is turned back by the walk's
-// heading hold. Neither sinks below World::isStanding's height.
+// shoot-out keeper did in the README match) nor, once the motion restarts as
+// the agent restarts it at Set, is turned back by the walk's heading hold.
+// Neither sinks below World::isStanding's height.
 TEST(MotionController, ARobotPutDownByTheRefereeStaysUpAndKeepsItsNewHeading) {
   world::World w(test::scenario(1));
   agents::MotionController mc = controllerWithoutGetUp(*w.robot(0).model);
@@ -375,6 +376,7 @@ TEST(MotionController, ARobotPutDownByTheRefereeStaysUpAndKeepsItsNewHeading) {
   for (int i = 0; i < 200; ++i) period();
   ASSERT_EQ(mc.state(), agents::MotionState::Walking);
   w.placeRobot(0, 2.0, 0.0, M_PI);
+  mc.restart();  // as the agent does when the game enters Set (the referee places robots then)
   stand = MotionRequest{};
   lowest = 1.0;
   for (int i = 0; i < 300; ++i) {

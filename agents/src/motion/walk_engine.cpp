@@ -108,12 +108,6 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
     yaw_offset_ = yaw - body_.yaw;
     intended_yaw_ = body_.yaw;
     yaw_known_ = true;
-  } else if (const double jump = std::remainder(yaw - yaw_, 2 * M_PI); std::abs(jump) > kYawJump) {
-    // Faster than any step turns (about 0.01 rad per control period): the
-    // robot was picked up and put down facing elsewhere (a referee's
-    // placement). The heading hold takes the new heading as the one asked
-    // for, instead of turning the robot back at full speed.
-    yaw_offset_ += jump;
   }
   yaw_ = yaw;
   if (walking_) {

@@ -103,8 +103,7 @@ class WalkEngine {
   Eigen::Vector3d wanted_ = Eigen::Vector3d::Zero(), average_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d step_ = Eigen::Vector3d::Zero();
   Vec3 gyro_filtered_ = Vec3::Zero();
-  static constexpr double kYawJump = 0.3;  // rad in one update: not a turn of the robot's own
-  double yaw_ = 0.0, yaw_offset_ = 0.0;    // IMU yaw, and its value when the walk's odometry began
+  double yaw_ = 0.0, yaw_offset_ = 0.0;  // IMU yaw, and its value when the walk's odometry began
   bool yaw_known_ = false;
   double intended_yaw_ = 0.0;  // the heading the commands asked for (odometry frame)
   LegSolution last_{};
