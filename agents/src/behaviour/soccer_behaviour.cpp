@@ -221,19 +221,16 @@ void SoccerBehaviour::updateBall(const Input& in) {
       const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
       const Vec2 b{self_.x + c * p.ball.x - s * p.ball.y, self_.y + s * p.ball.x + c * p.ball.y};
       if (p.ball.in_view) {
-        if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.5) {
-          // Not seen for a while (lost, or the robots were placed): the old
-          // velocity says nothing about the ball now. Start over.
+        const double gap = in.time - last_ball_time_;
+        if (gap > 0.5) {
+          // Never seen, or not for a while (lost, or the robots were placed):
+          // the old velocity says nothing about the ball now. Start over.
           ball_velocity_ = {0.0, 0.0};
-          last_ball_ = b;
-          last_ball_time_ = in.time;
-        } else if (last_ball_time_ > -1e8 && in.time - last_ball_time_ > 0.05) {
-          const double dt = in.time - last_ball_time_;
-          const Vec2 v{(b.x - last_ball_.x) / dt, (b.y - last_ball_.y) / dt};
+        } else if (gap > 0.05) {
+          const Vec2 v{(b.x - last_ball_.x) / gap, (b.y - last_ball_.y) / gap};
           ball_velocity_ = {0.7 * ball_velocity_.x + 0.3 * v.x, 0.7 * ball_velocity_.y + 0.3 * v.y};
-          last_ball_ = b;
-          last_ball_time_ = in.time;
-        } else if (last_ball_time_ < -1e8) {
+        }
+        if (gap > 0.05) {
           last_ball_ = b;
           last_ball_time_ = in.time;
         }
@@ -422,25 +419,30 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
   return r;
 }
 
+std::optional<SoccerBehaviour::Crossing> SoccerBehaviour::ballCrossing(double x,
+                                                                       double speed) const {
+  if (ball_velocity_.x >= -speed || ball_.x <= x) return std::nullopt;
+  const double t = (x - ball_.x) / ball_velocity_.x;
+  return Crossing{t, ball_.y + ball_velocity_.y * t};
+}
+
 MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   const double line = -field_.halfLength() + (shootout ? 0.05 : 0.25);
   const double half_goal = 0.5 * field_.goal.inner_width - 0.15;
   double y = std::clamp(ball_.y * (shootout ? 0.4 : 0.5), -half_goal, half_goal);
   // A ball rolling at the goal: stand where it will cross the line.
-  if (ball_velocity_.x < -0.3 && ball_.x > line) {
-    const double t = (line - ball_.x) / ball_velocity_.x;
-    y = std::clamp(ball_.y + ball_velocity_.y * t, -half_goal - 0.1, half_goal + 0.1);
-  }
+  if (const auto c = ballCrossing(line, 0.3))
+    y = std::clamp(c->y, -half_goal - 0.1, half_goal + 0.1);
   // A ball the keeper sees now (not a teammate's or an old sighting) that
   // will pass it within reach, soon: block it (a wide squat: the legs cover
   // the ground on both sides, with no fall to get up from); in the shoot-out,
   // one further out: dive for it, if the keeper faces the field (its left is
   // then +y; turned further, a dive would go partly forwards or backwards).
   const bool fresh = now_ - ball_seen_at_ < 0.2 && ball_known_at_ == ball_seen_at_;
-  if (fresh && ball_velocity_.x < -config_.block_speed && ball_.x > self_.x) {
-    const double t = (self_.x - ball_.x) / ball_velocity_.x;
-    // Where it passes, sideways of the keeper's middle (team frame).
-    const double off = ball_.y + ball_velocity_.y * t - self_.y;
+  const auto c = ballCrossing(self_.x, config_.block_speed);
+  if (fresh && c) {
+    const double t = c->t;
+    const double off = c->y - self_.y;  // where it passes, sideways of the keeper's middle
     MotionRequest r;
     if (t < config_.block_time && std::abs(off) < config_.block_reach) {
       r.kind = MotionRequest::Kind::Block;

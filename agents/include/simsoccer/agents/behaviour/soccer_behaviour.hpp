@@ -134,6 +134,12 @@ class SoccerBehaviour {
   MotionRequest ready();
   MotionRequest striker(double aim_y, bool penalty);
   MotionRequest goalkeeper(bool shootout);
+  struct Crossing {
+    double t, y;  // s from now; m, own frame
+  };
+  // When and where the ball, rolling towards the own goal (-x) faster than
+  // `speed` m/s, crosses the line at own-frame x; nothing if it does not.
+  std::optional<Crossing> ballCrossing(double x, double speed) const;
   MotionRequest walkTo(const Pose2& target, bool face_ball);
   void head(MotionRequest& r, const Input& in);
   Vec2 toOwn(double fx, double fy) const;    // field -> own frame
