@@ -122,6 +122,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);
   std::ofstream(f) << "behaviour: soccer\nready_positions: []\nmax_fowrard: 1\n";
   EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);  // a typo
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\nkeeper_line: -0.1\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);  // behind the goal line
   std::filesystem::remove_all(dir);
 }
 
@@ -252,7 +254,8 @@ TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
     }
     return o;
   };
-  const double line = -f.halfLength() + 0.25, shootout_line = -f.halfLength() + 0.05;
+  const double line = -f.halfLength() + cfg.keeper_line;
+  const double shootout_line = -f.halfLength() + cfg.shootout_keeper_line;
   // Straight at the keeper at 2 m/s: a block, before the ball is there.
   Outcome o = roll(Role::Goalkeeper, line, 0.1, -2.0, 0.0);
   EXPECT_EQ(o.kind, MotionRequest::Kind::Block);

@@ -465,8 +465,10 @@ BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
   world::Scenario s = emptyField();
   s.seed = seed;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
-  // Where SoccerBehaviour's keeper stands (in the shoot-out, on its line).
-  const double line = -f.halfLength() + (shootout ? 0.05 : 0.25);
+  const auto config = agents::loadBehaviourConfig(findConfig("", "configs/agents/soccer.yaml"));
+  // Where the behaviour's keeper stands.
+  const double line =
+      -f.halfLength() + (shootout ? config.shootout_keeper_line : config.keeper_line);
   s.robots[0].x = line;
   s.robots[0].y = 0.0;
   s.robots[0].yaw = 0.0;
@@ -494,7 +496,6 @@ BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
   // Where the ball would pass the keeper's line, from the keeper's middle;
   // its reach: the behaviour's (block, or in the shoot-out dive).
   const double y_at = from.y() + (to.y() - from.y()) * (from.x() - line) / (from.x() - to.x());
-  const auto config = agents::loadBehaviourConfig(findConfig("", "configs/agents/soccer.yaml"));
   r.in_reach = std::abs(y_at - w.torsoPose(0).translation().y()) <
                (shootout ? config.dive_reach : config.block_reach);
   for (int i = 0; i < 400; ++i) {

@@ -65,10 +65,13 @@ std::optional<Role> roleFromName(const std::string& name) {
 
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly({"behaviour", "ready_positions", "kick_off_position", "max_forward", "max_side",
-                  "max_turn", "kick_ball", "kick_tolerance", "approach_distance", "ball_lost_time",
-                  "team_ball_time", "keep_clear", "message_interval", "block_speed", "block_time",
-                  "block_reach", "dive_time", "dive_reach"});
+  root.allowOnly({"behaviour",        "ready_positions", "kick_off_position",
+                  "max_forward",      "max_side",        "max_turn",
+                  "kick_ball",        "kick_tolerance",  "approach_distance",
+                  "ball_lost_time",   "team_ball_time",  "keep_clear",
+                  "message_interval", "keeper_line",     "shootout_keeper_line",
+                  "block_speed",      "block_time",      "block_reach",
+                  "dive_time",        "dive_reach"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -95,6 +98,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
   c.keep_clear = root.number("keep_clear", c.keep_clear);
   c.message_interval = root.number("message_interval", c.message_interval);
+  c.keeper_line = root.number("keeper_line", c.keeper_line);
+  c.shootout_keeper_line = root.number("shootout_keeper_line", c.shootout_keeper_line);
   c.block_speed = root.number("block_speed", c.block_speed);
   c.block_time = root.number("block_time", c.block_time);
   c.block_reach = root.number("block_reach", c.block_reach);
@@ -104,6 +109,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
        {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval",
         "block_speed", "block_time", "block_reach", "dive_time", "dive_reach"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
+  for (const char* k : {"keeper_line", "shootout_keeper_line"})
+    if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
 
@@ -427,7 +434,8 @@ std::optional<SoccerBehaviour::Crossing> SoccerBehaviour::ballCrossing(double x,
 }
 
 MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
-  const double line = -field_.halfLength() + (shootout ? 0.05 : 0.25);
+  const double line =
+      -field_.halfLength() + (shootout ? config_.shootout_keeper_line : config_.keeper_line);
   const double half_goal = 0.5 * field_.goal.inner_width - 0.15;
   double y = std::clamp(ball_.y * (shootout ? 0.4 : 0.5), -half_goal, half_goal);
   // A ball rolling at the goal: stand where it will cross the line.

@@ -63,6 +63,10 @@ struct BehaviourConfig {
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
+  // Where the goalkeeper stands: this far in front of its goal line (m), in
+  // play and as the shoot-out's keeper (the rules keep it on the line).
+  double keeper_line = 0.25;
+  double shootout_keeper_line = 0.05;
   // The goalkeeper blocks (MotionRequest::Kind::Block) a ball coming at its
   // goal faster than block_speed that will pass it within block_time, no
   // further sideways than block_reach from its middle.
