@@ -436,10 +436,7 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
 
 TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGetUp) {
   const auto model = robots::loadRobotModel(test::naoH25());
-  const auto dir = test::sourceDir() / "configs/motions";
-  agents::FallDetectorParameters fall;
-  fall.get_up = false;
-  agents::MotionController mc = agents::loadMotionController(model, dir, fall);
+  agents::MotionController mc = controllerWithoutGetUp(model);
   std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
   const auto& stand = model.pose("stand");
   for (size_t a = 0; a < model.actuators.size(); ++a)

@@ -1,6 +1,5 @@
 // End to end: the real `simsoccer bench physics` program, its table and CSV.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -127,21 +126,22 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   ASSERT_EQ(rows.size(), 12u);
   // The issue's figures: >= 0.25 m/s forward over 5 m, >= 0.10 m/s sideways,
   // >= 45 deg/s turning, paths within 10 %, no falls.
-  EXPECT_GE(std::stod(rows["walk_forward"][3]), 0.245);
-  EXPECT_GE(std::stod(rows["walk_sideways"][3]), 0.10);
-  EXPECT_GE(std::stod(rows["turn"][3]), 45.0);
+  EXPECT_GE(std::stod(rows.at("walk_forward")[3]), 0.245);
+  EXPECT_GE(std::stod(rows.at("walk_sideways")[3]), 0.10);
+  EXPECT_GE(std::stod(rows.at("turn")[3]), 45.0);
   for (const char* t : {"walk_forward", "walk_sideways", "turn"}) {
-    EXPECT_LT(std::stod(rows[t][5]), 10.0) << t;
-    EXPECT_EQ(rows[t][6], "0") << t;
+    EXPECT_LT(std::stod(rows.at(t)[5]), 10.0) << t;
+    EXPECT_EQ(rows.at(t)[6], "0") << t;
   }
-  EXPECT_EQ(rows["random_commands"][6], "0");  // one simulated minute of random commands
+  EXPECT_EQ(rows.at("random_commands")[6], "0");  // one simulated minute of random commands
   // Kicks: the robot stays up and the ball leaves straight (the 3 m the issue
   // asks for is not reached yet: the README gives the figure).
-  EXPECT_EQ(rows["kick_distance"][6], "0");
-  EXPECT_GT(std::stod(rows["kick_distance"][3]), 1.5);
-  EXPECT_LT(std::stod(rows["kick_distance"][5]), 15.0);
+  EXPECT_EQ(rows.at("kick_distance")[6], "0");
+  EXPECT_GT(std::stod(rows.at("kick_distance")[3]), 1.5);
+  EXPECT_LT(std::stod(rows.at("kick_distance")[5]), 15.0);
   // The goalkeeper's block does not make it fall (dives are not falls).
-  for (const char* t : {"keeper_saves", "shootout_keeper_saves"}) EXPECT_EQ(rows[t][6], "0") << t;
+  for (const char* t : {"keeper_saves", "shootout_keeper_saves"})
+    EXPECT_EQ(rows.at(t)[6], "0") << t;
 }
 
 // The get-up tuning aids: another motions folder, the side-view snapshots
@@ -153,8 +153,8 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
     std::filesystem::path dir;
     ~RemoveAfter() { std::filesystem::remove_all(dir); }
   } remove_after{dir};
-  for (const char* f : {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml",
-                        "dive_right.yaml"})
+  for (const char* f :
+       {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml", "dive_right.yaml"})
     std::filesystem::copy_file(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs/motions" / f,
                                dir / f, std::filesystem::copy_options::overwrite_existing);
   const std::filesystem::path png = dir / "snapshots.png";

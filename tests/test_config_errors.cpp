@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/fields/field_model.hpp"

@@ -570,7 +570,7 @@ int benchMotion(int argc, char** argv, int first) {
   if (opt.flag("block")) {  // one ball at the goalkeeper, for tuning
     const BlockResult r = blockTrial(static_cast<uint64_t>(opt.number("seed", 1)),
                                      opt.flag("shootout"), opt.flag("verbose"));
-    std::printf("block: %s (%s), %d blocks, %d falls\n", r.saved ? "saved" : "not saved",
+    std::printf("block: %s (%s), %d blocks/dives, %d falls\n", r.saved ? "saved" : "not saved",
                 r.in_reach ? "in reach" : "out of reach", r.blocks, r.falls);
     return 0;
   }

@@ -15,7 +15,7 @@
 
 namespace simsoccer::agents {
 
-// A motion controller with the get-up motions of `motions_dir`
+// A motion controller with the keyframe motions of `motions_dir`
 // (get_up_front.yaml, get_up_back.yaml, block.yaml, dive_left.yaml, dive_right.yaml).
 MotionController loadMotionController(const robots::RobotModel& model,
                                       const std::filesystem::path& motions_dir,

@@ -105,7 +105,7 @@ class SoccerBehaviour {
     const PerceptionIn* perception = nullptr;       // this period's, if any
     const simsoccer_msg_GameState* game = nullptr;  // the latest, if any
     MotionState motion = MotionState::Stance;
-    // Down: falling, lying or getting up (from the motion state).
+    // Down: falling, lying, getting up or diving (from the motion state).
     bool fallen() const {
       return motion == MotionState::Falling || motion == MotionState::Lying ||
              motion == MotionState::GettingUp || motion == MotionState::Diving;
