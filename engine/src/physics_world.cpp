@@ -153,6 +153,7 @@ class ServoConstraint : public btMultiBodyJointMotor {
   // The impulse applied in the last step (0 without a row), N m s.
   btScalar impulse() { return row_made_ ? getAppliedImpulse(0) : btScalar(0); }
   void startStep() { row_made_ = false; }
+  size_t servo() const { return servo_; }  // its row in the servo batch
 
   void createConstraintRows(btMultiBodyConstraintArray& rows, btMultiBodyJacobianData& data,
                             const btContactSolverInfo& info) override {
@@ -301,7 +302,7 @@ struct PhysicsWorld::Impl {
   std::vector<btMultiBody*> servo_body;
   std::vector<int> servo_link;
   // The implicit servos' rows (owned by `constraints`), with their servo index.
-  std::vector<std::pair<size_t, ServoConstraint*>> servo_rows;
+  std::vector<ServoConstraint*> servo_rows;
   std::vector<double> q, qdot;
 
   StageTimes times;
@@ -559,7 +560,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       m.servo_link.push_back(j);
       if (motor.implicit_servo) {
         auto row = std::make_unique<ServoConstraint>(raw, j, m.servos, s);
-        m.servo_rows.emplace_back(s, row.get());
+        m.servo_rows.push_back(row.get());
         m.world->addMultiBodyConstraint(row.get());
         m.constraints.push_back(std::move(row));
       }
@@ -644,7 +645,7 @@ void PhysicsWorld::step() {
   for (size_t i = 0; i < n; ++i)
     m.servo_body[i]->addJointTorque(m.servo_link[i],
                                     static_cast<btScalar>(m.servos.appliedTorque(i)));
-  for (auto& [servo, row] : m.servo_rows) row->startStep();
+  for (ServoConstraint* row : m.servo_rows) row->startStep();
   if (timers_on_) m.times.servo_s += std::chrono::duration<double>(Clock::now() - t0).count();
 
   // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
@@ -653,7 +654,7 @@ void PhysicsWorld::step() {
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
-  for (auto& [servo, row] : m.servo_rows) m.servos.setRowImpulse(servo, row->impulse());
+  for (ServoConstraint* row : m.servo_rows) m.servos.setRowImpulse(row->servo(), row->impulse());
   for (Articulation& art : m.articulations) art.kinematics_stale = true;
   ++step_count_;
   if (timers_on_) {
