@@ -8,28 +8,36 @@ How configs/motions/get_up_front.yaml was found (README, "Get up").
 
 SIDE: front or back. START.yaml: a get-up motion file to start from (its frames up to
 the first `pose:` frame are searched; unnamed joints start from the stand pose).
+Defaults: 40 generations of 24 candidates (as run for the kept motion, with SQUAT_TAIL=1).
 Writes OUTDIR/get_up_SIDE.yaml (the best so far). SQUAT_TAIL=1: every candidate ends in
 a fixed deep squat and the stand. Needs python3-yaml; runs two trials at a time."""
-import math, os, random, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
+import atexit, math, os, random, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SIM = os.environ.get("SIM", os.path.join(ROOT, "build/apps/simsoccer"))
 MOTIONS = os.path.join(ROOT, "configs/motions")
-EVAL = tempfile.mkdtemp(prefix="tune_get_up.")
-STAND = {"HeadPitch": 0.0, "LShoulderPitch": 1.5, "LShoulderRoll": 0.15, "LElbowYaw": -1.2,
-         "LElbowRoll": -0.5, "LHipYawPitch": 0.0, "LHipRoll": 0.0, "LHipPitch": -0.45,
-         "LKneePitch": 0.9, "LAnklePitch": -0.45, "LAnkleRoll": 0.0}
+EVAL = tempfile.mkdtemp(prefix="tune_get_up.")  # candidates' motion folders, removed at exit
+atexit.register(shutil.rmtree, EVAL, True)
 JOINTS = ["HeadPitch", "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LHipYawPitch",
           "LHipRoll", "LHipPitch", "LKneePitch", "LAnklePitch", "LAnkleRoll"]
-LIMITS = {"HeadPitch": (-0.67, 0.51), "LShoulderPitch": (-2.08, 2.08), "LShoulderRoll": (-0.31, 1.32),
-          "LElbowYaw": (-2.08, 2.08), "LElbowRoll": (-1.54, -0.035), "LHipYawPitch": (-1.145, 0.74),
-          "LHipRoll": (-0.379, 0.79), "LHipPitch": (-1.535, 0.483), "LKneePitch": (-0.092, 2.112),
-          "LAnklePitch": (-1.186, 0.922), "LAnkleRoll": (-0.397, 0.768)}
 MIRROR = {"LShoulderPitch": ("RShoulderPitch", 1), "LShoulderRoll": ("RShoulderRoll", -1),
           "LElbowYaw": ("RElbowYaw", -1), "LElbowRoll": ("RElbowRoll", -1), "LHipRoll": ("RHipRoll", -1),
           "LHipPitch": ("RHipPitch", 1), "LKneePitch": ("RKneePitch", 1), "LAnklePitch": ("RAnklePitch", 1),
           "LAnkleRoll": ("RAnkleRoll", -1)}
+# The stand pose and the joint limits from the robot model (a left joint's range is
+# narrowed to what its mirrored right joint also allows).
+_ROBOT = yaml.safe_load(open(os.path.join(ROOT, "robots/nao_v6_h25.yaml")))
+_RANGE = {j["name"]: tuple(j["limits"]) for j in _ROBOT["joints"] if "limits" in j}
+STAND = {j: float(_ROBOT["poses"]["stand"].get(j, 0.0)) for j in JOINTS}
+LIMITS = {}
+for _j in JOINTS:
+    _lo, _hi = _RANGE[_j]
+    if _j in MIRROR:
+        _r, _sign = MIRROR[_j]
+        _rlo, _rhi = sorted((_sign * _RANGE[_r][0], _sign * _RANGE[_r][1]))
+        _lo, _hi = max(_lo, _rlo), min(_hi, _rhi)
+    LIMITS[_j] = (_lo, _hi)
 LINE = re.compile(r"^t (\S+) (\S+)\s+tilt \S+ torso z (\S+) forward \S+ up (\S+)")
 
 def to_vec(frames):
@@ -107,7 +115,7 @@ def evaluate(args):
 
 def main():
     side, init, outdir = sys.argv[1], sys.argv[2], sys.argv[3]
-    gens = int(sys.argv[4]) if len(sys.argv) > 4 else 25
+    gens = int(sys.argv[4]) if len(sys.argv) > 4 else 40
     pop = int(sys.argv[5]) if len(sys.argv) > 5 else 24
     q, frames = dict(STAND), []
     for f in yaml.safe_load(open(init))["frames"]:
