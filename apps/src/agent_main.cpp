@@ -123,7 +123,12 @@ int main(int argc, char** argv) {
     // robot is claimed, so the first frame is answered with it however late
     // it would have arrived (otherwise the first periods may be played
     // without it, and the same seed gives another game).
-    if (soccer) client.waitForGameState(opt.number("game-state-wait", 0.0));
+    const double game_wait = opt.number("game-state-wait", 0.0);
+    if (soccer && game_wait > 0.0 && !client.waitForGameState(game_wait))
+      std::fprintf(stderr,
+                   "simsoccer-agent: robot (%d, %d): no GameState within %g s; playing without "
+                   "it until one comes (a lockstep run may then differ between runs)\n",
+                   team, player, game_wait);
     if (!client.claim(opt.number("claim-timeout", 10.0))) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
       return 3;
