@@ -1,5 +1,8 @@
 #include "simsoccer/engine/model.hpp"
 
+#include <stdexcept>
+#include <string>
+
 namespace simsoccer::engine {
 
 int ArticulatedModel::linkIndex(const std::string& link_name) const {
@@ -15,7 +18,11 @@ int ArticulatedModel::jointIndex(const std::string& joint_name) const {
 }
 
 void ArticulatedModel::applyMimic(std::span<double> q) const {
-  for (size_t j = 0; j < q.size() && j < joints.size(); ++j)
+  if (q.size() != joints.size())
+    throw std::invalid_argument("applyMimic: " + std::to_string(q.size()) +
+                                " joint positions for " + std::to_string(joints.size()) +
+                                " joints");
+  for (size_t j = 0; j < q.size(); ++j)
     if (joints[j].mimic_of >= 0)
       q[j] = joints[j].mimic_multiplier * q[static_cast<size_t>(joints[j].mimic_of)];
 }
@@ -27,9 +34,11 @@ double ArticulatedModel::totalMass() const {
 }
 
 Vec3 ArticulatedModel::centreOfMass(std::span<const Pose> link_frames) const {
+  if (link_frames.size() != links.size())
+    throw std::invalid_argument("centreOfMass: " + std::to_string(link_frames.size()) +
+                                " link frames for " + std::to_string(links.size()) + " links");
   Vec3 sum = Vec3::Zero();
-  for (size_t l = 0; l < links.size() && l < link_frames.size(); ++l)
-    sum += links[l].mass * (link_frames[l] * links[l].com);
+  for (size_t l = 0; l < links.size(); ++l) sum += links[l].mass * (link_frames[l] * links[l].com);
   return sum / totalMass();
 }
 
