@@ -208,9 +208,8 @@ void World::step() {
       last_touch_ = BallTouch{static_cast<RobotId>(c.articulation), c.link, physics_->stepCount()};
   if (!scenario_.sensors.enabled) return;
   sensors_->afterStep(*physics_, contacts_);
-  const uint64_t steps = physics_->stepCount();
-  if (steps % static_cast<uint64_t>(steps_per_control_) == 0)
-    sensors_->finishPeriod(*physics_, steps / static_cast<uint64_t>(steps_per_control_), time());
+  if (stepCount() % static_cast<uint64_t>(steps_per_control_) == 0)
+    sensors_->finishPeriod(*physics_, controlTick(), time());
 }
 
 void World::stepControlPeriod() {
