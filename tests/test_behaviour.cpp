@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
@@ -280,6 +281,66 @@ TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
   EXPECT_EQ(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.6, 0.0, shootout_line + 0.9).kind,
             MotionRequest::Kind::Block);
   EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 1.2, -2.0, 0.0)));
+}
+
+// The shoot-out keeper waits for the kick with the ball on the penalty mark,
+// seen as the realistic perception profile sees it (world/perception.cpp:
+// 5 % range noise, 0.02 rad bearing noise, a self-pose estimate off by 5 cm
+// and 0.03 rad, 2 % misses, and now and then a false ball elsewhere), 100
+// times a second. Noise between two sightings a few periods apart reads as
+// metres per second: the keeper must neither dive nor block before the ball
+// moves (the referee gives a goal for a keeper down before the kick); a real
+// shot after 20 s still gets a dive.
+TEST(SoccerBehaviour, TheShootoutKeeperTakesNoiseForNoShotButDivesAtTheShot) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  const double x = -f.halfLength() + cfg.shootout_keeper_line;
+  const double mark = -f.halfLength() + f.penalty_mark_distance.value();
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::PenaltyGoalkeeper, 1);
+  int acted_before = 0;
+  std::optional<MotionRequest> at_shot;
+  double ball_x_at_shot = 0.0;
+  for (int i = 0; i < 2100 && !at_shot; ++i) {
+    const double t = 0.01 * i;
+    // Kicked at 20 s: 2 m/s towards 0.6 m to the keeper's left on its line.
+    const double since = std::max(0.0, t - 20.0), dist = x - mark;
+    const double bx = mark + dist * std::min(1.0, 2.0 * since / std::abs(dist));
+    const double by = 0.6 * (bx - mark) / dist;
+    if (since > 0.0 && bx <= x + 0.05) break;  // passed it
+    agents::PerceptionIn p;
+    p.sim_time = t;
+    p.self_pose = {static_cast<float>(x + 0.05 * noise(rng)), static_cast<float>(0.05 * noise(rng)),
+                   static_cast<float>(0.03 * noise(rng))};
+    double rx = bx - x, ry = by;
+    if (unit(rng) < 0.01) {  // a false ball somewhere in front of the keeper
+      rx = 0.5 + 4.0 * unit(rng);
+      ry = -3.0 + 6.0 * unit(rng);
+    }
+    const double d = std::hypot(rx, ry) * (1.0 + 0.05 * noise(rng));
+    const double bearing = std::atan2(ry, rx) + 0.02 * noise(rng);
+    p.ball.in_view = unit(rng) > 0.02;
+    p.ball.last_seen = t;
+    p.ball.x = static_cast<float>(d * std::cos(bearing));
+    p.ball.y = static_cast<float>(d * std::sin(bearing));
+    agents::SoccerBehaviour::Input in;
+    in.time = t;
+    in.perception = &p;
+    const MotionRequest r = keeper.update(in);
+    const bool acted = r.kind == MotionRequest::Kind::Block || r.kind == MotionRequest::Kind::Dive;
+    if (acted && since == 0.0) ++acted_before;
+    if (acted && since > 0.0) {
+      at_shot = r;
+      ball_x_at_shot = bx;
+    }
+  }
+  EXPECT_EQ(acted_before, 0);
+  ASSERT_TRUE(at_shot.has_value());
+  EXPECT_EQ(at_shot->kind, MotionRequest::Kind::Dive);
+  EXPECT_EQ(at_shot->side, agents::Leg::Left);
+  EXPECT_GT(ball_x_at_shot - x, 0.3);  // in time for the dive to reach the ground
 }
 
 // The block and the dive on the real robot (Bullet, joint targets only): the

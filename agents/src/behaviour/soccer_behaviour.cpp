@@ -65,13 +65,28 @@ std::optional<Role> roleFromName(const std::string& name) {
 
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly({"behaviour",        "ready_positions", "kick_off_position",
-                  "max_forward",      "max_side",        "max_turn",
-                  "kick_ball",        "kick_tolerance",  "approach_distance",
-                  "ball_lost_time",   "team_ball_time",  "keep_clear",
-                  "message_interval", "keeper_line",     "shootout_keeper_line",
-                  "block_speed",      "block_time",      "block_reach",
-                  "dive_time",        "dive_reach"});
+  root.allowOnly({"behaviour",
+                  "ready_positions",
+                  "kick_off_position",
+                  "max_forward",
+                  "max_side",
+                  "max_turn",
+                  "kick_ball",
+                  "kick_tolerance",
+                  "approach_distance",
+                  "ball_lost_time",
+                  "team_ball_time",
+                  "keep_clear",
+                  "ball_velocity_window",
+                  "ball_outlier_distance",
+                  "message_interval",
+                  "keeper_line",
+                  "shootout_keeper_line",
+                  "block_speed",
+                  "block_time",
+                  "block_reach",
+                  "dive_time",
+                  "dive_reach"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -96,6 +111,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.approach_distance = root.number("approach_distance", c.approach_distance);
   c.ball_lost_time = root.number("ball_lost_time", c.ball_lost_time);
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
+  c.ball_velocity_window = root.number("ball_velocity_window", c.ball_velocity_window);
+  c.ball_outlier_distance = root.number("ball_outlier_distance", c.ball_outlier_distance);
   c.keep_clear = root.number("keep_clear", c.keep_clear);
   c.message_interval = root.number("message_interval", c.message_interval);
   c.keeper_line = root.number("keeper_line", c.keeper_line);
@@ -105,9 +122,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.block_reach = root.number("block_reach", c.block_reach);
   c.dive_time = root.number("dive_time", c.dive_time);
   c.dive_reach = root.number("dive_reach", c.dive_reach);
-  for (const char* k :
-       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval",
-        "block_speed", "block_time", "block_reach", "dive_time", "dive_reach"})
+  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance",
+                        "message_interval", "block_speed", "block_time", "block_reach", "dive_time",
+                        "dive_reach", "ball_velocity_window"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
   for (const char* k : {"keeper_line", "shootout_keeper_line"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
@@ -198,6 +215,8 @@ void SoccerBehaviour::readGame(const Input& in) {
   // robot re-enters elsewhere) restarts the motion from the stance.
   if (penalised_ != was_penalised_) restart_motion_ = true;
   if (state_ != last_state_ && (state_ == kSet || state_ == kInitial)) restart_motion_ = true;
+  // The ball's track from before a placement would read as a roll.
+  if (restart_motion_) sightings_.clear();
   was_penalised_ = penalised_;
   last_state_ = state_;
 }
@@ -227,21 +246,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
       // The ball in the own frame, from where the robot is now (the sighting is relative).
       const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
       const Vec2 b{self_.x + c * p.ball.x - s * p.ball.y, self_.y + s * p.ball.x + c * p.ball.y};
-      if (p.ball.in_view) {
-        const double gap = in.time - last_ball_time_;
-        if (gap > 0.5) {
-          // Never seen, or not for a while (lost, or the robots were placed):
-          // the old velocity says nothing about the ball now. Start over.
-          ball_velocity_ = {0.0, 0.0};
-        } else if (gap > 0.05) {
-          const Vec2 v{(b.x - last_ball_.x) / gap, (b.y - last_ball_.y) / gap};
-          ball_velocity_ = {0.7 * ball_velocity_.x + 0.3 * v.x, 0.7 * ball_velocity_.y + 0.3 * v.y};
-        }
-        if (gap > 0.05) {
-          last_ball_ = b;
-          last_ball_time_ = in.time;
-        }
-      }
+      if (p.ball.in_view) updateBallVelocity(in.time, b);
       ball_ = b;
       ball_known_at_ = ball_seen_at_;
     }
@@ -424,6 +429,60 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
   r.turn = std::clamp(1.0 * ea, -0.4, 0.4);
   target_ = {ball_.x, ball_.y, aim};
   return r;
+}
+
+void SoccerBehaviour::updateBallVelocity(double time, const Vec2& ball) {
+  // Not seen for a while (lost, or the robots were placed): the old sightings
+  // say nothing about the ball now.
+  if (!sightings_.empty() && time - sightings_.back().time > 0.5) sightings_.clear();
+  sightings_.push_back({time, ball, false});
+  const double window = config_.ball_velocity_window;
+  while (time - sightings_.front().time > window) sightings_.pop_front();
+  ball_velocity_ = {0.0, 0.0};
+  if (sightings_.size() < 3 || time - sightings_.front().time < 0.5 * window) return;
+  // Least squares, ball(t) = a + v (t - mean t) per axis, refitted without
+  // the sighting furthest off the line while it is further than
+  // ball_outlier_distance (a false ball elsewhere on the field would
+  // otherwise tilt the line), up to a third of them.
+  const size_t max_dropped = sightings_.size() / 3;
+  for (Sighting& s : sightings_) s.outlier = false;
+  for (size_t dropped = 0;; ++dropped) {
+    double n = 0.0, mt = 0.0, mx = 0.0, my = 0.0;
+    for (const Sighting& s : sightings_) {
+      if (s.outlier) continue;
+      n += 1.0;
+      mt += s.time;
+      mx += s.ball.x;
+      my += s.ball.y;
+    }
+    mt /= n;
+    mx /= n;
+    my /= n;
+    double stt = 0.0, stx = 0.0, sty = 0.0;
+    for (const Sighting& s : sightings_) {
+      if (s.outlier) continue;
+      const double dt = s.time - mt;
+      stt += dt * dt;
+      stx += dt * (s.ball.x - mx);
+      sty += dt * (s.ball.y - my);
+    }
+    if (!(stt > 0.0)) return;
+    ball_velocity_ = {stx / stt, sty / stt};
+    Sighting* worst = nullptr;
+    double worst_off = config_.ball_outlier_distance;
+    for (Sighting& s : sightings_) {
+      if (s.outlier) continue;
+      const double dt = s.time - mt;
+      const double off =
+          std::hypot(s.ball.x - mx - ball_velocity_.x * dt, s.ball.y - my - ball_velocity_.y * dt);
+      if (off > worst_off) {
+        worst_off = off;
+        worst = &s;
+      }
+    }
+    if (!worst || dropped == max_dropped) return;
+    worst->outlier = true;
+  }
 }
 
 std::optional<SoccerBehaviour::Crossing> SoccerBehaviour::ballCrossing(double x,

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -60,6 +61,12 @@ struct BehaviourConfig {
   double kick_tolerance_angle = 0.15;  // rad off the aim
   double approach_distance = 0.35;     // m behind the ball before lining up
   double ball_lost_time = 3.0;         // s: after this, the own sighting is stale
+  // The ball's velocity: the least-squares slope of the own sightings of the
+  // last ball_velocity_window, once they span half of it (a ball lying on the
+  // penalty mark, seen with 5 % range noise at 100 Hz, must not look like a
+  // shot: two sightings a few periods apart read that noise as m/s).
+  double ball_velocity_window = 0.3;   // s
+  double ball_outlier_distance = 0.3;  // m off the fitted line: left out (a false ball)
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
@@ -170,8 +177,13 @@ class SoccerBehaviour {
   Vec2 ball_, ball_robot_;  // own frame; robot frame (own sighting)
   double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
   Vec2 ball_velocity_;
-  Vec2 last_ball_;
-  double last_ball_time_ = -1e9;
+  struct Sighting {
+    double time;
+    Vec2 ball;     // own frame
+    bool outlier;  // left out of the last fit
+  };
+  std::deque<Sighting> sightings_;  // own, in view, the last ball_velocity_window
+  void updateBallVelocity(double time, const Vec2& ball);
   std::vector<Teammate> mates_;
   double last_sent_ = -1e9, now_ = 0.0;
   Leg kick_foot_ = Leg::Right;
