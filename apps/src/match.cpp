@@ -418,7 +418,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   for (size_t i = 0; i < s.robots().size(); ++i) {
     const auto& rec = s.robots()[i];
     out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number
-        << ", \"falls\": " << rec.falls << ", \"distance_walked\": " << num(rec.distance, 2)
+        << ", \"falls\": " << rec.falls << ", \"keeper_dives\": " << rec.dives
+        << ", \"distance_walked\": " << num(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
         << "}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }
@@ -466,7 +467,8 @@ const char* kMatchHelp =
     "DDS, in lockstep (--realtime: paced to the wall clock). Agents that exit are restarted\n"
     "(agents.restart_limit times each); past that the match stops. Ctrl-C stops it too; what\n"
     "was recorded is kept. Writes to DIR (default runs/<date-time>/):\n"
-    "  summary.json  teams, score, goals (time, scorer), referee events, penalties, falls and\n"
+    "  summary.json  teams, score, goals (time, scorer), referee events, penalties, falls,\n"
+    "                shoot-out keeper dives (down once the shot is kicked: not falls) and\n"
     "                distance walked per robot, possession, agent restarts, simulated and\n"
     "                wall time, real-time factor, seed, config hash, final state hash\n"
     "  match.log     every control period (poses, joints, ball, game state, commands, state\n"

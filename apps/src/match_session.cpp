@@ -185,7 +185,13 @@ void MatchSession::record() {
     RobotRecord& rec = records_[r];
     const engine::Vec3 p = world_->torsoPose(r).translation();
     const bool standing = world_->isStanding(r);
-    if (rec.standing && !standing) ++rec.falls;
+    if (rec.standing && !standing) {
+      const referee::Game& g = referee_->game();
+      const bool keeper_after_shot = g.shootoutOpen() && g.shotKickedYet() &&
+                                     rec.team != g.kickingTeam() &&
+                                     rec.number == g.shootoutKeeper();
+      ++(keeper_after_shot ? rec.dives : rec.falls);
+    }
     rec.standing = standing;
     const double step = (p - rec.last).head<2>().norm();
     if (standing && step < 0.05) rec.distance += step;  // more: the referee moved it

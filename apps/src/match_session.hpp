@@ -46,6 +46,7 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file);
 struct RobotRecord {
   int team = 0, number = 0;
   int falls = 0;
+  int dives = 0;          // the shoot-out keeper going down once the shot is kicked: not a fall
   double distance = 0.0;  // m walked (torso, teleports left out)
   bool standing = true;
   engine::Vec3 last{0, 0, 0};

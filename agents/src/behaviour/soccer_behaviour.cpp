@@ -86,7 +86,10 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "block_time",
                   "block_reach",
                   "dive_time",
-                  "dive_reach"});
+                  "dive_reach",
+                  "avoid_near",
+                  "avoid_far",
+                  "avoid_ball"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -122,10 +125,19 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.block_reach = root.number("block_reach", c.block_reach);
   c.dive_time = root.number("dive_time", c.dive_time);
   c.dive_reach = root.number("dive_reach", c.dive_reach);
-  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance",
-                        "message_interval", "block_speed", "block_time", "block_reach", "dive_time",
-                        "dive_reach", "ball_velocity_window"})
+  c.avoid_near = root.number("avoid_near", c.avoid_near);
+  c.avoid_far = root.number("avoid_far", c.avoid_far);
+  c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
+  for (const char* k :
+       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval",
+        "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
+        "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
+  if (root.has("avoid_ball") && !(root["avoid_ball"].number() >= 0))
+    root["avoid_ball"].fail("must be >= 0");
+  if (!(c.avoid_far > c.avoid_near))
+    (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
+        .fail("avoid_far must be greater than avoid_near");
   for (const char* k : {"keeper_line", "shootout_keeper_line"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
@@ -230,6 +242,9 @@ bool SoccerBehaviour::takeMotionRestart() {
 void SoccerBehaviour::updateBall(const Input& in) {
   if (in.perception) {
     const PerceptionIn& p = *in.perception;
+    robots_seen_.clear();
+    for (const PerceivedIn& o : p.robots)
+      if (o.in_view && o.last_seen >= in.time - 0.05) robots_seen_.push_back({o.x, o.y});
     if (phase_ == kPhasePenaltyShoot) {
       // Every shoot-out kick goes at one goal, and the referee puts both the
       // kicker (at the penalty mark) and the keeper (on the line) in that
@@ -634,8 +649,32 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
     r = MotionRequest{};
   else if (self_known_)
     r = play(in);
+  avoidRobots(r);
   head(r, in);
   return r;
+}
+
+void SoccerBehaviour::avoidRobots(MotionRequest& r) const {
+  if (r.kind != MotionRequest::Kind::Walk) return;
+  // Near the ball in play it is contested (in Ready nobody plays it).
+  const bool ready = have_game_ && state_ == kReady;
+  if (!ready && std::hypot(ball_.x - self_.x, ball_.y - self_.y) < config_.avoid_ball) return;
+  for (const Vec2& o : robots_seen_) {
+    const double d = std::hypot(o.x, o.y);
+    if (d >= config_.avoid_far || d < 1e-6) continue;
+    // The walk's speed towards the robot (forward and sideways, m/s).
+    const double ux = o.x / d, uy = o.y / d;
+    const double towards = r.forward * ux + r.left * uy;
+    if (towards <= 0.0) continue;
+    // Take away the approach: all of it at avoid_near, none at avoid_far ...
+    const double share =
+        std::clamp((config_.avoid_far - d) / (config_.avoid_far - config_.avoid_near), 0.0, 1.0);
+    r.forward -= share * towards * ux;
+    r.left -= share * towards * uy;
+    // ... and step sideways past it instead, away from its side.
+    const double side = o.y > 0.0 ? -1.0 : 1.0;
+    r.left = std::clamp(r.left + side * share * towards, -config_.max_side, config_.max_side);
+  }
 }
 
 std::string SoccerBehaviour::status() const {

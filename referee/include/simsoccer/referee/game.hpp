@@ -115,6 +115,7 @@ class Game {
   bool shootoutOpen() const { return phase_ == gc::GamePhase::PenaltyShoot && !game_over_; }
   int shootoutStriker() const { return striker_; }
   int shootoutKeeper() const { return keeper_; }
+  bool shotKickedYet() const { return shot_kicked_; }  // this kick's striker touched the ball
 
   // --- state ----------------------------------------------------------------------------
   gc::State state() const { return state_; }

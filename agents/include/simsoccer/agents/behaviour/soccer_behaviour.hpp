@@ -85,6 +85,13 @@ struct BehaviourConfig {
   // in the shoot-out: a dive ends on the ground, and one shot is all there is.)
   double dive_time = 0.9;   // s
   double dive_reach = 0.8;  // m
+  // Other robots seen within avoid_far ahead of the walk slow its approach to
+  // them, down to none at avoid_near, and turn it into a step past them
+  // (robots that walk into each other fall). Not within avoid_ball of the
+  // ball in play: it is contested there, and the referee's pushing rule decides.
+  double avoid_near = 0.35;  // m, torso to torso
+  double avoid_far = 0.8;    // m
+  double avoid_ball = 0.6;   // m
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
@@ -152,6 +159,7 @@ class SoccerBehaviour {
   // `speed` m/s, crosses the line at own-frame x; nothing if it does not.
   std::optional<Crossing> ballCrossing(double x, double speed) const;
   MotionRequest walkTo(const Pose2& target, bool face_ball);
+  void avoidRobots(MotionRequest& r) const;
   void head(MotionRequest& r, const Input& in);
   Vec2 toOwn(double fx, double fy) const;    // field -> own frame
   Vec2 fromOwn(double ox, double oy) const;  // own -> field frame
@@ -183,6 +191,7 @@ class SoccerBehaviour {
     bool outlier;  // left out of the last fit
   };
   std::deque<Sighting> sightings_;  // own, in view, the last ball_velocity_window
+  std::vector<Vec2> robots_seen_;   // other robots in view now, robot frame
   void updateBallVelocity(double time, const Vec2& ball);
   std::vector<Teammate> mates_;
   double last_sent_ = -1e9, now_ = 0.0;
