@@ -125,6 +125,15 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);  // a typo
   std::ofstream(f) << "behaviour: soccer\nready_positions: []\nkeeper_line: -0.1\n";
   EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);  // behind the goal line
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\navoid_far: 0.3\n";
+  try {
+    agents::loadBehaviourConfig(f);
+    FAIL() << "accepted avoid_far under avoid_near";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("avoid_far"), std::string::npos);
+  }
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\nball_outlier_distance: 0\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);
   std::filesystem::remove_all(dir);
 }
 
@@ -281,6 +290,54 @@ TEST(SoccerBehaviour, TheGoalkeeperBlocksAndInTheShootoutDives) {
   EXPECT_EQ(roll(Role::PenaltyGoalkeeper, shootout_line, 0.1, -0.6, 0.0, shootout_line + 0.9).kind,
             MotionRequest::Kind::Block);
   EXPECT_FALSE(acted(roll(Role::PenaltyGoalkeeper, shootout_line, 1.2, -2.0, 0.0)));
+}
+
+// A walking robot that sees another robot ahead slows its approach to it and
+// steps past it, away from its side; robots further than avoid_far, behind it,
+// or met at the ball in play (contested there) change nothing.
+TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  // The striker at (-2, 0) facing +x, the ball at (bx, 0): it walks straight at it.
+  auto walk = [&](double bx, std::optional<std::pair<double, double>> other) {
+    agents::SoccerBehaviour striker(cfg, f, 0, 1, 2, Role::Striker, 1);
+    auto p = seeing(-2.0, 0.0, 0.0, bx, 0.0, 0.0);
+    if (other) {
+      agents::PerceivedIn o;
+      o.kind = 2;
+      o.team = 1;
+      o.in_view = true;
+      o.last_seen = 0.0;
+      o.x = static_cast<float>(other->first);
+      o.y = static_cast<float>(other->second);
+      p.robots.push_back(o);
+    }
+    agents::SoccerBehaviour::Input in;
+    in.perception = &p;
+    return striker.update(in);
+  };
+  const MotionRequest free = walk(1.0, std::nullopt);
+  ASSERT_EQ(free.kind, MotionRequest::Kind::Walk);
+  ASSERT_GT(free.forward, 0.2);
+  // 0.5 m ahead, a little to its left: slower, and a step to the right.
+  const MotionRequest near = walk(1.0, std::make_pair(0.5, 0.1));
+  EXPECT_LT(near.forward, 0.6 * free.forward);
+  EXPECT_LT(near.left, free.left - 0.03);
+  // ... a little to its right: a step to the left.
+  EXPECT_GT(walk(1.0, std::make_pair(0.5, -0.1)).left, free.left + 0.03);
+  // Right up against it (avoid_near): no approach left at all.
+  const MotionRequest touching = walk(1.0, std::make_pair(cfg.avoid_near, 0.0));
+  EXPECT_NEAR(touching.forward, 0.0, 1e-9);
+  for (const auto& [x, y] : {std::make_pair(1.5, 0.0), std::make_pair(-0.5, 0.0)}) {
+    const MotionRequest r = walk(1.0, std::make_pair(x, y));  // far ahead; behind
+    EXPECT_DOUBLE_EQ(r.forward, free.forward);
+    EXPECT_DOUBLE_EQ(r.left, free.left);
+  }
+  // At the ball (0.4 m ahead) with a robot there too: the ball is contested.
+  const MotionRequest at_ball = walk(-1.6, std::nullopt);
+  const MotionRequest contested = walk(-1.6, std::make_pair(0.45, 0.0));
+  EXPECT_DOUBLE_EQ(contested.forward, at_ball.forward);
+  EXPECT_DOUBLE_EQ(contested.left, at_ball.left);
 }
 
 // The shoot-out keeper waits for the kick with the ball on the penalty mark,
