@@ -299,13 +299,13 @@ TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
   const auto cfg = soccerConfig();
   const auto f = field();
   // The striker at (-2, 0) facing +x, the ball at (bx, 0): it walks straight at it.
-  auto walk = [&](double bx, std::optional<std::pair<double, double>> other) {
+  auto walk = [&](double bx, std::optional<std::pair<double, double>> other, int team = 1) {
     agents::SoccerBehaviour striker(cfg, f, 0, 1, 2, Role::Striker, 1);
     auto p = seeing(-2.0, 0.0, 0.0, bx, 0.0, 0.0);
     if (other) {
       agents::PerceivedIn o;
       o.kind = 2;
-      o.team = 1;
+      o.team = team;
       o.in_view = true;
       o.last_seen = 0.0;
       o.x = static_cast<float>(other->first);
@@ -333,11 +333,15 @@ TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
     EXPECT_DOUBLE_EQ(r.forward, free.forward);
     EXPECT_DOUBLE_EQ(r.left, free.left);
   }
-  // At the ball (0.4 m ahead) with a robot there too: the ball is contested.
+  // At the ball (0.4 m ahead) with an opponent there too: the ball is
+  // contested. A teammate nearer the ball is given way to.
   const MotionRequest at_ball = walk(-1.6, std::nullopt);
   const MotionRequest contested = walk(-1.6, std::make_pair(0.45, 0.0));
   EXPECT_DOUBLE_EQ(contested.forward, at_ball.forward);
   EXPECT_DOUBLE_EQ(contested.left, at_ball.left);
+  EXPECT_LT(walk(-1.6, std::make_pair(0.38, 0.05), 0).forward, 0.5 * at_ball.forward);
+  const MotionRequest teammate_further = walk(-1.6, std::make_pair(0.5, 0.6), 0);
+  EXPECT_DOUBLE_EQ(teammate_further.forward, at_ball.forward);  // further from the ball
 }
 
 // The shoot-out keeper waits for the kick with the ball on the penalty mark,

@@ -181,6 +181,7 @@ SoccerBehaviour::SoccerBehaviour(const BehaviourConfig& config, const fields::Fi
                                  int team, int team_number, int player, Role role, uint64_t seed)
     : config_(config),
       field_(field),
+      team_(team),
       team_number_(team_number),
       player_(player),
       fixed_role_(role) {
@@ -244,7 +245,8 @@ void SoccerBehaviour::updateBall(const Input& in) {
     const PerceptionIn& p = *in.perception;
     robots_seen_.clear();
     for (const PerceivedIn& o : p.robots)
-      if (o.in_view && o.last_seen >= in.time - 0.05) robots_seen_.push_back({o.x, o.y});
+      if (o.in_view && o.last_seen >= in.time - 0.05)
+        robots_seen_.push_back({{o.x, o.y}, o.team == team_});
     if (phase_ == kPhasePenaltyShoot) {
       // Every shoot-out kick goes at one goal, and the referee puts both the
       // kicker (at the penalty mark) and the keeper (on the line) in that
@@ -616,12 +618,25 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
 }
 
 void SoccerBehaviour::head(MotionRequest& r, const Input& in) {
+  // Walking to a place rather than to the ball (Ready; supporter, defender):
+  // look where the walk goes, in Ready all the time, in play one second in
+  // three, so that the robots in the way are seen (and stepped past).
+  const bool to_place = role_ == Role::Supporter || role_ == Role::Defender;
+  const bool ready = have_game_ && state_ == kReady;
+  if (r.kind == MotionRequest::Kind::Walk && r.forward > 0.05 &&
+      (ready || (to_place && std::fmod(in.time, 3.0) < 1.0))) {
+    r.head_yaw = std::clamp(std::atan2(r.left, r.forward), -0.5, 0.5);
+    r.head_pitch = 0.25;
+    return;
+  }
   const bool seen = in.time - ball_seen_at_ < 0.5;
-  if (seen) {
+  if (seen || in.time - ball_known_at_ < 1.5) {
     // Track: the head turned to the ball, pitched by its distance (the top
-    // camera sees far, the bottom one near the feet).
-    const double d = std::hypot(ball_robot_.x, ball_robot_.y);
-    r.head_yaw = std::atan2(ball_robot_.y, ball_robot_.x);
+    // camera sees far, the bottom one near the feet); where it was last
+    // known, if the head was turned away from it for a while.
+    const Vec2 b = seen ? ball_robot_ : toRobot(ball_);
+    const double d = std::hypot(b.x, b.y);
+    r.head_yaw = std::atan2(b.y, b.x);
     r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
   } else {
     // Scan: side to side, 4 s a sweep.
@@ -656,10 +671,14 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
 
 void SoccerBehaviour::avoidRobots(MotionRequest& r) const {
   if (r.kind != MotionRequest::Kind::Walk) return;
-  // Near the ball in play it is contested (in Ready nobody plays it).
-  const bool ready = have_game_ && state_ == kReady;
-  if (!ready && std::hypot(ball_.x - self_.x, ball_.y - self_.y) < config_.avoid_ball) return;
-  for (const Vec2& o : robots_seen_) {
+  // Near the ball in play it is contested (in Ready nobody plays it): only a
+  // teammate nearer to it is given way to.
+  const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
+  const bool at_ball = !(have_game_ && state_ == kReady) && to_ball < config_.avoid_ball;
+  const Vec2 ball = toRobot(ball_);
+  for (const SeenRobot& seen : robots_seen_) {
+    const Vec2& o = seen.at;
+    if (at_ball && (!seen.teammate || std::hypot(ball.x - o.x, ball.y - o.y) >= to_ball)) continue;
     const double d = std::hypot(o.x, o.y);
     if (d >= config_.avoid_far || d < 1e-6) continue;
     // The walk's speed towards the robot (forward and sideways, m/s).

@@ -87,8 +87,9 @@ struct BehaviourConfig {
   double dive_reach = 0.8;  // m
   // Other robots seen within avoid_far ahead of the walk slow its approach to
   // them, down to none at avoid_near, and turn it into a step past them
-  // (robots that walk into each other fall). Not within avoid_ball of the
-  // ball in play: it is contested there, and the referee's pushing rule decides.
+  // (robots that walk into each other fall). Within avoid_ball of the ball in
+  // play only from a teammate nearer the ball: the ball is contested with the
+  // opponents there, and the referee's pushing rule decides.
   double avoid_near = 0.35;  // m, torso to torso
   double avoid_far = 0.8;    // m
   double avoid_ball = 0.6;   // m
@@ -167,7 +168,7 @@ class SoccerBehaviour {
 
   BehaviourConfig config_;
   fields::FieldModel field_;
-  int team_number_, player_;
+  int team_, team_number_, player_;
   Role fixed_role_, role_ = Role::Striker;
   // Game.
   bool have_game_ = false;
@@ -191,7 +192,11 @@ class SoccerBehaviour {
     bool outlier;  // left out of the last fit
   };
   std::deque<Sighting> sightings_;  // own, in view, the last ball_velocity_window
-  std::vector<Vec2> robots_seen_;   // other robots in view now, robot frame
+  struct SeenRobot {
+    Vec2 at;  // robot frame
+    bool teammate;
+  };
+  std::vector<SeenRobot> robots_seen_;  // other robots in view now
   void updateBallVelocity(double time, const Vec2& ball);
   std::vector<Teammate> mates_;
   double last_sent_ = -1e9, now_ = 0.0;
