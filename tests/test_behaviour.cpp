@@ -11,6 +11,7 @@
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/world/match_log.hpp"
+#include "simsoccer/world/scenario.hpp"
 #include "test_support.hpp"
 
 using namespace simsoccer;
@@ -130,8 +131,17 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
     agents::loadBehaviourConfig(f);
     FAIL() << "accepted avoid_far under avoid_near";
   } catch (const engine::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("avoid_far"), std::string::npos);
+    EXPECT_EQ(e.key(), "avoid_far");
   }
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\navoid_near: 0.9\n";
+  try {
+    agents::loadBehaviourConfig(f);
+    FAIL() << "accepted avoid_near over avoid_far";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "avoid_near");
+  }
+  std::ofstream(f) << "behaviour: soccer\nready_positions: []\nball_velocity_window: 0.01\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);
   std::ofstream(f) << "behaviour: soccer\nready_positions: []\nball_outlier_distance: 0\n";
   EXPECT_THROW(agents::loadBehaviourConfig(f), engine::ConfigError);
   std::filesystem::remove_all(dir);
@@ -345,10 +355,12 @@ TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
 }
 
 // The shoot-out keeper waits for the kick with the ball on the penalty mark,
-// seen as the realistic perception profile sees it (world/perception.cpp:
-// 5 % range noise, 0.02 rad bearing noise, a self-pose estimate off by 5 cm
-// and 0.03 rad, 2 % misses, and now and then a false ball elsewhere), 100
-// times a second. Noise between two sightings a few periods apart reads as
+// seen 100 times a second with the realistic perception profile's noise and
+// misses (world::PerceptionSettings: range, bearing and self-pose noise,
+// misses growing with distance), and a false ball elsewhere in 1 % of the
+// periods (harsher than the profile, which adds one in 0.5 % of the periods
+// the ball is missed: the fit's outlier step is exercised). Noise between two
+// sightings a few periods apart reads as
 // metres per second: the keeper must neither dive nor block before the ball
 // moves (the referee gives a goal for a keeper down before the kick); a real
 // shot after 20 s still gets a dive.
@@ -361,6 +373,8 @@ TEST(SoccerBehaviour, TheShootoutKeeperTakesNoiseForNoShotButDivesAtTheShot) {
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::PenaltyGoalkeeper, 1);
+  const world::PerceptionSettings profile;  // the realistic profile's defaults
+  double last_seen = -1.0;
   int acted_before = 0;
   std::optional<MotionRequest> at_shot;
   double ball_x_at_shot = 0.0;
@@ -373,17 +387,20 @@ TEST(SoccerBehaviour, TheShootoutKeeperTakesNoiseForNoShotButDivesAtTheShot) {
     if (since > 0.0 && bx <= x + 0.05) break;  // passed it
     agents::PerceptionIn p;
     p.sim_time = t;
-    p.self_pose = {static_cast<float>(x + 0.05 * noise(rng)), static_cast<float>(0.05 * noise(rng)),
-                   static_cast<float>(0.03 * noise(rng))};
+    p.self_pose = {static_cast<float>(x + profile.pose_noise_xy * noise(rng)),
+                   static_cast<float>(profile.pose_noise_xy * noise(rng)),
+                   static_cast<float>(profile.pose_noise_yaw * noise(rng))};
     double rx = bx - x, ry = by;
+    const double miss = profile.miss_base + profile.miss_per_metre * std::hypot(rx, ry);
     if (unit(rng) < 0.01) {  // a false ball somewhere in front of the keeper
       rx = 0.5 + 4.0 * unit(rng);
       ry = -3.0 + 6.0 * unit(rng);
     }
-    const double d = std::hypot(rx, ry) * (1.0 + 0.05 * noise(rng));
-    const double bearing = std::atan2(ry, rx) + 0.02 * noise(rng);
-    p.ball.in_view = unit(rng) > 0.02;
-    p.ball.last_seen = t;
+    const double d = std::hypot(rx, ry) * (1.0 + profile.distance_noise * noise(rng));
+    const double bearing = std::atan2(ry, rx) + profile.bearing_noise * noise(rng);
+    p.ball.in_view = unit(rng) > miss;
+    if (p.ball.in_view) last_seen = t;
+    p.ball.last_seen = last_seen;
     p.ball.x = static_cast<float>(d * std::cos(bearing));
     p.ball.y = static_cast<float>(d * std::sin(bearing));
     agents::SoccerBehaviour::Input in;

@@ -420,9 +420,8 @@ PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
   keeper.yaw = M_PI;
   s.robots.push_back(keeper);
   s.ball_position = {mark, 0.0, -1.0};
-  // The keeper sees as in configs/scenarios/penalty.yaml: with the realistic
+  // Both robots see as in configs/scenarios/penalty.yaml: with the realistic
   // profile's noise, misses and false balls.
-  s.perception.enabled = true;
   s.perception.realistic = true;
   world::World w(s);
   InProcessAgents agents(w, {agents::Role::PenaltyKicker, agents::Role::PenaltyGoalkeeper}, seed);

@@ -181,16 +181,24 @@ void MatchSession::record() {
   const double dt = world_->scenario().physics.control_period;
   const engine::Vec3 ball = world_->ballState().pose.translation();
   double nearest[2] = {1e9, 1e9};
+  const referee::Game& g = referee_->game();
+  if (g.shootoutOpen() && g.shotKickedYet()) {
+    diving_keeper_.reset();
+    for (size_t i = 0; i < records_.size(); ++i)
+      if (records_[i].team != g.kickingTeam() && records_[i].number == g.shootoutKeeper())
+        diving_keeper_ = i;
+  }
   for (world::RobotId r = 0; r < world_->robotCount(); ++r) {
     RobotRecord& rec = records_[r];
     const engine::Vec3 p = world_->torsoPose(r).translation();
     const bool standing = world_->isStanding(r);
     if (rec.standing && !standing) {
-      const referee::Game& g = referee_->game();
-      const bool keeper_after_shot = g.shootoutOpen() && g.shotKickedYet() &&
-                                     rec.team != g.kickingTeam() &&
-                                     rec.number == g.shootoutKeeper();
-      ++(keeper_after_shot ? rec.dives : rec.falls);
+      if (diving_keeper_ == r) {
+        ++rec.dives;
+        diving_keeper_.reset();
+      } else {
+        ++rec.falls;
+      }
     }
     rec.standing = standing;
     const double step = (p - rec.last).head<2>().norm();

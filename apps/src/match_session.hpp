@@ -89,6 +89,10 @@ class MatchSession {
   std::unique_ptr<world::World> world_;
   std::unique_ptr<referee::Referee> referee_;
   std::vector<RobotRecord> records_;
+  // The shoot-out keeper of the last kicked shot (record index), until it goes
+  // down (a dive) or the next shot is kicked: a goal ends the shot, and the
+  // next kick is set up, before the diving keeper reaches the ground.
+  std::optional<size_t> diving_keeper_;
   std::array<double, 2> possession_{};
   std::vector<Goal> goals_;
   size_t events_seen_ = 0;

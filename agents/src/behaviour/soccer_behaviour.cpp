@@ -133,6 +133,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
         "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
+  // Three sightings at the least at 100 Hz over half the window.
+  if (root.has("ball_velocity_window") && !(c.ball_velocity_window >= 0.05))
+    root["ball_velocity_window"].fail("must be >= 0.05 s");
   if (root.has("avoid_ball") && !(root["avoid_ball"].number() >= 0))
     root["avoid_ball"].fail("must be >= 0");
   if (!(c.avoid_far > c.avoid_near))
@@ -226,10 +229,13 @@ void SoccerBehaviour::readGame(const Input& in) {
   penalised_ = player_ >= 1 && player_ <= 20 && t.players[player_ - 1].penalty != 0;
   // A state change that moves robots (Set: placement; leaving a penalty: the
   // robot re-enters elsewhere) restarts the motion from the stance.
-  if (penalised_ != was_penalised_) restart_motion_ = true;
-  if (state_ != last_state_ && (state_ == kSet || state_ == kInitial)) restart_motion_ = true;
-  // The ball's track from before a placement would read as a roll.
-  if (restart_motion_) sightings_.clear();
+  const bool moved = penalised_ != was_penalised_ ||
+                     (state_ != last_state_ && (state_ == kSet || state_ == kInitial));
+  if (moved) {
+    restart_motion_ = true;
+    // The ball's track from before a placement would read as a roll.
+    forgetBallTrack();
+  }
   was_penalised_ = penalised_;
   last_state_ = state_;
 }
@@ -245,7 +251,9 @@ void SoccerBehaviour::updateBall(const Input& in) {
     const PerceptionIn& p = *in.perception;
     robots_seen_.clear();
     for (const PerceivedIn& o : p.robots)
-      if (o.in_view && o.last_seen >= in.time - 0.05)
+      // Seen in the last 0.3 s (a perception miss drops a robot for a
+      // period; it has not moved far since).
+      if (o.last_seen >= 0.0 && in.time - o.last_seen < 0.3)
         robots_seen_.push_back({{o.x, o.y}, o.team == team_});
     if (phase_ == kPhasePenaltyShoot) {
       // Every shoot-out kick goes at one goal, and the referee puts both the
@@ -268,6 +276,8 @@ void SoccerBehaviour::updateBall(const Input& in) {
       ball_known_at_ = ball_seen_at_;
     }
   }
+  // Out of view for a while: no velocity from a track that has ended.
+  if (!sightings_.empty() && in.time - sightings_.back().time > 0.5) forgetBallTrack();
   // A teammate's fresher sighting replaces a stale own one.
   if (in.time - ball_seen_at_ > config_.ball_lost_time) {
     for (const Teammate& m : mates_) {
@@ -448,10 +458,12 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
   return r;
 }
 
+void SoccerBehaviour::forgetBallTrack() {
+  sightings_.clear();
+  ball_velocity_ = {0.0, 0.0};
+}
+
 void SoccerBehaviour::updateBallVelocity(double time, const Vec2& ball) {
-  // Not seen for a while (lost, or the robots were placed): the old sightings
-  // say nothing about the ball now.
-  if (!sightings_.empty() && time - sightings_.back().time > 0.5) sightings_.clear();
   sightings_.push_back({time, ball, false});
   const double window = config_.ball_velocity_window;
   while (time - sightings_.front().time > window) sightings_.pop_front();
@@ -617,15 +629,15 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
   return r;
 }
 
-void SoccerBehaviour::head(MotionRequest& r, const Input& in) {
+void SoccerBehaviour::head(MotionRequest& r, const MotionRequest& planned, const Input& in) {
   // Walking to a place rather than to the ball (Ready; supporter, defender):
   // look where the walk goes, in Ready all the time, in play one second in
   // three, so that the robots in the way are seen (and stepped past).
   const bool to_place = role_ == Role::Supporter || role_ == Role::Defender;
   const bool ready = have_game_ && state_ == kReady;
-  if (r.kind == MotionRequest::Kind::Walk && r.forward > 0.05 &&
+  if (planned.kind == MotionRequest::Kind::Walk && planned.forward > 0.05 &&
       (ready || (to_place && std::fmod(in.time, 3.0) < 1.0))) {
-    r.head_yaw = std::clamp(std::atan2(r.left, r.forward), -0.5, 0.5);
+    r.head_yaw = std::clamp(std::atan2(planned.left, planned.forward), -0.5, 0.5);
     r.head_pitch = 0.25;
     return;
   }
@@ -653,7 +665,7 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
   MotionRequest r;
   if (have_game_ &&
       (penalised_ || state_ == kInitial || state_ == kStandby || state_ == kFinished)) {
-    head(r, in);
+    head(r, r, in);
     r.head_yaw = 0.0;
     return r;
   }
@@ -664,8 +676,9 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
     r = MotionRequest{};
   else if (self_known_)
     r = play(in);
+  const MotionRequest planned = r;  // the head follows the plan, not the detour
   avoidRobots(r);
-  head(r, in);
+  head(r, planned, in);
   return r;
 }
 
@@ -693,6 +706,7 @@ void SoccerBehaviour::avoidRobots(MotionRequest& r) const {
     // ... and step sideways past it instead, away from its side.
     const double side = o.y > 0.0 ? -1.0 : 1.0;
     r.left = std::clamp(r.left + side * share * towards, -config_.max_side, config_.max_side);
+    r.forward = std::clamp(r.forward, -0.1, config_.max_forward);
   }
 }
 

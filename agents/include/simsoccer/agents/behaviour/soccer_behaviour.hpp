@@ -161,14 +161,16 @@ class SoccerBehaviour {
   std::optional<Crossing> ballCrossing(double x, double speed) const;
   MotionRequest walkTo(const Pose2& target, bool face_ball);
   void avoidRobots(MotionRequest& r) const;
-  void head(MotionRequest& r, const Input& in);
+  // The head's angles into r; `planned` is the walk before avoidRobots.
+  void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
   Vec2 toOwn(double fx, double fy) const;    // field -> own frame
   Vec2 fromOwn(double ox, double oy) const;  // own -> field frame
   Vec2 toRobot(const Vec2& own) const;       // own -> robot frame
 
   BehaviourConfig config_;
   fields::FieldModel field_;
-  int team_, team_number_, player_;
+  int team_;  // the world's team index (0, 1), as perception labels robots
+  int team_number_, player_;
   Role fixed_role_, role_ = Role::Striker;
   // Game.
   bool have_game_ = false;
@@ -198,6 +200,7 @@ class SoccerBehaviour {
   };
   std::vector<SeenRobot> robots_seen_;  // other robots in view now
   void updateBallVelocity(double time, const Vec2& ball);
+  void forgetBallTrack();
   std::vector<Teammate> mates_;
   double last_sent_ = -1e9, now_ = 0.0;
   Leg kick_foot_ = Leg::Right;
