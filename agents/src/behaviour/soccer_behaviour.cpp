@@ -651,8 +651,11 @@ void SoccerBehaviour::head(MotionRequest& r, const MotionRequest& planned, const
     r.head_yaw = std::atan2(b.y, b.x);
     r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
   } else {
-    // Scan: side to side, 4 s a sweep.
-    r.head_yaw = 1.2 * std::sin(2 * kPi * in.time / 4.0);
+    // Scan: side to side, 4 s a sweep, nearly to the yaw limits (±2.09 rad):
+    // with the cameras' width that covers all but the back 65° without
+    // turning (±1.2 rad made a searching striker miss a ball behind its
+    // shoulder while it turned away from it).
+    r.head_yaw = 2.0 * std::sin(2 * kPi * in.time / 4.0);
     r.head_pitch = 0.2;
   }
 }
