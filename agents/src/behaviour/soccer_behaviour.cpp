@@ -136,12 +136,10 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   // Three sightings at the least at 100 Hz over half the window.
   if (root.has("ball_velocity_window") && !(c.ball_velocity_window >= 0.05))
     root["ball_velocity_window"].fail("must be >= 0.05 s");
-  if (root.has("avoid_ball") && !(root["avoid_ball"].number() >= 0))
-    root["avoid_ball"].fail("must be >= 0");
   if (!(c.avoid_far > c.avoid_near))
     (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
         .fail("avoid_far must be greater than avoid_near");
-  for (const char* k : {"keeper_line", "shootout_keeper_line"})
+  for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
