@@ -41,11 +41,12 @@ const char* kHelp =
     "joint targets only (the agents' motion, in this process). Per test: commanded and achieved\n"
     "speed, path deviation, falls: forward 0.25 m/s over 5 m, sideways 0.1 m/s, turning 0.8\n"
     "rad/s, and M minutes (default 10) of random velocity commands.\n"
-    "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M]:\n"
+    "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
+    "[--ball-gap M]:\n"
     "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
     "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
     "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
-    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll).\n"
+    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
@@ -162,9 +163,11 @@ struct KickResult {
 };
 
 // One kick from the walk's stance with the ball in front of the kicking foot
-// (offset sideways by `ball_offset`); the ball's travel after 6 s.
+// (offset sideways by `ball_offset`, `gap` ahead of the toe); the ball's
+// travel after 6 s.
 KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
-                const agents::WalkParameters& wp, const agents::KickParameters& kp) {
+                const agents::WalkParameters& wp, const agents::KickParameters& kp,
+                bool verbose = false, double gap = 0.015) {
   world::Scenario s = emptyField();
   s.seed = seed;
   world::World w(s);
@@ -176,13 +179,15 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
   const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
   const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
   engine::RigidBodyState b;
-  b.pose.translation() = Vec3(f.x() + 0.1025 + w.field().ball.radius + 0.015, f.y() + ball_offset,
+  b.pose.translation() = Vec3(f.x() + 0.1025 + w.field().ball.radius + gap, f.y() + ball_offset,
                               w.field().ball.radius);
   w.setBallState(b);
   const Vec3 start = b.pose.translation();
   engine.start(foot);
   KickResult r;
   const double dt = w.scenario().physics.control_period;
+  const int foot_link = model.body->linkIndex(link);
+  Vec3 last_foot = w.linkPose(0, foot_link).translation();
   for (int i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
     const auto& fr = w.sensorFrame(0);
     if (engine.active()) {
@@ -191,6 +196,27 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
     }
     w.stepControlPeriod();
     r.fell = r.fell || !w.isStanding(0);
+    // For tuning: the kicking foot's speed along the kick and height, and the
+    // ball's speed and spin, while the foot is near the ball.
+    const auto foot_pose = w.linkPose(0, foot_link);
+    const Vec3 foot_now = foot_pose.translation();
+    const engine::RigidBodyState ball = w.ballState();
+    // The sole's lowest corner (the foot box: 0.15 x 0.075 x 0.03 m, its
+    // centre 0.02 m ahead of the ankle, the sole 0.045 m below it).
+    double sole = 1e9;
+    for (double cx : {-0.055, 0.095})
+      for (double cy : {-0.0375, 0.0375})
+        sole = std::min(sole, (foot_pose * Vec3(cx, cy, -0.045)).z());
+    if (verbose && (foot_now - ball.pose.translation()).norm() < 0.4 && i * dt < 3.5)
+      std::fprintf(
+          stderr,
+          "t %.2f foot x %+.3f z %.3f sole %.3f speed %+.2f m/s | ball x %+.3f speed %.2f m/s "
+          "spin %+.1f rad/s (rolling %+.1f)\n",
+          (i + 1) * dt, foot_now.x() - start.x(), foot_now.z(), sole,
+          (foot_now.x() - last_foot.x()) / dt, ball.pose.translation().x() - start.x(),
+          ball.linear_velocity.norm(), ball.angular_velocity.y(),
+          ball.linear_velocity.x() / w.field().ball.radius);
+    last_foot = foot_now;
   }
   const Vec3 d = w.ballState().pose.translation() - start;
   r.distance = std::hypot(d.x(), d.y());
@@ -540,11 +566,25 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-shift", &kp.shift},
       {"kick-lift", &kp.lift},
       {"kick-draw-back", &kp.draw_back},
-      {"kick-hip-roll", &kp.hip_roll_compensation}};
-  std::vector<std::string> valued{
-      "seconds",        "csv",     "vx",          "vy",          "turn",          "random-minutes",
-      "seed",           "foot",    "ball-offset", "get-up",      "get-up-trials", "striker-trials",
-      "penalty-trials", "motions", "snapshots",   "block-trials"};
+      {"kick-hip-roll", &kp.hip_roll_compensation},
+      {"kick-swing-height", &kp.swing_height}};
+  std::vector<std::string> valued{"seconds",
+                                  "csv",
+                                  "vx",
+                                  "vy",
+                                  "turn",
+                                  "random-minutes",
+                                  "seed",
+                                  "foot",
+                                  "ball-offset",
+                                  "ball-gap",
+                                  "get-up",
+                                  "get-up-trials",
+                                  "striker-trials",
+                                  "penalty-trials",
+                                  "motions",
+                                  "snapshots",
+                                  "block-trials"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first,
                     {"help", "verbose", "kick", "striker", "penalty", "block", "shootout"}, valued);
@@ -585,7 +625,8 @@ int benchMotion(int argc, char** argv, int first) {
   }
   if (opt.flag("kick")) {  // one kick, for tuning
     const KickResult r = kick(opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
-                              opt.number("ball-offset", 0), 1, wp, kp);
+                              opt.number("ball-offset", 0), 1, wp, kp, opt.flag("verbose"),
+                              opt.number("ball-gap", 0.015));
     std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
     return 0;
   }

@@ -421,7 +421,14 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
         << ", \"falls\": " << rec.falls << ", \"keeper_dives\": " << rec.dives
         << ", \"distance_walked\": " << num(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
-        << "}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
+        << ", \"fall_records\": [";
+    for (size_t k = 0; k < rec.fall_records.size(); ++k) {
+      const FallRecord& f = rec.fall_records[k];
+      out << (k ? ", " : "") << "{\"time\": " << num(f.time, 2) << ", \"x\": " << num(f.x, 2)
+          << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": " << num(f.nearest_robot, 2)
+          << ", \"ball\": " << num(f.ball, 2) << "}";
+    }
+    out << "]}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }
   out << "  ],\n";
   const auto p = s.possession();

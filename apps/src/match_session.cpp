@@ -198,6 +198,12 @@ void MatchSession::record() {
         diving_keeper_.reset();
       } else {
         ++rec.falls;
+        FallRecord f{world_->time(), p.x(), p.y(), 1e9, (p - ball).head<2>().norm()};
+        for (world::RobotId o = 0; o < world_->robotCount(); ++o)
+          if (o != r)
+            f.nearest_robot = std::min(f.nearest_robot,
+                                       (world_->torsoPose(o).translation() - p).head<2>().norm());
+        rec.fall_records.push_back(f);
       }
     }
     rec.standing = standing;

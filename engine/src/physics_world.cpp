@@ -11,6 +11,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <stdexcept>
@@ -368,6 +369,15 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world = std::make_unique<TimedMultiBodyWorld>(m.dispatcher.get(), m.broadphase.get(),
                                                   m.solver.get(), m.config.get());
   m.world->getPairCache()->setOverlapFilterCallback(&m.filter);
+  // Restitution: the bouncier of the two materials decides (Bullet's default
+  // multiplies them). A soft ball bounces off a hard foot, post or shin as it
+  // bounces off anything hard, at its own restitution, while robots, the
+  // carpet and the goal (all 0) meet each other inelastically. Process-wide
+  // in Bullet; every world here uses the same rule.
+  gCalculateCombinedRestitutionCallback = [](const btCollisionObject* a,
+                                             const btCollisionObject* b) {
+    return std::max(a->getRestitution(), b->getRestitution());
+  };
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;

@@ -36,7 +36,7 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
   const std::array<Key, 7> keys{{{0, 0, 0, 0},
                                  {1, 0, 0, p_.shift_time},
                                  {1, -p_.draw_back, p_.lift, p_.lift_time},
-                                 {1, p_.reach, p_.lift * 0.6, p_.swing_time},
+                                 {1, p_.reach, p_.swing_height, p_.swing_time},
                                  {1, 0, p_.lift, p_.retract_time},
                                  {1, 0, 0, p_.lower_time},
                                  {0, 0, 0, p_.return_time}}};

@@ -32,8 +32,8 @@ struct Shape {
   Pose pose = Pose::Identity();  // in the owner's frame (link joint frame or world)
 };
 
-// Contact material. Bullet combines two materials by multiplying frictions
-// and restitutions.
+// Contact material. Two materials in contact: the product of their frictions
+// (Bullet's rule) and the larger of their restitutions (PhysicsWorld's rule).
 struct Material {
   double friction = 0.8;
   double rolling_friction = 0.0;   // m (torque = value * normal force)
