@@ -109,6 +109,12 @@ TEST_F(ConfigErrors, NonPositiveMass) {
   expectError("robot.yaml", "links[2].mass", "must be > 0");
 }
 
+TEST_F(ConfigErrors, BadSoleMaterial) {
+  replace(robot_, "    material: {friction: 0.625}   # rubber sole\n    collision:\n      - {box: {size: [0.160, 0.090, 0.035]}, position: [0.0225, 0.0075",
+          "    material: {friction: -1.0}   # rubber sole\n    collision:\n      - {box: {size: [0.160, 0.090, 0.035]}, position: [0.0225, 0.0075");
+  expectError("robot.yaml", "links[13].material.friction", "must be >= 0");
+}
+
 TEST_F(ConfigErrors, RobotOutsideTheField) {
   replace(scenario_, "pose: [-3.0, 1.0, 0.0]", "pose: [-3.0, 9.0, 0.0]");
   expectError("scenario.yaml", "robots[1].pose", "outside the field");

@@ -523,7 +523,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     col->setUserIndex(collision_group);
     col->setUserIndex2(static_cast<int>(i));                       // link index in the model
     col->setUserIndex3(static_cast<int>(m.articulations.size()));  // articulation id
-    applyMaterial(col.get(), model.material);
+    applyMaterial(col.get(), link.material.value_or(model.material));
     m.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter,
                                 btBroadphaseProxy::AllFilter);
     if (i == 0)

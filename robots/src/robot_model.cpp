@@ -205,7 +205,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   std::map<std::string, Link> links;
   std::vector<std::string> link_order;
   for (const ConfigNode& n : root["links"].items()) {
-    n.allowOnly({"name", "mass", "com", "inertia", "collision"});
+    n.allowOnly({"name", "mass", "com", "inertia", "collision", "material"});
     Link l;
     l.name = n["name"].string();
     if (links.count(l.name)) n["name"].fail("duplicate link name '" + l.name + "'");
@@ -214,6 +214,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     l.inertia = readInertia(n["inertia"]);
     if (auto c = n.optional("collision"))
       for (const ConfigNode& s : c->items()) l.shapes.push_back(engine::readShape(s));
+    if (auto m = n.optional("material")) l.material = engine::readMaterial(*m, body->material);
     links[l.name] = l;
     link_order.push_back(l.name);
   }
@@ -263,6 +264,10 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     if (j.type != "fixed") continue;
     Vec3 off;
     const std::string parent = resolve(j.parent, off);
+    // One collider per link, so one material: a merged link keeps its parent's.
+    if (links[j.child].material && !links[j.child].shapes.empty())
+      j.node["child"].fail("link '" + j.child + "' has a material of its own but is fixed to '" +
+                           parent + "', whose material its shapes would take");
     mergeFixed(links[parent], links[j.child], off + j.origin);
     merged_into[j.child] = parent;
     merged_offset[j.child] = off + j.origin;

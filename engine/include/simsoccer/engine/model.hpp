@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <span>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,7 @@ struct Link {
   Vec3 com = Vec3::Zero();      // in the link's joint frame
   Mat3 inertia = Mat3::Zero();  // about the CoM, joint-frame axes
   std::vector<Shape> shapes;    // in the link's joint frame
+  std::optional<Material> material;  // this link's own (a rubber sole); else the body's
 };
 
 // A position-controlled DC motor with gearbox, as seen at the joint.
