@@ -110,8 +110,11 @@ TEST_F(ConfigErrors, NonPositiveMass) {
 }
 
 TEST_F(ConfigErrors, BadSoleMaterial) {
-  replace(robot_, "    material: {friction: 0.625}   # rubber sole\n    collision:\n      - {box: {size: [0.160, 0.090, 0.035]}, position: [0.0225, 0.0075",
-          "    material: {friction: -1.0}   # rubber sole\n    collision:\n      - {box: {size: [0.160, 0.090, 0.035]}, position: [0.0225, 0.0075");
+  replace(robot_,
+          "    material: {friction: 0.625}   # rubber sole\n    collision:\n      - {box: {size: "
+          "[0.160, 0.090, 0.035]}, position: [0.0225, 0.0075",
+          "    material: {friction: -1.0}   # rubber sole\n    collision:\n      - {box: {size: "
+          "[0.160, 0.090, 0.035]}, position: [0.0225, 0.0075");
   expectError("robot.yaml", "links[13].material.friction", "must be >= 0");
 }
 

@@ -9,8 +9,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <span>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -45,9 +45,9 @@ struct Material {
 struct Link {
   std::string name;
   double mass = 0.0;
-  Vec3 com = Vec3::Zero();      // in the link's joint frame
-  Mat3 inertia = Mat3::Zero();  // about the CoM, joint-frame axes
-  std::vector<Shape> shapes;    // in the link's joint frame
+  Vec3 com = Vec3::Zero();           // in the link's joint frame
+  Mat3 inertia = Mat3::Zero();       // about the CoM, joint-frame axes
+  std::vector<Shape> shapes;         // in the link's joint frame
   std::optional<Material> material;  // this link's own (a rubber sole); else the body's
 };
 
