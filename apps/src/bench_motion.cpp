@@ -201,12 +201,15 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
     const auto foot_pose = w.linkPose(0, foot_link);
     const Vec3 foot_now = foot_pose.translation();
     const engine::RigidBodyState ball = w.ballState();
-    // The sole's lowest corner (the foot box: 0.15 x 0.075 x 0.03 m, its
-    // centre 0.02 m ahead of the ankle, the sole 0.045 m below it).
+    // The sole's lowest corner: the bottom corners of the foot's collision box.
     double sole = 1e9;
-    for (double cx : {-0.055, 0.095})
-      for (double cy : {-0.0375, 0.0375})
-        sole = std::min(sole, (foot_pose * Vec3(cx, cy, -0.045)).z());
+    const engine::Shape& box = model.body->links[static_cast<size_t>(foot_link)].shapes.front();
+    for (double cx : {-0.5, 0.5})
+      for (double cy : {-0.5, 0.5})
+        sole = std::min(sole,
+                        (foot_pose * box.pose *
+                         Vec3(cx * box.extents.x(), cy * box.extents.y(), -0.5 * box.extents.z()))
+                            .z());
     if (verbose && (foot_now - ball.pose.translation()).norm() < 0.4 && i * dt < 3.5)
       std::fprintf(
           stderr,
