@@ -110,3 +110,29 @@ TEST(Ball, BouncesOffARobotsFoot) {
   EXPECT_GT(w.ballState().pose.translation().x(), foot.x() + 0.15);
   EXPECT_TRUE(w.isStanding(0));
 }
+
+// The ball dropped on the carpet bounces at its own restitution (0.5: the
+// larger of the two materials' counts): from 0.5 m it comes back up 0.17 m
+// (with Bullet's product rule, 0.5 x 0, it would not bounce).
+TEST(Ball, BouncesOnTheCarpet) {
+  world::World w(emptyField());
+  const double r = w.field().ball.radius, drop = 0.5;
+  engine::RigidBodyState b;
+  b.pose.translation() = Vec3(-3.0, 0.0, r + drop);
+  w.setBallState(b);
+  double lowest = 1e9, rebound = 0.0;
+  bool fell = false;
+  for (int i = 0; i < 400; ++i) {  // 2 s
+    w.step();
+    const double z = w.ballState().pose.translation().z() - r;
+    if (!fell) {
+      lowest = std::min(lowest, z);
+      fell = w.ballState().linear_velocity.z() > 0.0 && lowest < 0.01;
+    } else {
+      rebound = std::max(rebound, z);
+    }
+  }
+  std::printf("ball dropped from %.2f m comes back up %.3f m\n", drop, rebound);
+  EXPECT_GT(rebound, 0.06);
+  EXPECT_LT(rebound, 0.2);
+}

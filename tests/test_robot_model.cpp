@@ -63,7 +63,6 @@ TEST(RobotModel, FeetHaveRubberSolesTheRestPlastic) {
       ASSERT_EQ(link.material.has_value(), foot) << file << " " << link.name;
       if (foot) {
         EXPECT_DOUBLE_EQ(link.material->friction, 0.625);
-        EXPECT_DOUBLE_EQ(link.material->restitution, nao.body->material.restitution);
       }
     }
   }

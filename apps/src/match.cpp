@@ -425,7 +425,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
     for (size_t k = 0; k < rec.fall_records.size(); ++k) {
       const FallRecord& f = rec.fall_records[k];
       out << (k ? ", " : "") << "{\"time\": " << num(f.time, 2) << ", \"x\": " << num(f.x, 2)
-          << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": " << num(f.nearest_robot, 2)
+          << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": "
+          << (f.nearest_robot < 1e8 ? num(f.nearest_robot, 2) : std::string("null"))
           << ", \"ball\": " << num(f.ball, 2) << "}";
     }
     out << "]}" << (i + 1 < s.robots().size() ? "," : "") << "\n";

@@ -48,7 +48,7 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file);
 struct FallRecord {
   double time = 0.0;                       // s of simulated time
   double x = 0.0, y = 0.0;                 // torso, field frame, m
-  double nearest_robot = 0.0, ball = 0.0;  // m, torso to torso and torso to ball
+  double nearest_robot = 0.0, ball = 0.0;  // m, torso to torso (1e9: none) and torso to ball
 };
 
 struct RobotRecord {

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -372,12 +373,16 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it
   // bounces off anything hard, at its own restitution, while robots, the
-  // carpet and the goal (all 0) meet each other inelastically. Process-wide
-  // in Bullet; every world here uses the same rule.
-  gCalculateCombinedRestitutionCallback = [](const btCollisionObject* a,
-                                             const btCollisionObject* b) {
-    return std::max(a->getRestitution(), b->getRestitution());
-  };
+  // carpet and the goal (all 0) meet each other inelastically. (The ball on
+  // the carpet too bounces at 0.5: a foam ball dropped on turf does bounce.)
+  // Process-wide in Bullet: set once, before any world steps.
+  static std::once_flag restitution_rule;
+  std::call_once(restitution_rule, [] {
+    gCalculateCombinedRestitutionCallback = [](const btCollisionObject* a,
+                                               const btCollisionObject* b) {
+      return std::max(a->getRestitution(), b->getRestitution());
+    };
+  });
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;

@@ -90,8 +90,8 @@ struct BehaviourConfig {
   // (robots that walk into each other fall). Within avoid_ball of the ball in
   // play only from a teammate nearer the ball: the ball is contested with the
   // opponents there, and the referee's pushing rule decides.
-  double avoid_near = 0.35;  // m, torso to torso
-  double avoid_far = 0.8;    // m
+  double avoid_near = 0.45;  // m, torso to torso
+  double avoid_far = 1.0;    // m
   double avoid_ball = 0.6;   // m
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).

@@ -29,8 +29,9 @@ struct KickParameters {
   double lower_time = 0.3;    // s
   double return_time = 0.6;   // s
   double hip_roll_compensation = 0.07;  // rad, the support hip's sag (see WalkParameters)
-  double swing_height = 0.02;  // m, the kicking foot up at the swing's end (the sole meets the
-                               // ball about 0.03 m up, the foot's face at the ball's middle)
+  double swing_height = 0.02;  // m, the kicking foot up at the swing's end (the servos lag the
+                               // path: measured, the sole meets the ball about 0.03 m up, the
+                               // foot's face at the ball's middle)
 };
 
 class KickEngine {
