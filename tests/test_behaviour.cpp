@@ -135,8 +135,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
     return "";
   };
   EXPECT_EQ(refusedAt("keeper_line: -0.1"), "keeper_line");  // behind the goal line
-  EXPECT_EQ(refusedAt("avoid_far: 0.3"), "avoid_far");       // under avoid_near
-  EXPECT_EQ(refusedAt("avoid_near: 0.9"), "avoid_near");     // over avoid_far
+  EXPECT_EQ(refusedAt("avoid_far: 0.4"), "avoid_far");       // under avoid_near (0.45)
+  EXPECT_EQ(refusedAt("avoid_near: 1.1"), "avoid_near");     // over avoid_far (1.0)
   EXPECT_EQ(refusedAt("avoid_ball: -1"), "avoid_ball");
   EXPECT_EQ(refusedAt("ball_velocity_window: 0.01"), "ball_velocity_window");
   EXPECT_EQ(refusedAt("ball_outlier_distance: 0"), "ball_outlier_distance");
