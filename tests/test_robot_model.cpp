@@ -4,7 +4,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
+#include "simsoccer/engine/config.hpp"
 #include "simsoccer/engine/physics_world.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 #include "test_support.hpp"
@@ -209,4 +212,62 @@ TEST(RobotModel, RightSideMatchesReferenceTable) {
               1e-9);
   EXPECT_NEAR(nao.body->links[static_cast<size_t>(nao.body->linkIndex("Head"))].mass, 0.65973,
               1e-9);
+}
+
+// One collider per moving link, so one material: a link fixed to another
+// cannot keep its own (it would silently take its parent's).
+TEST(RobotModel, AFixedLinkWithItsOwnMaterialIsRefused) {
+  std::string text = test::readFile(test::naoH21());
+  const std::string hand = "  - name: LHand   # rigid hand, fixed to the forearm\n";
+  ASSERT_NE(text.find(hand), std::string::npos);
+  text.replace(text.find(hand), hand.size(), hand + "    material: {friction: 1.0}\n");
+  const auto dir = test::freshTempDir("fixed_material");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "robot.yaml") << text;
+  try {
+    robots::loadRobotModel(dir / "robot.yaml");
+    ADD_FAILURE() << "a fixed link's own material was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "joints[6].child");
+    EXPECT_NE(std::string(e.what()).find("LHand"), std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A link's own material is the one its collider meets the ground with: two
+// boxes of the same body material (friction 0.2) under gravity tilted 0.4
+// sideways, one with a root link material of 0.8 of its own; on a ground of
+// 1.0 the first slides, the second holds.
+TEST(RobotModel, ALinksOwnMaterialReachesTheContacts) {
+  engine::PhysicsSettings settings;
+  settings.gravity = Vec3(0.4 * 9.81, 0.0, -9.81);
+  engine::PhysicsWorld physics(settings);
+  physics.addGround({1.0, 0.0, 0.0, 0.0});
+  auto box = [](std::optional<engine::Material> own) {
+    auto m = std::make_shared<engine::ArticulatedModel>();
+    m->name = "box";
+    m->material = {0.2, 0.0, 0.0, 0.0};
+    engine::Link l;
+    l.name = "root";
+    l.mass = 1.0;
+    l.inertia = Vec3(0.0042, 0.0042, 0.0067).asDiagonal();  // 0.2 x 0.2 x 0.1 m
+    engine::Shape s;
+    s.type = engine::ShapeType::Box;
+    s.extents = Vec3(0.2, 0.2, 0.1);
+    l.shapes.push_back(s);
+    l.material = own;
+    m->links.push_back(l);
+    return std::shared_ptr<const engine::ArticulatedModel>(m);
+  };
+  engine::Pose at = engine::Pose::Identity();
+  at.translation() = Vec3(0, -1, 0.05);
+  const auto slides = physics.addArticulation(box(std::nullopt), at, {}, 0);
+  at.translation() = Vec3(0, 1, 0.05);
+  const auto holds = physics.addArticulation(box(engine::Material{0.8, 0.0, 0.0, 0.0}), at, {}, 1);
+  for (int i = 0; i < 200; ++i) physics.step();  // 1 s
+  const double slid = physics.linkPose(slides, 0).translation().x();
+  const double held = physics.linkPose(holds, 0).translation().x();
+  std::printf("body material 0.2: slid %.3f m; own material 0.8: %.4f m\n", slid, held);
+  EXPECT_GT(slid, 0.5);  // (0.4 - 0.2) g / 2 over 1 s: about 1 m
+  EXPECT_LT(std::abs(held), 0.01);
 }

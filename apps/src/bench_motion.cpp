@@ -162,6 +162,35 @@ struct KickResult {
   bool fell = false;
 };
 
+// For tuning a kick: while the kicking foot is near the ball, its speed along
+// the kick (from `last_foot`, a control period ago), its height and its
+// sole's lowest corner, and the ball's speed and spin; `start`: the ball's
+// start.
+void traceKick(const world::World& w, int foot_link, const Vec3& start, double dt, double t,
+               Vec3& last_foot) {
+  const auto foot_pose = w.linkPose(0, foot_link);
+  const Vec3 foot = foot_pose.translation();
+  const engine::RigidBodyState ball = w.ballState();
+  if ((foot - ball.pose.translation()).norm() < 0.4 && t < 3.5) {
+    double sole = 1e9;  // the bottom corners of the foot's collision box
+    const auto& model = *w.robot(0).model;
+    const engine::Shape& box = model.body->links[static_cast<size_t>(foot_link)].shapes.front();
+    for (double cx : {-0.5, 0.5})
+      for (double cy : {-0.5, 0.5})
+        sole = std::min(sole,
+                        (foot_pose * box.pose *
+                         Vec3(cx * box.extents.x(), cy * box.extents.y(), -0.5 * box.extents.z()))
+                            .z());
+    std::fprintf(stderr,
+                 "t %.2f foot x %+.3f z %.3f sole %.3f speed %+.2f m/s | ball x %+.3f speed %.2f "
+                 "m/s spin %+.1f rad/s (rolling %+.1f)\n",
+                 t, foot.x() - start.x(), foot.z(), sole, (foot.x() - last_foot.x()) / dt,
+                 ball.pose.translation().x() - start.x(), ball.linear_velocity.norm(),
+                 ball.angular_velocity.y(), ball.linear_velocity.x() / w.field().ball.radius);
+  }
+  last_foot = foot;
+}
+
 // One kick from the walk's stance with the ball in front of the kicking foot
 // (offset sideways by `ball_offset`, `gap` ahead of the toe); the ball's
 // travel after 6 s.
@@ -187,7 +216,7 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
   KickResult r;
   const double dt = w.scenario().physics.control_period;
   const int foot_link = model.body->linkIndex(link);
-  Vec3 last_foot = w.linkPose(0, foot_link).translation();
+  Vec3 last_foot = w.linkPose(0, foot_link).translation();  // for the trace
   for (int i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
     const auto& fr = w.sensorFrame(0);
     if (engine.active()) {
@@ -196,30 +225,7 @@ KickResult kick(agents::Leg foot, double ball_offset, uint64_t seed,
     }
     w.stepControlPeriod();
     r.fell = r.fell || !w.isStanding(0);
-    // For tuning: the kicking foot's speed along the kick and height, and the
-    // ball's speed and spin, while the foot is near the ball.
-    const auto foot_pose = w.linkPose(0, foot_link);
-    const Vec3 foot_now = foot_pose.translation();
-    const engine::RigidBodyState ball = w.ballState();
-    // The sole's lowest corner: the bottom corners of the foot's collision box.
-    double sole = 1e9;
-    const engine::Shape& box = model.body->links[static_cast<size_t>(foot_link)].shapes.front();
-    for (double cx : {-0.5, 0.5})
-      for (double cy : {-0.5, 0.5})
-        sole = std::min(sole,
-                        (foot_pose * box.pose *
-                         Vec3(cx * box.extents.x(), cy * box.extents.y(), -0.5 * box.extents.z()))
-                            .z());
-    if (verbose && (foot_now - ball.pose.translation()).norm() < 0.4 && i * dt < 3.5)
-      std::fprintf(
-          stderr,
-          "t %.2f foot x %+.3f z %.3f sole %.3f speed %+.2f m/s | ball x %+.3f speed %.2f m/s "
-          "spin %+.1f rad/s (rolling %+.1f)\n",
-          (i + 1) * dt, foot_now.x() - start.x(), foot_now.z(), sole,
-          (foot_now.x() - last_foot.x()) / dt, ball.pose.translation().x() - start.x(),
-          ball.linear_velocity.norm(), ball.angular_velocity.y(),
-          ball.linear_velocity.x() / w.field().ball.radius);
-    last_foot = foot_now;
+    if (verbose) traceKick(w, foot_link, start, dt, (i + 1) * dt, last_foot);
   }
   const Vec3 d = w.ballState().pose.translation() - start;
   r.distance = std::hypot(d.x(), d.y());

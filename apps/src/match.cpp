@@ -418,15 +418,15 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   for (size_t i = 0; i < s.robots().size(); ++i) {
     const auto& rec = s.robots()[i];
     out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number
-        << ", \"falls\": " << rec.falls << ", \"keeper_dives\": " << rec.dives
+        << ", \"falls\": " << rec.falls.size() << ", \"keeper_dives\": " << rec.dives
         << ", \"distance_walked\": " << num(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
         << ", \"fall_records\": [";
-    for (size_t k = 0; k < rec.fall_records.size(); ++k) {
-      const FallRecord& f = rec.fall_records[k];
+    for (size_t k = 0; k < rec.falls.size(); ++k) {
+      const FallRecord& f = rec.falls[k];
       out << (k ? ", " : "") << "{\"time\": " << num(f.time, 2) << ", \"x\": " << num(f.x, 2)
           << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": "
-          << (f.nearest_robot < 1e8 ? num(f.nearest_robot, 2) : std::string("null"))
+          << (f.nearest_robot ? num(*f.nearest_robot, 2) : std::string("null"))
           << ", \"ball\": " << num(f.ball, 2) << "}";
     }
     out << "]}" << (i + 1 < s.robots().size() ? "," : "") << "\n";

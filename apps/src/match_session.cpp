@@ -197,13 +197,13 @@ void MatchSession::record() {
         ++rec.dives;
         diving_keeper_.reset();
       } else {
-        ++rec.falls;
-        FallRecord f{world_->time(), p.x(), p.y(), 1e9, (p - ball).head<2>().norm()};
-        for (world::RobotId o = 0; o < world_->robotCount(); ++o)
-          if (o != r)
-            f.nearest_robot = std::min(f.nearest_robot,
-                                       (world_->torsoPose(o).translation() - p).head<2>().norm());
-        rec.fall_records.push_back(f);
+        FallRecord f{world_->time(), p.x(), p.y(), std::nullopt, (p - ball).head<2>().norm()};
+        for (world::RobotId o = 0; o < world_->robotCount(); ++o) {
+          if (o == r) continue;
+          const double d = (world_->torsoPose(o).translation() - p).head<2>().norm();
+          f.nearest_robot = std::min(f.nearest_robot.value_or(d), d);
+        }
+        rec.falls.push_back(f);
       }
     }
     rec.standing = standing;

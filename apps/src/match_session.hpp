@@ -46,15 +46,15 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file);
 // A robot going down (not a keeper's dive): when, where, and how near the
 // nearest other robot and the ball were (a push, a kick, or on its own).
 struct FallRecord {
-  double time = 0.0;                       // s of simulated time
-  double x = 0.0, y = 0.0;                 // torso, field frame, m
-  double nearest_robot = 0.0, ball = 0.0;  // m, torso to torso (1e9: none) and torso to ball
+  double time = 0.0;                    // s of simulated time
+  double x = 0.0, y = 0.0;              // torso, field frame, m
+  std::optional<double> nearest_robot;  // m, torso to torso (none: no other robot)
+  double ball = 0.0;                    // m, torso to ball
 };
 
 struct RobotRecord {
   int team = 0, number = 0;
-  int falls = 0;
-  std::vector<FallRecord> fall_records;
+  std::vector<FallRecord> falls;
   int dives = 0;          // the shoot-out keeper going down once the shot is kicked: not a fall
   double distance = 0.0;  // m walked (torso, teleports left out)
   bool standing = true;

@@ -264,10 +264,10 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
     if (j.type != "fixed") continue;
     Vec3 off;
     const std::string parent = resolve(j.parent, off);
-    // One collider per link, so one material: a merged link keeps its parent's.
-    if (links[j.child].material && !links[j.child].shapes.empty())
+    // One collider per link, so one material: a fixed link joins its parent's.
+    if (links[j.child].material)
       j.node["child"].fail("link '" + j.child + "' has a material of its own but is fixed to '" +
-                           parent + "', whose material its shapes would take");
+                           parent + "' (one material per moving link)");
     mergeFixed(links[parent], links[j.child], off + j.origin);
     merged_into[j.child] = parent;
     merged_offset[j.child] = off + j.origin;
