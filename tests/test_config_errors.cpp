@@ -118,6 +118,15 @@ TEST_F(ConfigErrors, BadSoleMaterial) {
   expectError("robot.yaml", "links[13].material.friction", "must be >= 0");
 }
 
+// One collider per moving link, so one material: a link fixed to another
+// (the H21's rigid hand) cannot keep its own.
+TEST_F(ConfigErrors, AFixedLinkWithItsOwnMaterial) {
+  robot_ = test::readFile(test::naoH21());
+  replace(robot_, "  - name: LHand   # rigid hand, fixed to the forearm\n",
+          "  - name: LHand   # rigid hand, fixed to the forearm\n    material: {friction: 1.0}\n");
+  expectError("robot.yaml", "joints[6].child", "'LHand' has a material of its own");
+}
+
 TEST_F(ConfigErrors, RobotOutsideTheField) {
   replace(scenario_, "pose: [-3.0, 1.0, 0.0]", "pose: [-3.0, 9.0, 0.0]");
   expectError("scenario.yaml", "robots[1].pose", "outside the field");

@@ -4,10 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 
-#include "simsoccer/engine/config.hpp"
 #include "simsoccer/engine/physics_world.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 #include "test_support.hpp"
@@ -212,26 +209,6 @@ TEST(RobotModel, RightSideMatchesReferenceTable) {
               1e-9);
   EXPECT_NEAR(nao.body->links[static_cast<size_t>(nao.body->linkIndex("Head"))].mass, 0.65973,
               1e-9);
-}
-
-// One collider per moving link, so one material: a link fixed to another
-// cannot keep its own (it would silently take its parent's).
-TEST(RobotModel, AFixedLinkWithItsOwnMaterialIsRefused) {
-  std::string text = test::readFile(test::naoH21());
-  const std::string hand = "  - name: LHand   # rigid hand, fixed to the forearm\n";
-  ASSERT_NE(text.find(hand), std::string::npos);
-  text.replace(text.find(hand), hand.size(), hand + "    material: {friction: 1.0}\n");
-  const auto dir = test::freshTempDir("fixed_material");
-  std::filesystem::create_directories(dir);
-  std::ofstream(dir / "robot.yaml") << text;
-  try {
-    robots::loadRobotModel(dir / "robot.yaml");
-    ADD_FAILURE() << "a fixed link's own material was accepted";
-  } catch (const engine::ConfigError& e) {
-    EXPECT_EQ(e.key(), "joints[6].child");
-    EXPECT_NE(std::string(e.what()).find("LHand"), std::string::npos);
-  }
-  std::filesystem::remove_all(dir);
 }
 
 // A link's own material is the one its collider meets the ground with: two
