@@ -26,6 +26,13 @@ MIRROR = {"LShoulderPitch": ("RShoulderPitch", 1), "LShoulderRoll": ("RShoulderR
           "LElbowYaw": ("RElbowYaw", -1), "LElbowRoll": ("RElbowRoll", -1), "LHipRoll": ("RHipRoll", -1),
           "LHipPitch": ("RHipPitch", 1), "LKneePitch": ("RKneePitch", 1), "LAnklePitch": ("RAnklePitch", 1),
           "LAnkleRoll": ("RAnkleRoll", -1)}
+# ASYM=1: every joint searched on its own (no mirroring), for a motion that is not
+# symmetric (the roll onto the front that starts the get-up from the back).
+ASYM = bool(os.environ.get("ASYM"))
+if ASYM:
+    JOINTS = ["HeadYaw"] + JOINTS[:5] + ["R" + j[1:] for j in JOINTS[1:5]] + JOINTS[5:] + \
+             ["R" + j[1:] for j in JOINTS[6:]]
+    MIRROR = {}
 # The stand pose and the joint limits from the robot model (a left joint's range is
 # narrowed to what its mirrored right joint also allows).
 _ROBOT = yaml.safe_load(open(os.path.join(ROOT, "robots/nao_v6_h25.yaml")))
@@ -38,8 +45,8 @@ for _j in JOINTS:
         _r, _sign = MIRROR[_j]
         _rlo, _rhi = sorted((_sign * _RANGE[_r][0], _sign * _RANGE[_r][1]))
         _lo, _hi = max(_lo, _rlo), min(_hi, _rhi)
-    LIMITS[_j] = (_lo, _hi)
-LINE = re.compile(r"^t (\S+) (\S+)\s+tilt \S+ torso z (\S+) forward \S+ up (\S+)")
+    LIMITS[_j] = (_lo + 1e-3, _hi - 1e-3)  # inside the limits after rounding to 3 decimals
+LINE = re.compile(r"^t (\S+) (\S+)\s+tilt \S+ torso z (\S+) forward (\S+) up (\S+)")
 
 def to_vec(frames):
     v = []
@@ -57,8 +64,12 @@ def to_frames(v):
         k += 1 + len(JOINTS)
     return frames
 
+LINEAR = bool(os.environ.get("LINEAR"))  # write `interpolation: linear`
+SEEDS = int(os.environ.get("SEEDS", "4"))  # seeded trials per candidate
+SIGMA = float(os.environ.get("SIGMA", "0.25"))  # initial spread of the joint angles, rad
+
 def write_yaml(side, frames, path, tail):
-    out = [f"motion: get_up_{side}", "frames:"]
+    out = [f"motion: get_up_{side}"] + (["interpolation: linear"] if LINEAR else []) + ["frames:"]
     for f in frames:
         js = dict(HeadYaw=0.0)
         for j, x in f["joints"].items():
@@ -73,6 +84,12 @@ def write_yaml(side, frames, path, tail):
         fh.write("\n".join(out) + "\n")
 
 TAIL = ["  - duration: 1.0", "    pose: stand"]
+# ROLL=1: the motion is a roll onto the front, ending on the ground (no stand at its
+# end); scored by how far onto the front it ends, +2 when the front get-up that follows
+# it stands the robot up in time.
+ROLL = bool(os.environ.get("ROLL"))
+if ROLL:
+    TAIL = []
 if os.environ.get("SQUAT_TAIL"):
     TAIL = ["  - duration: 0.5",
             "    joints: {HeadYaw: 0.0, HeadPitch: 0.0, LShoulderPitch: 0.6, RShoulderPitch: 0.6, LShoulderRoll: 0.1, RShoulderRoll: -0.1,",
@@ -90,12 +107,20 @@ def run(side, motions_dir, seed):
     for line in p.stderr.splitlines():
         m = LINE.match(line)
         if m:
-            rows.append((float(m.group(1)), m.group(2), float(m.group(3)), float(m.group(4))))
+            rows.append((float(m.group(1)), m.group(2), float(m.group(3)), float(m.group(5)),
+                         float(m.group(4))))
     ok = re.search(r"standing in (\S+) s", p.stdout)
     start = next((i for i, r in enumerate(rows) if r[1] == "getting_up"), None)
     if start is None:
         return 0.0, False
     end = next((i for i in range(start, len(rows)) if rows[i][1] != "getting_up"), len(rows))
+    if ROLL:
+        # How far onto the front (the torso's x axis down) the motion leaves it,
+        # over the 0.3 s after it ends.
+        after = rows[end:end + 3] or rows[-1:]
+        score = sum(-r[4] for r in after) / len(after)
+        success = bool(ok) and float(ok.group(1)) < 8.0
+        return score + (2.0 if success else 0.0), success
     window = rows[start:min(len(rows), end + 15)]
     h = [min(r[2], 0.33) / 0.33 * (0.4 + 0.6 * max(r[3], 0.0)) for r in window]
     last = h[-10:]
@@ -126,13 +151,13 @@ def main():
         frames.append({"duration": f["duration"], "joints": dict(q)})
     mean = to_vec(frames)
     n = len(mean)
-    sig = [0.08 if (i % (1 + len(JOINTS))) == 0 else 0.25 for i in range(n)]
+    sig = [0.3 * SIGMA if (i % (1 + len(JOINTS))) == 0 else SIGMA for i in range(n)]
     rng = random.Random(1)
     os.makedirs(outdir, exist_ok=True)
     best = (-1, None)
     with cf.ProcessPoolExecutor(2) as ex:
         for g in range(gens):
-            seeds = [1000 + 3 * g, 1001 + 3 * g, 1002 + 3 * g, 1500 + g]
+            seeds = [1000 + SEEDS * g + k for k in range(SEEDS)]
             cands = [mean] + [[m + s * rng.gauss(0, 1) for m, s in zip(mean, sig)] for _ in range(pop - 1)]
             cands = [to_vec(to_frames(c)) for c in cands]
             scores = list(ex.map(evaluate, [(side, c, seeds, f"{side}{i}") for i, c in enumerate(cands)]))
@@ -142,10 +167,11 @@ def main():
                 best = (scores[order[0]][0], cands[order[0]])
                 write_yaml(side, to_frames(best[1]), os.path.join(outdir, f"get_up_{side}.yaml"), TAIL)
             mean = [sum(e[i] for e in elite) / len(elite) for i in range(n)]
+            write_yaml(side, to_frames(mean), os.path.join(outdir, f"get_up_{side}_mean.yaml"), TAIL)
             sig = [max(0.02, 0.7 * s + 0.3 * math.sqrt(sum((e[i] - mean[i]) ** 2 for e in elite) / len(elite)))
                    for i, s in enumerate(sig)]
-            print(f"gen {g}: best {scores[order[0]][0]:.3f} ({scores[order[0]][1]}/4 up) mean-cand "
-                  f"{scores[0][0]:.3f} overall {best[0]:.3f}", flush=True)
+            print(f"gen {g}: best {scores[order[0]][0]:.3f} ({scores[order[0]][1]}/{SEEDS} up) mean-cand "
+                  f"{scores[0][0]:.3f} ({scores[0][1]}/{SEEDS} up) overall {best[0]:.3f}", flush=True)
     write_yaml(side, to_frames(mean), os.path.join(outdir, f"get_up_{side}_mean.yaml"), TAIL)
 
 if __name__ == "__main__":

@@ -570,6 +570,37 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   EXPECT_EQ(q, model.pose("stand"));
 }
 
+// `interpolation: linear` moves at constant speed within a frame; the default
+// (smoothstep) starts and ends each frame at rest. A bad value names the key.
+TEST(KeyframeMotion, InterpolatesLinearlyOrSmoothly) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const auto dir = test::freshTempDir("keyframes_interp");
+  std::filesystem::create_directories(dir);
+  const size_t knee = static_cast<size_t>(model.body->jointIndex("LKneePitch"));
+  auto kneeAt = [&](const std::string& interp, double t) {
+    std::ofstream(dir / "m.yaml") << "motion: m\n"
+                                  << interp
+                                  << "frames:\n  - {duration: 1.0, joints: {LKneePitch: 2.0}}\n";
+    const auto m = agents::loadKeyframeMotion(dir / "m.yaml", model);
+    agents::KeyframePlayer player;
+    std::vector<double> q(model.body->joints.size(), 0.0);
+    player.start(m, q);
+    double k = 0;
+    player.update(t, q, k);
+    return q[knee];
+  };
+  EXPECT_NEAR(kneeAt("interpolation: linear\n", 0.25), 0.5, 1e-9);
+  EXPECT_NEAR(kneeAt("", 0.25), 2.0 * 0.15625, 1e-9);  // smoothstep(0.25) = 0.15625
+  EXPECT_NEAR(kneeAt("interpolation: smooth\n", 0.5), 1.0, 1e-9);
+  try {
+    kneeAt("interpolation: cubic\n", 0.5);
+    FAIL();
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("interpolation"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("smooth or linear"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGetUp) {
   const auto model = robots::loadRobotModel(test::naoH25());
   agents::MotionController mc = controllerWithoutGetUp(model);

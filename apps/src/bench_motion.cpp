@@ -334,11 +334,12 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
     w.stepControlPeriod();
     if (verbose && i % 10 == 0) {
       const engine::Pose t = w.torsoPose(0);
-      // The torso's x axis (forward) and z axis (up), world z components:
-      // forward > 0 leans back, up < 0 is upside down.
-      std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f forward %.2f up %.2f\n", i * dt,
-                   agents::motionStateName(motion.state()), motion.tilt(), t.translation().z(),
-                   t.linear()(2, 0), t.linear()(2, 2));
+      // The torso's x axis (forward), z axis (up) and y axis (left), world z
+      // components: forward > 0 leans back, up < 0 is upside down, left > 0
+      // rolled onto the right side.
+      std::fprintf(stderr, "t %.2f %-10s tilt %.2f torso z %.3f forward %.2f up %.2f left %.2f\n",
+                   i * dt, agents::motionStateName(motion.state()), motion.tilt(),
+                   t.translation().z(), t.linear()(2, 0), t.linear()(2, 2), t.linear()(2, 1));
       traceSupport(w, position);
     }
     if (renderer && i % 20 == 0 && i >= 20 && tiles.size() < 36) {

@@ -16,9 +16,16 @@ double KeyframeMotion::duration() const {
 KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
                                   const robots::RobotModel& model) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly({"motion", "frames"});
+  root.allowOnly({"motion", "interpolation", "frames"});
   KeyframeMotion m;
   m.name = root["motion"].string();
+  if (auto interp = root.optional("interpolation")) {
+    const std::string v = interp->string();
+    if (v == "linear")
+      m.interpolation = KeyframeMotion::Interpolation::Linear;
+    else if (v != "smooth")
+      interp->fail("must be smooth or linear");
+  }
   const auto& joints = model.body->joints;
   std::vector<double> q = model.pose("stand");
   for (const engine::ConfigNode& item : root["frames"].items()) {
@@ -69,7 +76,9 @@ void KeyframePlayer::update(double dt, std::vector<double>& targets, double& sti
   const std::vector<double>* prev = &from_;
   for (const Keyframe& f : motion_->frames) {
     if (t_ < begin + f.duration) {
-      const double w = smoothstep((t_ - begin) / f.duration);
+      const double s = (t_ - begin) / f.duration;
+      const double w =
+          motion_->interpolation == KeyframeMotion::Interpolation::Linear ? s : smoothstep(s);
       for (size_t j = 0; j < targets.size() && j < f.position.size(); ++j)
         targets[j] = (*prev)[j] + w * (f.position[j] - (*prev)[j]);
       stiffness = f.stiffness;

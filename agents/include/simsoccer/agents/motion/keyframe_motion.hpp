@@ -20,15 +20,18 @@ struct Keyframe {
 
 struct KeyframeMotion {
   std::string name;
+  // How a frame is approached: smoothstep (each frame reached at rest, for a
+  // few long frames) or linear (constant speed within a frame, so a dense
+  // sequence of short frames moves without stopping at each).
+  enum class Interpolation { Smooth, Linear } interpolation = Interpolation::Smooth;
   std::vector<Keyframe> frames;
   double duration() const;
 };
 
-// Reads a motion for `model`: frames: [{duration, stiffness, pose: NAME (a
-// pose of the robot model), joints: {Name: rad, ...}}]. A frame starts from
-// the previous frame (the first from the model's `stand` pose) or from its
-// `pose`, then sets its `joints`; mimic joints follow their masters. Throws
-// engine::ConfigError (file, key, reason).
+// Reads a motion for `model`: interpolation: smooth|linear (default smooth), frames: [{duration,
+// stiffness, pose: NAME (a pose of the robot model), joints: {Name: rad, ...}}]. A frame starts
+// from the previous frame (the first from the model's `stand` pose) or from its `pose`, then sets
+// its `joints`; mimic joints follow their masters. Throws engine::ConfigError (file, key, reason).
 KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
                                   const robots::RobotModel& model);
 
