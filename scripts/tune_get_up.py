@@ -69,7 +69,8 @@ SEEDS = int(os.environ.get("SEEDS", "4"))  # seeded trials per candidate
 SIGMA = float(os.environ.get("SIGMA", "0.25"))  # initial spread of the joint angles, rad
 
 def write_yaml(side, frames, path, tail):
-    out = [f"motion: get_up_{side}"] + (["interpolation: linear"] if LINEAR else []) + ["frames:"]
+    out = [f"motion: get_up_{side}"] + (["interpolation: linear"] if LINEAR else []) + \
+          (["ends: front"] if ROLL else []) + ["frames:"]
     for f in frames:
         js = dict(HeadYaw=0.0)
         for j, x in f["joints"].items():

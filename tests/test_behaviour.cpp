@@ -631,6 +631,46 @@ TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGet
   EXPECT_EQ(mc.counters().get_ups, 0);
 }
 
+// A motion that `ends: front` (the roll that starts the get-up from the back)
+// leaves the robot lying on its front on purpose: no failed get-up, and the
+// get-up from the front follows once it lies still. One that leaves it on its
+// back failed.
+TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const auto dir = test::freshTempDir("roll_motions");
+  std::filesystem::create_directories(dir);
+  for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
+    std::filesystem::copy_file(f.path(), dir / f.path().filename());
+  std::filesystem::remove(dir / "get_up_back.yaml");
+  std::ofstream(dir / "get_up_back.yaml") << "motion: get_up_back\nends: front\nframes:\n  - "
+                                             "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
+  EXPECT_EQ(agents::loadKeyframeMotion(dir / "get_up_back.yaml", model).ends,
+            agents::KeyframeMotion::Ends::Front);
+  for (const bool rolled : {true, false}) {
+    agents::FallDetectorParameters fall;
+    fall.get_up = true;
+    agents::MotionController mc = agents::loadMotionController(model, dir, fall);
+    std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
+    agents::MotionSensors s;
+    s.position = joints;
+    MotionRequest stand;
+    auto run = [&](double seconds) {
+      for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i)
+        mc.update(0.01, s, stand, position, stiffness);
+    };
+    run(0.5);
+    s.accel = Vec3(9.81, 0, 0);  // on its back: up is +x in the torso frame
+    for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
+    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);  // the roll
+    if (rolled) s.accel = Vec3(-9.81, 0, 0);                // now on its front
+    run(0.55);
+    EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
+    EXPECT_EQ(mc.counters().failed_get_ups, rolled ? 0 : 1);
+    run(0.5);
+    EXPECT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;  // front get-up, or a new roll
+  }
+}
+
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
   world::World w(test::scenario(2));
   const auto file = std::filesystem::temp_directory_path() / "simsoccer_test.log";

@@ -16,7 +16,7 @@ double KeyframeMotion::duration() const {
 KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
                                   const robots::RobotModel& model) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly({"motion", "interpolation", "frames"});
+  root.allowOnly({"motion", "interpolation", "ends", "frames"});
   KeyframeMotion m;
   m.name = root["motion"].string();
   if (auto interp = root.optional("interpolation")) {
@@ -25,6 +25,13 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
       m.interpolation = KeyframeMotion::Interpolation::Linear;
     else if (v != "smooth")
       interp->fail("must be smooth or linear");
+  }
+  if (auto ends = root.optional("ends")) {
+    const std::string v = ends->string();
+    if (v == "front")
+      m.ends = KeyframeMotion::Ends::Front;
+    else if (v != "standing")
+      ends->fail("must be standing or front");
   }
   const auto& joints = model.body->joints;
   std::vector<double> q = model.pose("stand");
@@ -65,6 +72,7 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
 
 void KeyframePlayer::start(const KeyframeMotion& motion, const std::vector<double>& measured) {
   motion_ = &motion;
+  last_ = &motion;
   from_ = measured;
   t_ = 0.0;
 }

@@ -204,6 +204,10 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         if (upright()) {
           ++counters_.get_ups;
           easeIntoStance();
+        } else if (player_.motion()->ends == KeyframeMotion::Ends::Front && gravity_.x() < 0.0) {
+          // Rolled from the back onto the front, as meant: lying, so the fall
+          // detector starts the get-up from the front once it is still.
+          enter(MotionState::Lying);
         } else {
           ++counters_.failed_get_ups;
           enter(MotionState::Falling);

@@ -24,11 +24,15 @@ struct KeyframeMotion {
   // few long frames) or linear (constant speed within a frame, so a dense
   // sequence of short frames moves without stopping at each).
   enum class Interpolation { Smooth, Linear } interpolation = Interpolation::Smooth;
+  // Where the motion leaves the robot: standing (a get-up), or lying on its
+  // front (a roll from the back, after which the get-up from the front runs).
+  enum class Ends { Standing, Front } ends = Ends::Standing;
   std::vector<Keyframe> frames;
   double duration() const;
 };
 
-// Reads a motion for `model`: interpolation: smooth|linear (default smooth), frames: [{duration,
+// Reads a motion for `model`: interpolation: smooth|linear (default smooth),
+// ends: standing|front (default standing), frames: [{duration,
 // stiffness, pose: NAME (a pose of the robot model), joints: {Name: rad, ...}}]. A frame starts
 // from the previous frame (the first from the model's `stand` pose) or from its `pose`, then sets
 // its `joints`; mimic joints follow their masters. Throws engine::ConfigError (file, key, reason).
@@ -41,12 +45,15 @@ class KeyframePlayer {
  public:
   void start(const KeyframeMotion& motion, const std::vector<double>& measured);
   bool active() const { return motion_ != nullptr; }
+  // The motion playing, or the last one played.
+  const KeyframeMotion* motion() const { return last_; }
   double elapsed() const { return t_; }
   // Advances by dt and writes targets (per body joint) and the stiffness.
   void update(double dt, std::vector<double>& targets, double& stiffness);
 
  private:
   const KeyframeMotion* motion_ = nullptr;
+  const KeyframeMotion* last_ = nullptr;
   std::vector<double> from_;
   double t_ = 0.0;
 };
