@@ -121,7 +121,9 @@ def run(side, motions_dir, seed):
         after = rows[end:end + 3] or rows[-1:]
         score = sum(-r[4] for r in after) / len(after)
         success = bool(ok) and float(ok.group(1)) < 8.0
-        return score + (2.0 if success else 0.0), success
+        if ok:  # standing: +2, more the sooner (up to +0.5 at 7 s, -1 at 10 s)
+            score += 2.0 + max(-1.0, min(0.5, 0.5 * (8.0 - float(ok.group(1)))))
+        return score, success
     window = rows[start:min(len(rows), end + 15)]
     h = [min(r[2], 0.33) / 0.33 * (0.4 + 0.6 * max(r[3], 0.0)) for r in window]
     last = h[-10:]

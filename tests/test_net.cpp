@@ -578,3 +578,35 @@ TEST(NetKick, AStrikerAgentKicksTheBallTwoMetres) {
   EXPECT_GT(d.x(), 1.5);  // towards the goal it attacks
   EXPECT_FALSE(fell);
 }
+
+TEST(NetGetUp, AnAgentProcessGetsItsRobotUpFromItsBack) {
+  // Lockstep over DDS: the robot starts lying on its back; simsoccer-agent
+  // --get-up detects it from the IMU, rolls onto its front and gets up
+  // (joint targets only), within the 8 s the motion figures ask for.
+  const uint32_t domain = 118;
+  world::Scenario s = teams(1);
+  s.perception.enabled = true;
+  world::World w(s);
+  engine::Pose torso = engine::Pose::Identity();
+  torso.linear() = Eigen::AngleAxisd(-M_PI / 2, engine::Vec3::UnitY()).toRotationMatrix();
+  torso.translation() = engine::Vec3(-2.0, 1.0, 0.16);
+  w.placeRobot(0, torso, "stand");
+  for (int i = 0; i < 100; ++i) w.stepControlPeriod();  // settled on its back
+  ASSERT_GT(w.torsoPose(0).linear()(2, 0), 0.9);        // chest up
+  net::ServerConfig config = serverConfig(domain, 2.0);
+  net::SimServer server(w, config);
+  AgentProcess agent(domain, 0, 1, {"--role", "defender", "--get-up"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  double standing_for = 0.0, up_at = -1.0;
+  const double dt = s.physics.control_period;
+  for (int i = 0; i < 1000 && standing_for < 1.0; ++i) {  // up to 10 s
+    server.runPeriod();
+    standing_for = w.isStanding(0) ? standing_for + dt : 0.0;
+    if (standing_for >= 1.0) up_at = (i + 1) * dt - 1.0;
+  }
+  std::printf("standing from %.2f s (-1: never); missed %llu\n", up_at,
+              (unsigned long long)server.stats(0).missed);
+  EXPECT_GE(up_at, 0.0);
+  EXPECT_LT(up_at, 8.0);
+  EXPECT_EQ(server.stats(0).missed, 0u);
+}

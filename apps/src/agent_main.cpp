@@ -24,7 +24,7 @@ namespace {
 const char* kHelp =
     "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE]\n"
     "                       [--robot FILE] [--role ROLE [--config FILE] [--field FILE]\n"
-    "                        [--team-number N] [--seed N] [--get-up] [--verbose]]\n"
+    "                        [--team-number N] [--seed N] [--no-get-up] [--verbose]]\n"
     "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
     "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
     "                       [--game-state-wait S]\n"
@@ -36,8 +36,9 @@ const char* kHelp =
     "                   penalty-kicker or penalty-goalkeeper. Needs perception on in the\n"
     "                   scenario; obeys the GameState (team number --team-number, default T+1).\n"
     "                   --config: the behaviour (default configs/agents/soccer.yaml); --field:\n"
-    "                   the field (default fields/spl.yaml); --get-up: try to get up after a\n"
-    "                   fall (off by default: the motions do not succeed yet, see the README)\n"
+    "                   the field (default fields/spl.yaml). After a fall the robot gets up\n"
+    "                   (from the back: rolls onto its front first); --no-get-up: it stays\n"
+    "                   down, soft (--get-up, the default, is accepted)\n"
     "Without --role, --mode (default nod): the stand pose and a nodding head (0.2 rad at 0.5 Hz).\n"
     "  --mode walk      eases into the walk's stance for 1 s, then walks at --vx, --vy (m/s)\n"
     "                   and --turn (rad/s) with the walk engine (default 0.2 m/s forward)\n"
@@ -54,7 +55,7 @@ const char* kHelp =
 int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
-    const apps::Options opt(argc, argv, 1, {"help", "get-up", "verbose"},
+    const apps::Options opt(argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
                             {"team", "player", "domain", "dds-config", "robot", "mode",
                              "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
                              "config", "field", "team-number", "seed", "game-state-wait"});
@@ -91,7 +92,7 @@ int main(int argc, char** argv) {
       setup.player = player;
       setup.role = *role;
       setup.seed = static_cast<uint64_t>(opt.number("seed", 1));
-      setup.get_up = opt.flag("get-up");
+      setup.get_up = !opt.flag("no-get-up");
       soccer = std::make_unique<agents::SoccerAgent>(
           model,
           agents::loadBehaviourConfig(

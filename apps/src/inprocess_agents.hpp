@@ -18,7 +18,7 @@ class InProcessAgents {
   // `roles`: one per robot (world order). The perception settings are the
   // scenario's if it turns perception on, else the ideal profile.
   InProcessAgents(world::World& world, const std::vector<agents::Role>& roles, uint64_t seed,
-                  bool get_up = false);
+                  bool get_up = true);
   ~InProcessAgents();
   // One control period's agent work: perception, behaviour, motion, the
   // commands set on the world. Call before World::stepControlPeriod().

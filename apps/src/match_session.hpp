@@ -30,7 +30,7 @@ struct MatchConfig {
   std::optional<double> half_duration, half_time_break;
   std::array<int, 2> team_numbers{1, 2};
   std::string role = "auto";
-  bool get_up = false;
+  bool get_up = true;
   int restart_limit = 3;
   double message_delay = 0.0, message_loss = 0.0;
   double command_timeout = 0.5;  // s of wall time a lockstep period waits for commands

@@ -45,8 +45,8 @@ struct SoccerAgentOptions {
   std::filesystem::path config;    // empty: the agent's default
   std::optional<int> team_number;  // GameController team number
   std::optional<uint64_t> seed;    // the agent's own random numbers
-  bool get_up = false;
-  double game_state_wait = 10.0;  // s
+  bool get_up = true;              // after a fall
+  double game_state_wait = 10.0;   // s
 };
 std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o);
 
