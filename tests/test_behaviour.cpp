@@ -671,6 +671,38 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   }
 }
 
+// A robot picked up in the middle of its get-up and put on its feet (the
+// referee removing an inactive player) stops the get-up and eases into the
+// stance, instead of playing the rest of the motion from standing.
+TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpStopsIt) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  agents::FallDetectorParameters fall;
+  fall.get_up = true;
+  agents::MotionController mc =
+      agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
+  std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
+  agents::MotionSensors s;
+  s.position = joints;
+  MotionRequest stand;
+  auto run = [&](double seconds) {
+    for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i)
+      mc.update(0.01, s, stand, position, stiffness);
+  };
+  run(0.5);
+  s.accel = Vec3(-9.81, 0, 0);  // on its front
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
+  ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
+  run(1.0);  // well inside the get-up from the front (5 s)
+  ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
+  s.accel = Vec3(0, 0, 9.81);  // standing, still
+  run(0.2);
+  EXPECT_NE(mc.state(), agents::MotionState::GettingUp);
+  EXPECT_NE(mc.state(), agents::MotionState::Falling);
+  EXPECT_EQ(mc.counters().failed_get_ups, 0);
+  run(1.0);
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+}
+
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
   world::World w(test::scenario(2));
   const auto file = std::filesystem::temp_directory_path() / "simsoccer_test.log";

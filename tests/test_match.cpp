@@ -99,6 +99,24 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
     EXPECT_NE(summary.find(std::string("\"") + key + "\""), std::string::npos) << key;
   EXPECT_EQ(jsonValue(summary, "interrupted"), "false");
   EXPECT_EQ(jsonValue(summary, "aborted"), "null");
+  // Per robot: falls, the get-ups among them, and a record per fall whose
+  // up_after (s to stand again, or null) is there for each.
+  const std::regex robot_re(
+      "\"falls\": (\\d+), \"get_ups\": (\\d+), \"keeper_dives\": \\d+, .*\"fall_records\": "
+      "\\[(.*)\\]\\}");
+  int robots = 0;
+  for (std::sregex_iterator it(summary.begin(), summary.end(), robot_re), end; it != end; ++it) {
+    ++robots;
+    const int falls = std::stoi((*it)[1]), get_ups = std::stoi((*it)[2]);
+    const std::string records = (*it)[3];
+    EXPECT_LE(get_ups, falls);
+    const std::regex up_re("\"up_after\": (null|[0-9.]+)");
+    EXPECT_EQ(std::distance(std::sregex_iterator(records.begin(), records.end(), up_re),
+                            std::sregex_iterator()),
+              falls)
+        << records;
+  }
+  EXPECT_EQ(robots, 4);
   // The game was played: halves and a result.
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
   EXPECT_NE(summary.find("\"game_over\""), std::string::npos);

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -418,8 +419,10 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   for (size_t i = 0; i < s.robots().size(); ++i) {
     const auto& rec = s.robots()[i];
     out << "    {\"team\": " << rec.team << ", \"player\": " << rec.number
-        << ", \"falls\": " << rec.falls.size() << ", \"keeper_dives\": " << rec.dives
-        << ", \"distance_walked\": " << num(rec.distance, 2)
+        << ", \"falls\": " << rec.falls.size() << ", \"get_ups\": "
+        << std::count_if(rec.falls.begin(), rec.falls.end(),
+                         [](const FallRecord& f) { return f.up_after.has_value(); })
+        << ", \"keeper_dives\": " << rec.dives << ", \"distance_walked\": " << num(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
         << ", \"fall_records\": [";
     for (size_t k = 0; k < rec.falls.size(); ++k) {
@@ -427,7 +430,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
       out << (k ? ", " : "") << "{\"time\": " << num(f.time, 2) << ", \"x\": " << num(f.x, 2)
           << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": "
           << (f.nearest_robot ? num(*f.nearest_robot, 2) : std::string("null"))
-          << ", \"ball\": " << num(f.ball, 2) << "}";
+          << ", \"ball\": " << num(f.ball, 2)
+          << ", \"up_after\": " << (f.up_after ? num(*f.up_after, 2) : std::string("null")) << "}";
     }
     out << "]}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }

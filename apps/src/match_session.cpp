@@ -197,14 +197,24 @@ void MatchSession::record() {
         ++rec.dives;
         diving_keeper_.reset();
       } else {
-        FallRecord f{world_->time(), p.x(), p.y(), std::nullopt, (p - ball).head<2>().norm()};
+        FallRecord f;
+        f.time = world_->time();
+        f.x = p.x();
+        f.y = p.y();
+        f.ball = (p - ball).head<2>().norm();
         for (world::RobotId o = 0; o < world_->robotCount(); ++o) {
           if (o == r) continue;
           const double d = (world_->torsoPose(o).translation() - p).head<2>().norm();
           f.nearest_robot = std::min(f.nearest_robot.value_or(d), d);
         }
         rec.falls.push_back(f);
+        rec.down_after_fall = true;
       }
+    }
+    if (!rec.standing && standing && rec.down_after_fall) {
+      FallRecord& f = rec.falls.back();
+      if (std::hypot(p.x() - f.x, p.y() - f.y) < 0.5) f.up_after = world_->time() - f.time;
+      rec.down_after_fall = false;
     }
     rec.standing = standing;
     const double step = (p - rec.last).head<2>().norm();

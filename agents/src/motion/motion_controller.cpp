@@ -199,6 +199,14 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       break;
     case MotionState::GettingUp:
+      if (upright() && rate < fall_.lying_rate &&
+          player_.elapsed() < 0.5 * player_.motion()->duration()) {
+        // Upright and still in the first half of a get-up, which cannot
+        // stand the robot up by then: the referee picked it up (an inactive
+        // player) and put it on its feet. Stop the get-up; back to the stance.
+        restart_ = true;
+        break;
+      }
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) {
         if (upright()) {
