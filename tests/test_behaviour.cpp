@@ -660,9 +660,13 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
     };
     run(0.5);
     s.accel = Vec3(9.81, 0, 0);  // on its back: up is +x in the torso frame
+    s.pitch = -M_PI / 2;
     for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
     ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);  // the roll
-    if (rolled) s.accel = Vec3(-9.81, 0, 0);                // now on its front
+    if (rolled) {                                           // now on its front
+      s.accel = Vec3(-9.81, 0, 0);
+      s.pitch = M_PI / 2;
+    }
     run(0.55);
     EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
     EXPECT_EQ(mc.counters().failed_get_ups, rolled ? 0 : 1);
@@ -671,36 +675,51 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   }
 }
 
-// A robot picked up in the middle of its get-up and put on its feet (the
-// referee removing an inactive player) stops the get-up and eases into the
-// stance, instead of playing the rest of the motion from standing.
-TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpStopsIt) {
-  const auto model = robots::loadRobotModel(test::naoH25());
+// A robot picked up in the middle of its get-up (the referee removing an
+// inactive player) or of a dive (the shoot-out's next kick) and put on its
+// feet stops the motion and eases into the stance, instead of playing the rest
+// of it from standing and falling at its waiting spot (as in a 5 v 5 match).
+TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
+  world::World w(test::scenario(1));
   agents::FallDetectorParameters fall;
   fall.get_up = true;
   agents::MotionController mc =
-      agents::loadMotionController(model, test::sourceDir() / "configs/motions", fall);
-  std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
-  agents::MotionSensors s;
-  s.position = joints;
-  MotionRequest stand;
-  auto run = [&](double seconds) {
-    for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i)
-      mc.update(0.01, s, stand, position, stiffness);
-  };
-  run(0.5);
-  s.accel = Vec3(-9.81, 0, 0);  // on its front
-  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
+      agents::loadMotionController(*w.robot(0).model, test::sourceDir() / "configs/motions", fall);
+  std::vector<float> position(25), stiffness(25);
+  MotionRequest request;
+  auto period = [&] { controlPeriod(w, mc, request, position, stiffness); };
+  for (int i = 0; i < 100; ++i) period();
+  engine::Pose lying = engine::Pose::Identity();
+  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // on its front
+  lying.translation() = Vec3(-2.0, 0.0, 0.16);
+  w.placeRobot(0, lying, "stand");
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
   ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
-  run(1.0);  // well inside the get-up from the front (5 s)
-  ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
-  s.accel = Vec3(0, 0, 9.81);  // standing, still
-  run(0.2);
-  EXPECT_NE(mc.state(), agents::MotionState::GettingUp);
-  EXPECT_NE(mc.state(), agents::MotionState::Falling);
-  EXPECT_EQ(mc.counters().failed_get_ups, 0);
-  run(1.0);
+  for (int t : {100, 250}) {  // 1 s and 2.5 s into the get-up
+    for (int i = 0; i < t; ++i) period();
+    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << t;
+    w.placeRobot(0, -2.0, 0.0, 0.0);
+    for (int i = 0; i < 300; ++i) period();
+    EXPECT_EQ(mc.state(), agents::MotionState::Stance) << t;
+    EXPECT_TRUE(w.isStanding(0)) << t;
+    EXPECT_EQ(mc.counters().failed_get_ups, 0) << t;
+    w.placeRobot(0, lying, "stand");  // down again for the next one
+    for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
+  }
+  // A dive, put on its feet while it lies (the dive's last frames).
+  for (int i = 0; i < 800 && mc.state() != agents::MotionState::Stance; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::Stance);
+  request.kind = MotionRequest::Kind::Dive;
+  request.side = agents::Leg::Left;
+  period();
+  request = MotionRequest{};
+  ASSERT_EQ(mc.state(), agents::MotionState::Diving);
+  for (int i = 0; i < 60; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::Diving);
+  w.placeRobot(0, -2.0, 0.0, 0.0);
+  for (int i = 0; i < 300; ++i) period();
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_TRUE(w.isStanding(0));
 }
 
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {

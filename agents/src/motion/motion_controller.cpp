@@ -48,14 +48,45 @@ MotionController::MotionController(const robots::RobotModel& model, KeyframeMoti
       targets_(model.pose("stand")) {
   head_yaw_ = model.body->jointIndex("HeadYaw");
   head_pitch_ = model.body->jointIndex("HeadPitch");
+  for (const char* side : {"L", "R"})
+    for (const char* name :
+         {"HipYawPitch", "HipRoll", "HipPitch", "KneePitch", "AnklePitch", "AnkleRoll"}) {
+      const int j = model.body->jointIndex(std::string(side) + name);
+      if (j >= 0) leg_joints_.push_back(j);
+    }
 }
 
 void MotionController::restart() {
   restart_ = true;
 }
 
+void MotionController::restartFrom(const std::vector<double>& measured) {
+  restart_ = false;
+  ease_from_ = measured;
+  walk_ = WalkEngine(model_, walk_parameters_);
+  kick_ = KickEngine(model_, walk_parameters_, kick_parameters_);
+  player_ = KeyframePlayer();
+  targets_ = measured;
+  stiffness_ = 1.0;
+  enter(MotionState::Easing);
+}
+
 bool MotionController::upright() const {
   return tilt_ < fall_.upright_tilt;
+}
+
+bool MotionController::placedOnItsFeet(const MotionSensors& sensors,
+                                       const std::vector<double>& measured) const {
+  if (std::abs(sensors.roll) > fall_.upright_tilt || std::abs(sensors.pitch) > fall_.upright_tilt)
+    return false;
+  const std::vector<double>& stand = model_.pose("stand");
+  double off_measured = 0.0, off_targets = 0.0;  // rad, the largest over the legs
+  for (int j : leg_joints_) {
+    const size_t k = static_cast<size_t>(j);
+    off_measured = std::max(off_measured, std::abs(measured[k] - stand[k]));
+    off_targets = std::max(off_targets, std::abs(targets_[k] - stand[k]));
+  }
+  return off_measured < 0.2 && off_targets > 0.4;
 }
 
 void MotionController::enter(MotionState s) {
@@ -105,16 +136,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   std::vector<double> measured;
   measuredJoints(sensors, measured);
 
-  if (restart_) {
-    restart_ = false;
-    ease_from_ = measured;
-    walk_ = WalkEngine(model_, walk_parameters_);
-    kick_ = KickEngine(model_, walk_parameters_, kick_parameters_);
-    player_ = KeyframePlayer();
-    targets_ = measured;
-    stiffness_ = 1.0;
-    enter(MotionState::Easing);
-  }
+  if (restart_) restartFrom(measured);
   const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
                       state_ == MotionState::Walking || state_ == MotionState::Kicking ||
                       state_ == MotionState::Blocking;
@@ -167,6 +189,10 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Diving:
       // Meant to end on the ground: not a fall. Lying afterwards, the fall
       // detector's rules apply (soft, then the get-up if it is on).
+      if (placedOnItsFeet(sensors, measured)) {  // the shoot-out's next kick
+        restartFrom(measured);
+        break;
+      }
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) enter(MotionState::Lying);
       break;
@@ -199,12 +225,11 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       break;
     case MotionState::GettingUp:
-      if (upright() && rate < fall_.lying_rate &&
-          player_.elapsed() < 0.5 * player_.motion()->duration()) {
-        // Upright and still in the first half of a get-up, which cannot
-        // stand the robot up by then: the referee picked it up (an inactive
-        // player) and put it on its feet. Stop the get-up; back to the stance.
-        restart_ = true;
+      if (placedOnItsFeet(sensors, measured)) {
+        // The referee picked it up (an inactive player) and put it on its
+        // feet: stop the get-up, back to the stance from this period on (one
+        // more period of the get-up's targets is enough to knock it over).
+        restartFrom(measured);
         break;
       }
       player_.update(dt, targets_, stiffness_);

@@ -38,7 +38,9 @@ struct MotionSensors {
   std::span<const float> position;  // rad, actuator order
   Vec3 gyro = Vec3::Zero();         // rad/s, torso frame
   Vec3 accel = Vec3(0, 0, 9.81);    // m/s^2, torso frame (specific force)
-  double yaw = 0.0;                 // rad, the IMU's torso yaw
+  // rad, the IMU's torso angles (its attitude estimate, as the Nao's AngleX/Y/Z)
+  double roll = 0.0, pitch = 0.0;
+  double yaw = 0.0;
 };
 
 struct FallDetectorParameters {
@@ -93,6 +95,11 @@ class MotionController {
   // Torso tilt from upright (rad), from the accelerometer (filtered).
   double tilt() const { return tilt_; }
   bool upright() const;
+  // Put on its feet by someone (the referee taking out a player) during a
+  // motion that keeps it on or near the ground: upright (the IMU's angles:
+  // the accelerometer reads the legs folding under the motion's targets) with
+  // the legs in the stand pose while the motion's targets are far from it.
+  bool placedOnItsFeet(const MotionSensors& sensors, const std::vector<double>& measured) const;
   const WalkEngine& walk() const { return walk_; }
   const robots::RobotModel& model() const { return model_; }
 
@@ -105,6 +112,8 @@ class MotionController {
   // After a keyframe motion that ends on the feet: ease into a fresh walk's stance.
   void easeIntoStance();
   void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
+  // Drops whatever motion runs and eases into the stance from `measured`.
+  void restartFrom(const std::vector<double>& measured);
 
   const robots::RobotModel& model_;
   KeyframeMotion get_up_front_, get_up_back_, block_, dive_left_, dive_right_;
@@ -117,6 +126,7 @@ class MotionController {
   MotionState state_ = MotionState::Easing;
   MotionCounters counters_;
   std::vector<double> targets_, ease_from_;
+  std::vector<int> leg_joints_;  // body joint indices of both legs
   double state_time_ = 0.0, still_for_ = 0.0, tilt_ = 0.0;
   Vec3 gravity_ = Vec3(0, 0, 9.81);  // low-passed accelerometer
   double stiffness_ = 1.0;
@@ -132,6 +142,8 @@ MotionSensors motionSensors(const Frame& f) {
   s.position = std::span<const float>(&f.position[0], 25);
   s.gyro = Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]);
   s.accel = Vec3(f.accelerometer[0], f.accelerometer[1], f.accelerometer[2]);
+  s.roll = f.angles[0];
+  s.pitch = f.angles[1];
   s.yaw = f.angles[2];
   return s;
 }
