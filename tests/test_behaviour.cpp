@@ -619,6 +619,7 @@ TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGet
   for (int i = 0; i < 30; ++i) {
     const double a = std::min(1.5, 0.05 * i);
     s.accel = Vec3(-9.81 * std::sin(a), 0, 9.81 * std::cos(a));
+    s.pitch = a;  // the IMU's angle
     s.gyro = Vec3(0, 2.0, 0);
     mc.update(0.01, s, stand_still, position, stiffness);
   }
@@ -720,6 +721,26 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
   for (int i = 0; i < 300; ++i) period();
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
   EXPECT_TRUE(w.isStanding(0));
+  // Dived and lying when the shoot-out's next kick is set up: the agent
+  // restarts its motion at Set (stiff, still on the ground: a fall, soft
+  // again), then the referee puts it on its feet. Stiff at once, it stays up.
+  request.kind = MotionRequest::Kind::Dive;
+  period();
+  request = MotionRequest{};
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::Lying; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::Lying);
+  mc.restart();
+  for (int i = 0; i < 5; ++i) period();
+  ASSERT_TRUE(mc.state() == agents::MotionState::Falling ||
+              mc.state() == agents::MotionState::Lying);
+  w.placeRobot(0, -2.0, 0.0, 0.0);
+  double lowest = 1.0;
+  for (int i = 0; i < 300; ++i) {
+    period();
+    lowest = std::min(lowest, w.torsoPose(0).translation().z());
+  }
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_GT(lowest, 0.23);
 }
 
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {

@@ -76,7 +76,8 @@ bool MotionController::upright() const {
 }
 
 bool MotionController::placedOnItsFeet(const MotionSensors& sensors,
-                                       const std::vector<double>& measured) const {
+                                       const std::vector<double>& measured,
+                                       bool targets_far) const {
   if (std::abs(sensors.roll) > fall_.upright_tilt || std::abs(sensors.pitch) > fall_.upright_tilt)
     return false;
   const std::vector<double>& stand = model_.pose("stand");
@@ -86,7 +87,7 @@ bool MotionController::placedOnItsFeet(const MotionSensors& sensors,
     off_measured = std::max(off_measured, std::abs(measured[k] - stand[k]));
     off_targets = std::max(off_targets, std::abs(targets_[k] - stand[k]));
   }
-  return off_measured < 0.2 && off_targets > 0.4;
+  return off_measured < 0.2 && (!targets_far || off_targets > 0.4);
 }
 
 void MotionController::enter(MotionState s) {
@@ -189,7 +190,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Diving:
       // Meant to end on the ground: not a fall. Lying afterwards, the fall
       // detector's rules apply (soft, then the get-up if it is on).
-      if (placedOnItsFeet(sensors, measured)) {  // the shoot-out's next kick
+      if (placedOnItsFeet(sensors, measured, true)) {  // the shoot-out's next kick
         restartFrom(measured);
         break;
       }
@@ -202,6 +203,12 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       break;
     case MotionState::Falling:
     case MotionState::Lying:
+      if (placedOnItsFeet(sensors, measured, false)) {
+        // Put on its feet: stiff at once (soft, it would sink before the
+        // filtered tilt below says upright).
+        restartFrom(measured);
+        break;
+      }
       // Soft joints that keep their current angles: no servo fights the impact.
       targets_ = measured;
       stiffness_ = fall_.safe_stiffness;
@@ -225,7 +232,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       break;
     case MotionState::GettingUp:
-      if (placedOnItsFeet(sensors, measured)) {
+      if (placedOnItsFeet(sensors, measured, true)) {
         // The referee picked it up (an inactive player) and put it on its
         // feet: stop the get-up, back to the stance from this period on (one
         // more period of the get-up's targets is enough to knock it over).

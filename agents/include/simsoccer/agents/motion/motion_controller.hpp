@@ -95,11 +95,14 @@ class MotionController {
   // Torso tilt from upright (rad), from the accelerometer (filtered).
   double tilt() const { return tilt_; }
   bool upright() const;
-  // Put on its feet by someone (the referee taking out a player) during a
-  // motion that keeps it on or near the ground: upright (the IMU's angles:
-  // the accelerometer reads the legs folding under the motion's targets) with
-  // the legs in the stand pose while the motion's targets are far from it.
-  bool placedOnItsFeet(const MotionSensors& sensors, const std::vector<double>& measured) const;
+  // Put on its feet by someone (the referee taking out a player or setting
+  // up the shoot-out's next kick) while it lies or plays a motion that keeps
+  // it on the ground: upright by the IMU's angles (the filtered accelerometer
+  // lags, and reads the legs folding under the motion's targets) with the
+  // legs in the stand pose; during a motion (`targets_far`), the motion's
+  // targets far from it (its own get-up ends in the stand pose).
+  bool placedOnItsFeet(const MotionSensors& sensors, const std::vector<double>& measured,
+                       bool targets_far) const;
   const WalkEngine& walk() const { return walk_; }
   const robots::RobotModel& model() const { return model_; }
 
