@@ -203,9 +203,9 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       break;
     case MotionState::Falling:
     case MotionState::Lying:
-      if (placedOnItsFeet(sensors, measured, false)) {
-        // Put on its feet: stiff at once (soft, it would sink before the
-        // filtered tilt below says upright).
+      if (rate < fall_.lying_rate && placedOnItsFeet(sensors, measured, false)) {
+        // Put on its feet, at rest: stiff at once (soft, it would sink before
+        // the filtered tilt below says upright).
         restartFrom(measured);
         break;
       }
