@@ -73,6 +73,18 @@ void controlPeriod(world::World& w, agents::MotionController& mc, const MotionRe
   w.stepControlPeriod();
 }
 
+// Runs `period` (one control period) `periods` times: robot 0's lowest torso
+// height meanwhile, m.
+template <class Period>
+double lowestTorsoOver(const world::World& w, Period&& period, int periods) {
+  double lowest = 1.0;
+  for (int i = 0; i < periods; ++i) {
+    period();
+    lowest = std::min(lowest, w.torsoPose(0).translation().z());
+  }
+  return lowest;
+}
+
 }  // namespace
 
 TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
@@ -499,13 +511,8 @@ TEST(MotionController, ARobotPutDownByTheRefereeStaysUpAndKeepsItsNewHeading) {
   for (int i = 0; i < 300; ++i) period();
   ASSERT_EQ(mc.state(), agents::MotionState::Lying);
   w.placeRobot(0, -2.0, 0.0, 0.0);
-  double lowest = 1.0;
-  for (int i = 0; i < 300; ++i) {
-    period();
-    lowest = std::min(lowest, w.torsoPose(0).translation().z());
-  }
+  EXPECT_GT(lowestTorsoOver(w, period, 300), 0.23);
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
-  EXPECT_GT(lowest, 0.23);
   EXPECT_TRUE(w.isStanding(0));
   // Walking when it is put down facing the other way: it stops, stays up.
   MotionRequest walk;
@@ -517,13 +524,8 @@ TEST(MotionController, ARobotPutDownByTheRefereeStaysUpAndKeepsItsNewHeading) {
   w.placeRobot(0, 2.0, 0.0, M_PI);
   mc.restart();  // as the agent does when the game enters Set (the referee places robots then)
   stand = MotionRequest{};
-  lowest = 1.0;
-  for (int i = 0; i < 300; ++i) {
-    period();
-    lowest = std::min(lowest, w.torsoPose(0).translation().z());
-  }
+  EXPECT_GT(lowestTorsoOver(w, period, 300), 0.23);
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
-  EXPECT_GT(lowest, 0.23);
   // Walking on from there: straight on in the new heading (the walk's heading
   // hold does not turn it back to the one it had before it was put down).
   stand = walk;
@@ -734,13 +736,8 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
   ASSERT_TRUE(mc.state() == agents::MotionState::Falling ||
               mc.state() == agents::MotionState::Lying);
   w.placeRobot(0, -2.0, 0.0, 0.0);
-  double lowest = 1.0;
-  for (int i = 0; i < 300; ++i) {
-    period();
-    lowest = std::min(lowest, w.torsoPose(0).translation().z());
-  }
+  EXPECT_GT(lowestTorsoOver(w, period, 300), 0.23);
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
-  EXPECT_GT(lowest, 0.23);
 }
 
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {

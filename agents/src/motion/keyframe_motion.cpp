@@ -7,6 +7,21 @@
 
 namespace simsoccer::agents {
 
+namespace {
+
+// An optional `key: first|second` (default first): true for second; any other
+// value is an error naming the key.
+bool secondChoice(const engine::ConfigNode& root, const std::string& key, const std::string& first,
+                  const std::string& second) {
+  const auto node = root.optional(key);
+  if (!node) return false;
+  const std::string v = node->string();
+  if (v != first && v != second) node->fail("must be " + first + " or " + second);
+  return v == second;
+}
+
+}  // namespace
+
 double KeyframeMotion::duration() const {
   double d = 0.0;
   for (const Keyframe& f : frames) d += f.duration;
@@ -19,20 +34,9 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
   root.allowOnly({"motion", "interpolation", "ends", "frames"});
   KeyframeMotion m;
   m.name = root["motion"].string();
-  if (auto interp = root.optional("interpolation")) {
-    const std::string v = interp->string();
-    if (v == "linear")
-      m.interpolation = KeyframeMotion::Interpolation::Linear;
-    else if (v != "smooth")
-      interp->fail("must be smooth or linear");
-  }
-  if (auto ends = root.optional("ends")) {
-    const std::string v = ends->string();
-    if (v == "front")
-      m.ends = KeyframeMotion::Ends::Front;
-    else if (v != "standing")
-      ends->fail("must be standing or front");
-  }
+  if (secondChoice(root, "interpolation", "smooth", "linear"))
+    m.interpolation = KeyframeMotion::Interpolation::Linear;
+  if (secondChoice(root, "ends", "standing", "front")) m.ends = KeyframeMotion::Ends::Front;
   const auto& joints = model.body->joints;
   std::vector<double> q = model.pose("stand");
   for (const engine::ConfigNode& item : root["frames"].items()) {
