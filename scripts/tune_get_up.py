@@ -1,17 +1,27 @@
 #!/usr/bin/env python3
-"""Cross-entropy search over symmetric get-up keyframes, each candidate scored in the
-simulator (`simsoccer bench motion --get-up SIDE --verbose`, seeded trials): how high and
-upright the torso gets while the motion plays and 1.5 s after, +2 for standing.
-How configs/motions/get_up_front.yaml was found (README, "Get up").
+"""Cross-entropy search over get-up keyframes, each candidate scored in the simulator
+(`simsoccer bench motion --get-up SIDE --verbose`, seeded trials on fresh seeds each
+generation): how high and upright the torso gets while the motion plays and 1.5 s after,
++2 for standing within 8 s. How configs/motions/get_up_*.yaml were found: each file's
+header says with which settings (README, "Get up").
 
   python3 scripts/tune_get_up.py SIDE START.yaml OUTDIR [generations] [population]
 
 SIDE: front or back. START.yaml: a get-up motion file to start from (its frames up to
 the first `pose:` frame are searched; unnamed joints start from the stand pose).
-Defaults: 40 generations of 24 candidates. (The kept front motion: SQUAT_TAIL=1, found in
-generation 7 of a run of 24 candidates stopped after 21 generations.)
-Writes OUTDIR/get_up_SIDE.yaml (the best so far). SQUAT_TAIL=1: every candidate ends in
-a fixed deep squat and the stand. Needs python3-yaml; runs two trials at a time."""
+Defaults: 40 generations of 24 candidates. Writes OUTDIR/get_up_SIDE.yaml (the best
+single candidate so far) and OUTDIR/get_up_SIDE_mean.yaml (the search's mean, each
+generation: the kept motions are means). Environment:
+  SEEDS=N     trials per candidate (default 4; the kept motions used 8)
+  SIGMA=R     initial spread of the joint angles, rad (default 0.25; durations 0.3 R s)
+  LINEAR=1    write `interpolation: linear` (constant speed within a frame)
+  ASYM=1      every joint searched on its own (default: the left side, mirrored)
+  ROLL=1      the motion is a roll onto the front (`ends: front`, no stand at its end),
+              scored by how far onto the front it leaves the robot, plus 2 for standing
+              (after the get-up from the front) and up to +0.5 the sooner (-1 at 10 s)
+  SQUAT_TAIL=1  every candidate ends in a fixed deep squat and the stand
+  SIM=PATH    the simsoccer binary (default build/apps/simsoccer)
+Needs python3-yaml; runs two trials at a time."""
 import atexit, math, os, random, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
 import yaml
 

@@ -57,7 +57,7 @@ simsoccer_msg_GameState gameState(int state, int team0_number = 1) {
   return g;
 }
 
-// The motion controller with the get-up off, as the agents run it.
+// The motion controller with the get-up off (as `simsoccer-agent --no-get-up` runs it).
 agents::MotionController controllerWithoutGetUp(const robots::RobotModel& model) {
   agents::FallDetectorParameters fall;
   fall.get_up = false;
@@ -593,7 +593,7 @@ TEST(KeyframeMotion, InterpolatesLinearlyOrSmoothly) {
   };
   EXPECT_NEAR(kneeAt("interpolation: linear\n", 0.25), 0.5, 1e-9);
   EXPECT_NEAR(kneeAt("", 0.25), 2.0 * 0.15625, 1e-9);  // smoothstep(0.25) = 0.15625
-  EXPECT_NEAR(kneeAt("interpolation: smooth\n", 0.5), 1.0, 1e-9);
+  EXPECT_NEAR(kneeAt("interpolation: smooth\n", 0.25), 2.0 * 0.15625, 1e-9);
   try {
     kneeAt("interpolation: cubic\n", 0.5);
     FAIL();
@@ -674,7 +674,9 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
     EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
     EXPECT_EQ(mc.counters().failed_get_ups, rolled ? 0 : 1);
     run(0.5);
-    EXPECT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;  // front get-up, or a new roll
+    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;
+    ASSERT_NE(mc.keyframeMotion(), nullptr);
+    EXPECT_EQ(mc.keyframeMotion()->name, rolled ? "get_up_front" : "get_up_back");
   }
 }
 

@@ -128,7 +128,7 @@ TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
   int lifted = 0;
   for (const auto& e : g.events()) lifted += e.type == "unpenalise";
   EXPECT_GE(lifted, 2);
-  EXPECT_EQ(lifted, 4);  // four of the five penalties have run out
+  EXPECT_EQ(lifted, 4);                                 // four of the five penalties have run out
   EXPECT_EQ(g.penalty(0, 6), gc::Penalty::Substitute);  // numbers beyond the 5 players
 
   // A request for pick-up replaces a running penalty and keeps its timer, at least 45 s.

@@ -581,7 +581,7 @@ TEST(NetKick, AStrikerAgentKicksTheBallTwoMetres) {
 
 TEST(NetGetUp, AnAgentProcessGetsItsRobotUpFromItsBack) {
   // Lockstep over DDS: the robot starts lying on its back; simsoccer-agent
-  // --get-up detects it from the IMU, rolls onto its front and gets up
+  // (get-up on by default) detects it from the IMU, rolls onto its front and gets up
   // (joint targets only), within the 8 s the motion figures ask for.
   const uint32_t domain = 118;
   world::Scenario s = teams(1);
@@ -595,7 +595,7 @@ TEST(NetGetUp, AnAgentProcessGetsItsRobotUpFromItsBack) {
   ASSERT_GT(w.torsoPose(0).linear()(2, 0), 0.9);        // chest up
   net::ServerConfig config = serverConfig(domain, 2.0);
   net::SimServer server(w, config);
-  AgentProcess agent(domain, 0, 1, {"--role", "defender", "--get-up"});
+  AgentProcess agent(domain, 0, 1, {"--role", "defender"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   double standing_for = 0.0, up_at = -1.0;
   const double dt = s.physics.control_period;

@@ -211,9 +211,10 @@ void MatchSession::record() {
         rec.down_after_fall = true;
       }
     }
-    if (!rec.standing && standing && rec.down_after_fall) {
+    if (!rec.standing && standing) rec.standing_since = world_->time();
+    if (standing && rec.down_after_fall && world_->time() - rec.standing_since >= 1.0) {
       FallRecord& f = rec.falls.back();
-      if (std::hypot(p.x() - f.x, p.y() - f.y) < 0.5) f.up_after = world_->time() - f.time;
+      if (std::hypot(p.x() - f.x, p.y() - f.y) < 1.0) f.up_after = rec.standing_since - f.time;
       rec.down_after_fall = false;
     }
     rec.standing = standing;

@@ -50,8 +50,9 @@ struct FallRecord {
   double x = 0.0, y = 0.0;              // torso, field frame, m
   std::optional<double> nearest_robot;  // m, torso to torso (none: no other robot)
   double ball = 0.0;                    // m, torso to ball
-  // s until it stood again near where it fell (its get-up); none: it did not
-  // before the match ended, or the referee moved it (a penalty's placement).
+  // s until it stood again, for 1 s, within 1 m of where it fell (its
+  // get-up); none: it did not before the match ended, or the referee moved
+  // it (a penalty's placement).
   std::optional<double> up_after;
 };
 
@@ -62,6 +63,7 @@ struct RobotRecord {
   double distance = 0.0;  // m walked (torso, teleports left out)
   bool standing = true;
   bool down_after_fall = false;  // lying after the last of `falls` (not a dive)
+  double standing_since = 0.0;   // s, the time it last stood up
   engine::Vec3 last{0, 0, 0};
 };
 

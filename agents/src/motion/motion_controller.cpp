@@ -190,7 +190,9 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Diving:
       // Meant to end on the ground: not a fall. Lying afterwards, the fall
       // detector's rules apply (soft, then the get-up if it is on).
-      if (placedOnItsFeet(sensors, measured, true)) {  // the shoot-out's next kick
+      // Put on its feet (the shoot-out's next kick); not in its first 0.3 s,
+      // while it still stands in the stance it dived from.
+      if (state_time_ > 0.3 && placedOnItsFeet(sensors, measured, true)) {
         restartFrom(measured);
         break;
       }

@@ -25,7 +25,7 @@ struct SoccerAgentSetup {
   int team = 0, team_number = 1, player = 1;
   Role role = Role::Auto;
   uint64_t seed = 1;
-  bool get_up = false;  // see FallDetectorParameters::get_up
+  bool get_up = true;  // see FallDetectorParameters::get_up
 };
 
 class SoccerAgent {

@@ -1,7 +1,7 @@
 // Keyframe motions (get-up from the front or the back, ...) as data: a
 // sequence of whole-body joint targets, each reached from the one before
-// over its duration with a smoothstep, the first from wherever the joints
-// are when the motion starts. Files: configs/motions/*.yaml.
+// over its duration (smoothstep or linear), the first from wherever the
+// joints are when the motion starts. Files: configs/motions/*.yaml.
 #pragma once
 
 #include <filesystem>

@@ -51,10 +51,9 @@ struct FallDetectorParameters {
   double upright_tilt = 0.35;    // rad: a get-up that ends within this succeeded
   double safe_stiffness = 0.15;  // while falling and lying
   double head_stiffness = 0.6;   // the head's stiffness in normal motion
-  // Try to get up once lying still. Off: the robot stays down, soft (the
-  // referee takes it out as an inactive player). See the README: the get-up
-  // motions do not succeed yet, and with the robot off its feet the leg
-  // servos can go unstable at the 5 ms step.
+  // Try to get up once lying still (from the back: roll onto the front
+  // first). Off: the robot stays down, soft (the referee takes it out as an
+  // inactive player).
   bool get_up = true;
 };
 
@@ -94,6 +93,10 @@ class MotionController {
   const MotionCounters& counters() const { return counters_; }
   // Torso tilt from upright (rad), from the accelerometer (filtered).
   double tilt() const { return tilt_; }
+  // The keyframe motion playing (get-up, roll, block, dive), or none.
+  const KeyframeMotion* keyframeMotion() const {
+    return player_.active() ? player_.motion() : nullptr;
+  }
   bool upright() const;
   // Put on its feet by someone (the referee taking out a player or setting
   // up the shoot-out's next kick) while it lies or plays a motion that keeps
