@@ -169,14 +169,16 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
   const size_t ground = out.find("ground:");
   ASSERT_NE(ground, std::string::npos);
   EXPECT_NE(out.find(" Torso(", ground), std::string::npos);  // lying on its back at first
-  // The get-up motion drives the legs through the implicit servos' solver
-  // rows: the robot stays on the ground (with explicit leg pitch servos this
-  // trial threw it 270 m up). Measured: torso at most 0.087 m up.
+  // It rolls onto its front and gets up. The get-up drives the legs through
+  // the implicit servos' solver rows: never higher than standing (with
+  // explicit leg pitch servos an earlier get-up threw it 270 m up). Measured:
+  // the torso at most 0.334 m up, standing.
+  EXPECT_NE(out.find("get-up from the back: standing in"), std::string::npos) << out;
   double highest = 0.0;
   for (size_t at = out.find("torso z "); at != std::string::npos; at = out.find("torso z ", at + 1))
     highest = std::max(highest, std::stod(out.substr(at + 8)));
-  EXPECT_GT(highest, 0.05);
-  EXPECT_LT(highest, 0.3);
+  EXPECT_GT(highest, 0.3);
+  EXPECT_LT(highest, 0.36);
   const cv::Mat image = cv::imread(png.string());
   ASSERT_FALSE(image.empty());
   EXPECT_EQ(image.cols, 6 * 320);
