@@ -703,11 +703,13 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
   for (int t : {100, 250}) {  // 1 s and 2.5 s into the get-up
     for (int i = 0; i < t; ++i) period();
     ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << t;
+    const int falls = mc.counters().falls;
     w.placeRobot(0, -2.0, 0.0, 0.0);
     for (int i = 0; i < 300; ++i) period();
     EXPECT_EQ(mc.state(), agents::MotionState::Stance) << t;
     EXPECT_TRUE(w.isStanding(0)) << t;
     EXPECT_EQ(mc.counters().failed_get_ups, 0) << t;
+    EXPECT_EQ(mc.counters().falls, falls) << t;  // put on its feet is not a fall
     w.placeRobot(0, lying, "stand");  // down again for the next one
     for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
   }

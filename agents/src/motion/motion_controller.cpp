@@ -76,8 +76,22 @@ bool MotionController::upright() const {
 }
 
 bool MotionController::placedOnItsFeet(const MotionSensors& sensors,
-                                       const std::vector<double>& measured,
-                                       bool targets_far) const {
+                                       const std::vector<double>& measured, double rate) const {
+  bool targets_far = true;  // during a motion: its targets far from the stand pose
+  switch (state_) {
+    case MotionState::Falling:
+    case MotionState::Lying:
+      if (rate >= fall_.lying_rate) return false;  // soft, it lies still where it is put
+      targets_far = false;
+      break;
+    case MotionState::GettingUp:
+      break;
+    case MotionState::Diving:
+      if (state_time_ <= 0.3) return false;  // still in the stance it dived from
+      break;
+    default:
+      return false;
+  }
   if (std::abs(sensors.roll) > fall_.upright_tilt || std::abs(sensors.pitch) > fall_.upright_tilt)
     return false;
   const std::vector<double>& stand = model_.pose("stand");
@@ -138,6 +152,16 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   measuredJoints(sensors, measured);
 
   if (restart_) restartFrom(measured);
+  if (placedOnItsFeet(sensors, measured, rate)) {
+    // Stiff in the stance at once: one more period of a get-up's targets
+    // knocks it over, and soft it sinks. The filtered "up" still says lying
+    // (the next period would count a fall): restarted from the IMU's angles.
+    restartFrom(measured);
+    const double cp = std::cos(sensors.pitch);
+    gravity_ = 9.81 * Vec3(-std::sin(sensors.pitch), cp * std::sin(sensors.roll),
+                           cp * std::cos(sensors.roll));
+    tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
+  }
   const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
                       state_ == MotionState::Walking || state_ == MotionState::Kicking ||
                       state_ == MotionState::Blocking;
@@ -190,12 +214,6 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Diving:
       // Meant to end on the ground: not a fall. Lying afterwards, the fall
       // detector's rules apply (soft, then the get-up if it is on).
-      // Put on its feet (the shoot-out's next kick); not in its first 0.3 s,
-      // while it still stands in the stance it dived from.
-      if (state_time_ > 0.3 && placedOnItsFeet(sensors, measured, true)) {
-        restartFrom(measured);
-        break;
-      }
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) enter(MotionState::Lying);
       break;
@@ -205,12 +223,6 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       break;
     case MotionState::Falling:
     case MotionState::Lying:
-      if (rate < fall_.lying_rate && placedOnItsFeet(sensors, measured, false)) {
-        // Put on its feet, at rest: stiff at once (soft, it would sink before
-        // the filtered tilt below says upright).
-        restartFrom(measured);
-        break;
-      }
       // Soft joints that keep their current angles: no servo fights the impact.
       targets_ = measured;
       stiffness_ = fall_.safe_stiffness;
@@ -234,13 +246,6 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       break;
     case MotionState::GettingUp:
-      if (placedOnItsFeet(sensors, measured, true)) {
-        // The referee picked it up (an inactive player) and put it on its
-        // feet: stop the get-up, back to the stance from this period on (one
-        // more period of the get-up's targets is enough to knock it over).
-        restartFrom(measured);
-        break;
-      }
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) {
         if (upright()) {

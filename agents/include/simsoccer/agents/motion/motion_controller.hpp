@@ -99,13 +99,13 @@ class MotionController {
   }
   bool upright() const;
   // Put on its feet by someone (the referee taking out a player or setting
-  // up the shoot-out's next kick) while it lies or plays a motion that keeps
-  // it on the ground: upright by the IMU's angles (the filtered accelerometer
-  // lags, and reads the legs folding under the motion's targets) with the
-  // legs in the stand pose; during a motion (`targets_far`), the motion's
-  // targets far from it (its own get-up ends in the stand pose).
+  // up the shoot-out's next kick) while it falls or lies (at rest: `rate`,
+  // rad/s), gets up, or dives (after its first 0.3 s): upright by the IMU's
+  // angles (the filtered accelerometer lags, and reads the legs folding under
+  // a motion's targets) with the legs in the stand pose; during a get-up or
+  // a dive also the motion's targets far from it (a get-up ends in it).
   bool placedOnItsFeet(const MotionSensors& sensors, const std::vector<double>& measured,
-                       bool targets_far) const;
+                       double rate) const;
   const WalkEngine& walk() const { return walk_; }
   const robots::RobotModel& model() const { return model_; }
 
