@@ -201,11 +201,17 @@ TEST(SoccerBehaviour, ObeysTheGameState) {
   auto p = seeing(-3.0, 1.0, 0.0, 0.0, 0.0, 0.0);
   agents::SoccerBehaviour::Input in;
   in.perception = &p;
-  for (int s : {0, 2, 4, 5}) {  // Initial, Set, Finished, Standby: stand
+  for (int s : {0, 2, 5}) {  // Initial, Set, Standby: stand
     const auto g = gameState(s);
     in.game = &g;
     EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand) << s;
   }
+  // Finished: sits down, except between the shoot-out's kicks.
+  auto finished = gameState(4);
+  in.game = &finished;
+  EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Sit);
+  finished.game_phase = 1;  // penalty shoot-out
+  EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand);
   // Ready: walks to its kick-off place (player 4: (-0.35, -0.55) of the half-sizes).
   auto g = gameState(1);
   in.game = &g;
@@ -710,7 +716,7 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
     EXPECT_TRUE(w.isStanding(0)) << t;
     EXPECT_EQ(mc.counters().failed_get_ups, 0) << t;
     EXPECT_EQ(mc.counters().falls, falls) << t;  // put on its feet is not a fall
-    w.placeRobot(0, lying, "stand");  // down again for the next one
+    w.placeRobot(0, lying, "stand");             // down again for the next one
     for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
   }
   // A dive, put on its feet while it lies (the dive's last frames).
@@ -799,4 +805,64 @@ TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
   std::ofstream(file) << "hello";
   EXPECT_THROW(world::MatchLogReader{file}, std::runtime_error);
   std::filesystem::remove(file);
+}
+
+// Sitting down when the game is over: a crouch on the feet that the referee
+// and the match summary still count as standing (World::isStanding: torso
+// above 0.22 m, within 45 degrees of upright), resting on soft joints, and
+// back up into the stance on the next other request.
+TEST(MotionController, SitsDownOnItsFeetRestsSoftAndStandsUpAgain) {
+  world::World w(test::scenario(1));
+  agents::MotionController mc =
+      agents::loadMotionController(*w.robot(0).model, test::sourceDir() / "configs/motions");
+  std::vector<float> position(25), stiffness(25);
+  MotionRequest request;
+  request.kind = MotionRequest::Kind::Walk;
+  request.forward = 0.2;
+  auto period = [&] { controlPeriod(w, mc, request, position, stiffness); };
+  for (int i = 0; i < 200; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::Walking);
+  const double standing = w.torsoPose(0).translation().z();
+  request = MotionRequest{};
+  request.kind = MotionRequest::Kind::Sit;
+  // The walk stops first, then it sits down.
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::SittingDown; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::SittingDown);
+  EXPECT_FALSE(mc.walk().walking());
+  double lowest = 1.0;
+  for (int i = 0; i < 500; ++i) {  // 5 s: down (1.5 s), then resting
+    period();
+    lowest = std::min(lowest, w.torsoPose(0).translation().z());
+    ASSERT_TRUE(w.isStanding(0)) << i;
+  }
+  EXPECT_EQ(mc.state(), agents::MotionState::Sitting);
+  const double sitting = w.torsoPose(0).translation().z();
+  EXPECT_LT(sitting, standing - 0.05);
+  EXPECT_GT(lowest, 0.225);
+  for (size_t a = 0; a < 25; ++a) EXPECT_LE(stiffness[a], 0.31f) << a;
+  EXPECT_EQ(mc.counters().sits, 1);
+  // Anything else stands it up, then the stance and the request follow.
+  request = MotionRequest{};
+  period();
+  EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
+  for (int i = 0; i < 300; ++i) {
+    period();
+    ASSERT_TRUE(w.isStanding(0)) << i;
+  }
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_NEAR(w.torsoPose(0).translation().z(), standing, 0.02);
+  // Asked to sit for a moment only: up again from half-way down.
+  request.kind = MotionRequest::Kind::Sit;
+  for (int i = 0; i < 50; ++i) period();
+  EXPECT_EQ(mc.state(), agents::MotionState::SittingDown);
+  request = MotionRequest{};
+  period();
+  EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
+  for (int i = 0; i < 300; ++i) {
+    period();
+    ASSERT_TRUE(w.isStanding(0)) << i;
+  }
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_EQ(mc.counters().sits, 2);
+  EXPECT_EQ(mc.counters().falls, 0);
 }

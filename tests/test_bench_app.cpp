@@ -123,7 +123,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
     ASSERT_EQ(cells.size(), 8u) << line;
     rows[cells[1]] = cells;
   }
-  ASSERT_EQ(rows.size(), 12u);
+  ASSERT_EQ(rows.size(), 13u);
   // The figures: >= 0.25 m/s forward over 5 m, >= 0.10 m/s sideways,
   // >= 45 deg/s turning, paths within 10 %, no falls.
   EXPECT_GE(std::stod(rows.at("walk_forward")[3]), 0.245);
@@ -142,6 +142,9 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   // The goalkeeper's block does not make it fall (dives are not falls).
   for (const char* t : {"keeper_saves", "shootout_keeper_saves"})
     EXPECT_EQ(rows.at(t)[6], "0") << t;
+  // Sitting down after walking and standing up again, on its feet throughout.
+  EXPECT_EQ(rows.at("sit_and_stand")[3], "1.000");
+  EXPECT_EQ(rows.at("sit_and_stand")[6], "0");
 }
 
 // The get-up tuning aids: another motions folder, the side-view snapshots
@@ -153,8 +156,8 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
     std::filesystem::path dir;
     ~RemoveAfter() { std::filesystem::remove_all(dir); }
   } remove_after{dir};
-  for (const char* f :
-       {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml", "dive_right.yaml"})
+  for (const char* f : {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml",
+                        "dive_right.yaml", "sit_down.yaml", "stand_up.yaml"})
     std::filesystem::copy_file(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs/motions" / f,
                                dir / f, std::filesystem::copy_options::overwrite_existing);
   const std::filesystem::path png = dir / "snapshots.png";

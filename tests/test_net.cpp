@@ -610,3 +610,46 @@ TEST(NetGetUp, AnAgentProcessGetsItsRobotUpFromItsBack) {
   EXPECT_LT(up_at, 8.0);
   EXPECT_EQ(server.stats(0).missed, 0u);
 }
+
+TEST(NetSit, AnAgentProcessSitsDownWhenTheGameIsOverAndStandsUpForTheNext) {
+  // Lockstep over DDS: a soccer agent process reads Finished from the
+  // GameState and sits down on its feet (still standing to the referee),
+  // resting on soft joints; Initial (the next half) stands it up again.
+  const uint32_t domain = 119;
+  world::World w(teams(1));
+  net::ServerConfig config = serverConfig(domain, 2.0);
+  net::SimServer server(w, config);
+  referee::ControlData d;
+  d.state = static_cast<uint8_t>(referee::gc::State::Finished);
+  d.teams[0].team_number = 1;
+  d.teams[1].team_number = 2;
+  simsoccer_msg_GameState m{};
+  net::toMessage(d, 0, m);
+  server.setGameState(m);
+  AgentProcess agent(domain, 0, 1, {"--role", "defender", "--game-state-wait", "10"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const double standing = w.torsoPose(0).translation().z();
+  double lowest = 1.0;
+  for (int i = 0; i < 400; ++i) {  // 4 s: down in 1.5 s, then resting
+    server.runPeriod();
+    lowest = std::min(lowest, w.torsoPose(0).translation().z());
+    ASSERT_TRUE(w.isStanding(0)) << i;
+  }
+  const double sitting = w.torsoPose(0).translation().z();
+  const float leg_stiffness = w.sensorFrame(0).stiffness[10];  // a knee (actuator order)
+  std::printf("torso standing %.3f m, sitting %.3f m, knee stiffness %.2f\n", standing, sitting,
+              leg_stiffness);
+  EXPECT_LT(sitting, standing - 0.05);
+  EXPECT_GT(lowest, 0.22);
+  EXPECT_LT(leg_stiffness, 0.5f);
+  d.state = static_cast<uint8_t>(referee::gc::State::Initial);
+  net::toMessage(d, 400, m);
+  server.setGameState(m);
+  for (int i = 0; i < 400; ++i) {  // up again within 4 s
+    server.runPeriod();
+    ASSERT_TRUE(w.isStanding(0)) << i;
+  }
+  EXPECT_NEAR(w.torsoPose(0).translation().z(), standing, 0.02);
+  EXPECT_GT(w.sensorFrame(0).stiffness[10], 0.9f);
+  EXPECT_EQ(server.stats(0).missed, 0u);
+}

@@ -77,6 +77,38 @@ TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
   EXPECT_NEAR(fast.odometry().x / 10.0, fast.parameters().max_forward / 0.25, 0.03);
 }
 
+// The torso's yaw sways a little with the steps (about 0.01 rad). In step
+// with the feet, the heading hold corrected it on every step, so a stopping
+// walk kept stepping on the spot and never stopped (a kick, a sit, never came).
+TEST(WalkEngine, StopsAlthoughTheYawSwaysWithTheSteps) {
+  const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
+  agents::WalkEngine e(model);
+  std::vector<double> q = model.pose("stand");
+  const double period = e.parameters().step_period;
+  // Each step's end reads +-0.012 rad, alternating with the swinging foot:
+  // the correction's sign always matches the side that may turn.
+  const auto yaw = [&](int i) { return -0.012 * std::cos(M_PI * i * 0.01 / period); };
+  e.update(0.01, engine::Vec3::Zero(), 0.0, q);  // its heading: yaw 0
+  e.setVelocity(0.1, 0.0, 0.0);
+  int i = 0;
+  for (; i < 200; ++i) e.update(0.01, engine::Vec3::Zero(), yaw(i), q);
+  e.stop();
+  for (int k = 0; k < 300 && e.walking(); ++k, ++i)
+    e.update(0.01, engine::Vec3::Zero(), e.walking() ? yaw(i) : 0.0, q);
+  EXPECT_FALSE(e.walking());
+  // A real heading error is still corrected before it stops.
+  agents::WalkEngine off(model);
+  off.setVelocity(0.1, 0.0, 0.0);
+  for (int k = 0; k < 200; ++k) off.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  off.stop();
+  int turned = 0;
+  for (int k = 0; k < 300 && off.walking(); ++k) {
+    off.update(0.01, engine::Vec3::Zero(), -0.2, q);  // 0.2 rad right of its heading
+    turned += std::abs(off.odometry().yaw) > 1e-6;
+  }
+  EXPECT_GT(turned, 0);
+}
+
 namespace {
 
 // The sole of a foot link: the xy rectangle of its collision boxes, in the

@@ -5,12 +5,14 @@ namespace simsoccer::agents {
 MotionController loadMotionController(const robots::RobotModel& model,
                                       const std::filesystem::path& motions_dir,
                                       const FallDetectorParameters& fall) {
-  return MotionController(model, loadKeyframeMotion(motions_dir / "get_up_front.yaml", model),
-                          loadKeyframeMotion(motions_dir / "get_up_back.yaml", model),
-                          loadKeyframeMotion(motions_dir / "block.yaml", model),
-                          loadKeyframeMotion(motions_dir / "dive_left.yaml", model),
-                          loadKeyframeMotion(motions_dir / "dive_right.yaml", model),
-                          WalkParameters{}, KickParameters{}, fall);
+  const auto load = [&](const char* name) {
+    return loadKeyframeMotion(motions_dir / (std::string(name) + ".yaml"), model);
+  };
+  return MotionController(
+      model,
+      KeyframeMotions{load("get_up_front"), load("get_up_back"), load("block"), load("dive_left"),
+                      load("dive_right"), load("sit_down"), load("stand_up")},
+      WalkParameters{}, KickParameters{}, fall);
 }
 
 namespace {

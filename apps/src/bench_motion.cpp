@@ -51,7 +51,7 @@ const char* kHelp =
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
-    "  --get-up-trials N  get-up trials per side in the table (default 20)\n"
+    "  --get-up-trials N  get-up trials per side, and sit trials, in the table (default 20)\n"
     "  --motions DIR the motions (get-up, block, dives) from DIR (default configs/motions; for\n"
     "                tuning them)\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
@@ -382,6 +382,58 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
 
 // The ball in a goal: past the goal line between the posts (field frame),
 // +1 / -1 for the goal at +x / -x, 0 none.
+// One sit trial: the robot walks at a seeded velocity for 2 s, is asked to
+// sit for 5 s (the walk stops first), then to stand for 5 s. Success: on its
+// feet throughout (World::isStanding, as the referee counts it), the torso at
+// least 5 cm lower when seated, and back in the stance afterwards.
+struct SitResult {
+  bool success = false;
+  double seated_height = 0.0;  // m, the torso after 5 s of sitting
+  double up_seconds = -1.0;    // from the stand request to the stance
+  int falls = 0;
+};
+
+SitResult sitTrial(uint64_t seed, const std::string& motions_dir) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  world::World w(s);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  w.placeRobot(0, -3.0 + 0.5 * u(rng), 0.5 * u(rng), M_PI * u(rng));
+  agents::MotionController motion = agents::loadMotionController(*w.robot(0).model, motions_dir);
+  std::vector<float> position(25), stiffness(25);
+  const double dt = w.scenario().physics.control_period;
+  agents::MotionRequest request;
+  request.kind = agents::MotionRequest::Kind::Walk;
+  request.forward = 0.1 + 0.1 * u(rng);
+  request.left = 0.05 * u(rng);
+  request.turn = 0.3 * u(rng);
+  bool on_feet = true;
+  double standing_height = 0.0;
+  SitResult r;
+  for (int i = 0; i < 1200; ++i) {
+    if (i == 200) {
+      standing_height = w.torsoPose(0).translation().z();
+      request = agents::MotionRequest{};
+      request.kind = agents::MotionRequest::Kind::Sit;
+    }
+    if (i == 700) {
+      r.seated_height = w.torsoPose(0).translation().z();
+      request = agents::MotionRequest{};
+    }
+    motion.update(dt, agents::motionSensors(w.sensorFrame(0)), request, position, stiffness);
+    w.setCommand(0, std::span<const float>(position), std::span<const float>(stiffness));
+    w.stepControlPeriod();
+    on_feet = on_feet && w.isStanding(0);
+    if (i >= 700 && r.up_seconds < 0 && motion.state() == agents::MotionState::Stance)
+      r.up_seconds = (i + 1 - 700) * dt;
+  }
+  r.falls = motion.counters().falls;
+  r.success = on_feet && r.falls == 0 && r.seated_height < standing_height - 0.05 &&
+              motion.counters().sits == 1 && r.up_seconds >= 0;
+  return r;
+}
+
 int goalScored(const world::World& w) {
   const Vec3 b = w.ballState().pose.translation();
   const auto& f = w.field();
@@ -721,6 +773,23 @@ int benchMotion(int argc, char** argv, int first) {
     }
   }
   {
+    // Sit down (after walking) and stand up again: N seeded trials.
+    const int trials = static_cast<int>(opt.number("get-up-trials", 20));
+    int ok = 0, falls = 0;
+    double slowest = 0.0, highest = 0.0;
+    for (int i = 0; i < trials; ++i) {
+      const SitResult t = sitTrial(seed + 250 + static_cast<uint64_t>(i), motions_dir);
+      ok += t.success;
+      falls += t.falls;
+      slowest = std::max(slowest, t.up_seconds < 0 ? 5.0 : t.up_seconds);
+      highest = std::max(highest, t.seated_height);
+    }
+    std::fprintf(stderr, "  sit: seated torso at most %.3f m, back in the stance within %.2f s\n",
+                 highest, slowest);
+    row("sit_and_stand", 0, ok / std::max(1.0, double(trials)), "share", slowest, falls,
+        trials * 12.0);
+  }
+  {
     // The striker alone: N seeded trials from random spots, 60 s each to score.
     const int trials = static_cast<int>(opt.number("striker-trials", 20));
     int scored = 0, falls = 0;
@@ -800,6 +869,9 @@ int benchMotion(int argc, char** argv, int first) {
       "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; get_up_front / "
       "get_up_back: share of trials (robot dropped on its front / back, seeded) standing in the "
       "stance within 8 s, deviation column = the slowest trial's seconds (12: failed); "
+      "sit_and_stand: share of trials (2 s walking at a seeded velocity, 5 s sitting, 5 s "
+      "standing) on its feet throughout with the torso >= 5 cm lower seated and back in the "
+      "stance, deviation column = the slowest stand-up's seconds; "
       "striker_scores: share of trials (robot and ball at seeded random spots, the striker "
       "behaviour alone) that score within 60 s, deviation column = the median seconds to score; "
       "penalty_scoring: share of penalty kicks (kicker behaviour against the goalkeeper "

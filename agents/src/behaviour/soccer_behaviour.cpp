@@ -668,6 +668,10 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
       (penalised_ || state_ == kInitial || state_ == kStandby || state_ == kFinished)) {
     head(r, r, in);
     r.head_yaw = 0.0;
+    // A half or the game is over: it sits down and rests, as Naos do. (In the
+    // shoot-out Finished comes between the kicks: the next one is set up at
+    // once, so it stays on its feet.)
+    if (state_ == kFinished && phase_ != kPhasePenaltyShoot) r.kind = MotionRequest::Kind::Sit;
     return r;
   }
   role_ = chooseRole(in);

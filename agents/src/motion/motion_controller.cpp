@@ -19,6 +19,12 @@ const char* motionStateName(MotionState s) {
       return "blocking";
     case MotionState::Diving:
       return "diving";
+    case MotionState::SittingDown:
+      return "sitting_down";
+    case MotionState::Sitting:
+      return "sitting";
+    case MotionState::StandingUp:
+      return "standing_up";
     case MotionState::Falling:
       return "falling";
     case MotionState::Lying:
@@ -29,17 +35,11 @@ const char* motionStateName(MotionState s) {
   return "?";
 }
 
-MotionController::MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
-                                   KeyframeMotion get_up_back, KeyframeMotion block,
-                                   KeyframeMotion dive_left, KeyframeMotion dive_right,
+MotionController::MotionController(const robots::RobotModel& model, KeyframeMotions motions,
                                    const WalkParameters& walk, const KickParameters& kick,
                                    const FallDetectorParameters& fall)
     : model_(model),
-      get_up_front_(std::move(get_up_front)),
-      get_up_back_(std::move(get_up_back)),
-      block_(std::move(block)),
-      dive_left_(std::move(dive_left)),
-      dive_right_(std::move(dive_right)),
+      motions_(std::move(motions)),
       walk_parameters_(walk),
       kick_parameters_(kick),
       fall_(fall),
@@ -164,7 +164,8 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   }
   const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
                       state_ == MotionState::Walking || state_ == MotionState::Kicking ||
-                      state_ == MotionState::Blocking;
+                      state_ == MotionState::Blocking || state_ == MotionState::SittingDown ||
+                      state_ == MotionState::Sitting || state_ == MotionState::StandingUp;
   if (normal && tilt_ > fall_.falling_tilt) {
     ++counters_.falls;
     enter(MotionState::Falling);
@@ -183,12 +184,13 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         // No time to stop the walk first: the block starts from the joints as
         // they are (its first frame is short and low, which steadies the robot).
         ++counters_.blocks;
-        startKeyframes(MotionState::Blocking, block_, measured, dt);
+        startKeyframes(MotionState::Blocking, motions_.block, measured, dt);
         break;
       }
       if (request.kind == MotionRequest::Kind::Dive) {
         ++counters_.dives;
-        startKeyframes(MotionState::Diving, request.side == Leg::Left ? dive_left_ : dive_right_,
+        startKeyframes(MotionState::Diving,
+                       request.side == Leg::Left ? motions_.dive_left : motions_.dive_right,
                        measured, dt);
         break;
       }
@@ -200,10 +202,16 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         kick_.update(dt, sensors.gyro, targets_);
         break;
       }
+      if (request.kind == MotionRequest::Kind::Sit && state_ == MotionState::Stance &&
+          !walk_.walking()) {
+        ++counters_.sits;
+        startKeyframes(MotionState::SittingDown, motions_.sit_down, measured, dt);
+        break;
+      }
       if (request.kind == MotionRequest::Kind::Walk)
         walk_.setVelocity(request.forward, request.left, request.turn);
       else
-        walk_.stop();  // stand, or stop before a kick
+        walk_.stop();  // stand, or stop before a kick or sitting down
       walk_.update(dt, sensors.gyro, sensors.yaw, targets_);
       state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
       break;
@@ -220,6 +228,26 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
     case MotionState::Blocking:
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) easeIntoStance();  // back up
+      break;
+    case MotionState::SittingDown:
+    case MotionState::Sitting:
+      // Sitting, it rests in the motion's last frame at its stiffness (the
+      // servos hold the crouch without fighting it: cool joints while the
+      // game is over). Another request stands it up from where it is, also
+      // half-way down (a Finished that lasts one period, between a match's
+      // end and its shoot-out).
+      if (request.kind != MotionRequest::Kind::Sit) {
+        startKeyframes(MotionState::StandingUp, motions_.stand_up, measured, dt);
+        break;
+      }
+      if (state_ == MotionState::SittingDown) {
+        player_.update(dt, targets_, stiffness_);
+        if (!player_.active()) enter(MotionState::Sitting);
+      }
+      break;
+    case MotionState::StandingUp:
+      player_.update(dt, targets_, stiffness_);
+      if (!player_.active()) easeIntoStance();
       break;
     case MotionState::Falling:
     case MotionState::Lying:
@@ -240,7 +268,8 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       if (still_for_ >= fall_.lying_time && fall_.get_up) {
         // Up in the torso frame: -x lying on the front (chest down), +x on the back.
         const bool front = gravity_.x() < 0.0;
-        startKeyframes(MotionState::GettingUp, front ? get_up_front_ : get_up_back_, measured, dt);
+        startKeyframes(MotionState::GettingUp, front ? motions_.get_up_front : motions_.get_up_back,
+                       measured, dt);
       } else if (state_ == MotionState::Falling && tilt_ > fall_.lying_tilt) {
         state_ = MotionState::Lying;
       }

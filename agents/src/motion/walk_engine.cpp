@@ -63,8 +63,11 @@ void WalkEngine::startStep() {
   intended_yaw_ += average_.z();
   const double measured = yaw_ - yaw_offset_;
   const double error = std::remainder(intended_yaw_ - measured, 2 * M_PI);
-  const double turn =
-      std::clamp(2.0 * average_.z() + p_.heading_gain * error, -p_.max_turn, p_.max_turn);
+  const bool settling =
+      stopping_ && average_.isZero(1e-6) && std::abs(error) < p_.stop_heading_tolerance;
+  const double turn = settling ? 0.0
+                               : std::clamp(2.0 * average_.z() + p_.heading_gain * error,
+                                            -p_.max_turn, p_.max_turn);
   step_.z() = (turn * side > 0) ? turn : 0.0;
   body_start_ = body_;
   body_end_ = compose(body_, p_.forward_scale * step_.x(), step_.y(), step_.z());

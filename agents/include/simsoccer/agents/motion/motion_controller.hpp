@@ -2,8 +2,8 @@
 // at a velocity, kick with a foot, where the head looks) and the robot's
 // sensors, and produces the joint targets and stiffnesses for one control
 // period. It owns the walk, the kick, the goalkeeper's block and dive and the
-// get-up motions, switches between them only where that is safe (a kick from
-// a standing stance, the walk stopped first; the block and the dive, which
+// get-up and sit motions, switches between them only where that is safe (a kick or
+// sitting down from a standing stance, the walk stopped first; the block and the dive, which
 // cannot wait, at once from standing or walking), and runs the fall detector: while the robot falls
 // its joints go soft (safe stiffness), once it lies still it gets up from the front or the back
 // (keyframe motions), and then eases back into the stance.
@@ -24,8 +24,11 @@ struct MotionRequest {
   // Block: the goalkeeper's block (a keyframe motion down into a wide squat
   // and back up). Dive: the goalkeeper throws itself to the side of `side`
   // (a keyframe motion; it ends lying, then the fall detector's get-up
-  // applies). Both start at once from standing or walking.
-  enum class Kind { Stand, Walk, Kick, Block, Dive };
+  // applies). Both start at once from standing or walking. Sit: down into a
+  // crouch on its feet (the walk stopped first) and rest there with soft
+  // joints, as a Nao does when the game is over; any other request stands it
+  // up again first.
+  enum class Kind { Stand, Walk, Kick, Block, Dive, Sit };
   Kind kind = Kind::Stand;
   double forward = 0.0, left = 0.0, turn = 0.0;  // m/s, m/s, rad/s (robot frame)
   Leg kick_foot = Leg::Right;
@@ -64,6 +67,9 @@ enum class MotionState {
   Kicking,
   Blocking,
   Diving,
+  SittingDown,
+  Sitting,
+  StandingUp,
   Falling,
   Lying,
   GettingUp
@@ -71,15 +77,22 @@ enum class MotionState {
 const char* motionStateName(MotionState s);
 
 struct MotionCounters {
-  int falls = 0, get_ups = 0, failed_get_ups = 0, kicks = 0, blocks = 0, dives = 0;
+  int falls = 0, get_ups = 0, failed_get_ups = 0, kicks = 0, blocks = 0, dives = 0, sits = 0;
+};
+
+// The controller's keyframe motions, one file each in configs/motions/
+// (<member name>.yaml).
+struct KeyframeMotions {
+  KeyframeMotion get_up_front, get_up_back, block, dive_left, dive_right;
+  KeyframeMotion sit_down;  // from the stance into the crouch; its last frame's stiffness rests
+  KeyframeMotion stand_up;  // from the crouch back to the stand pose
 };
 
 class MotionController {
  public:
-  MotionController(const robots::RobotModel& model, KeyframeMotion get_up_front,
-                   KeyframeMotion get_up_back, KeyframeMotion block, KeyframeMotion dive_left,
-                   KeyframeMotion dive_right, const WalkParameters& walk = {},
-                   const KickParameters& kick = {}, const FallDetectorParameters& fall = {});
+  MotionController(const robots::RobotModel& model, KeyframeMotions motions,
+                   const WalkParameters& walk = {}, const KickParameters& kick = {},
+                   const FallDetectorParameters& fall = {});
 
   // One control period: writes 25 targets (rad) and stiffnesses (0..1) in
   // actuator order.
@@ -93,7 +106,7 @@ class MotionController {
   const MotionCounters& counters() const { return counters_; }
   // Torso tilt from upright (rad), from the accelerometer (filtered).
   double tilt() const { return tilt_; }
-  // The keyframe motion playing (get-up, roll, block, dive), or none.
+  // The keyframe motion playing (get-up, roll, block, dive, sit down, stand up), or none.
   const KeyframeMotion* keyframeMotion() const {
     return player_.active() ? player_.motion() : nullptr;
   }
@@ -122,7 +135,7 @@ class MotionController {
   void restartFrom(const std::vector<double>& measured);
 
   const robots::RobotModel& model_;
-  KeyframeMotion get_up_front_, get_up_back_, block_, dive_left_, dive_right_;
+  KeyframeMotions motions_;
   WalkParameters walk_parameters_;
   KickParameters kick_parameters_;
   FallDetectorParameters fall_;

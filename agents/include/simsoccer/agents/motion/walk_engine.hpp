@@ -46,6 +46,10 @@ struct WalkParameters {
   // the walk's own heading and the IMU's torso yaw (feet slip and the
   // mechanism is not perfectly symmetric; open loop the robot drifts).
   double heading_gain = 0.5;
+  // Coming to a stop, heading errors below this are left alone (rad): the
+  // torso's yaw sways about 0.01 rad with the steps, and a correction on each
+  // step kept a robot stepping on the spot, never stopped.
+  double stop_heading_tolerance = 0.03;
   double ankle_pitch_gyro = 0.05;  // rad per rad/s of torso pitch rate
   double ankle_roll_gyro = 0.05;   // rad per rad/s of torso roll rate
   double stiffness = 1.0;
