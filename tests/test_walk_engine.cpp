@@ -78,9 +78,10 @@ TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
 }
 
 // The torso's yaw sways a little with the steps (about 0.01 rad). In step
-// with the feet, the heading hold corrected it on every step, so a stopping
-// walk kept stepping on the spot and never stopped (a kick, a sit, never came).
-TEST(WalkEngine, StopsAlthoughTheYawSwaysWithTheSteps) {
+// with the feet, the heading hold corrects it on every step, so a plain stop
+// keeps stepping on the spot (a robot asked to stand: it holds its heading);
+// settling to sit down, it stops.
+TEST(WalkEngine, SettlesToAStopAlthoughTheYawSwaysWithTheSteps) {
   const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
   agents::WalkEngine e(model);
   std::vector<double> q = model.pose("stand");
@@ -93,6 +94,9 @@ TEST(WalkEngine, StopsAlthoughTheYawSwaysWithTheSteps) {
   int i = 0;
   for (; i < 200; ++i) e.update(0.01, engine::Vec3::Zero(), yaw(i), q);
   e.stop();
+  for (int k = 0; k < 300; ++k, ++i) e.update(0.01, engine::Vec3::Zero(), yaw(i), q);
+  EXPECT_TRUE(e.walking());  // 3 s later still stepping, correcting the sway
+  e.stop(true);
   for (int k = 0; k < 300 && e.walking(); ++k, ++i)
     e.update(0.01, engine::Vec3::Zero(), e.walking() ? yaw(i) : 0.0, q);
   EXPECT_FALSE(e.walking());
@@ -100,7 +104,7 @@ TEST(WalkEngine, StopsAlthoughTheYawSwaysWithTheSteps) {
   agents::WalkEngine off(model);
   off.setVelocity(0.1, 0.0, 0.0);
   for (int k = 0; k < 200; ++k) off.update(0.01, engine::Vec3::Zero(), 0.0, q);
-  off.stop();
+  off.stop(true);
   int turned = 0;
   for (int k = 0; k < 300 && off.walking(); ++k) {
     off.update(0.01, engine::Vec3::Zero(), -0.2, q);  // 0.2 rad right of its heading

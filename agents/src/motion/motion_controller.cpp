@@ -210,8 +210,8 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       if (request.kind == MotionRequest::Kind::Walk)
         walk_.setVelocity(request.forward, request.left, request.turn);
-      else
-        walk_.stop();  // stand, or stop before a kick or sitting down
+      else  // stand, or stop before a kick; before sitting down, come to rest
+        walk_.stop(request.kind == MotionRequest::Kind::Sit);
       walk_.update(dt, sensors.gyro, sensors.yaw, targets_);
       state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
       break;

@@ -44,8 +44,9 @@ void WalkEngine::setVelocity(double forward, double left, double turn) {
   stopping_ = false;
 }
 
-void WalkEngine::stop() {
+void WalkEngine::stop(bool settle) {
   if (walking_) stopping_ = true;
+  settling_ = settle;
 }
 
 void WalkEngine::startStep() {
@@ -63,8 +64,8 @@ void WalkEngine::startStep() {
   intended_yaw_ += average_.z();
   const double measured = yaw_ - yaw_offset_;
   const double error = std::remainder(intended_yaw_ - measured, 2 * M_PI);
-  const bool settling =
-      stopping_ && average_.isZero(1e-6) && std::abs(error) < p_.stop_heading_tolerance;
+  const bool settling = stopping_ && settling_ && average_.isZero(1e-6) &&
+                        std::abs(error) < p_.stop_heading_tolerance;
   const double turn = settling ? 0.0
                                : std::clamp(2.0 * average_.z() + p_.heading_gain * error,
                                             -p_.max_turn, p_.max_turn);
