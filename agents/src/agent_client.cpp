@@ -43,7 +43,7 @@ struct AgentClient::Impl {
         frames(participant, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
                {true, 1, false, net::robotPartitionName(team, player)}),
         status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
-               {true, 1, true, ""}),
+               {true, 1, true, net::robotPartitionName(team, player)}),
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 1, true, ""}),
         perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
                    {true, 1, false, net::robotPartitionName(team, player)}),

@@ -7,7 +7,7 @@
 //   simsoccer_SensorFrame   sim -> agent, partition robot_<team>_<player>
 //   simsoccer_JointCommand  agent -> sim
 //   simsoccer_JoinRequest   agent -> sim
-//   simsoccer_RobotStatus   sim -> agents
+//   simsoccer_RobotStatus   sim -> agent, partition robot_<team>_<player>
 //   simsoccer_SimClock      sim -> agents
 //   simsoccer_GameState     sim -> agents
 //   simsoccer_TeamMessageSend / simsoccer_TeamMessageDeliver
