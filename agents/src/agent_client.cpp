@@ -48,7 +48,7 @@ struct AgentClient::Impl {
         perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
                    {true, 1, false, net::robotPartitionName(team, player)}),
         team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
-                     {true, 16, false, ""}) {
+                     {true, 16, false, net::robotPartitionName(team, player)}) {
     waitset = net::Entity(net::check(dds_create_waitset(participant.get()), "create waitset"));
     frame_condition = net::Entity(
         net::check(dds_create_readcondition(frames.get(), DDS_ANY_STATE), "read condition"));

@@ -160,7 +160,9 @@ struct SimServer::Impl {
   std::vector<std::unique_ptr<Writer<simsoccer_msg_RobotStatus>>> statuses;
   Writer<simsoccer_msg_SimClock> clock;
   Writer<simsoccer_msg_GameState> game;
-  Writer<simsoccer_msg_TeamMessage> team_deliver;
+  // Team messages, one writer per recipient's partition (to every agent, each
+  // threw away all but its own: 11 v 11, 4,840 samples a second).
+  std::vector<std::unique_ptr<Writer<simsoccer_msg_TeamMessage>>> team_delivers;
   std::unique_ptr<Writer<simsoccer_msg_WorldTruth>> truth;
   Reader<simsoccer_msg_JointCommand> commands;
   Reader<simsoccer_msg_JoinRequest> joins;
@@ -188,8 +190,6 @@ struct SimServer::Impl {
       : participant(c.dds),
         clock(participant, simsoccer_msg_SimClock_desc, "simsoccer_SimClock", latest()),
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", latestDurable()),
-        team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
-                     {true, 16, false, ""}),
         commands(participant, simsoccer_msg_JointCommand_desc, "simsoccer_JointCommand",
                  {true, 16, false, ""}),
         joins(participant, simsoccer_msg_JoinRequest_desc, "simsoccer_JoinRequest",
@@ -236,6 +236,9 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
     impl_->statuses.push_back(std::make_unique<Writer<simsoccer_msg_RobotStatus>>(
         impl_->participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
         QosSpec{true, 1, true, robotPartitionName(info.team, info.number)}));
+    impl_->team_delivers.push_back(std::make_unique<Writer<simsoccer_msg_TeamMessage>>(
+        impl_->participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
+        QosSpec{true, 16, false, robotPartitionName(info.team, info.number)}));
     publishStatus(r);
   }
   if (world.scenario().perception.enabled) {
@@ -496,12 +499,13 @@ void SimServer::relayTeamMessages(uint64_t tick) {
     msg.data._buffer = it->data.data();
     msg.data._release = false;
     ++team_messages_[msg.team == 0 ? 0 : 1];
-    for (const RobotSlot& to : robots_) {
+    for (size_t k = 0; k < robots_.size(); ++k) {
+      const RobotSlot& to = robots_[k];
       if (to.team != msg.team || to.player == msg.from_player) continue;
       if (config_.team_message_loss > 0.0 && unit(impl_->loss_rng) < config_.team_message_loss)
         continue;
       msg.to_player = static_cast<uint8_t>(to.player);
-      impl_->team_deliver.write(msg);
+      impl_->team_delivers[k]->write(msg);
     }
   }
   pending.erase(pending.begin(), due_end);
@@ -545,12 +549,13 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
     for (size_t r = 0; r < robots_.size(); ++r) {
       if (!robots_[r].stats.owned) continue;
       ++owned;
-      if (!writer_matched(impl_->frames[r]->get(), 1)) return false;
+      if (!writer_matched(impl_->frames[r]->get(), 1) ||
+          !writer_matched(impl_->team_delivers[r]->get(), 1))
+        return false;
       if (!impl_->perceptions.empty() && !writer_matched(impl_->perceptions[r]->get(), 1))
         return false;
     }
     return owned >= count && reader_matched(impl_->commands.get(), owned) &&
-           writer_matched(impl_->team_deliver.get(), owned) &&
            reader_matched(impl_->team_send.get(), owned);
   };
   while (!ready() && Clock::now() < end) poll(0.02);
