@@ -842,27 +842,23 @@ TEST(MotionController, SitsDownOnItsFeetRestsSoftAndStandsUpAgain) {
   for (size_t a = 0; a < 25; ++a) EXPECT_LE(stiffness[a], 0.31f) << a;
   EXPECT_EQ(mc.counters().sits, 1);
   // Anything else stands it up, then the stance and the request follow.
-  request = MotionRequest{};
-  period();
-  EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
-  for (int i = 0; i < 300; ++i) {
+  const auto standsUp = [&] {
+    request = MotionRequest{};
     period();
-    ASSERT_TRUE(w.isStanding(0)) << i;
-  }
-  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+    EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
+    for (int i = 0; i < 300; ++i) {
+      period();
+      ASSERT_TRUE(w.isStanding(0)) << i;
+    }
+    EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  };
+  standsUp();
   EXPECT_NEAR(w.torsoPose(0).translation().z(), standing, 0.02);
   // Asked to sit for a moment only: up again from half-way down.
   request.kind = MotionRequest::Kind::Sit;
   for (int i = 0; i < 50; ++i) period();
   EXPECT_EQ(mc.state(), agents::MotionState::SittingDown);
-  request = MotionRequest{};
-  period();
-  EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
-  for (int i = 0; i < 300; ++i) {
-    period();
-    ASSERT_TRUE(w.isStanding(0)) << i;
-  }
-  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  standsUp();
   EXPECT_EQ(mc.counters().sits, 2);
   EXPECT_EQ(mc.counters().falls, 0);
 }
