@@ -860,5 +860,15 @@ TEST(MotionController, SitsDownOnItsFeetRestsSoftAndStandsUpAgain) {
   EXPECT_EQ(mc.state(), agents::MotionState::SittingDown);
   standsUp();
   EXPECT_EQ(mc.counters().sits, 2);
+  // Restarted while sitting (the behaviour does at the next half's Initial):
+  // up by the stand-up motion too, not eased from the crouch.
+  request.kind = MotionRequest::Kind::Sit;
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::Sitting; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::Sitting);
+  mc.restart();
+  period();
+  EXPECT_EQ(mc.state(), agents::MotionState::StandingUp);
+  standsUp();
+  EXPECT_EQ(mc.counters().sits, 3);
   EXPECT_EQ(mc.counters().falls, 0);
 }

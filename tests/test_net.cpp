@@ -164,6 +164,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   claimant.join();
   EXPECT_FALSE(granted);
   EXPECT_FALSE(intruder.ownsRobot());
+  EXPECT_GT(intruder.status().refused, 0u);  // told so, in the robot's partition
   // It sends head-yaw commands for the coming ticks; the owner keeps HeadYaw at 0.
   std::vector<float> pos(25, 0.0f), stiff(25, 1.0f);
   pos[0] = 1.5f;  // HeadYaw

@@ -52,8 +52,8 @@ const char* kHelp =
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
     "  --get-up-trials N  get-up trials per side, and sit trials, in the table (default 20)\n"
-    "  --motions DIR the motions (get-up, block, dives) from DIR (default configs/motions; for\n"
-    "                tuning them)\n"
+    "  --motions DIR the motions from DIR (default configs/motions; for tuning them): all of\n"
+    "                get_up_front, get_up_back, block, dive_left, dive_right, sit_down, stand_up\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
     "                7.2 s), tiled\n"
     "  --striker-trials N, --penalty-trials N, --block-trials N  trials in the table (default\n"
@@ -380,8 +380,6 @@ GetUpResult getUp(bool front, uint64_t seed, const std::string& motions_dir, boo
   return r;
 }
 
-// The ball in a goal: past the goal line between the posts (field frame),
-// +1 / -1 for the goal at +x / -x, 0 none.
 // One sit trial: the robot walks at a seeded velocity for 2 s, is asked to
 // sit for 5 s (the walk stops first), then to stand for 5 s. Success: on its
 // feet throughout (World::isStanding, as the referee counts it), the torso at
@@ -434,6 +432,8 @@ SitResult sitTrial(uint64_t seed, const std::string& motions_dir) {
   return r;
 }
 
+// The ball in a goal: past the goal line between the posts (field frame),
+// +1 / -1 for the goal at +x / -x, 0 none.
 int goalScored(const world::World& w) {
   const Vec3 b = w.ballState().pose.translation();
   const auto& f = w.field();

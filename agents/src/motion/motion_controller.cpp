@@ -151,7 +151,15 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   std::vector<double> measured;
   measuredJoints(sensors, measured);
 
-  if (restart_) restartFrom(measured);
+  if (restart_ && (state_ == MotionState::SittingDown || state_ == MotionState::Sitting)) {
+    // Restarted while sitting (the next half's Initial): up by the stand-up
+    // motion, not an ease from the crouch (this period plays its first step).
+    restart_ = false;
+    enter(MotionState::StandingUp);
+    player_.start(motions_.stand_up, measured);
+  } else if (restart_) {
+    restartFrom(measured);
+  }
   if (placedOnItsFeet(sensors, measured, rate)) {
     // Stiff in the stance at once: one more period of a get-up's targets
     // knocks it over, and soft it sinks. The filtered "up" still says lying

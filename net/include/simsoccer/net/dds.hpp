@@ -152,7 +152,8 @@ bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication
 // Whether a writer is still matched with (alive for) this reader.
 bool publicationMatched(dds_entity_t reader, dds_instance_handle_t publication);
 
-// The DDS partition that carries one robot's SensorFrames.
+// The DDS partition of one robot's own topics: its SensorFrames, status,
+// team messages to it, perception and camera images.
 inline std::string robotPartitionName(int team, int player) {
   return "robot_" + std::to_string(team) + "_" + std::to_string(player);
 }

@@ -10,7 +10,8 @@
 //   simsoccer_RobotStatus   sim -> agent, partition robot_<team>_<player>
 //   simsoccer_SimClock      sim -> agents
 //   simsoccer_GameState     sim -> agents
-//   simsoccer_TeamMessageSend / simsoccer_TeamMessageDeliver
+//   simsoccer_TeamMessageSend    agent -> sim
+//   simsoccer_TeamMessageDeliver sim -> agent, partition robot_<team>_<to>
 //   simsoccer_WorldTruth    sim -> monitors (optional)
 //   simsoccer_CameraImage   sim -> agent, partition robot_<team>_<player> (cameras on)
 //   simsoccer_Perception    sim -> agent, partition robot_<team>_<player> (perception on)

@@ -99,7 +99,7 @@ class MotionController {
   void update(double dt, const MotionSensors& sensors, const MotionRequest& request,
               std::span<float> position, std::span<float> stiffness);
   // Starts over from the measured joints (after the robot was moved by the
-  // referee, e.g. a penalty): eases into the stance.
+  // referee, e.g. a penalty): eases into the stance (sitting: stands up first).
   void restart();
 
   MotionState state() const { return state_; }
