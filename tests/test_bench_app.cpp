@@ -107,7 +107,8 @@ TEST(BenchCamerasApp, PrintsTableAndWritesCsv) {
 TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   const test::BenchRun run = test::runBench(
       SIMSOCCER_BIN,
-      "bench motion --random-minutes 1 --get-up-trials 1 --striker-trials 1 --penalty-trials 1 "
+      "bench motion --random-minutes 1 --get-up-trials 1 --sit-trials 1 --striker-trials 1 "
+      "--penalty-trials 1 "
       "--block-trials 2");
   const std::string& out = run.out;
   ASSERT_EQ(run.status, 0) << out;

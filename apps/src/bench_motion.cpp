@@ -51,7 +51,8 @@ const char* kHelp =
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
-    "  --get-up-trials N  get-up trials per side, and sit trials, in the table (default 20)\n"
+    "  --get-up-trials N, --sit-trials N  get-up trials per side, sit trials, in the table\n"
+    "                (default 20, 20)\n"
     "  --motions DIR the motions from DIR (default configs/motions; for tuning them): all of\n"
     "                get_up_front, get_up_back, block, dive_left, dive_right, sit_down, stand_up\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
@@ -642,6 +643,7 @@ int benchMotion(int argc, char** argv, int first) {
                                   "ball-gap",
                                   "get-up",
                                   "get-up-trials",
+                                  "sit-trials",
                                   "striker-trials",
                                   "penalty-trials",
                                   "motions",
@@ -774,7 +776,7 @@ int benchMotion(int argc, char** argv, int first) {
   }
   {
     // Sit down (after walking) and stand up again: N seeded trials.
-    const int trials = static_cast<int>(opt.number("get-up-trials", 20));
+    const int trials = static_cast<int>(opt.number("sit-trials", 20));
     int ok = 0, falls = 0;
     double slowest = 0.0, highest = 0.0;
     for (int i = 0; i < trials; ++i) {

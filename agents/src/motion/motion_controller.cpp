@@ -62,6 +62,12 @@ void MotionController::restart() {
 
 void MotionController::restartFrom(const std::vector<double>& measured) {
   restart_ = false;
+  if (state_ == MotionState::SittingDown || state_ == MotionState::Sitting) {
+    // Restarted while sitting (the next half's Initial): up by the stand-up
+    // motion, not an ease from the crouch.
+    standUp(measured);
+    return;
+  }
   ease_from_ = measured;
   walk_ = WalkEngine(model_, walk_parameters_);
   kick_ = KickEngine(model_, walk_parameters_, kick_parameters_);
@@ -117,6 +123,11 @@ void MotionController::startKeyframes(MotionState s, const KeyframeMotion& motio
   player_.update(dt, targets_, stiffness_);
 }
 
+void MotionController::standUp(const std::vector<double>& measured) {
+  enter(MotionState::StandingUp);
+  player_.start(motions_.stand_up, measured);
+}
+
 void MotionController::easeIntoStance() {
   ease_from_ = targets_;
   walk_ = WalkEngine(model_, walk_parameters_);
@@ -151,15 +162,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   std::vector<double> measured;
   measuredJoints(sensors, measured);
 
-  if (restart_ && (state_ == MotionState::SittingDown || state_ == MotionState::Sitting)) {
-    // Restarted while sitting (the next half's Initial): up by the stand-up
-    // motion, not an ease from the crouch (this period plays its first step).
-    restart_ = false;
-    enter(MotionState::StandingUp);
-    player_.start(motions_.stand_up, measured);
-  } else if (restart_) {
-    restartFrom(measured);
-  }
+  if (restart_) restartFrom(measured);
   if (placedOnItsFeet(sensors, measured, rate)) {
     // Stiff in the stance at once: one more period of a get-up's targets
     // knocks it over, and soft it sinks. The filtered "up" still says lying
@@ -170,10 +173,10 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
                            cp * std::cos(sensors.roll));
     tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
   }
-  const bool normal = state_ == MotionState::Easing || state_ == MotionState::Stance ||
-                      state_ == MotionState::Walking || state_ == MotionState::Kicking ||
-                      state_ == MotionState::Blocking || state_ == MotionState::SittingDown ||
-                      state_ == MotionState::Sitting || state_ == MotionState::StandingUp;
+  // On its feet by intent: a tilt past falling_tilt is a fall (a dive is
+  // meant to end on the ground; the rest are already down).
+  const bool normal = state_ != MotionState::Diving && state_ != MotionState::Falling &&
+                      state_ != MotionState::Lying && state_ != MotionState::GettingUp;
   if (normal && tilt_ > fall_.falling_tilt) {
     ++counters_.falls;
     enter(MotionState::Falling);
@@ -244,15 +247,15 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       // game is over). Another request stands it up from where it is, also
       // half-way down (a Finished that lasts one period, between a match's
       // end and its shoot-out).
-      if (request.kind != MotionRequest::Kind::Sit) {
-        startKeyframes(MotionState::StandingUp, motions_.stand_up, measured, dt);
+      if (request.kind == MotionRequest::Kind::Sit) {
+        if (state_ == MotionState::SittingDown) {
+          player_.update(dt, targets_, stiffness_);
+          if (!player_.active()) enter(MotionState::Sitting);
+        }
         break;
       }
-      if (state_ == MotionState::SittingDown) {
-        player_.update(dt, targets_, stiffness_);
-        if (!player_.active()) enter(MotionState::Sitting);
-      }
-      break;
+      standUp(measured);
+      [[fallthrough]];
     case MotionState::StandingUp:
       player_.update(dt, targets_, stiffness_);
       if (!player_.active()) easeIntoStance();

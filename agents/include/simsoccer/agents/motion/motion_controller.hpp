@@ -128,10 +128,13 @@ class MotionController {
   // included): the get-up, the block and the dive.
   void startKeyframes(MotionState s, const KeyframeMotion& motion,
                       const std::vector<double>& measured, double dt);
+  // From sitting (or half-way down): starts the stand-up motion from `measured`.
+  void standUp(const std::vector<double>& measured);
   // After a keyframe motion that ends on the feet: ease into a fresh walk's stance.
   void easeIntoStance();
   void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
-  // Drops whatever motion runs and eases into the stance from `measured`.
+  // Drops whatever motion runs and eases into the stance from `measured`
+  // (sitting: stands up first).
   void restartFrom(const std::vector<double>& measured);
 
   const robots::RobotModel& model_;
