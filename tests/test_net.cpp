@@ -186,7 +186,8 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   world::World w(teams(2));
   net::ServerConfig cfg = serverConfig(domain, 0.05);
   net::SimServer server(w, cfg);
-  auto a = std::make_unique<AgentProcess>(domain, 0, 1);
+  // A 2 s lease (--lease; the default is 5 s): the robot is free about 2 s after.
+  auto a = std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{"--lease", "2"});
   AgentProcess b(domain, 1, 1);
   ASSERT_TRUE(server.waitForOwners(2, 20.0));
   for (int i = 0; i < 50; ++i) server.runPeriod();
@@ -195,6 +196,7 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   while (server.stats(0).owned && seconds(t0) < 10.0) server.runPeriod();
   const double released_after = seconds(t0);
   EXPECT_FALSE(server.stats(0).owned);
+  EXPECT_GT(released_after, 1.0);  // the lease expired: nothing told the simulator sooner
   EXPECT_LT(released_after, 5.0);  // about 2 s measured: the writers unmatch, no hang
   const uint64_t b_accepted = server.stats(1).accepted;
   for (int i = 0; i < 50; ++i) server.runPeriod();
@@ -319,6 +321,25 @@ TEST(NetApps, BenchNetWritesItsTable) {
   EXPECT_NE(header.find("bytes_per_tick"), std::string::npos);
   EXPECT_EQ(row1.rfind("1,", 0), 0u);
   EXPECT_EQ(row2.rfind("2,", 0), 0u);
+  // The CPU the processes spent on messaging, and the packets: at least a
+  // frame and a command per robot and tick.
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream in(line);
+    for (std::string cell; std::getline(in, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  const std::vector<std::string> names = cells(header);
+  const auto column = [&](const std::string& row, const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    EXPECT_NE(it, names.end()) << name;
+    const std::vector<std::string> values = cells(row);
+    const auto k = static_cast<size_t>(it - names.begin());
+    return it == names.end() || k >= values.size() ? -1.0 : std::stod(values[k]);
+  };
+  EXPECT_GT(column(row1, "net_cpu_ms_per_period"), 0.0);
+  EXPECT_GE(column(row1, "packets_per_tick"), 2.0);
+  EXPECT_GE(column(row2, "packets_per_tick"), 4.0);
 }
 
 TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {

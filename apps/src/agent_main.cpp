@@ -22,7 +22,7 @@
 namespace {
 
 const char* kHelp =
-    "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE]\n"
+    "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE] [--lease S]\n"
     "                       [--robot FILE] [--role ROLE [--config FILE] [--field FILE]\n"
     "                        [--team-number N] [--seed N] [--no-get-up] [--verbose]]\n"
     "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
@@ -30,6 +30,8 @@ const char* kHelp =
     "                       [--game-state-wait S]\n"
     "\n"
     "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
+    "  --lease S        s the simulator waits after this process went silent (crashed)\n"
+    "                   before it frees the robot (default 5; shorter costs more traffic)\n"
     "  --role ROLE      play soccer: auto (the GameState's goalkeeper keeps goal, the field\n"
     "                   players share striker / supporter / defender by distance to the ball\n"
     "                   over team messages), striker, supporter, defender, goalkeeper,\n"
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
     const apps::Options opt(argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
-                            {"team", "player", "domain", "dds-config", "robot", "mode",
+                            {"team", "player", "domain", "dds-config", "lease", "robot", "mode",
                              "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
                              "config", "field", "team-number", "seed", "game-state-wait"});
     if (opt.help(kHelp)) return 0;
@@ -68,6 +70,8 @@ int main(int argc, char** argv) {
     net::DomainConfig dds;
     dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
+    dds.lease = opt.number("lease", dds.lease);
+    if (!(dds.lease > 0.0)) throw apps::UsageError("--lease must be > 0 s");
     const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
     const std::string mode = opt.get("mode", "nod");
     if (mode != "nod" && mode != "walk" && mode != "garbage" && mode != "stall")

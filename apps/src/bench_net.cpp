@@ -1,5 +1,7 @@
 // simsoccer bench net: the lockstep loop with N real agent processes over
 // loopback DDS, against the same world stepped without the network.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -21,8 +23,10 @@ const char* kHelp =
     "Per N: starts N simsoccer-agent processes (stand and nod), runs the lockstep loop for S\n"
     "simulated seconds (default 10) over loopback DDS, then the same world for S seconds\n"
     "without the network. Prints the messaging overhead per control period (total minus the\n"
-    "world's stepping), the bytes per tick on the loopback interface, commands missed, and the\n"
-    "real-time factor with and without the network.\n";
+    "world's stepping), the CPU time all processes spent on messaging per period (the\n"
+    "simulator's and the agents' CPU time minus the world's stepping: it does not depend on\n"
+    "how the two share the cores), the bytes and packets per tick on the loopback interface,\n"
+    "commands missed, and the real-time factor with and without the network.\n";
 
 using Clock = std::chrono::steady_clock;
 
@@ -50,9 +54,18 @@ int benchNet(int argc, char** argv, int first) {
   std::fflush(stdout);
 
   Table table;
-  table.header = {
-      "robots",       "overhead_ms_per_period", "publish_ms", "wait_ms",      "world_ms_per_period",
-      "overhead_pct", "bytes_per_tick",         "missed",     "rtf_with_net", "rtf_without_net"};
+  table.header = {"robots",
+                  "overhead_ms_per_period",
+                  "publish_ms",
+                  "wait_ms",
+                  "world_ms_per_period",
+                  "overhead_pct",
+                  "net_cpu_ms_per_period",
+                  "bytes_per_tick",
+                  "packets_per_tick",
+                  "missed",
+                  "rtf_with_net",
+                  "rtf_without_net"};
   for (const int n : counts) {
     world::Scenario s = placeRobots(cfg, n, field.halfLength(), field.halfWidth());
     s.sensors.enabled = true;
@@ -76,11 +89,24 @@ int benchNet(int argc, char** argv, int first) {
                                std::to_string(w.robotCount()) + " agents claimed their robots");
     for (int i = 0; i < 50; ++i) server.runPeriod();  // warm-up
     const net::ServerTimes before = server.times();
-    const long long bytes0 = loopbackBytes();
+    // CPU time of the simulator and of every agent process, over the timed
+    // periods only (not the start-up and its discovery traffic).
+    const auto cpu_now = [&] {
+      double s = processCpuSeconds(getpid());
+      for (const auto& a : agents) {
+        const double c = processCpuSeconds(a->pid());
+        if (c < 0 || s < 0) return -1.0;
+        s += c;
+      }
+      return s;
+    };
+    const long long bytes0 = loopbackBytes(), packets0 = loopbackPackets();
+    const double cpu0 = cpu_now();
     const auto t0 = Clock::now();
     for (long i = 0; i < periods; ++i) server.runPeriod();
     const double wall_net = std::chrono::duration<double>(Clock::now() - t0).count();
-    const long long bytes = loopbackBytes() - bytes0;
+    const double cpu1 = cpu_now(), cpu_net = cpu0 >= 0 && cpu1 >= 0 ? cpu1 - cpu0 : -1.0;
+    const long long bytes = loopbackBytes() - bytes0, packets = loopbackPackets() - packets0;
     const auto& after = server.times();
     const double world_s = after.physics_s - before.physics_s;
     uint64_t missed = 0;
@@ -100,7 +126,9 @@ int benchNet(int argc, char** argv, int first) {
     const double wait_ms = 1e3 * (after.wait_s - before.wait_s) / periods;
     table.rows.push_back({std::to_string(n), fmt(overhead_ms, 3), fmt(publish_ms, 3),
                           fmt(wait_ms, 3), fmt(world_ms, 3), fmt(100.0 * overhead_ms / world_ms, 1),
+                          cpu_net >= 0 ? fmt(1e3 * (cpu_net - world_s) / periods, 3) : "n/a",
                           bytes >= 0 ? std::to_string(bytes / periods) : "n/a",
+                          packets >= 0 ? fmt(static_cast<double>(packets) / periods, 1) : "n/a",
                           std::to_string(missed), fmt(sim_seconds / wall_net, 2),
                           fmt(sim_seconds / wall_alone, 2)});
     std::fprintf(stderr, "  %d robots done\n", n);
@@ -108,8 +136,9 @@ int benchNet(int argc, char** argv, int first) {
   table.finish(
       "overhead = wall time per period minus the world's stepping (publishing frames, "
       "waiting for and taking commands); world = the same world stepped alone (physics and "
-      "sensors); bytes = loopback interface traffic per tick (all processes, RTPS headers "
-      "and acknowledgements included).",
+      "sensors); net_cpu = CPU time of the simulator and all agents per period minus the "
+      "world's stepping; bytes, packets = loopback interface traffic per tick (all processes, "
+      "RTPS headers, heartbeats, acknowledgements and discovery included).",
       csv);
   return 0;
 }

@@ -331,6 +331,10 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
           break;
         }
         ++a.restarts;
+        // Its robot is free at once: a crashed process says nothing on DDS, and
+        // lockstep would wait for it every period until its lease ran out.
+        for (world::RobotId r = 0; r < w.robotCount(); ++r)
+          if (w.robot(r).team == a.team && w.robot(r).number == a.number) server.releaseRobot(r);
         std::snprintf(buf, sizeof buf,
                       "{\"time\": %s, \"team\": %d, \"player\": %d, \"exit_status\": %d, "
                       "\"restart\": %d}",

@@ -71,7 +71,10 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
   return a;
 }
 
-long long loopbackBytes() {
+namespace {
+// Field `index` of the loopback line in /proc/net/dev (0: rx bytes, 1: rx
+// packets, ..., 8: tx bytes, 9: tx packets), or -1.
+long long loopbackField(int index) {
   std::ifstream f("/proc/net/dev");
   std::string line;
   while (std::getline(f, line)) {
@@ -81,13 +84,39 @@ long long loopbackBytes() {
     name.erase(0, name.find_first_not_of(' '));
     if (name != "lo") continue;
     std::istringstream in(line.substr(colon + 1));
-    long long rx_bytes = 0, v = 0, tx_bytes = 0;
-    in >> rx_bytes;
-    for (int i = 0; i < 7; ++i) in >> v;  // rx packets .. rx multicast
-    in >> tx_bytes;
-    return tx_bytes;
+    long long v = -1;
+    for (int i = 0; i <= index; ++i)
+      if (!(in >> v)) return -1;
+    return v;
   }
   return -1;
+}
+}  // namespace
+
+long long loopbackBytes() {
+  return loopbackField(8);
+}
+
+long long loopbackPackets() {
+  return loopbackField(9);
+}
+
+double processCpuSeconds(pid_t pid) {
+  // Nanoseconds on the CPU per thread (/proc/PID/task/TID/schedstat, first
+  // field): /proc/PID/stat counts in clock ticks (10 ms), too coarse for a
+  // short run.
+  const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
+  std::error_code ec;
+  double total = 0.0;
+  bool any = false;
+  for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
+    std::ifstream f(task.path() / "schedstat");
+    long long ns = 0;
+    if (!(f >> ns)) continue;  // a thread that just ended
+    total += 1e-9 * static_cast<double>(ns);
+    any = true;
+  }
+  return any && !ec ? total : -1.0;
 }
 
 }  // namespace simsoccer::apps

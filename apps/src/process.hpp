@@ -22,6 +22,7 @@ class ChildProcess {
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
   bool started() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
   // False once the process has exited (reaped; exitStatus() then tells how).
   bool running();
   int exitStatus() const { return exit_status_; }  // exit code, or 128 + signal
@@ -52,5 +53,10 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o);
 
 // Bytes sent on the loopback interface so far (/proc/net/dev), or -1.
 long long loopbackBytes();
+// Packets sent on the loopback interface so far (/proc/net/dev), or -1.
+long long loopbackPackets();
+// CPU time (user + system) the threads of a process have used so far, in
+// seconds (/proc/PID/task/*/schedstat), or -1 when it cannot be read.
+double processCpuSeconds(pid_t pid);
 
 }  // namespace simsoccer::apps

@@ -1,7 +1,10 @@
 #include "simsoccer/net/dds.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace simsoccer::net {
 
@@ -26,7 +29,10 @@ Entity::~Entity() {
   if (e_ > 0) dds_delete(e_);
 }
 
-Participant::Participant(const DomainConfig& config, double lease_seconds) {
+Participant::Participant(const DomainConfig& config) {
+  if (!(config.lease > 0.0) || !std::isfinite(config.lease))
+    throw std::invalid_argument("DDS lease must be a positive number of seconds, not " +
+                                std::to_string(config.lease));
   if (!config.config_file.empty()) {
     std::ifstream f(config.config_file);
     if (!f)
@@ -39,8 +45,7 @@ Participant::Participant(const DomainConfig& config, double lease_seconds) {
     if (d > 0) domain_ = Entity(d);
   }
   dds_qos_t* q = dds_create_qos();
-  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC,
-                      static_cast<dds_duration_t>(lease_seconds * 1e9));
+  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, static_cast<dds_duration_t>(config.lease * 1e9));
   const dds_entity_t p = dds_create_participant(config.domain, q, nullptr);
   dds_delete_qos(q);
   participant_ = Entity(check(p, "create participant"));

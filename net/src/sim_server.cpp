@@ -373,6 +373,13 @@ void SimServer::release(world::RobotId r) {
   publishStatus(r);
 }
 
+bool SimServer::releaseRobot(world::RobotId r) {
+  std::lock_guard lock(mutex_);
+  if (!robots_.at(r).stats.owned) return false;
+  release(r);
+  return true;
+}
+
 void SimServer::handleJoins() {
   impl_->joins.take([&](const simsoccer_msg_JoinRequest& j, const dds_sample_info_t& info) {
     const int ri = robotIndex(j.team, j.player);

@@ -83,6 +83,11 @@ class SimServer {
 
   size_t ownedCount() const;
   RobotNetStats stats(world::RobotId r) const;
+  // Frees robot r now, as its owner's lease running out would (it holds its
+  // pose or goes limp, and lockstep stops waiting for it): for a launcher
+  // that saw the owner's process exit, which says nothing on DDS when it
+  // crashed. False if nobody owned it.
+  bool releaseRobot(world::RobotId r);
   // Team messages of `team` (index) relayed so far (each sent message once).
   uint64_t teamMessagesRelayed(int team) const { return team_messages_[team == 0 ? 0 : 1]; }
   // The command applied to robot r in the last period (quantised as the
