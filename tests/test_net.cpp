@@ -212,6 +212,36 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   EXPECT_GE(server.stats(0).accepted, before + 90);
 }
 
+// A launcher that saw its agent process exit frees the robot at once: lockstep
+// stops waiting for it, and another agent can claim it.
+TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
+  const uint32_t domain = 121;
+  world::World w(teams(1));
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess stalled(domain, 0, 1, {"--mode", "stall", "--stall-after", "20"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  for (int i = 0; i < 20; ++i) server.runPeriod();
+  EXPECT_EQ(server.stats(0).missed, 0u);
+  EXPECT_TRUE(server.releaseRobot(0));
+  EXPECT_FALSE(server.releaseRobot(0));  // nobody owns it now
+  EXPECT_FALSE(server.stats(0).owned);
+  const auto t0 = Clock::now();
+  for (int i = 0; i < 10; ++i) server.runPeriod();
+  EXPECT_LT(seconds(t0), 1.0);  // not 10 x the 2 s timeout
+  EXPECT_EQ(server.stats(0).missed, 0u);
+  EXPECT_TRUE(w.isStanding(0));  // released: holds its pose
+  agents::AgentClient again(dds(domain), 0, 1);
+  std::atomic<bool> granted{false}, answered{false};
+  std::thread claimant([&] {
+    granted = again.claim(10.0);
+    answered = true;
+  });
+  for (int i = 0; i < 500 && !answered; ++i) server.poll(0.02);
+  claimant.join();
+  EXPECT_TRUE(granted);
+  EXPECT_TRUE(server.stats(0).owned);
+}
+
 TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   const uint32_t domain = 106;
   world::World w(teams(2));
