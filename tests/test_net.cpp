@@ -90,6 +90,20 @@ class AgentProcess {
   pid_t pid_ = -1;
 };
 
+// An agent in this process claims its robot (in a thread) while the server
+// handles claims; true if granted within `timeout` s.
+bool claimWhilePolling(net::SimServer& server, agents::AgentClient& agent, double timeout) {
+  std::atomic<bool> answered{false}, granted{false};
+  std::thread claimant([&] {
+    granted = agent.claim(timeout);
+    answered = true;
+  });
+  const auto end = Clock::now() + std::chrono::duration<double>(timeout + 1.0);
+  while (!answered && Clock::now() < end) server.poll(0.02);
+  claimant.join();
+  return granted;
+}
+
 world::Scenario teams(int n) {
   world::Scenario s = test::scenario(n);
   return s;
@@ -155,14 +169,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   // An intruder in this process (its own participant) claims the same robot.
   agents::AgentClient intruder(dds(domain), 0, 1);
-  std::atomic<bool> answered{false}, granted{false};
-  std::thread claimant([&] {
-    granted = intruder.claim(5.0);
-    answered = true;
-  });
-  for (int i = 0; i < 300 && !answered; ++i) server.poll(0.02);
-  claimant.join();
-  EXPECT_FALSE(granted);
+  EXPECT_FALSE(claimWhilePolling(server, intruder, 5.0));
   EXPECT_FALSE(intruder.ownsRobot());
   EXPECT_GT(intruder.status().refused, 0u);  // told so, in the robot's partition
   // It sends head-yaw commands for the coming ticks; the owner keeps HeadYaw at 0.
@@ -231,14 +238,7 @@ TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
   EXPECT_EQ(server.stats(0).missed, 0u);
   EXPECT_TRUE(w.isStanding(0));  // released: holds its pose
   agents::AgentClient again(dds(domain), 0, 1);
-  std::atomic<bool> granted{false}, answered{false};
-  std::thread claimant([&] {
-    granted = again.claim(10.0);
-    answered = true;
-  });
-  for (int i = 0; i < 500 && !answered; ++i) server.poll(0.02);
-  claimant.join();
-  EXPECT_TRUE(granted);
+  EXPECT_TRUE(claimWhilePolling(server, again, 10.0));
   EXPECT_TRUE(server.stats(0).owned);
 }
 
