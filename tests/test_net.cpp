@@ -92,10 +92,11 @@ class AgentProcess {
 
 // An agent in this process claims its robot (in a thread) while the server
 // handles claims; true if granted within `timeout` s.
-bool claimWhilePolling(net::SimServer& server, agents::AgentClient& agent, double timeout) {
+bool claimWhilePolling(net::SimServer& server, agents::AgentClient& agent, double timeout,
+                       agents::AgentClient::IfOwned if_owned) {
   std::atomic<bool> answered{false}, granted{false};
   std::thread claimant([&] {
-    granted = agent.claim(timeout);
+    granted = agent.claim(timeout, if_owned);
     answered = true;
   });
   const auto end = Clock::now() + std::chrono::duration<double>(timeout + 1.0);
@@ -169,7 +170,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   // An intruder in this process (its own participant) claims the same robot.
   agents::AgentClient intruder(dds(domain), 0, 1);
-  EXPECT_FALSE(claimWhilePolling(server, intruder, 5.0));
+  EXPECT_FALSE(claimWhilePolling(server, intruder, 5.0, agents::AgentClient::IfOwned::Refuse));
   EXPECT_FALSE(intruder.ownsRobot());
   EXPECT_GT(intruder.status().refused, 0u);  // told so, in the robot's partition
   // It sends head-yaw commands for the coming ticks; the owner keeps HeadYaw at 0.
@@ -219,6 +220,34 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   EXPECT_GE(server.stats(0).accepted, before + 90);
 }
 
+// An agent restarted right after a crash, while its robot is still owned by
+// the dead process, gets it back when that lease runs out (claim() waits).
+TEST(Net, AnAgentRestartedAtOnceGetsItsRobotBackWhenTheLeaseRunsOut) {
+  const uint32_t domain = 122;
+  world::World w(teams(1));
+  net::SimServer server(w, serverConfig(domain, 0.05));
+  auto crashed =
+      std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{"--lease", "2"});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  for (int i = 0; i < 20; ++i) server.runPeriod();
+  crashed->kill();
+  AgentProcess restarted(domain, 0, 1);  // claims while the robot is still owned
+  const auto t0 = Clock::now();
+  bool released = false;
+  while (seconds(t0) < 15.0 && !(released && server.stats(0).owned)) {
+    server.runPeriod();
+    released = released || !server.stats(0).owned;
+  }
+  ASSERT_TRUE(released);
+  ASSERT_TRUE(server.stats(0).owned) << "the restarted agent did not get its robot back";
+  const double back_after = seconds(t0);
+  const uint64_t before = server.stats(0).accepted;
+  for (int i = 0; i < 60; ++i) server.runPeriod();
+  EXPECT_GE(server.stats(0).accepted, before + 55);  // it drives the robot
+  EXPECT_TRUE(restarted.running());
+  std::printf("the restarted agent had its robot back %.2f s after the crash\n", back_after);
+}
+
 // A launcher that saw its agent process exit frees the robot at once: lockstep
 // stops waiting for it, and another agent can claim it.
 TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
@@ -238,7 +267,7 @@ TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
   EXPECT_EQ(server.stats(0).missed, 0u);
   EXPECT_TRUE(w.isStanding(0));  // released: holds its pose
   agents::AgentClient again(dds(domain), 0, 1);
-  EXPECT_TRUE(claimWhilePolling(server, again, 10.0));
+  EXPECT_TRUE(claimWhilePolling(server, again, 10.0, agents::AgentClient::IfOwned::WaitForRelease));
   EXPECT_TRUE(server.stats(0).owned);
 }
 

@@ -101,7 +101,7 @@ bool AgentClient::ownsRobot() const {
   return status_.owned && std::memcmp(status_.owner_guid, me.v, 16) == 0;
 }
 
-bool AgentClient::claim(double timeout_seconds) {
+bool AgentClient::claim(double timeout_seconds, IfOwned if_owned) {
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(timeout_seconds));
   // Claim once the simulator's readers of our commands and team messages are
@@ -116,12 +116,19 @@ bool AgentClient::claim(double timeout_seconds) {
     dds_sleepfor(DDS_MSECS(5));
   simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
   impl_->join.write(j);
+  bool refused = false;
   while (Clock::now() < end) {
     readStatus();
     if (status_.owned) {
       if (ownsRobot()) return true;
       // Owned by someone else: the simulator's refusal counter says it saw us.
-      if (status_.refused > 0) return false;
+      if (status_.refused > 0) {
+        if (if_owned == IfOwned::Refuse) return false;
+        refused = true;
+      }
+    } else if (refused) {
+      refused = false;  // released: its owner went away; ask again
+      impl_->join.write(j);
     }
     dds_sleepfor(DDS_MSECS(5));
   }

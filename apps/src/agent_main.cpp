@@ -50,7 +50,9 @@ const char* kHelp =
     "  --ticks N        exit after answering N frames (default: run until the simulator is gone)\n"
     "  --game-state-wait S  with --role: wait up to S s (default 0) for the referee's GameState\n"
     "                   before claiming the robot (the match starts its agents so)\n"
-    "Exit status: 0 done, 3 the claim was refused or not answered, 4 the simulator went away.\n";
+    "A robot owned by another agent is waited for (its owner may have crashed: the simulator\n"
+    "frees the robot when that agent's lease runs out) for up to --claim-timeout (default 10 s).\n"
+    "Exit status: 0 done, 3 the robot was not granted in time, 4 the simulator went away.\n";
 
 }  // namespace
 

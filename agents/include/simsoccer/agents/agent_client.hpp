@@ -62,10 +62,17 @@ class AgentClient {
   int team() const { return team_; }
   int player() const { return player_; }
 
+  // What claim() does when another agent owns the robot.
+  enum class IfOwned {
+    Refuse,          // returns false at once
+    WaitForRelease,  // waits for that owner to go away and asks again
+  };
   // Sends a join request and waits until the simulator says who owns the
-  // robot: true if this agent does, false if another agent does or no
-  // answer came in time.
-  bool claim(double timeout_seconds);
+  // robot: true once this agent does; false if no answer came in time, or
+  // another agent owns it (IfOwned::Refuse) or still owns it at the timeout.
+  // Waiting is what a restarted agent needs: the robot of one that crashed is
+  // released only when its DDS lease runs out (net::DomainConfig::lease).
+  bool claim(double timeout_seconds, IfOwned if_owned = IfOwned::WaitForRelease);
   // The latest RobotStatus seen for this robot (owner, counters).
   const simsoccer_msg_RobotStatus& status() const { return status_; }
   bool ownsRobot() const;
