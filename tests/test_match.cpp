@@ -257,6 +257,13 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
                        status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("/proc/simsoccer_no"), std::string::npos) << out;
+  out =
+      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --lockstep-timeout 0 --out " + (dir / "never").string(),
+                       status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("--lockstep-timeout must be > 0"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "never"));  // refused before anything ran
   std::filesystem::remove_all(dir);
 }
 
