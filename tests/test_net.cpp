@@ -394,11 +394,43 @@ TEST(NetApps, BenchNetWritesItsTable) {
     EXPECT_NE(it, names.end()) << name;
     const std::vector<std::string> values = cells(row);
     const auto k = static_cast<size_t>(it - names.begin());
-    return it == names.end() || k >= values.size() ? -1.0 : std::stod(values[k]);
+    if (it == names.end() || k >= values.size() || values[k] == "n/a") {
+      ADD_FAILURE() << name << " missing in: " << row;
+      return -1.0;
+    }
+    return std::stod(values[k]);
   };
   EXPECT_GT(column(row1, "net_cpu_ms_per_period"), 0.0);
   EXPECT_GE(column(row1, "packets_per_tick"), 2.0);
   EXPECT_GE(column(row2, "packets_per_tick"), 4.0);
+}
+
+// Bad DDS settings are refused with the setting named: a lease out of range,
+// a configuration file that is not there (the library and the agent program).
+TEST(NetApps, BadLeaseAndMissingDdsConfigAreNamed) {
+  net::DomainConfig bad = dds(123);
+  bad.lease = 0.01;
+  try {
+    net::Participant p(bad);
+    ADD_FAILURE() << "a 10 ms lease was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lease"), std::string::npos) << e.what();
+  }
+  net::DomainConfig missing = dds(123);
+  missing.config_file = "/nonexistent/loopback.xml";
+  try {
+    net::Participant p(missing);
+    ADD_FAILURE() << "a missing configuration file was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/loopback.xml"), std::string::npos)
+        << e.what();
+  }
+  int status = 0;
+  const std::string out = runCommand(
+      std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 --domain 123 --lease 0 2>&1",
+      status);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;  // a usage error
+  EXPECT_NE(out.find("--lease"), std::string::npos) << out;
 }
 
 TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {

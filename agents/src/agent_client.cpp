@@ -114,21 +114,25 @@ bool AgentClient::claim(double timeout_seconds, IfOwned if_owned) {
   };
   while (Clock::now() < end && !(matched(impl_->command.get()) && matched(impl_->team_send.get())))
     dds_sleepfor(DDS_MSECS(5));
+  // Refusals counted before this claim are somebody else's.
+  readStatus();
+  const uint32_t refused_before = status_.refused;
   simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
   impl_->join.write(j);
-  bool refused = false;
+  auto asked = Clock::now();
   while (Clock::now() < end) {
     readStatus();
     if (status_.owned) {
       if (ownsRobot()) return true;
-      // Owned by someone else: the simulator's refusal counter says it saw us.
-      if (status_.refused > 0) {
-        if (if_owned == IfOwned::Refuse) return false;
-        refused = true;
-      }
-    } else if (refused) {
-      refused = false;  // released: its owner went away; ask again
+      // Owned by someone else, and the simulator counted our request.
+      if (if_owned == IfOwned::Refuse && status_.refused > refused_before) return false;
+    } else if (Clock::now() - asked > std::chrono::milliseconds(100)) {
+      // Not owned (yet, or released: its owner went away): ask again. The
+      // status keeps only the latest sample, so a release can hide the
+      // refusal before it; asking again is harmless (the same agent's
+      // requests are one claim).
       impl_->join.write(j);
+      asked = Clock::now();
     }
     dds_sleepfor(DDS_MSECS(5));
   }

@@ -332,9 +332,11 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
         }
         ++a.restarts;
         // Its robot is free at once: a crashed process says nothing on DDS, and
-        // lockstep would wait for it every period until its lease ran out.
-        for (world::RobotId r = 0; r < w.robotCount(); ++r)
-          if (w.robot(r).team == a.team && w.robot(r).number == a.number) server.releaseRobot(r);
+        // lockstep would wait for it every period until its lease ran out. (Not
+        // when it exited 3, not granted: then another participant owns it.)
+        if (a.process->exitStatus() != 3)
+          for (world::RobotId r = 0; r < w.robotCount(); ++r)
+            if (w.robot(r).team == a.team && w.robot(r).number == a.number) server.releaseRobot(r);
         std::snprintf(buf, sizeof buf,
                       "{\"time\": %s, \"team\": %d, \"player\": %d, \"exit_status\": %d, "
                       "\"restart\": %d}",

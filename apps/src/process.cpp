@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -107,16 +108,25 @@ double processCpuSeconds(pid_t pid) {
   // short run.
   const std::filesystem::path tasks = "/proc/" + std::to_string(pid) + "/task";
   std::error_code ec;
+  std::filesystem::directory_iterator it(tasks, ec);
+  if (ec) return -1.0;
   double total = 0.0;
   bool any = false;
-  for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
-    std::ifstream f(task.path() / "schedstat");
+  for (; it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    if (ec) return -1.0;
+    std::ifstream f(it->path() / "schedstat");
     long long ns = 0;
     if (!(f >> ns)) continue;  // a thread that just ended
     total += 1e-9 * static_cast<double>(ns);
     any = true;
   }
   return any && !ec ? total : -1.0;
+}
+
+double threadCpuSeconds() {
+  timespec t{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) != 0) return -1.0;
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 }  // namespace simsoccer::apps

@@ -58,5 +58,7 @@ long long loopbackPackets();
 // CPU time (user + system) the threads of a process have used so far, in
 // seconds (/proc/PID/task/*/schedstat), or -1 when it cannot be read.
 double processCpuSeconds(pid_t pid);
+// CPU time the calling thread has used so far, in seconds.
+double threadCpuSeconds();
 
 }  // namespace simsoccer::apps

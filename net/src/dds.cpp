@@ -1,6 +1,5 @@
 #include "simsoccer/net/dds.hpp"
 
-#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -30,8 +29,10 @@ Entity::~Entity() {
 }
 
 Participant::Participant(const DomainConfig& config) {
-  if (!(config.lease > 0.0) || !std::isfinite(config.lease))
-    throw std::invalid_argument("DDS lease must be a positive number of seconds, not " +
+  // (Cyclone counts in int64 nanoseconds; below 0.1 s every participant
+  // would announce itself to every port more than ten times a second.)
+  if (!(config.lease >= 0.1 && config.lease <= 86400.0))
+    throw std::invalid_argument("DDS lease must be between 0.1 and 86400 s, not " +
                                 std::to_string(config.lease));
   if (!config.config_file.empty()) {
     std::ifstream f(config.config_file);

@@ -64,7 +64,7 @@ class AgentClient {
 
   // What claim() does when another agent owns the robot.
   enum class IfOwned {
-    Refuse,          // returns false at once
+    Refuse,          // returns false as soon as the simulator refuses the request
     WaitForRelease,  // waits for that owner to go away and asks again
   };
   // Sends a join request and waits until the simulator says who owns the
