@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
     dds.lease = opt.number("lease", dds.lease);
-    if (!(dds.lease >= 0.1 && dds.lease <= 86400.0))
+    if (!(dds.lease >= net::DomainConfig::kMinLease && dds.lease <= net::DomainConfig::kMaxLease))
       throw apps::UsageError("--lease must be between 0.1 and 86400 s");
     const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
     const std::string mode = opt.get("mode", "nod");

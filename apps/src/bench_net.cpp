@@ -142,9 +142,8 @@ int benchNet(int argc, char** argv, int first) {
       "overhead = wall time per period minus the world's stepping (publishing frames, "
       "waiting for and taking commands); world = the same world stepped alone (physics and "
       "sensors); net_cpu = CPU time of the simulator and all agents per period minus the CPU "
-      "time of the world stepped alone; bytes, packets = loopback interface traffic per tick (all "
-      "processes, "
-      "RTPS headers, heartbeats, acknowledgements and discovery included).",
+      "time of the world stepped alone; bytes, packets = loopback interface traffic per tick "
+      "(all processes, RTPS headers, heartbeats, acknowledgements and discovery included).",
       csv);
   return 0;
 }

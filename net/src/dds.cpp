@@ -29,11 +29,10 @@ Entity::~Entity() {
 }
 
 Participant::Participant(const DomainConfig& config) {
-  // (Cyclone counts in int64 nanoseconds; below 0.1 s every participant
-  // would announce itself to every port more than ten times a second.)
-  if (!(config.lease >= 0.1 && config.lease <= 86400.0))
-    throw std::invalid_argument("DDS lease must be between 0.1 and 86400 s, not " +
-                                std::to_string(config.lease));
+  if (!(config.lease >= DomainConfig::kMinLease && config.lease <= DomainConfig::kMaxLease))
+    throw std::invalid_argument(
+        "DDS lease must be between " + std::to_string(DomainConfig::kMinLease) + " and " +
+        std::to_string(DomainConfig::kMaxLease) + " s, not " + std::to_string(config.lease));
   if (!config.config_file.empty()) {
     std::ifstream f(config.config_file);
     if (!f)

@@ -155,20 +155,30 @@ struct SimServer::Impl {
   // agent before, which threw away all but its own: at 22 robots 484 status
   // samples a second; 11 v 11, 4,840 team message samples.)
   struct RobotWriters {
-    RobotWriters(Participant& p, const std::string& partition)
+    RobotWriters(Participant& p, const std::string& partition, bool with_perception,
+                 bool with_images)
         : frame(p, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
                 QosSpec{true, 1, false, partition}),
           status(p, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
                  QosSpec{true, 1, true, partition}),
           team_deliver(p, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
-                       QosSpec{true, 16, false, partition}) {}
+                       QosSpec{true, 16, false, partition}) {
+      if (with_perception)
+        perception = std::make_unique<Writer<simsoccer_msg_Perception>>(
+            p, simsoccer_msg_Perception_desc, "simsoccer_Perception",
+            QosSpec{true, 1, false, partition});
+      if (with_images)
+        images = std::make_unique<Writer<simsoccer_msg_CameraImage>>(
+            p, simsoccer_msg_CameraImage_desc, "simsoccer_CameraImage",
+            QosSpec{true, 1, false, partition});
+    }
     Writer<simsoccer_msg_SensorFrame> frame;
     Writer<simsoccer_msg_RobotStatus> status;
-    Writer<simsoccer_msg_TeamMessage> team_deliver;  // messages to this robot
+    Writer<simsoccer_msg_TeamMessage> team_deliver;                // messages to this robot
+    std::unique_ptr<Writer<simsoccer_msg_Perception>> perception;  // perception on
+    std::unique_ptr<Writer<simsoccer_msg_CameraImage>> images;     // cameras on (both)
   };
-  std::vector<std::unique_ptr<RobotWriters>> robot_writers;                // world order
-  std::vector<std::unique_ptr<Writer<simsoccer_msg_CameraImage>>> images;  // per robot, cameras on
-  std::vector<std::unique_ptr<Writer<simsoccer_msg_Perception>>> perceptions;  // perception on
+  std::vector<std::unique_ptr<RobotWriters>> robot_writers;  // world order
   std::vector<simsoccer_msg_PerceivedObject> perceived_scratch;
   Writer<simsoccer_msg_SimClock> clock;
   Writer<simsoccer_msg_GameState> game;
@@ -240,22 +250,14 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
     slot.player = info.number;
     robots_.push_back(slot);
     impl_->robot_writers.push_back(std::make_unique<Impl::RobotWriters>(
-        impl_->participant, robotPartitionName(info.team, info.number)));
+        impl_->participant, robotPartitionName(info.team, info.number),
+        world.scenario().perception.enabled, world.scenario().cameras.enabled));
     publishStatus(r);
   }
-  if (world.scenario().perception.enabled) {
+  if (world.scenario().perception.enabled)
     perception_ = std::make_unique<world::PerceptionSystem>(world, world.scenario().perception);
-    for (world::RobotId r = 0; r < world.robotCount(); ++r)
-      impl_->perceptions.push_back(std::make_unique<Writer<simsoccer_msg_Perception>>(
-          impl_->participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
-          QosSpec{true, 1, false, robotPartitionName(world.robot(r).team, world.robot(r).number)}));
-  }
   const world::CameraSettings& cameras = world.scenario().cameras;
   if (cameras.enabled) {
-    for (world::RobotId r = 0; r < world.robotCount(); ++r)
-      impl_->images.push_back(std::make_unique<Writer<simsoccer_msg_CameraImage>>(
-          impl_->participant, simsoccer_msg_CameraImage_desc, "simsoccer_CameraImage",
-          QosSpec{true, 1, false, robotPartitionName(world.robot(r).team, world.robot(r).number)}));
     // The sink runs on the render thread; DDS writers are thread-safe.
     cameras_ = std::make_unique<world::CameraSystem>(
         world, cameras, config.lockstep ? world::BehindPolicy::Wait : world::BehindPolicy::Drop,
@@ -266,7 +268,7 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
           }
           simsoccer_msg_CameraImage m{};
           toMessage(image, m);
-          impl_->images[image.robot]->write(m);
+          impl_->robot_writers[image.robot]->images->write(m);
         });
     cameras_->capture(world_);  // the images of tick 0
   }
@@ -561,8 +563,8 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
       if (!writer_matched(impl_->robot_writers[r]->frame.get(), 1) ||
           !writer_matched(impl_->robot_writers[r]->team_deliver.get(), 1))
         return false;
-      if (!impl_->perceptions.empty() && !writer_matched(impl_->perceptions[r]->get(), 1))
-        return false;
+      const auto& perception = impl_->robot_writers[r]->perception;
+      if (perception && !writer_matched(perception->get(), 1)) return false;
     }
     return owned >= count && reader_matched(impl_->commands.get(), owned) &&
            reader_matched(impl_->team_send.get(), owned);
@@ -597,7 +599,7 @@ void SimServer::runPeriod() {
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
       toMessage(perception_->perception(r), robots_[r].team, robots_[r].player, m,
                 impl_->perceived_scratch);
-      impl_->perceptions[r]->write(m);
+      impl_->robot_writers[r]->perception->write(m);
     }
   }
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {

@@ -50,8 +50,11 @@ struct DomainConfig {
   // participant to every peer port (61 with loopback.xml) at 4/5 of it: at
   // 22 robots a 2 s lease cost 8-10 packets and about 0.25 ms of CPU per
   // control period more than 5 s (bench net); at 5 s a killed agent's robot
-  // is free after about 5 s. 0.1 to 86400 s.
+  // is free after about 5 s.
   double lease = 5.0;
+  // Its range: Cyclone counts in int64 nanoseconds, and below 0.1 s every
+  // participant would announce itself to every port more than ten times a second.
+  static constexpr double kMinLease = 0.1, kMaxLease = 86400.0;
 };
 
 // A participant on a domain configured from an XML file.
