@@ -121,8 +121,7 @@ TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
 }
 
 TEST(BehaviourConfig, ErrorsNameFileAndKey) {
-  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_behaviour_cfg";
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("behaviour_cfg");
   const auto f = dir / "bad.yaml";
   std::ofstream(f) << "behaviour: soccer\nready_positions: [[0, 0, 0]]\nmax_forward: -1\n";
   try {
@@ -153,7 +152,6 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("ball_velocity_window: 0.01"), "ball_velocity_window");
   EXPECT_EQ(refusedAt("ball_outlier_distance: 0"), "ball_outlier_distance");
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
-  std::filesystem::remove_all(dir);
 }
 
 TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {
@@ -550,8 +548,7 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
   EXPECT_LT(m.duration(), 8.0);
   // The last frame is the stand pose.
   EXPECT_EQ(m.frames.back().position, model.pose("stand"));
-  const auto dir = test::freshTempDir("keyframes");
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("keyframes");
   std::ofstream(dir / "bad.yaml")
       << "motion: bad\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 3.0}}\n";
   try {
@@ -582,8 +579,7 @@ TEST(KeyframeMotion, LoadsThePosesAndRejectsBadJoints) {
 // (smoothstep) starts and ends each frame at rest. A bad value names the key.
 TEST(KeyframeMotion, InterpolatesLinearlyOrSmoothly) {
   const auto model = robots::loadRobotModel(test::naoH25());
-  const auto dir = test::freshTempDir("keyframes_interp");
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("keyframes_interp");
   const size_t knee = static_cast<size_t>(model.body->jointIndex("LKneePitch"));
   auto kneeAt = [&](const std::string& interp, double t) {
     std::ofstream(dir / "m.yaml") << "motion: m\n"
@@ -646,8 +642,7 @@ TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGet
 // back failed.
 TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   const auto model = robots::loadRobotModel(test::naoH25());
-  const auto dir = test::freshTempDir("roll_motions");
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("roll_motions");
   for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
     std::filesystem::copy_file(f.path(), dir / f.path().filename());
   std::filesystem::remove(dir / "get_up_back.yaml");
@@ -658,7 +653,7 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   for (const bool rolled : {true, false}) {
     agents::FallDetectorParameters fall;
     fall.get_up = true;
-    agents::MotionController mc = agents::loadMotionController(model, dir, fall);
+    agents::MotionController mc = agents::loadMotionController(model, dir.path(), fall);
     std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
     agents::MotionSensors s;
     s.position = joints;
@@ -752,7 +747,8 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
 
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
   world::World w(test::scenario(2));
-  const auto file = std::filesystem::temp_directory_path() / "simsoccer_test.log";
+  const test::TempDir dir("match_log");
+  const auto file = dir / "test.log";
   world::MatchLogHeader h;
   h.values["scenario"] = "x.yaml";
   h.values["seed"] = "9";

@@ -52,7 +52,8 @@ TEST(CheckApp, ValidScenarioAndConfigError) {
                                     status);
   EXPECT_EQ(status, 0) << ok;
   EXPECT_NE(ok.find("robot 9: team 1 number 5, nao_h21"), std::string::npos) << ok;
-  const auto bad = std::filesystem::temp_directory_path() / "simsoccer_check_bad.yaml";
+  const test::TempDir dir("check");
+  const auto bad = dir / "simsoccer_check_bad.yaml";
   std::ofstream(bad) << "scenario: bad\nfield: " << SIMSOCCER_SOURCE_DIR
                      << "/fields/spl.yaml\nrobot_model: " << SIMSOCCER_SOURCE_DIR
                      << "/robots/nao_v6_h25.yaml\nphysics: {dt: 0.005, control_period: 0.012}\n"
@@ -62,7 +63,6 @@ TEST(CheckApp, ValidScenarioAndConfigError) {
   EXPECT_NE(err.find("simsoccer_check_bad.yaml: physics.control_period: must be a whole multiple"),
             std::string::npos)
       << err;
-  std::filesystem::remove(bad);
 }
 
 TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
@@ -151,12 +151,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
 // The get-up tuning aids: another motions folder, the side-view snapshots
 // (real EGL rendering, tiled), the support trace; a bad motion file is named.
 TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
-  const std::filesystem::path dir = test::freshTempDir("motions");
-  std::filesystem::create_directories(dir);
-  struct RemoveAfter {
-    std::filesystem::path dir;
-    ~RemoveAfter() { std::filesystem::remove_all(dir); }
-  } remove_after{dir};
+  const test::TempDir dir("motions");
   for (const char* f : {"get_up_front.yaml", "get_up_back.yaml", "block.yaml", "dive_left.yaml",
                         "dive_right.yaml", "sit_down.yaml", "stand_up.yaml"})
     std::filesystem::copy_file(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs/motions" / f,
@@ -165,7 +160,7 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
   int status = 0;
   const std::string out =
       runCommand(std::string(SIMSOCCER_BIN) + " bench motion --get-up back --seed 3 --motions " +
-                     dir.string() + " --snapshots " + png.string() + " --verbose 2>&1",
+                     dir.path().string() + " --snapshots " + png.string() + " --verbose 2>&1",
                  status);
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("get-up from the back:"), std::string::npos) << out;
@@ -197,7 +192,7 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
   }
   const std::string err =
       runCommand(std::string(SIMSOCCER_BIN) + " bench motion --get-up back --motions " +
-                     dir.string() + " 2>&1",
+                     dir.path().string() + " 2>&1",
                  status);
   EXPECT_NE(status, 0);
   EXPECT_NE(err.find("get_up_back.yaml"), std::string::npos) << err;

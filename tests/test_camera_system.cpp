@@ -298,8 +298,7 @@ TEST(CameraSystem, JpegAndSpectatorImages) {
 }
 
 TEST(CameraSystem, ScenarioCamerasBlockIsReadAndChecked) {
-  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_camera_cfg";
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("camera_cfg");
   auto write = [&](const std::string& cameras) {
     const auto file = dir / "s.yaml";
     std::ofstream(file) << "scenario: s\nfield: " << test::splField().string()

@@ -231,8 +231,7 @@ TEST(Game, PacketCarriesTheState) {
 }
 
 TEST(Game, RuleBookErrorsNameTheKey) {
-  const auto dir = std::filesystem::temp_directory_path() / "simsoccer_rules_test";
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("rules");
   std::ifstream in(test::sourceDir() / "configs" / "rules" / "spl.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   text.replace(text.find("half_duration: 600"), 18, "half_duration: -5");
@@ -243,7 +242,6 @@ TEST(Game, RuleBookErrorsNameTheKey) {
   } catch (const engine::ConfigError& e) {
     EXPECT_EQ(e.key(), "half_duration");
   }
-  std::filesystem::remove_all(dir);
   EXPECT_NO_THROW(loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"));
 }
 

@@ -41,17 +41,16 @@ std::string withoutWallTimes(const std::string& json) {
 // One short 2 v 2 game (2 x 15 s halves). ctest runs each test in its own
 // process, maybe side by side: each plays its own, in its own folder and DDS domain.
 struct ShortMatch {
-  std::filesystem::path dir;
+  test::TempDir dir;
   std::string out;
   int status = -1;
 };
 ShortMatch shortMatch(const std::string& name, int domain, const std::string& extra = "") {
-  ShortMatch r;
-  r.dir = test::freshTempDir(name);
+  ShortMatch r{test::TempDir(name), {}, -1};
   r.out =
       test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
                            " --half 15 --domain " + std::to_string(domain) + " --out " +
-                           r.dir.string() + " " + extra,
+                           r.dir.path().string() + " " + extra,
                        r.status);
   return r;
 }
@@ -59,16 +58,15 @@ ShortMatch shortMatch(const std::string& name, int domain, const std::string& ex
 // A match of match_2v2.yaml run on a thread while the test acts on it; the
 // test's action waits for the game to be under way (the log has grown).
 struct BackgroundMatch {
-  std::filesystem::path dir;
+  test::TempDir dir;
   int status = -1;
   std::string out;
   std::thread thread;
-  BackgroundMatch(const std::string& name, const std::string& options)
-      : dir(test::freshTempDir(name)) {
+  BackgroundMatch(const std::string& name, const std::string& options) : dir(name) {
     thread = std::thread([this, options] {
       out = test::runCommand(kBin + " match " +
                                  (test::sourceDir() / "configs/match_2v2.yaml").string() + " " +
-                                 options + " --out " + dir.string(),
+                                 options + " --out " + dir.path().string(),
                              status);
     });
   }
@@ -150,7 +148,6 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   const double expected = std::ceil(last * 25.0 - 1e-6);
   EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), expected, 2.0);
   EXPECT_GT(std::filesystem::file_size(m.dir / "heatmap.png"), 1000u);
-  std::filesystem::remove_all(m.dir);
 }
 
 TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
@@ -163,7 +160,7 @@ TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
   ASSERT_EQ(a.status, 0) << a.out;
   const ShortMatch b = shortMatch("match_b2", 137, "--no-video --lockstep-timeout 5");
   ASSERT_EQ(b.status, 0) << b.out;
-  const auto dir = b.dir;
+  const auto& dir = b.dir;
   const std::string one = test::readFile(a.dir / "summary.json"),
                     two = test::readFile(dir / "summary.json");
   for (const std::string* s : {&one, &two}) {
@@ -176,8 +173,6 @@ TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
   }
   EXPECT_EQ(jsonValue(one, "final_state_hash"), jsonValue(two, "final_state_hash"));
   EXPECT_EQ(withoutWallTimes(one), withoutWallTimes(two));
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove_all(a.dir);
 }
 
 TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
@@ -200,7 +195,6 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
   ASSERT_EQ(status, 0);
   cv::VideoCapture video(part.string());
   EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), 50.0, 1.0);
-  std::filesystem::remove_all(m.dir);
 }
 
 TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
@@ -216,7 +210,6 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
   EXPECT_NE(jsonValue(summary, "agent_restarts"), "[]") << summary;
   EXPECT_NE(summary.find("\"team\": 1, \"player\": 2, \"exit_status\""), std::string::npos);
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
@@ -239,12 +232,10 @@ TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
   int ps = 0;
   const std::string left = test::runCommand("pgrep -f '^[^ ]*simsoccer-agent .*--domain 134 '", ps);
   EXPECT_TRUE(left.empty()) << left;
-  std::filesystem::remove_all(dir);
 }
 
 TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
-  const auto dir = test::freshTempDir("match_bad");
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("match_bad");
   std::ofstream(dir / "bad.yaml") << "match: bad\nscenario: nowhere.yaml\nrules: rules/spl.yaml\n";
   int status = 0;
   std::string out = test::runCommand(kBin + " match " + (dir / "bad.yaml").string(), status);
@@ -264,15 +255,14 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--lockstep-timeout must be > 0"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir / "never"));  // refused before anything ran
-  std::filesystem::remove_all(dir);
 }
 
 TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
-  const auto dir = test::freshTempDir("penalty");
+  const test::TempDir dir("penalty");
   int status = -1;
   const std::string out =
       test::runCommand(kBin + " penalty " + (test::sourceDir() / "configs/penalty.yaml").string() +
-                           " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.string(),
+                           " --kicks 5 --video-kicks 1 --domain 135 --out " + dir.path().string(),
                        status);
   ASSERT_EQ(status, 0) << out;
   const std::string json = test::readFile(dir / "penalty.json");
@@ -303,12 +293,10 @@ TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {
   EXPECT_NEAR(hi, std::min(1.0, centre + half), 0.006) << ci;
   EXPECT_NE(out.find("95% CI"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "kick_1.mp4"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
-  const auto dir = test::freshTempDir("scaling");
-  std::filesystem::create_directories(dir);
+  const test::TempDir dir("scaling");
   int status = -1;
   const std::string out = test::runCommand(
       kBin + " bench scaling --robots 1,2 --seconds 2 --domain 136 --csv " +
@@ -321,5 +309,4 @@ TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
   EXPECT_EQ(lines[1].rfind("1,", 0), 0u);
   EXPECT_EQ(lines[2].rfind("2,", 0), 0u);
   EXPECT_GT(std::filesystem::file_size(dir / "scaling.png"), 1000u);
-  std::filesystem::remove_all(dir);
 }

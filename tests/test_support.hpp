@@ -33,14 +33,31 @@ inline std::string readFile(const std::filesystem::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
-// An empty folder of this test process's own (name and process id: test
-// runs side by side do not share it); removed first if it was left over.
-inline std::filesystem::path freshTempDir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() /
-                 ("simsoccer_test_" + name + "_" + std::to_string(getpid()));
-  std::filesystem::remove_all(d);
-  return d;
-}
+// A folder of this test process's own (name and process id: test runs side
+// by side do not share it), empty when made (a leftover is removed first) and
+// removed with what is in it when the test ends, passed or failed.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("simsoccer_test_" + name + "_" + std::to_string(getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;  // a destructor must not throw
+    if (!path_.empty()) std::filesystem::remove_all(path_, ignored);
+  }
+  TempDir(TempDir&& other) noexcept : path_(std::move(other.path_)) { other.path_.clear(); }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  TempDir& operator=(TempDir&&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::filesystem::path& p) const { return path_ / p; }
+
+ private:
+  std::filesystem::path path_;
+};
 inline std::filesystem::path dataDir() {
   return sourceDir() / "tests" / "data";
 }
