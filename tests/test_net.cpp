@@ -71,23 +71,27 @@ class AgentProcess {
       pid_ = -1;
     }
   }
-  // Exit status once it ended by itself (waits up to `seconds`), or -1.
+  // Exit status once it ended by itself (waits up to `seconds`, 0: looks
+  // once), or -1.
   int exitStatus(double seconds) {
     const auto end = Clock::now() + std::chrono::milliseconds(static_cast<int>(seconds * 1000));
-    while (Clock::now() < end) {
+    for (;;) {
       int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      if (pid_ > 0 && waitpid(pid_, &status, WNOHANG) == pid_) {
         pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        return exit_status_;
       }
+      if (pid_ <= 0) return exit_status_;
+      if (Clock::now() >= end) return -1;
       usleep(10000);
     }
-    return -1;
   }
   bool running() const { return pid_ > 0; }
 
  private:
   pid_t pid_ = -1;
+  int exit_status_ = -1;
 };
 
 // An agent in this process claims its robot (in a thread) while the server
@@ -431,6 +435,49 @@ TEST(NetApps, BadLeaseAndMissingDdsConfigAreNamed) {
       status);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;  // a usage error
   EXPECT_NE(out.find("--lease"), std::string::npos) << out;
+}
+
+// simsoccer-agent for a robot another agent owns: --if-owned refuse gives up
+// (exit status 3) when the simulator refuses it, long before its claim
+// timeout; the default waits the claim timeout out for a release first. The
+// owner keeps its robot throughout.
+TEST(NetApps, AnAgentProgramRefusedItsRobotGivesUpOrWaits) {
+  const uint32_t domain = 124;
+  world::World w(teams(1));
+  net::SimServer server(w, serverConfig(domain, 2.0));
+  AgentProcess owner(domain, 0, 1);
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  // Runs the lockstep loop until `agent` exits (at most 25 s): its exit
+  // status and the seconds it ran.
+  const auto runUntilExit = [&](AgentProcess& agent) {
+    const auto t0 = Clock::now();
+    int status = -1;
+    while (status < 0 && seconds(t0) < 25.0) {
+      server.runPeriod();
+      status = agent.exitStatus(0.0);
+    }
+    return std::make_pair(status, seconds(t0));
+  };
+  const uint64_t accepted = server.stats(0).accepted;
+  AgentProcess refusing(domain, 0, 1, {"--if-owned", "refuse", "--claim-timeout", "20"});
+  const auto [refused_status, refused_after] = runUntilExit(refusing);
+  EXPECT_EQ(refused_status, 3);
+  EXPECT_LT(refused_after, 10.0);  // not the 20 s claim timeout
+  AgentProcess waiting(domain, 0, 1, {"--claim-timeout", "2"});
+  const auto [waited_status, waited_after] = runUntilExit(waiting);
+  EXPECT_EQ(waited_status, 3);
+  EXPECT_GT(waited_after, 1.9);  // it waited for a release
+  std::printf("refused agent gave up after %.2f s; the waiting one after %.2f s\n", refused_after,
+              waited_after);
+  EXPECT_TRUE(server.stats(0).owned);
+  EXPECT_EQ(server.stats(0).missed, 0u);
+  EXPECT_GT(server.stats(0).accepted, accepted + 50);  // the owner drove it all along
+  int status = 0;
+  const std::string out = runCommand(
+      std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 --domain 124 --if-owned never 2>&1",
+      status);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;  // a usage error
+  EXPECT_NE(out.find("--if-owned"), std::string::npos) << out;
 }
 
 TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {

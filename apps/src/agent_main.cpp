@@ -27,7 +27,7 @@ const char* kHelp =
     "                        [--team-number N] [--seed N] [--no-get-up] [--verbose]]\n"
     "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
     "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
-    "                       [--game-state-wait S]\n"
+    "                       [--if-owned wait|refuse] [--game-state-wait S]\n"
     "\n"
     "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
     "  --lease S        s the simulator waits after this process went silent (crashed)\n"
@@ -51,7 +51,8 @@ const char* kHelp =
     "  --game-state-wait S  with --role: wait up to S s (default 0) for the referee's GameState\n"
     "                   before claiming the robot (the match starts its agents so)\n"
     "A robot owned by another agent is waited for (its owner may have crashed: the simulator\n"
-    "frees the robot when that agent's lease runs out) for up to --claim-timeout (default 10 s).\n"
+    "frees the robot when that agent's lease runs out) for up to --claim-timeout (default 10 s);\n"
+    "with --if-owned refuse the agent gives up as soon as the simulator refuses it.\n"
     "Exit status: 0 done, 3 the robot was not granted in time, 4 the simulator went away.\n";
 
 }  // namespace
@@ -60,9 +61,26 @@ int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
     const apps::Options opt(argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
-                            {"team", "player", "domain", "dds-config", "lease", "robot", "mode",
-                             "stall-after", "ticks", "claim-timeout", "vx", "vy", "turn", "role",
-                             "config", "field", "team-number", "seed", "game-state-wait"});
+                            {"team",
+                             "player",
+                             "domain",
+                             "dds-config",
+                             "lease",
+                             "robot",
+                             "mode",
+                             "stall-after",
+                             "ticks",
+                             "claim-timeout",
+                             "vx",
+                             "vy",
+                             "turn",
+                             "role",
+                             "config",
+                             "field",
+                             "team-number",
+                             "seed",
+                             "game-state-wait",
+                             "if-owned"});
     if (opt.help(kHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -77,6 +95,9 @@ int main(int argc, char** argv) {
       throw apps::UsageError("--lease must be between 0.1 and 86400 s");
     const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
     const std::string mode = opt.get("mode", "nod");
+    const std::string if_owned = opt.get("if-owned", "wait");
+    if (if_owned != "wait" && if_owned != "refuse")
+      throw apps::UsageError("--if-owned must be wait or refuse, not '" + if_owned + "'");
     if (mode != "nod" && mode != "walk" && mode != "garbage" && mode != "stall")
       throw apps::UsageError("--mode must be nod, walk, garbage or stall");
     const long stall_after = static_cast<long>(opt.number("stall-after", 50));
@@ -137,7 +158,9 @@ int main(int argc, char** argv) {
                    "simsoccer-agent: robot (%d, %d): no GameState within %g s; playing without "
                    "it until one comes (a lockstep run may then differ between runs)\n",
                    team, player, game_wait);
-    if (!client.claim(opt.number("claim-timeout", 10.0))) {
+    if (!client.claim(opt.number("claim-timeout", 10.0),
+                      if_owned == "refuse" ? agents::AgentClient::IfOwned::Refuse
+                                           : agents::AgentClient::IfOwned::WaitForRelease)) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
       return 3;
     }
