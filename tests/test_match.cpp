@@ -255,6 +255,37 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--lockstep-timeout must be > 0"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir / "never"));  // refused before anything ran
+  out =
+      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --dds-config /nonexistent/lan.xml --out " + (dir / "never").string(),
+                       status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("--dds-config /nonexistent/lan.xml: no such file"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "never"));
+}
+
+// --dds-config: the simulator and the agents it starts use configs/dds/lan.xml
+// (discovery by multicast on a network interface): 2 s of a game, every
+// period answered.
+TEST(MatchApp, RunsOverTheLanDdsConfiguration) {
+  if (!test::hasMulticastInterface()) GTEST_SKIP() << "no network interface that can multicast";
+  const test::TempDir dir("match_lan");
+  const unsigned long long sent_before = test::networkPacketsSent();
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+          " --max-seconds 2 --no-video --domain 139 --dds-config " +
+          (test::sourceDir() / "configs/dds/lan.xml").string() + " --out " + dir.path().string(),
+      status);
+  ASSERT_EQ(status, 0) << out;
+  const std::string summary = test::readFile(dir / "summary.json");
+  const std::regex missed("\"missed_commands\": ([0-9]+)");
+  int robots = 0;
+  for (auto m = std::sregex_iterator(summary.begin(), summary.end(), missed);
+       m != std::sregex_iterator(); ++m, ++robots)
+    EXPECT_EQ((*m)[1].str(), "0");
+  EXPECT_EQ(robots, 4) << summary;
+  EXPECT_GT(test::networkPacketsSent(), sent_before);  // discovery on the network interface
 }
 
 TEST(PenaltyApp, FiveKicksGiveOutcomesAndARate) {

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -273,6 +274,28 @@ TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
   agents::AgentClient again(dds(domain), 0, 1);
   EXPECT_TRUE(claimWhilePolling(server, again, 10.0, agents::AgentClient::IfOwned::WaitForRelease));
   EXPECT_TRUE(server.stats(0).owned);
+}
+
+// configs/dds/lan.xml, for agents on other machines: discovery by multicast
+// on a network interface, data by unicast. The same loop as on loopback, with
+// the simulator and the agent on this machine (its own address).
+TEST(Net, TheLanConfigurationFindsTheAgentOnANetworkInterface) {
+  if (!test::hasMulticastInterface()) GTEST_SKIP() << "no network interface that can multicast";
+  const uint32_t domain = 125;
+  const std::string lan = (test::sourceDir() / "configs" / "dds" / "lan.xml").string();
+  world::World w(teams(1));
+  net::ServerConfig cfg = serverConfig(domain);
+  cfg.dds.config_file = lan;
+  const unsigned long long sent_before = test::networkPacketsSent();
+  net::SimServer server(w, cfg);
+  AgentProcess agent(domain, 0, 1, {"--dds-config", lan});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
+  for (int i = 0; i < 100; ++i) server.runPeriod();
+  const auto& st = server.stats(0);
+  EXPECT_GE(st.accepted, 95u);
+  EXPECT_EQ(st.missed, 0u);
+  // Discovery went out on the network interface (multicast), not on loopback.
+  EXPECT_GT(test::networkPacketsSent(), sent_before);
 }
 
 TEST(Net, GarbageCommandsAreRejectedAndCounted) {

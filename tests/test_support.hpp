@@ -2,12 +2,15 @@
 // small scenarios built in code.
 #pragma once
 
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -58,6 +61,37 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+// True if an interface other than loopback is up and can multicast (what
+// configs/dds/lan.xml needs).
+inline bool hasMulticastInterface() {
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return false;
+  bool found = false;
+  for (const ifaddrs* a = list; a && !found; a = a->ifa_next)
+    found = a->ifa_addr && a->ifa_addr->sa_family == AF_INET && (a->ifa_flags & IFF_UP) &&
+            (a->ifa_flags & IFF_MULTICAST) && !(a->ifa_flags & IFF_LOOPBACK);
+  freeifaddrs(list);
+  return found;
+}
+
+// Packets sent on all interfaces but loopback (/proc/net/dev).
+inline unsigned long long networkPacketsSent() {
+  std::ifstream in("/proc/net/dev");
+  std::string line;
+  unsigned long long total = 0;
+  while (std::getline(in, line)) {
+    const size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    std::string name = line.substr(0, colon);
+    name.erase(0, name.find_first_not_of(' '));
+    if (name == "lo") continue;
+    std::istringstream fields(line.substr(colon + 1));
+    unsigned long long v[10] = {};
+    for (auto& x : v) fields >> x;  // received: 8 fields; sent: bytes, packets, ...
+    total += v[9];
+  }
+  return total;
+}
 inline std::filesystem::path dataDir() {
   return sourceDir() / "tests" / "data";
 }

@@ -226,7 +226,8 @@ struct RunOptions {
   uint64_t seed = 1;
   bool realtime = false, external = false, video = true, quiet = false;
   uint32_t domain = 0;
-  double max_seconds = 0.0;  // > 0: stop after this much simulated time
+  std::filesystem::path dds_config;  // the simulator's and the agents' Cyclone configuration
+  double max_seconds = 0.0;          // > 0: stop after this much simulated time
 };
 
 struct RunResult {
@@ -250,7 +251,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   const MatchConfig& c = session.config();
   net::ServerConfig sc;
   sc.dds.domain = o.domain;
-  sc.dds.config_file = findConfig("", "configs/dds/loopback.xml");
+  sc.dds.config_file = o.dds_config;
   sc.lockstep = !o.realtime;
   sc.command_timeout = c.command_timeout;
   sc.team_message_delay = c.message_delay;
@@ -262,6 +263,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     ao.team = team;
     ao.player = number;
     ao.domain = o.domain;
+    ao.dds_config = o.dds_config;
     ao.role = c.role;
     ao.field = w.scenario().field_file;
     ao.config = c.agent_config;
@@ -477,7 +479,8 @@ world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o) {
 
 const char* kMatchHelp =
     "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
-    "                       [--no-video] [--half S] [--max-seconds S] [--domain D] [--quiet]\n"
+    "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
+    "                       [--dds-config FILE] [--quiet]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -499,12 +502,14 @@ const char* kMatchHelp =
     "                config's lockstep.timeout; a missed answer changes the game, and\n"
     "                summary.json counts them per robot: raise it on a loaded machine)\n"
     "  --external-agents   start no agents: wait for agents started elsewhere (same domain)\n"
+    "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"
+    "                configs/dds/loopback.xml; configs/dds/lan.xml for agents on other machines)\n"
     "  --no-video          skip the video\n"
     "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
 
 const char* kPenaltyHelp =
     "usage: simsoccer penalty CONFIG [--kicks N] [--out DIR] [--seed N] [--video-kicks K]\n"
-    "                         [--domain D]\n"
+    "                         [--domain D] [--dds-config FILE]\n"
     "\n"
     "Penalty kicks (configs/penalty.yaml): per kick a fresh world seeded SEED+k, the ball on\n"
     "the penalty mark, a striker and a goalkeeper agent (simsoccer-agent --role auto, which\n"
@@ -528,6 +533,9 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : defaultOut();
   o.seed = static_cast<uint64_t>(opt.number("seed", static_cast<double>(c.seed)));
   o.domain = static_cast<uint32_t>(opt.number("domain", 0));
+  o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
+  if (!std::filesystem::is_regular_file(o.dds_config))
+    throw UsageError("--dds-config " + o.dds_config.string() + ": no such file");
   o.quiet = opt.flag("quiet");
   return o;
 }
@@ -535,8 +543,9 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
 }  // namespace
 
 int match(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
-                    {"out", "seed", "half", "domain", "max-seconds", "lockstep-timeout"});
+  const Options opt(
+      argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
+      {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout"});
   if (opt.help(kMatchHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match config file");
   MatchConfig config = loadMatchConfig(opt.positional()[0]);
@@ -597,7 +606,7 @@ int match(int argc, char** argv, int first) {
 
 int penalty(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "quiet"},
-                    {"kicks", "out", "seed", "video-kicks", "domain"});
+                    {"kicks", "out", "seed", "video-kicks", "domain", "dds-config"});
   if (opt.help(kPenaltyHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one penalty config file");
   MatchConfig config = loadMatchConfig(opt.positional()[0]);

@@ -68,6 +68,7 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
   if (o.team_number) a.insert(a.end(), {"--team-number", std::to_string(*o.team_number)});
   if (o.seed) a.insert(a.end(), {"--seed", std::to_string(*o.seed)});
   if (!o.config.empty()) a.insert(a.end(), {"--config", o.config.string()});
+  if (!o.dds_config.empty()) a.insert(a.end(), {"--dds-config", o.dds_config.string()});
   if (!o.get_up) a.push_back("--no-get-up");
   return a;
 }

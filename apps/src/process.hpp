@@ -43,11 +43,12 @@ struct SoccerAgentOptions {
   int team = 0, player = 0, domain = 0;
   std::string role = "auto";
   std::filesystem::path field;
-  std::filesystem::path config;    // empty: the agent's default
-  std::optional<int> team_number;  // GameController team number
-  std::optional<uint64_t> seed;    // the agent's own random numbers
-  bool get_up = true;              // after a fall
-  double game_state_wait = 10.0;   // s
+  std::filesystem::path config;      // empty: the agent's default
+  std::filesystem::path dds_config;  // Cyclone configuration; empty: the agent's default
+  std::optional<int> team_number;    // GameController team number
+  std::optional<uint64_t> seed;      // the agent's own random numbers
+  bool get_up = true;                // after a fall
+  double game_state_wait = 10.0;     // s
 };
 std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o);
 
