@@ -84,6 +84,11 @@ TEST_F(ConfigErrors, WrongType) {
   expectError("scenario.yaml", "physics.solver_iterations", "expected an integer");
 }
 
+TEST_F(ConfigErrors, SolverThreadsMustBeAutoOrACount) {
+  replace(scenario_, "threads: auto", "threads: 0");
+  expectError("scenario.yaml", "physics.threads", "must be auto or 1-64");
+}
+
 TEST_F(ConfigErrors, UnknownKeyIsATypo) {
   replace(scenario_, "seed: 7", "seed: 7\nsede: 8");
   expectError("scenario.yaml", "sede", "unknown key");

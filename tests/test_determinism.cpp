@@ -1,6 +1,7 @@
 // Same config + seed + commands => same state hash, bit for bit (real Bullet).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -13,8 +14,12 @@ using namespace simsoccer;
 namespace {
 
 // 10 robots, 2,000 steps, every joint driven by a sinusoid (phase per robot).
-uint64_t run(uint64_t seed, double amplitude, int steps = 2000) {
+// `threads`: the solver threads (0: the default); `most_batches`: the most
+// constraint batches a step solved side by side.
+uint64_t run(uint64_t seed, double amplitude, int steps = 2000, int threads = 0,
+             int* most_batches = nullptr) {
   world::Scenario s = test::scenario(10, seed);
+  s.physics.threads = threads;
   s.noise.position = 0.01;
   s.noise.yaw = 0.02;
   s.noise.joints = 0.01;
@@ -33,6 +38,7 @@ uint64_t run(uint64_t seed, double amplitude, int steps = 2000) {
       }
     }
     w.step();
+    if (most_batches) *most_batches = std::max(*most_batches, w.physics().lastStepSolverBatches());
   }
   return w.stateHash();
 }
@@ -44,6 +50,25 @@ TEST(Determinism, SameSeedAndCommandsGiveSameHash) {
   const uint64_t b = run(11, 0.1);
   std::printf("state hash after 2000 steps: %016llx\n", static_cast<unsigned long long>(a));
   EXPECT_EQ(a, b);
+}
+
+// The constraint batches are solved side by side on the solver threads; each
+// batch alone, as Bullet solves it on one thread: the same state, bit for
+// bit, for any number of threads. (Large motions: the robots fall against
+// each other, islands merge and split.)
+TEST(Determinism, AnyNumberOfSolverThreadsGivesTheSameHash) {
+  int batches_one = 0, batches_two = 0, batches_three = 0;
+  const uint64_t one = run(21, 0.5, 1500, 1, &batches_one);
+  const uint64_t two = run(21, 0.5, 1500, 2, &batches_two);
+  const uint64_t three = run(21, 0.5, 1500, 3, &batches_three);
+  std::printf("1 thread %016llx, 2 threads %016llx, 3 threads %016llx; up to %d batches a step\n",
+              static_cast<unsigned long long>(one), static_cast<unsigned long long>(two),
+              static_cast<unsigned long long>(three), batches_two);
+  EXPECT_EQ(batches_one, 0);  // one thread: Bullet's own loop
+  EXPECT_GE(batches_two, 2);  // solved side by side
+  EXPECT_GE(batches_three, 2);
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, three);
 }
 
 TEST(Determinism, DifferentSeedGivesDifferentHash) {

@@ -187,6 +187,15 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("every state hash equal"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::exists(still));
+  // With one solver thread (Bullet's own loop) and with three: the same game,
+  // whatever the number the match ran with.
+  for (const char* threads : {"1", "3"}) {
+    const std::string again = test::runCommand(
+        kBin + " replay " + (m.dir / "match.log").string() + " --physics --threads " + threads,
+        status);
+    ASSERT_EQ(status, 0) << again;
+    EXPECT_NE(again.find("every state hash equal"), std::string::npos) << again;
+  }
   // A part of the log as a video: 2 s at 25 fps.
   const auto part = m.dir / "part.mp4";
   test::runCommand(kBin + " replay " + (m.dir / "match.log").string() + " --video " +

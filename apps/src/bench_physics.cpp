@@ -1,6 +1,5 @@
 // simsoccer bench physics: N Naos on the field, every joint tracking a slow
-// sinusoid, stepped on one thread; prints steps/s, real-time factor and
-// where the time goes.
+// sinusoid; prints steps/s, real-time factor and where the time goes.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,16 +18,19 @@ namespace {
 
 const char* kHelp =
     "usage: simsoccer bench physics [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
-    "                               [--csv FILE]\n"
+    "                               [--threads N] [--repeat N] [--csv FILE]\n"
     "\n"
     "Places N Naos on the field in side-by-side pairs, all joints tracking slow sinusoids\n"
-    "around the stand pose, runs the settling time and then the timed interval on one thread.\n"
-    "Prints per N: steps/s, real-time factor, ms per step, contacts per step (all, and robot\n"
-    "against robot), robots standing at the end, and the share of the step spent in each stage.\n"
+    "around the stand pose, runs the settling time and then the timed interval. Prints per N:\n"
+    "steps/s, real-time factor, ms per step, contacts per step (all, and robot against robot),\n"
+    "the constraint batches solved side by side per step, robots standing at the end, and the\n"
+    "share of the step spent in each stage.\n"
     "\n"
     "  --config FILE   benchmark scenario (default configs/bench/physics.yaml)\n"
     "  --robots LIST   robot counts (default from the config)\n"
     "  --seconds S     simulated seconds timed per robot count (default from the config)\n"
+    "  --threads N     solver threads (default: the config's physics.threads, else one per\n"
+    "                  core up to 4); the result is the same for any number\n"
     "  --repeat N      time each robot count N times (fresh world each) and report the run\n"
     "                  with the median steps/s (default 1)\n"
     "  --csv FILE      also write the table as CSV (one row per robot count)\n";
@@ -36,7 +38,8 @@ const char* kHelp =
 }  // namespace
 
 int benchPhysics(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help"}, {"config", "robots", "seconds", "repeat", "csv"});
+  const Options opt(argc, argv, first, {"help"},
+                    {"config", "robots", "seconds", "threads", "repeat", "csv"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
@@ -44,6 +47,14 @@ int benchPhysics(int argc, char** argv, int first) {
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
   cfg.seconds = opt.number("seconds", cfg.seconds);
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
+  if (opt.has("threads")) {
+    const double t = opt.number("threads", 0);
+    if (t < 1 || t > 64 || t != std::floor(t))
+      throw UsageError("--threads must be a whole number from 1 to 64");
+    cfg.base.physics.threads = static_cast<int>(t);
+  }
+  const int threads =
+      cfg.base.physics.threads > 0 ? cfg.base.physics.threads : world::autoSolverThreads();
   const std::string csv = opt.get("csv", "");
   const double repeat_value = opt.number("repeat", 1);
   if (repeat_value < 1 || repeat_value > 1000 || repeat_value != std::floor(repeat_value))
@@ -54,17 +65,26 @@ int benchPhysics(int argc, char** argv, int first) {
   const double dt = cfg.base.physics.dt;
   std::printf(
       "simsoccer bench physics: %s, field %s, dt %.1f ms, control %.1f ms, %d solver "
-      "iterations, %.1f s settling + %.1f s timed per row, one thread\n",
+      "iterations, %d solver thread%s, %.1f s settling + %.1f s timed per row\n",
       config_file.string().c_str(), field.name.c_str(), dt * 1e3,
-      cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, cfg.settle,
-      cfg.seconds);
+      cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, threads,
+      threads == 1 ? "" : "s", cfg.settle, cfg.seconds);
   std::fflush(stdout);
 
   Table table;
-  table.header = {"robots",      "steps_per_s",       "real_time_factor",
-                  "ms_per_step", "contacts_per_step", "robot_contacts_per_step",
-                  "standing",    "collision_pct",     "dynamics_pct",
-                  "solver_pct",  "integrate_pct",     "servo_pct",
+  table.header = {"robots",
+                  "steps_per_s",
+                  "real_time_factor",
+                  "ms_per_step",
+                  "contacts_per_step",
+                  "robot_contacts_per_step",
+                  "solver_batches_per_step",
+                  "standing",
+                  "collision_pct",
+                  "dynamics_pct",
+                  "solver_pct",
+                  "integrate_pct",
+                  "servo_pct",
                   "other_pct"};
   // One timed run with n robots: (steps/s, table row).
   auto measure = [&](int n) {
@@ -79,7 +99,7 @@ int benchPhysics(int argc, char** argv, int first) {
     }
     w.physics().resetStageTimes();
     w.physics().enableStageTimers(true);
-    long contacts = 0, robot_contacts = 0;
+    long contacts = 0, robot_contacts = 0, batches = 0;
     const auto t0 = std::chrono::steady_clock::now();
     for (long i = 0; i < timed_steps; ++i) {
       if (i % per_control == 0) motion.command(w);
@@ -87,6 +107,7 @@ int benchPhysics(int argc, char** argv, int first) {
       const engine::ContactCount cc = w.physics().contactCount();
       contacts += cc.total;
       robot_contacts += cc.between_articulations;
+      batches += w.physics().lastStepSolverBatches();
     }
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -104,6 +125,7 @@ int benchPhysics(int argc, char** argv, int first) {
          fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
          fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
          fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
+         fmt(static_cast<double>(batches) / static_cast<double>(timed_steps), 1),
          std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
          pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s), pct(st.servo_s), pct(other)}};
   };
@@ -119,9 +141,10 @@ int benchPhysics(int argc, char** argv, int first) {
   }
   table.finish(
       "Stages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
-      "dynamics; solver = contact and joint-limit constraints; integrate = positions; "
-      "servo = joint PD torques; other = everything else in the step and the loop "
-      "(commands, contact counting).",
+      "dynamics; solver = contact and joint-limit constraints (their batches side by side "
+      "on the solver threads; 0 batches: one thread, Bullet's own loop); integrate = "
+      "positions; servo = joint PD torques; other = everything else in the step and the "
+      "loop (commands, contact counting).",
       csv);
   return 0;
 }

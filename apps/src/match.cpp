@@ -519,14 +519,16 @@ const char* kPenaltyHelp =
     "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n";
 
 const char* kReplayHelp =
-    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics] [--events]\n"
+    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics [--threads N]]\n"
+    "                            [--events]\n"
     "\n"
     "Reads a match log: prints what it holds (--events: every referee event); --video renders the "
     "spectator camera over\n"
     "[--from, --to] s (default the whole log) to FILE (.mp4 or .avi; .png: one still at\n"
     "--from); --physics re-runs the\n"
     "game through the physics and the referee with the recorded commands and checks every\n"
-    "period's state hash against the log (exit status 1 on the first difference).\n";
+    "period's state hash against the log (exit status 1 on the first difference); --threads:\n"
+    "with N solver threads instead of the scenario's (the hashes must not change).\n";
 
 RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
@@ -694,12 +696,16 @@ int penalty(int argc, char** argv, int first) {
 }
 
 int replay(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "physics", "events"}, {"video", "from", "to"});
+  const Options opt(argc, argv, first, {"help", "physics", "events"},
+                    {"video", "from", "to", "threads"});
   if (opt.help(kReplayHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match log");
   const std::filesystem::path file = opt.positional()[0];
   const double from = opt.number("from", 0.0), to = opt.number("to", 1e12);
   if (to < from) throw UsageError("--to must not be before --from");
+  const double threads = opt.number("threads", 0);
+  if (opt.has("threads") && (threads < 1 || threads > 64 || threads != std::floor(threads)))
+    throw UsageError("--threads must be a whole number from 1 to 64");
   world::MatchLogReader reader(file);
   const auto& h = reader.header().values;
   int frames = 0;
@@ -729,7 +735,7 @@ int replay(int argc, char** argv, int first) {
       std::printf("warning: %s changed since the log was written\n", config.file.c_str());
     if (h.count("half_duration")) config.half_duration = std::stod(h.at("half_duration"));
     const uint64_t seed = std::stoull(h.at("seed"));
-    MatchSession session(config, seed);
+    MatchSession session(config, seed, static_cast<int>(threads));
     world::World& w = session.world();
     world::MatchLogReader again(file);
     int checked = 0;

@@ -109,9 +109,11 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   return c;
 }
 
-MatchSession::MatchSession(const MatchConfig& config, uint64_t seed) : config_(config) {
+MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_threads)
+    : config_(config) {
   world::Scenario s = world::loadScenario(config.scenario);
   s.seed = seed;
+  if (solver_threads > 0) s.physics.threads = solver_threads;
   if (!s.perception.enabled)  // not switched on behind the scenario's back
     throw engine::ConfigError(config.scenario.string(), "perception",
                               "a match's agents see through perception: turn it on");

@@ -71,7 +71,7 @@ class MatchSession {
  public:
   // `seed` overrides the config's. The world is built from the scenario with
   // that seed; the rule book's half duration and break as the config says.
-  MatchSession(const MatchConfig& config, uint64_t seed);
+  MatchSession(const MatchConfig& config, uint64_t seed, int solver_threads = 0);
 
   world::World& world() { return *world_; }
   const world::World& world() const { return *world_; }

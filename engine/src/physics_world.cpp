@@ -18,6 +18,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "island_solver.hpp"
+
 namespace simsoccer::engine {
 namespace {
 
@@ -105,7 +107,8 @@ struct SameRobotFilter : btOverlapFilterCallback {
 class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
  public:
   using btMultiBodyDynamicsWorld::btMultiBodyDynamicsWorld;
-  StageTimes* times = nullptr;  // null: timers off
+  StageTimes* times = nullptr;              // null: timers off
+  ParallelIslandSolver* islands = nullptr;  // null: Bullet solves the islands in turn
 
   void performDiscreteCollisionDetection() override {
     timed(&StageTimes::collision_s,
@@ -118,7 +121,26 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   // share is the whole constraint stage less the forward dynamics inside it.
   void solveConstraints(btContactSolverInfo& info) override {
     const double dynamics_before = times ? times->dynamics_s : 0.0;
-    timed(&StageTimes::solver_s, [&] { btMultiBodyDynamicsWorld::solveConstraints(info); });
+    timed(&StageTimes::solver_s, [&] {
+      if (!islands) {
+        btMultiBodyDynamicsWorld::solveConstraints(info);
+        return;
+      }
+      // Bullet's three stages, the islands solved on the threads in between:
+      // the forward dynamics (which also sorts the constraints by island),
+      // the islands, and what follows Bullet's last batch (joint feedback,
+      // the solver's velocity changes applied; its own batch is empty).
+      solveExternalForces(info);
+      islands->setup(
+          info, m_sortedConstraints.size() ? &m_sortedConstraints[0] : nullptr,
+          m_sortedConstraints.size(),
+          m_sortedMultiBodyConstraints.size() ? &m_sortedMultiBodyConstraints[0] : nullptr,
+          m_sortedMultiBodyConstraints.size());
+      m_islandManager->buildAndProcessIslands(getCollisionWorld()->getDispatcher(),
+                                              getCollisionWorld(), islands);
+      islands->solve(getDebugDrawer(), getCollisionWorld()->getDispatcher());
+      solveInternalConstraints(info);
+    });
     if (times) times->solver_s -= times->dynamics_s - dynamics_before;
   }
   void integrateTransforms(btScalar dt) override {
@@ -288,6 +310,7 @@ struct PhysicsWorld::Impl {
   std::unique_ptr<btDbvtBroadphase> broadphase;
   std::unique_ptr<btMultiBodyConstraintSolver> solver;
   std::unique_ptr<TimedMultiBodyWorld> world;
+  std::unique_ptr<ParallelIslandSolver> islands;  // with solver_threads > 1
   SameRobotFilter filter;
 
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -360,6 +383,7 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   if (!(settings.dt > 0.0)) throw std::invalid_argument("physics dt must be > 0");
   if (settings.friction_directions != 1 && settings.friction_directions != 2)
     throw std::invalid_argument("friction_directions must be 1 or 2");
+  if (settings.solver_threads < 1) throw std::invalid_argument("solver_threads must be >= 1");
   Impl& m = *impl_;
   m.config = std::make_unique<btDefaultCollisionConfiguration>();
   // Several contact points for a box resting on the ground plane (feet).
@@ -370,6 +394,10 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world = std::make_unique<TimedMultiBodyWorld>(m.dispatcher.get(), m.broadphase.get(),
                                                   m.solver.get(), m.config.get());
   m.world->getPairCache()->setOverlapFilterCallback(&m.filter);
+  if (settings.solver_threads > 1) {
+    m.islands = std::make_unique<ParallelIslandSolver>(settings.solver_threads);
+    m.world->islands = m.islands.get();
+  }
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it
   // bounces off anything hard, at its own restitution, while robots, the
@@ -676,6 +704,10 @@ void PhysicsWorld::step() {
     m.times.total_s += std::chrono::duration<double>(Clock::now() - t0).count();
     ++m.times.steps;
   }
+}
+
+int PhysicsWorld::lastStepSolverBatches() const {
+  return impl_->islands ? impl_->islands->batchCount() : 0;
 }
 
 const StageTimes& PhysicsWorld::stageTimes() const {

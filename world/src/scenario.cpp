@@ -1,6 +1,8 @@
 #include "simsoccer/world/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "simsoccer/engine/config.hpp"
 
@@ -100,7 +102,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
     if (!std::filesystem::exists(path)) root.failKey(key, "file not found: " + path.string());
 
   const ConfigNode ph = root["physics"];
-  ph.allowOnly({"dt", "control_period", "solver_iterations", "friction_directions", "gravity"});
+  ph.allowOnly(
+      {"dt", "control_period", "solver_iterations", "friction_directions", "gravity", "threads"});
   s.physics.dt = ph["dt"].positive();
   s.physics.control_period = ph["control_period"].positive();
   s.physics.solver_iterations = ph.integer("solver_iterations", s.physics.solver_iterations);
@@ -109,6 +112,14 @@ Scenario loadScenario(const std::filesystem::path& file) {
   if (s.physics.friction_directions != 1 && s.physics.friction_directions != 2)
     ph.failKey("friction_directions", "must be 1 or 2");
   s.physics.gravity = ph.number("gravity", s.physics.gravity);
+  if (const auto threads = ph.optional("threads")) {
+    if (threads->string() == "auto")
+      s.physics.threads = 0;
+    else if (const int n = threads->integer(); n >= 1 && n <= 64)
+      s.physics.threads = n;
+    else
+      ph.failKey("threads", "must be auto or 1-64");
+  }
   const double ratio = s.physics.control_period / s.physics.dt;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || std::round(ratio) < 1.0)
     ph.failKey("control_period", "must be a whole multiple of dt (" +
@@ -207,6 +218,10 @@ Scenario loadScenario(const std::filesystem::path& file) {
     }
   }
   return s;
+}
+
+int autoSolverThreads() {
+  return std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 4);
 }
 
 }  // namespace simsoccer::world

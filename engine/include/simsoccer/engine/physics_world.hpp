@@ -28,6 +28,9 @@ struct PhysicsSettings {
   double dt = 0.005;            // s, physics step
   int solver_iterations = 10;   // sequential-impulse iterations per step
   int friction_directions = 2;  // friction rows per contact (see world::PhysicsConfig)
+  // Threads that solve the simulation islands (robots and what touches them)
+  // side by side; 1: Bullet's own loop. The result is the same bit for bit.
+  int solver_threads = 1;
   Vec3 gravity{0.0, 0.0, -9.81};
 };
 
@@ -106,6 +109,10 @@ class PhysicsWorld {
   void enableStageTimers(bool on) { timers_on_ = on; }
   const StageTimes& stageTimes() const;
   void resetStageTimes();
+  int solverThreads() const { return settings_.solver_threads; }
+  // Constraint batches the last step's solver solved side by side (0 with one
+  // thread: Bullet's own loop).
+  int lastStepSolverBatches() const;
 
   // --- reading -----------------------------------------------------------------
   // Joint frame of a link in the world.

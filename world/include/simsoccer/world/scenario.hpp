@@ -31,7 +31,15 @@ struct PhysicsConfig {
   // cannot walk. Kept for comparisons only.
   int friction_directions = 2;
   double gravity = -9.81;  // m/s^2 along z
+  // Threads that solve the constraint batches (groups of robots and what
+  // touches them) side by side; 0 (`auto`, the default): autoSolverThreads().
+  // The result is the same bit for bit for any number.
+  int threads = 0;
 };
+
+// One thread per core, at most 4: a step of 22 robots has about 6 batches,
+// and the agents of a lockstep match wait while the physics steps.
+int autoSolverThreads();
 
 // Standard deviations of the seeded random perturbations applied when the
 // robots are placed (0 = exact placement).

@@ -1,0 +1,97 @@
+// Solving the simulation islands of a btMultiBodyDynamicsWorld on several
+// threads (engine-internal).
+//
+// An island is a set of bodies that touch or are jointed (a robot, robots in
+// contact, the ball against a foot); islands share no body. Bullet solves
+// them in batches: it appends island after island to a batch until the batch
+// holds more than m_minimumSolverBatchSize manifolds and constraints, solves
+// it, and starts the next. Here the batches are formed the same way, then
+// solved side by side on several threads, each with its own solver. A batch
+// reads and writes only its own bodies, so the result is Bullet's, bit for
+// bit, whatever the number of threads (the tests hold it to that). (Solving
+// each island on its own would not be: a batch iterates until all its rows
+// have converged, which differs in the last bits from stopping each island
+// when its own rows have.)
+#pragma once
+
+#include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace simsoccer::engine {
+
+// Threads that run one job together: run() calls job(i) on every thread i
+// (0 is the caller's) and returns when all have finished.
+class WorkerThreads {
+ public:
+  explicit WorkerThreads(int threads);  // threads >= 1; threads - 1 are started
+  ~WorkerThreads();
+  WorkerThreads(const WorkerThreads&) = delete;
+  WorkerThreads& operator=(const WorkerThreads&) = delete;
+  int count() const { return static_cast<int>(workers_.size()) + 1; }
+  void run(const std::function<void(int)>& job);
+
+ private:
+  void loop(int index);
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_, finished_;
+  const std::function<void(int)>* job_ = nullptr;
+  uint64_t generation_ = 0;
+  int running_ = 0;
+  bool stop_ = false;
+};
+
+// The island callback: collects the islands while Bullet's island manager
+// builds them, then solves them on the threads.
+class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
+ public:
+  explicit ParallelIslandSolver(int threads);
+
+  // Before the islands are built: the solver settings and the world's
+  // constraints, sorted by island (as Bullet sorts them for its own callback).
+  void setup(const btContactSolverInfo& info, btTypedConstraint** constraints, int num_constraints,
+             btMultiBodyConstraint** multibody_constraints, int num_multibody_constraints);
+  void processIsland(btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds,
+                     int num_manifolds, int island_id) override;
+  // Solves every batch collected since setup().
+  void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher);
+  int batchCount() const { return static_cast<int>(batch_count_); }
+
+ private:
+  struct Batch {
+    btAlignedObjectArray<btCollisionObject*> bodies;
+    btAlignedObjectArray<btPersistentManifold*> manifolds;
+    btAlignedObjectArray<btTypedConstraint*> constraints;
+    btAlignedObjectArray<btMultiBodyConstraint*> multibody_constraints;
+    long cost = 0;  // about the number of solver rows
+  };
+  Batch& openBatch();  // the batch islands are appended to
+  void solveBatch(btMultiBodyConstraintSolver& solver, Batch& batch);
+
+  WorkerThreads threads_;
+  std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  // one per thread
+  std::vector<Batch> batches_;                                         // reused step to step
+  size_t batch_count_ = 0;  // in use this step; the last one may still be open
+  bool batch_open_ = false;
+  std::vector<std::vector<size_t>> shares_;  // per thread: its batches
+  std::vector<size_t> order_;                // batches, largest first
+  std::vector<long> load_;                   // per thread: the cost of its batches
+  std::function<void(int)> job_;             // thread t solves shares_[t]
+  btTypedConstraint** constraints_ = nullptr;
+  int num_constraints_ = 0;
+  btMultiBodyConstraint** multibody_constraints_ = nullptr;
+  int num_multibody_constraints_ = 0;
+  const btContactSolverInfo* info_ = nullptr;
+  btIDebugDraw* debug_draw_ = nullptr;
+  btDispatcher* dispatcher_ = nullptr;
+};
+
+}  // namespace simsoccer::engine
