@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/fields/field_model.hpp"
@@ -19,11 +20,9 @@ namespace {
 class ConfigErrors : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("simsoccer_cfg_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    tmp_ = std::make_unique<test::TempDir>(
+        "cfg_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir_ = tmp_->path();
     robot_ = test::readFile(test::naoH25());
     scenario_ = test::readFile(test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml");
     // Point the copied scenario at the copied robot file and the real field.
@@ -31,7 +30,7 @@ class ConfigErrors : public ::testing::Test {
     replace(scenario_, "../../robots/nao_v6_h25.yaml", (dir_ / "robot.yaml").string());
     replace(scenario_, "../../robots/nao_h21.yaml", test::naoH21().string());
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override { tmp_.reset(); }
 
   static void replace(std::string& s, const std::string& from, const std::string& to) {
     const size_t at = s.find(from);
@@ -60,6 +59,7 @@ class ConfigErrors : public ::testing::Test {
     EXPECT_NE(what.find(reason), std::string::npos) << what;
   }
 
+  std::unique_ptr<test::TempDir> tmp_;  // removed after each test
   fs::path dir_;
   std::string robot_, scenario_;
 };

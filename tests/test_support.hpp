@@ -2,16 +2,22 @@
 // small scenarios built in code.
 #pragma once
 
+#include <arpa/inet.h>
 #include <ifaddrs.h>
 #include <net/if.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <sstream>
+#include <optional>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "simsoccer/world/scenario.hpp"
@@ -61,37 +67,62 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
-// True if an interface other than loopback is up and can multicast (what
-// configs/dds/lan.xml needs).
-inline bool hasMulticastInterface() {
+// The IPv4 address of an interface other than loopback that is up, running
+// and can multicast (what configs/dds/lan.xml needs); none if there is none.
+inline std::optional<in_addr> multicastInterfaceAddress() {
   ifaddrs* list = nullptr;
-  if (getifaddrs(&list) != 0) return false;
-  bool found = false;
+  if (getifaddrs(&list) != 0) return std::nullopt;
+  std::optional<in_addr> found;
   for (const ifaddrs* a = list; a && !found; a = a->ifa_next)
-    found = a->ifa_addr && a->ifa_addr->sa_family == AF_INET && (a->ifa_flags & IFF_UP) &&
-            (a->ifa_flags & IFF_MULTICAST) && !(a->ifa_flags & IFF_LOOPBACK);
+    if (a->ifa_addr && a->ifa_addr->sa_family == AF_INET && (a->ifa_flags & IFF_UP) &&
+        (a->ifa_flags & IFF_RUNNING) && (a->ifa_flags & IFF_MULTICAST) &&
+        !(a->ifa_flags & IFF_LOOPBACK))
+      found = reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr;
   freeifaddrs(list);
   return found;
 }
 
-// Packets sent on all interfaces but loopback (/proc/net/dev).
-inline unsigned long long networkPacketsSent() {
-  std::ifstream in("/proc/net/dev");
-  std::string line;
-  unsigned long long total = 0;
-  while (std::getline(in, line)) {
-    const size_t colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    std::string name = line.substr(0, colon);
-    name.erase(0, name.find_first_not_of(' '));
-    if (name == "lo") continue;
-    std::istringstream fields(line.substr(colon + 1));
-    unsigned long long v[10] = {};
-    for (auto& x : v) fields >> x;  // received: 8 fields; sent: bytes, packets, ...
-    total += v[9];
+// Listens, on a network interface, for the RTPS participant announcements
+// (SPDP) that Cyclone DDS multicasts for a domain: 239.255.0.1, port
+// 7400 + 250 x domain (the RTPS specification's defaults). Created before the
+// participants, it shares the port with them.
+class SpdpMulticastListener {
+ public:
+  SpdpMulticastListener(uint32_t domain, in_addr interface_address) {
+    fd_ = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+    const int one = 1;
+    setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    setsockopt(fd_, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
+    sockaddr_in at{};
+    at.sin_family = AF_INET;
+    at.sin_port = htons(static_cast<uint16_t>(7400 + 250 * domain));
+    at.sin_addr.s_addr = htonl(INADDR_ANY);
+    ip_mreq group{};
+    inet_pton(AF_INET, "239.255.0.1", &group.imr_multiaddr);
+    group.imr_interface = interface_address;
+    ok_ = fd_ >= 0 && bind(fd_, reinterpret_cast<const sockaddr*>(&at), sizeof at) == 0 &&
+          setsockopt(fd_, IPPROTO_IP, IP_ADD_MEMBERSHIP, &group, sizeof group) == 0;
   }
-  return total;
-}
+  ~SpdpMulticastListener() {
+    if (fd_ >= 0) close(fd_);
+  }
+  SpdpMulticastListener(const SpdpMulticastListener&) = delete;
+  SpdpMulticastListener& operator=(const SpdpMulticastListener&) = delete;
+  bool ok() const { return ok_; }
+  // RTPS datagrams received so far (reads what is waiting).
+  int received() {
+    char buf[2048];
+    ssize_t n;
+    while ((n = recv(fd_, buf, sizeof buf, 0)) > 0)
+      if (n >= 4 && std::memcmp(buf, "RTPS", 4) == 0) ++count_;
+    return count_;
+  }
+
+ private:
+  int fd_ = -1;
+  bool ok_ = false;
+  int count_ = 0;
+};
 inline std::filesystem::path dataDir() {
   return sourceDir() / "tests" / "data";
 }

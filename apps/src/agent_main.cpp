@@ -30,6 +30,9 @@ const char* kHelp =
     "                       [--if-owned wait|refuse] [--game-state-wait S]\n"
     "\n"
     "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
+    "  --dds-config FILE\n"
+    "                   Cyclone DDS configuration (default configs/dds/loopback.xml;\n"
+    "                   configs/dds/lan.xml when the simulator runs on another machine)\n"
     "  --lease S        s the simulator waits after this process went silent (crashed)\n"
     "                   before it frees the robot (default 5; shorter costs more traffic)\n"
     "  --role ROLE      play soccer: auto (the GameState's goalkeeper keeps goal, the field\n"
@@ -52,7 +55,8 @@ const char* kHelp =
     "                   before claiming the robot (the match starts its agents so)\n"
     "A robot owned by another agent is waited for (its owner may have crashed: the simulator\n"
     "frees the robot when that agent's lease runs out) for up to --claim-timeout (default 10 s);\n"
-    "with --if-owned refuse the agent gives up as soon as the simulator refuses it.\n"
+    "with --if-owned refuse (the default is wait) it gives up as soon as the simulator refuses "
+    "it.\n"
     "Exit status: 0 done, 3 the robot was not granted in time, 4 the simulator went away.\n";
 
 }  // namespace

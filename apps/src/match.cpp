@@ -501,6 +501,7 @@ const char* kMatchHelp =
     "  --lockstep-timeout S  wall seconds a period waits for the agents (overrides the\n"
     "                config's lockstep.timeout; a missed answer changes the game, and\n"
     "                summary.json counts them per robot: raise it on a loaded machine)\n"
+    "  --domain D          DDS domain id (default 0): one per match running side by side\n"
     "  --external-agents   start no agents: wait for agents started elsewhere (same domain)\n"
     "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"
     "                configs/dds/loopback.xml; configs/dds/lan.xml for agents on other machines)\n"
@@ -516,7 +517,10 @@ const char* kPenaltyHelp =
     "plays the penalty roles in the shoot-out phase), the shoot-out rules of the referee\n"
     "(30 s per kick, the keeper on its line until the kick). Prints and writes the scoring\n"
     "rate with a 95 % confidence interval (Wilson) and each kick's outcome (goal / saved /\n"
-    "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n";
+    "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n"
+    "  --domain D          DDS domain id (default 0)\n"
+    "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"
+    "                      configs/dds/loopback.xml)\n";
 
 const char* kReplayHelp =
     "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics [--threads N]]\n"
@@ -537,7 +541,10 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   o.domain = static_cast<uint32_t>(opt.number("domain", 0));
   o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   if (!std::filesystem::is_regular_file(o.dds_config))
-    throw UsageError("--dds-config " + o.dds_config.string() + ": no such file");
+    throw UsageError(opt.has("dds-config")
+                         ? "--dds-config " + o.dds_config.string() + ": no such file"
+                         : "the default DDS configuration " + o.dds_config.string() +
+                               " is missing (give one with --dds-config)");
   o.quiet = opt.flag("quiet");
   return o;
 }
