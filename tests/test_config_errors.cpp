@@ -85,8 +85,9 @@ TEST_F(ConfigErrors, WrongType) {
 }
 
 TEST_F(ConfigErrors, SolverThreadsMustBeAutoOrACount) {
-  replace(scenario_, "threads: auto", "threads: 0");
-  expectError("scenario.yaml", "physics.threads", "must be auto or 1-64");
+  replace(scenario_, "threads: auto", "threads: two");
+  expectError("scenario.yaml", "physics.threads",
+              "must be auto or a whole number from 1 to 64, got 'two'");
 }
 
 TEST_F(ConfigErrors, UnknownKeyIsATypo) {

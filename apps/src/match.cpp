@@ -713,6 +713,8 @@ int replay(int argc, char** argv, int first) {
   const double threads = opt.number("threads", 0);
   if (opt.has("threads") && (threads < 1 || threads > 64 || threads != std::floor(threads)))
     throw UsageError("--threads must be a whole number from 1 to 64");
+  if (opt.has("threads") && !opt.flag("physics"))
+    throw UsageError("--threads goes with --physics (the solver threads of the re-run)");
   world::MatchLogReader reader(file);
   const auto& h = reader.header().values;
   int frames = 0;

@@ -12,16 +12,26 @@ namespace simsoccer::engine {
 
 WorkerThreads::WorkerThreads(int threads) {
   if (threads < 1) throw std::invalid_argument("WorkerThreads: threads must be >= 1");
-  for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { loop(i); });
+  try {
+    for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { loop(i); });
+  } catch (...) {  // a thread could not start: stop those that did
+    stop();
+    throw;
+  }
 }
 
 WorkerThreads::~WorkerThreads() {
+  stop();
+}
+
+void WorkerThreads::stop() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
   }
   start_.notify_all();
-  for (std::thread& t : workers_) t.join();
+  for (std::thread& t : workers_)
+    if (t.joinable()) t.join();
 }
 
 void WorkerThreads::run(const std::function<void(int)>& job) {
@@ -33,13 +43,22 @@ void WorkerThreads::run(const std::function<void(int)>& job) {
     std::lock_guard lock(mutex_);
     job_ = &job;
     running_ = static_cast<int>(workers_.size());
+    error_ = nullptr;
     ++generation_;
   }
   start_.notify_all();
-  job(0);
+  std::exception_ptr own;
+  try {
+    job(0);
+  } catch (...) {
+    own = std::current_exception();
+  }
+  // Always wait: the workers use what the job refers to.
   std::unique_lock lock(mutex_);
   finished_.wait(lock, [&] { return running_ == 0; });
   job_ = nullptr;
+  if (own) std::rethrow_exception(own);
+  if (error_) std::rethrow_exception(error_);
 }
 
 void WorkerThreads::loop(int index) {
@@ -53,10 +72,16 @@ void WorkerThreads::loop(int index) {
       seen = generation_;
       job = job_;
     }
-    (*job)(index);
+    std::exception_ptr error;
+    try {
+      (*job)(index);
+    } catch (...) {  // handed to run()'s caller
+      error = std::current_exception();
+    }
     bool last = false;
     {
       std::lock_guard lock(mutex_);
+      if (error && !error_) error_ = error;
       last = --running_ == 0;
     }
     if (last) finished_.notify_one();
@@ -86,9 +111,9 @@ void appendIsland(T** sorted, int n, int island, btAlignedObjectArray<T*>& out) 
 }  // namespace
 
 ParallelIslandSolver::ParallelIslandSolver(int threads) : threads_(threads) {
-  for (int i = 0; i < threads_.count(); ++i)
+  for (int i = 0; i < threads; ++i)
     solvers_.push_back(std::make_unique<btMultiBodyConstraintSolver>());
-  shares_.resize(static_cast<size_t>(threads_.count()));
+  shares_.resize(static_cast<size_t>(threads));
   load_.resize(shares_.size());
   job_ = [this](int t) {
     for (const size_t i : shares_[static_cast<size_t>(t)]) solveBatch(*solvers_[t], batches_[i]);
@@ -164,8 +189,9 @@ void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatc
   // arrays keep their capacity: no allocation once warmed up).
   order_.resize(batch_count_);
   std::iota(order_.begin(), order_.end(), size_t{0});
-  std::stable_sort(order_.begin(), order_.end(),
-                   [&](size_t a, size_t b) { return batches_[a].cost > batches_[b].cost; });
+  std::sort(order_.begin(), order_.end(), [&](size_t a, size_t b) {
+    return batches_[a].cost != batches_[b].cost ? batches_[a].cost > batches_[b].cost : a < b;
+  });
   std::fill(load_.begin(), load_.end(), 0L);
   for (auto& share : shares_) share.clear();
   for (const size_t i : order_) {

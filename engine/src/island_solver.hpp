@@ -19,6 +19,7 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -28,7 +29,8 @@
 namespace simsoccer::engine {
 
 // Threads that run one job together: run() calls job(i) on every thread i
-// (0 is the caller's) and returns when all have finished.
+// (0 is the caller's) and returns when all have finished; an exception thrown
+// by the job on any thread is rethrown there, after all have finished.
 class WorkerThreads {
  public:
   explicit WorkerThreads(int threads);  // threads >= 1; threads - 1 are started
@@ -40,6 +42,7 @@ class WorkerThreads {
 
  private:
   void loop(int index);
+  void stop();
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable start_, finished_;
@@ -47,10 +50,16 @@ class WorkerThreads {
   uint64_t generation_ = 0;
   int running_ = 0;
   bool stop_ = false;
+  std::exception_ptr error_;  // the first a worker threw in this run
 };
 
 // The island callback: collects the islands while Bullet's island manager
-// builds them, then solves them on the threads.
+// builds them, then solves them on the threads. It relies on batches sharing
+// no body that the solver writes: true for dynamic rigid bodies and floating-
+// base multibodies (each in one island), which is all the engine creates; a
+// kinematic body or a fixed-base multibody touching two batches would be
+// written by two threads (their solver ids). PhysicsWorld uses Bullet's own
+// loop when the solver randomises its order or islands are not split.
 class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
  public:
   explicit ParallelIslandSolver(int threads);
@@ -76,7 +85,6 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   Batch& openBatch();  // the batch islands are appended to
   void solveBatch(btMultiBodyConstraintSolver& solver, Batch& batch);
 
-  WorkerThreads threads_;
   std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  // one per thread
   std::vector<Batch> batches_;                                         // reused step to step
   size_t batch_count_ = 0;  // in use this step; the last one may still be open
@@ -85,6 +93,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   std::vector<size_t> order_;                // batches, largest first
   std::vector<long> load_;                   // per thread: the cost of its batches
   std::function<void(int)> job_;             // thread t solves shares_[t]
+  WorkerThreads threads_;                    // last: stopped before the rest goes
   btTypedConstraint** constraints_ = nullptr;
   int num_constraints_ = 0;
   btMultiBodyConstraint** multibody_constraints_ = nullptr;

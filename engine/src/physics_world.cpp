@@ -122,8 +122,13 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   void solveConstraints(btContactSolverInfo& info) override {
     const double dynamics_before = times ? times->dynamics_s : 0.0;
     timed(&StageTimes::solver_s, [&] {
-      if (!islands) {
+      // Bullet's own loop with one thread, and where batches could share
+      // state: a randomised row order (one seed across batches) or islands
+      // not split (one group).
+      if (!islands || (info.m_solverMode & SOLVER_RANDMIZE_ORDER) ||
+          !m_islandManager->getSplitIslands()) {
         btMultiBodyDynamicsWorld::solveConstraints(info);
+        if (islands) islands->setup(info, nullptr, 0, nullptr, 0);  // no batches this step
         return;
       }
       // Bullet's three stages, the islands solved on the threads in between:

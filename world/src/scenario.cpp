@@ -1,6 +1,9 @@
 #include "simsoccer/world/scenario.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <thread>
 
@@ -113,12 +116,15 @@ Scenario loadScenario(const std::filesystem::path& file) {
     ph.failKey("friction_directions", "must be 1 or 2");
   s.physics.gravity = ph.number("gravity", s.physics.gravity);
   if (const auto threads = ph.optional("threads")) {
-    if (threads->string() == "auto")
+    const std::string text = threads->raw().IsScalar() ? threads->raw().Scalar() : "";
+    int n = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), n);
+    if (text == "auto")
       s.physics.threads = 0;
-    else if (const int n = threads->integer(); n >= 1 && n <= 64)
+    else if (error == std::errc() && end == text.data() + text.size() && n >= 1 && n <= 64)
       s.physics.threads = n;
     else
-      ph.failKey("threads", "must be auto or 1-64");
+      ph.failKey("threads", "must be auto or a whole number from 1 to 64, got '" + text + "'");
   }
   const double ratio = s.physics.control_period / s.physics.dt;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || std::round(ratio) < 1.0)
@@ -221,7 +227,14 @@ Scenario loadScenario(const std::filesystem::path& file) {
 }
 
 int autoSolverThreads() {
-  return std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 4);
+  // The cores this process may run on (a container or `taskset` may allow
+  // fewer than the machine has).
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  const int n = sched_getaffinity(0, sizeof cpus, &cpus) == 0
+                    ? CPU_COUNT(&cpus)
+                    : static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(n, 1, 4);
 }
 
 }  // namespace simsoccer::world

@@ -37,8 +37,9 @@ struct PhysicsConfig {
   int threads = 0;
 };
 
-// One thread per core, at most 4: a step of 22 robots has about 6 batches,
-// and the agents of a lockstep match wait while the physics steps.
+// One thread per core this process may run on, at most 4: a step of 22
+// robots has about 6 batches, and the agents of a lockstep match wait while
+// the physics steps.
 int autoSolverThreads();
 
 // Standard deviations of the seeded random perturbations applied when the
