@@ -260,20 +260,18 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
                        status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("/proc/simsoccer_no"), std::string::npos) << out;
-  out =
-      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                           " --lockstep-timeout 0 --out " + (dir / "never").string(),
-                       status);
-  EXPECT_NE(status, 0);
-  EXPECT_NE(out.find("--lockstep-timeout must be > 0"), std::string::npos) << out;
-  EXPECT_FALSE(std::filesystem::exists(dir / "never"));  // refused before anything ran
-  out =
-      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
-                           " --dds-config /nonexistent/lan.xml --out " + (dir / "never").string(),
-                       status);
-  EXPECT_NE(status, 0);
-  EXPECT_NE(out.find("--dds-config /nonexistent/lan.xml: no such file"), std::string::npos) << out;
-  EXPECT_FALSE(std::filesystem::exists(dir / "never"));
+  // Bad options: refused with `message`, before anything is written.
+  const auto refused = [&](const std::string& options, const std::string& message) {
+    const std::string said = test::runCommand(
+        kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() + " " + options +
+            " --out " + (dir / "never").string(),
+        status);
+    EXPECT_NE(status, 0);
+    EXPECT_NE(said.find(message), std::string::npos) << said;
+    EXPECT_FALSE(std::filesystem::exists(dir / "never"));
+  };
+  refused("--lockstep-timeout 0", "--lockstep-timeout must be > 0");
+  refused("--dds-config /nonexistent/lan.xml", "--dds-config /nonexistent/lan.xml: no such file");
 }
 
 // --dds-config: the simulator and the agents it starts use configs/dds/lan.xml

@@ -118,6 +118,16 @@ double seconds(Clock::time_point a) {
   return std::chrono::duration<double>(Clock::now() - a).count();
 }
 
+// simsoccer-agent for robot (0, 1) with `options`: a usage error (exit status
+// 2) that names `option`.
+void expectAgentUsageError(const std::string& options, const std::string& option) {
+  int status = 0;
+  const std::string out = runCommand(
+      std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 " + options + " 2>&1", status);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;
+  EXPECT_NE(out.find(option), std::string::npos) << out;
+}
+
 }  // namespace
 
 TEST(Net, RoundTripAgentDrivesItsRobot) {
@@ -454,12 +464,7 @@ TEST(NetApps, BadLeaseAndMissingDdsConfigAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/loopback.xml"), std::string::npos)
         << e.what();
   }
-  int status = 0;
-  const std::string out = runCommand(
-      std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 --domain 123 --lease 0 2>&1",
-      status);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;  // a usage error
-  EXPECT_NE(out.find("--lease"), std::string::npos) << out;
+  expectAgentUsageError("--domain 123 --lease 0", "--lease");
 }
 
 // simsoccer-agent for a robot another agent owns: --if-owned refuse gives up
@@ -497,12 +502,7 @@ TEST(NetApps, AnAgentProgramRefusedItsRobotGivesUpOrWaits) {
   EXPECT_TRUE(server.stats(0).owned);
   EXPECT_EQ(server.stats(0).missed, 0u);
   EXPECT_GT(server.stats(0).accepted, accepted + 50);  // the owner drove it all along
-  int status = 0;
-  const std::string out = runCommand(
-      std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 --domain 124 --if-owned never 2>&1",
-      status);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << out;  // a usage error
-  EXPECT_NE(out.find("--if-owned"), std::string::npos) << out;
+  expectAgentUsageError("--domain 124 --if-owned never", "--if-owned");
 }
 
 TEST(NetApps, ServeRunsAScenarioForAnExternalAgent) {
