@@ -17,6 +17,7 @@
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
+#include "simsoccer/engine/config.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
 namespace {
@@ -96,7 +97,9 @@ int main(int argc, char** argv) {
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
     dds.lease = opt.number("lease", dds.lease);
     if (!(dds.lease >= net::DomainConfig::kMinLease && dds.lease <= net::DomainConfig::kMaxLease))
-      throw apps::UsageError("--lease must be between 0.1 and 86400 s");
+      throw apps::UsageError("--lease must be between " +
+                             engine::formatNumber(net::DomainConfig::kMinLease) + " and " +
+                             engine::formatNumber(net::DomainConfig::kMaxLease) + " s");
     const auto robot_file = apps::findConfig(opt.get("robot", ""), "robots/nao_v6_h25.yaml");
     const std::string mode = opt.get("mode", "nod");
     const std::string if_owned = opt.get("if-owned", "wait");

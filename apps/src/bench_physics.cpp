@@ -47,19 +47,11 @@ int benchPhysics(int argc, char** argv, int first) {
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
   cfg.seconds = opt.number("seconds", cfg.seconds);
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
-  if (opt.has("threads")) {
-    const double t = opt.number("threads", 0);
-    if (t < 1 || t > 64 || t != std::floor(t))
-      throw UsageError("--threads must be a whole number from 1 to 64");
-    cfg.base.physics.threads = static_cast<int>(t);
-  }
-  const int threads =
-      cfg.base.physics.threads > 0 ? cfg.base.physics.threads : world::autoSolverThreads();
+  cfg.base.physics.threads =
+      opt.wholeNumber("threads", cfg.base.physics.threads, 1, world::PhysicsConfig::kMaxThreads);
+  const int threads = world::solverThreads(cfg.base.physics);
   const std::string csv = opt.get("csv", "");
-  const double repeat_value = opt.number("repeat", 1);
-  if (repeat_value < 1 || repeat_value > 1000 || repeat_value != std::floor(repeat_value))
-    throw UsageError("--repeat must be a whole number from 1 to 1000");
-  const int repeat = static_cast<int>(repeat_value);
+  const int repeat = opt.wholeNumber("repeat", 1, 1, 1000);
 
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
   const double dt = cfg.base.physics.dt;

@@ -62,6 +62,15 @@ double Options::number(const std::string& name, double fallback) const {
   }
 }
 
+int Options::wholeNumber(const std::string& name, int fallback, int lo, int hi) const {
+  if (!has(name)) return fallback;
+  const double v = number(name, fallback);
+  if (v < lo || v > hi || v != std::floor(v))
+    throw UsageError("--" + name + " must be a whole number from " + std::to_string(lo) + " to " +
+                     std::to_string(hi));
+  return static_cast<int>(v);
+}
+
 std::vector<int> Options::intList(const std::string& name, const std::vector<int>& fallback) const {
   if (!has(name)) return fallback;
   std::vector<int> out;

@@ -23,6 +23,9 @@ class Options {
   bool has(const std::string& name) const { return values_.count(name) > 0; }
   std::string get(const std::string& name, const std::string& fallback) const;
   double number(const std::string& name, double fallback) const;
+  // A whole number from `lo` to `hi` (a usage error naming the option if
+  // not), or `fallback` when the option is not given.
+  int wholeNumber(const std::string& name, int fallback, int lo, int hi) const;
   std::vector<int> intList(const std::string& name, const std::vector<int>& fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
   // --help given: prints `text` and returns true.

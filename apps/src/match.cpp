@@ -710,9 +710,7 @@ int replay(int argc, char** argv, int first) {
   const std::filesystem::path file = opt.positional()[0];
   const double from = opt.number("from", 0.0), to = opt.number("to", 1e12);
   if (to < from) throw UsageError("--to must not be before --from");
-  const double threads = opt.number("threads", 0);
-  if (opt.has("threads") && (threads < 1 || threads > 64 || threads != std::floor(threads)))
-    throw UsageError("--threads must be a whole number from 1 to 64");
+  const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
   if (opt.has("threads") && !opt.flag("physics"))
     throw UsageError("--threads goes with --physics (the solver threads of the re-run)");
   world::MatchLogReader reader(file);
@@ -744,7 +742,7 @@ int replay(int argc, char** argv, int first) {
       std::printf("warning: %s changed since the log was written\n", config.file.c_str());
     if (h.count("half_duration")) config.half_duration = std::stod(h.at("half_duration"));
     const uint64_t seed = std::stoull(h.at("seed"));
-    MatchSession session(config, seed, static_cast<int>(threads));
+    MatchSession session(config, seed, threads);
     world::World& w = session.world();
     world::MatchLogReader again(file);
     int checked = 0;

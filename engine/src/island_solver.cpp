@@ -100,12 +100,13 @@ int islandOf(const btMultiBodyConstraint* c) {
   return a >= 0 ? a : c->getIslandIdB();
 }
 
-// The constraints of `island` in an array sorted by island: appended to `out`.
+// The constraints of `island` in an array sorted by island: appended to `out`
+// (found by bisection: every island of every step looks them up).
 template <class T>
 void appendIsland(T** sorted, int n, int island, btAlignedObjectArray<T*>& out) {
-  int i = 0;
-  while (i < n && islandOf(sorted[i]) != island) ++i;
-  for (; i < n && islandOf(sorted[i]) == island; ++i) out.push_back(sorted[i]);
+  T** i = std::lower_bound(sorted, sorted + n, island,
+                           [](const T* c, int id) { return islandOf(c) < id; });
+  for (; i != sorted + n && islandOf(*i) == island; ++i) out.push_back(*i);
 }
 
 }  // namespace
@@ -157,15 +158,9 @@ void ParallelIslandSolver::processIsland(btCollisionObject** bodies, int num_bod
   }
   const int constraints_before = batch.constraints.size(),
             multibody_before = batch.multibody_constraints.size();
-  if (island_id < 0) {  // the islands are not split: everything is one
-    for (int i = 0; i < num_constraints_; ++i) batch.constraints.push_back(constraints_[i]);
-    for (int i = 0; i < num_multibody_constraints_; ++i)
-      batch.multibody_constraints.push_back(multibody_constraints_[i]);
-  } else {
-    appendIsland(constraints_, num_constraints_, island_id, batch.constraints);
-    appendIsland(multibody_constraints_, num_multibody_constraints_, island_id,
-                 batch.multibody_constraints);
-  }
+  appendIsland(constraints_, num_constraints_, island_id, batch.constraints);
+  appendIsland(multibody_constraints_, num_multibody_constraints_, island_id,
+               batch.multibody_constraints);
   batch.cost += (batch.constraints.size() - constraints_before) +
                 (batch.multibody_constraints.size() - multibody_before) + 1;
   // Bullet's rule (MultiBodyInplaceSolverIslandCallback::processIsland).

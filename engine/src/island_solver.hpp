@@ -59,7 +59,8 @@ class WorkerThreads {
 // base multibodies (each in one island), which is all the engine creates; a
 // kinematic body or a fixed-base multibody touching two batches would be
 // written by two threads (their solver ids). PhysicsWorld uses Bullet's own
-// loop when the solver randomises its order or islands are not split.
+// loop when the solver randomises its order or islands are not split (island
+// ids are then >= 0 here).
 class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
  public:
   explicit ParallelIslandSolver(int threads);
@@ -72,6 +73,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
                      int num_manifolds, int island_id) override;
   // Solves every batch collected since setup().
   void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher);
+  void clear() { batch_count_ = 0; }  // a step solved without it
   int batchCount() const { return static_cast<int>(batch_count_); }
 
  private:

@@ -128,7 +128,7 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
       if (!islands || (info.m_solverMode & SOLVER_RANDMIZE_ORDER) ||
           !m_islandManager->getSplitIslands()) {
         btMultiBodyDynamicsWorld::solveConstraints(info);
-        if (islands) islands->setup(info, nullptr, 0, nullptr, 0);  // no batches this step
+        if (islands) islands->clear();  // no batches this step
         return;
       }
       // Bullet's three stages, the islands solved on the threads in between:

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "simsoccer/engine/config.hpp"
+
 namespace simsoccer::net {
 
 DdsError::DdsError(const std::string& what, dds_return_t code)
@@ -30,9 +32,10 @@ Entity::~Entity() {
 
 Participant::Participant(const DomainConfig& config) {
   if (!(config.lease >= DomainConfig::kMinLease && config.lease <= DomainConfig::kMaxLease))
-    throw std::invalid_argument(
-        "DDS lease must be between " + std::to_string(DomainConfig::kMinLease) + " and " +
-        std::to_string(DomainConfig::kMaxLease) + " s, not " + std::to_string(config.lease));
+    throw std::invalid_argument("DDS lease must be between " +
+                                engine::formatNumber(DomainConfig::kMinLease) + " and " +
+                                engine::formatNumber(DomainConfig::kMaxLease) + " s, not " +
+                                engine::formatNumber(config.lease));
   if (!config.config_file.empty()) {
     std::ifstream f(config.config_file);
     if (!f)

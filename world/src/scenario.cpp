@@ -121,10 +121,13 @@ Scenario loadScenario(const std::filesystem::path& file) {
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), n);
     if (text == "auto")
       s.physics.threads = 0;
-    else if (error == std::errc() && end == text.data() + text.size() && n >= 1 && n <= 64)
+    else if (error == std::errc() && end == text.data() + text.size() && n >= 1 &&
+             n <= PhysicsConfig::kMaxThreads)
       s.physics.threads = n;
     else
-      ph.failKey("threads", "must be auto or a whole number from 1 to 64, got '" + text + "'");
+      ph.failKey("threads", "must be auto or a whole number from 1 to " +
+                                std::to_string(PhysicsConfig::kMaxThreads) + ", got '" + text +
+                                "'");
   }
   const double ratio = s.physics.control_period / s.physics.dt;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || std::round(ratio) < 1.0)
@@ -226,7 +229,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
   return s;
 }
 
-int autoSolverThreads() {
+int solverThreads(const PhysicsConfig& physics) {
+  if (physics.threads > 0) return physics.threads;
   // The cores this process may run on (a container or `taskset` may allow
   // fewer than the machine has).
   cpu_set_t cpus;

@@ -50,7 +50,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   settings.solver_iterations = pc.solver_iterations;
   settings.friction_directions = pc.friction_directions;
   settings.gravity = Vec3(0, 0, pc.gravity);
-  settings.solver_threads = pc.threads > 0 ? pc.threads : autoSolverThreads();
+  settings.solver_threads = solverThreads(pc);
   physics_ = std::make_unique<engine::PhysicsWorld>(settings);
   fields::addFieldToPhysics(*physics_, *field_);
 

@@ -109,7 +109,6 @@ class PhysicsWorld {
   void enableStageTimers(bool on) { timers_on_ = on; }
   const StageTimes& stageTimes() const;
   void resetStageTimes();
-  int solverThreads() const { return settings_.solver_threads; }
   // Constraint batches the last step's solver solved side by side (0 with one
   // thread: Bullet's own loop).
   int lastStepSolverBatches() const;

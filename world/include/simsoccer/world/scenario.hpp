@@ -32,15 +32,17 @@ struct PhysicsConfig {
   int friction_directions = 2;
   double gravity = -9.81;  // m/s^2 along z
   // Threads that solve the constraint batches (groups of robots and what
-  // touches them) side by side; 0 (`auto`, the default): autoSolverThreads().
+  // touches them) side by side; 0 (`auto`, the default): see solverThreads().
   // The result is the same bit for bit for any number.
   int threads = 0;
+  static constexpr int kMaxThreads = 64;
 };
 
-// One thread per core this process may run on, at most 4: a step of 22
-// robots has about 6 batches, and the agents of a lockstep match wait while
-// the physics steps.
-int autoSolverThreads();
+// The solver threads a world of this physics uses: `threads`, or with auto
+// one per core this process may run on, at most 4 (a step of 22 robots has
+// about 6 batches, and the agents of a lockstep match wait while the physics
+// steps).
+int solverThreads(const PhysicsConfig& physics);
 
 // Standard deviations of the seeded random perturbations applied when the
 // robots are placed (0 = exact placement).
