@@ -167,7 +167,7 @@ TEST(RobotModel, StandPoseHasFlatFeetUnderTheHips) {
   }
 }
 
-// Independent numbers typed from ../shared/reference/nao.md section 2.2 (not
+// Independent numbers typed from docs/reference.md, Nao V6 section 2.2 (not
 // read from our YAML): right-side signs and the mirrored hip axes.
 TEST(RobotModel, RightSideMatchesReferenceTable) {
   const auto nao = robots::loadRobotModel(test::naoH25());

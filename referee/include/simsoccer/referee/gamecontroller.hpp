@@ -2,7 +2,7 @@
 // version 18 ("RGme", 118 bytes, GameController -> robots, UDP broadcast to
 // port 3838 at 2 Hz) and RoboCupGameControlReturnData version 4 ("RGrt",
 // 32 bytes, robot -> GameController, UDP unicast to port 3939). Little-endian,
-// serialised field by field (../shared/reference/gamecontroller-protocol.md).
+// serialised field by field (docs/reference.md, GameController packets).
 #pragma once
 
 #include <array>
