@@ -5,7 +5,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "simsoccer/world/realtime_driver.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 #include "simsoccer/world/world.hpp"
 #include "test_support.hpp"
 
@@ -118,11 +118,14 @@ TEST(Determinism, SnapshotMatchesWorld) {
   EXPECT_EQ(s.robots[2].joint_positions.size(), w.robot(2).model->body->joints.size());
 }
 
-TEST(RealTimeDriver, NeverRunsAheadOfTheWallClockAndMatchesFreeRunning) {
+TEST(RunLoop, RealTimeNeverRunsAheadOfTheWallClockAndMatchesFreeRunning) {
   // Pacing changes when steps happen, not what they compute.
   world::World paced(test::scenario(2)), free_running(test::scenario(2));
+  sim::Simulation simulation(paced);
   const auto t0 = std::chrono::steady_clock::now();
-  world::RealTimeDriver(paced, 2.0).run(0.4);  // 0.4 s simulated at twice real time
+  // 0.4 s simulated at twice real time.
+  const sim::RunStats run = sim::RunLoop(simulation, sim::Pacing::RealTime, 2.0).run(40);
+  EXPECT_EQ(run.periods, 40);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (int i = 0; i < 40; ++i) free_running.stepControlPeriod();
   EXPECT_GE(wall, 0.2 - 1e-3);  // a lower bound only: never faster than asked

@@ -126,7 +126,7 @@ TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
   run(g, 20);
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
   int lifted = 0;
-  for (const auto& e : g.events()) lifted += e.type == "unpenalise";
+  for (const auto& e : g.events()) lifted += e.type == referee::EventType::Unpenalise;
   EXPECT_GE(lifted, 2);
   EXPECT_EQ(lifted, 4);                                 // four of the five penalties have run out
   EXPECT_EQ(g.penalty(0, 6), gc::Penalty::Substitute);  // numbers beyond the 5 players

@@ -349,9 +349,15 @@ TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
       status);
   ASSERT_EQ(status, 0) << out;
   const auto lines = test::readLines(dir / "scaling.csv");
-  ASSERT_EQ(lines.size(), 3u);
-  EXPECT_EQ(lines[0].rfind("robots,steps_per_s,fps,rtf", 0), 0u) << lines[0];
-  EXPECT_EQ(lines[1].rfind("1,", 0), 0u);
-  EXPECT_EQ(lines[2].rfind("2,", 0), 0u);
+  // Both period modes per robot count (the default --modes serial,pipelined).
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0].rfind("robots,mode,steps_per_s,fps,rtf", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("1,serial,", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind("1,pipelined,", 0), 0u) << lines[2];
+  EXPECT_EQ(lines[3].rfind("2,serial,", 0), 0u) << lines[3];
+  EXPECT_EQ(lines[4].rfind("2,pipelined,", 0), 0u) << lines[4];
+  // Every agent answered every period in both modes (the last column: missed).
+  for (size_t i = 1; i < lines.size(); ++i)
+    EXPECT_EQ(lines[i].substr(lines[i].rfind(',')), ",0") << lines[i];
   EXPECT_GT(std::filesystem::file_size(dir / "scaling.png"), 1000u);
 }

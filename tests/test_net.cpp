@@ -134,13 +134,14 @@ TEST(Net, RoundTripAgentDrivesItsRobot) {
   const uint32_t domain = 101;
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess agent(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
   const int head = w.robot(0).model->body->jointIndex("HeadPitch");
   double lo = 1e9, hi = -1e9;
   for (int i = 0; i < 200; ++i) {  // 2 s: a whole nod
-    server.runPeriod();
+    simulation.period();
     const double q = w.jointPosition(0, head);
     lo = std::min(lo, q);
     hi = std::max(hi, q);
@@ -159,12 +160,13 @@ TEST(Net, LockstepIsDeterministicWithAgentProcesses) {
   auto run = [](uint32_t domain) {
     world::World w(teams(5));
     net::ServerConfig cfg = serverConfig(domain, 5.0);  // a slow machine must not change the result
-    net::SimServer server(w, cfg);
+    sim::Simulation simulation(w);
+    net::SimServer server(simulation, cfg);
     std::vector<std::unique_ptr<AgentProcess>> agents;
     for (world::RobotId r = 0; r < w.robotCount(); ++r)
       agents.push_back(std::make_unique<AgentProcess>(domain, w.robot(r).team, w.robot(r).number));
     EXPECT_TRUE(server.waitForOwners(5, 30.0));
-    for (int i = 0; i < 500; ++i) server.runPeriod();
+    for (int i = 0; i < 500; ++i) simulation.period();
     uint64_t missed = 0;
     for (world::RobotId r = 0; r < w.robotCount(); ++r) missed += server.stats(r).missed;
     EXPECT_EQ(missed, 0u);
@@ -179,7 +181,8 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   const uint32_t domain = 104;
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain, 2.0);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess owner(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   // An intruder in this process (its own participant) claims the same robot.
@@ -194,7 +197,7 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
   for (int i = 0; i < 100; ++i) {
     const uint64_t tick = w.controlTick();
     intruder.send(tick, pos, stiff);
-    server.runPeriod();
+    simulation.period();
   }
   std::printf("refused %llu commands, head yaw %.3f\n",
               (unsigned long long)(server.stats(0).refused - refused_before),
@@ -207,28 +210,29 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
   const uint32_t domain = 105;
   world::World w(teams(2));
   net::ServerConfig cfg = serverConfig(domain, 0.05);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   // A 2 s lease (--lease; the default is 5 s): the robot is free about 2 s after.
   auto a = std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{"--lease", "2"});
   AgentProcess b(domain, 1, 1);
   ASSERT_TRUE(server.waitForOwners(2, 20.0));
-  for (int i = 0; i < 50; ++i) server.runPeriod();
+  for (int i = 0; i < 50; ++i) simulation.period();
   a->kill();  // SIGKILL: no goodbye on DDS, the lease has to expire
   const auto t0 = Clock::now();
-  while (server.stats(0).owned && seconds(t0) < 10.0) server.runPeriod();
+  while (server.stats(0).owned && seconds(t0) < 10.0) simulation.period();
   const double released_after = seconds(t0);
   EXPECT_FALSE(server.stats(0).owned);
   EXPECT_GT(released_after, 1.0);  // the lease expired: nothing told the simulator sooner
   EXPECT_LT(released_after, 5.0);  // about 2 s measured: the writers unmatch, no hang
   const uint64_t b_accepted = server.stats(1).accepted;
-  for (int i = 0; i < 50; ++i) server.runPeriod();
+  for (int i = 0; i < 50; ++i) simulation.period();
   EXPECT_GE(server.stats(1).accepted, b_accepted + 45);  // the other robot kept going
   EXPECT_TRUE(w.isStanding(0));                          // released: holds its pose
   // Restarted, it claims the robot again and drives it.
   AgentProcess again(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(2, 20.0));
   const uint64_t before = server.stats(0).accepted;
-  for (int i = 0; i < 100; ++i) server.runPeriod();
+  for (int i = 0; i < 100; ++i) simulation.period();
   std::printf("released %.2f s after SIGKILL; after restart accepted %llu commands\n",
               released_after, (unsigned long long)(server.stats(0).accepted - before));
   EXPECT_GE(server.stats(0).accepted, before + 90);
@@ -239,24 +243,25 @@ TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {
 TEST(Net, AnAgentRestartedAtOnceGetsItsRobotBackWhenTheLeaseRunsOut) {
   const uint32_t domain = 122;
   world::World w(teams(1));
-  net::SimServer server(w, serverConfig(domain, 0.05));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 0.05));
   auto crashed =
       std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{"--lease", "2"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
-  for (int i = 0; i < 20; ++i) server.runPeriod();
+  for (int i = 0; i < 20; ++i) simulation.period();
   crashed->kill();
   AgentProcess restarted(domain, 0, 1);  // claims while the robot is still owned
   const auto t0 = Clock::now();
   bool released = false;
   while (seconds(t0) < 15.0 && !(released && server.stats(0).owned)) {
-    server.runPeriod();
+    simulation.period();
     released = released || !server.stats(0).owned;
   }
   ASSERT_TRUE(released);
   ASSERT_TRUE(server.stats(0).owned) << "the restarted agent did not get its robot back";
   const double back_after = seconds(t0);
   const uint64_t before = server.stats(0).accepted;
-  for (int i = 0; i < 60; ++i) server.runPeriod();
+  for (int i = 0; i < 60; ++i) simulation.period();
   EXPECT_GE(server.stats(0).accepted, before + 55);  // it drives the robot
   EXPECT_TRUE(restarted.running());
   std::printf("the restarted agent had its robot back %.2f s after the crash\n", back_after);
@@ -267,16 +272,17 @@ TEST(Net, AnAgentRestartedAtOnceGetsItsRobotBackWhenTheLeaseRunsOut) {
 TEST(Net, ReleasedRobotIsNotWaitedForAndCanBeClaimedAgain) {
   const uint32_t domain = 121;
   world::World w(teams(1));
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess stalled(domain, 0, 1, {"--mode", "stall", "--stall-after", "20"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
-  for (int i = 0; i < 20; ++i) server.runPeriod();
+  for (int i = 0; i < 20; ++i) simulation.period();
   EXPECT_EQ(server.stats(0).missed, 0u);
   EXPECT_TRUE(server.releaseRobot(0));
   EXPECT_FALSE(server.releaseRobot(0));  // nobody owns it now
   EXPECT_FALSE(server.stats(0).owned);
   const auto t0 = Clock::now();
-  for (int i = 0; i < 10; ++i) server.runPeriod();
+  for (int i = 0; i < 10; ++i) simulation.period();
   EXPECT_LT(seconds(t0), 1.0);  // not 10 x the 2 s timeout
   EXPECT_EQ(server.stats(0).missed, 0u);
   EXPECT_TRUE(w.isStanding(0));  // released: holds its pose
@@ -298,10 +304,11 @@ TEST(Net, TheLanConfigurationFindsTheAgentOnANetworkInterface) {
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain);
   cfg.dds.config_file = lan;
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess agent(domain, 0, 1, {"--dds-config", lan});
   ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
-  for (int i = 0; i < 100; ++i) server.runPeriod();
+  for (int i = 0; i < 100; ++i) simulation.period();
   const auto& st = server.stats(0);
   EXPECT_GE(st.accepted, 95u);
   EXPECT_EQ(st.missed, 0u);
@@ -314,11 +321,12 @@ TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   const uint32_t domain = 106;
   world::World w(teams(2));
   net::ServerConfig cfg = serverConfig(domain, 2.0);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess garbage(domain, 0, 1, {"--mode", "garbage"});
   AgentProcess good(domain, 1, 1);
   ASSERT_TRUE(server.waitForOwners(2, 20.0));
-  for (int i = 0; i < 150; ++i) server.runPeriod();
+  for (int i = 0; i < 150; ++i) simulation.period();
   const auto& g = server.stats(0);
   std::printf(
       "garbage agent: accepted %llu, rejected %llu; good agent: accepted %llu rejected %llu\n",
@@ -338,11 +346,12 @@ TEST(Net, LockstepTimeoutBoundsAStalledAgent) {
   const uint32_t domain = 107;
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain, 0.05);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess stall(domain, 0, 1, {"--mode", "stall", "--stall-after", "20"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   const auto t0 = Clock::now();
-  for (int i = 0; i < 80; ++i) server.runPeriod();
+  for (int i = 0; i < 80; ++i) simulation.period();
   const double elapsed = seconds(t0);
   std::printf("80 periods in %.2f s; missed %llu\n", elapsed,
               (unsigned long long)server.stats(0).missed);
@@ -357,7 +366,8 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   net::ServerConfig cfg = serverConfig(domain);
   cfg.lockstep = false;
   cfg.team_message_delay = 0.05;
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   agents::AgentClient a(dds(domain), 0, 1), b(dds(domain), 0, 2), c(dds(domain), 1, 1);
   bool ok_a = false, ok_b = false, ok_c = false;
   std::thread ta([&] { ok_a = a.claim(10.0); }), tb([&] { ok_b = b.claim(10.0); }),
@@ -374,7 +384,7 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   // At least 40 periods; more while the message is on its way on a busy machine.
   auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   for (int i = 0; i < 40 || (got_b.empty() && std::chrono::steady_clock::now() < until); ++i) {
-    server.runPeriod();
+    simulation.period();
     dds_sleepfor(DDS_MSECS(2));
     for (auto& m : b.receiveTeamMessages()) got_b.push_back(m);
     for (auto& m : c.receiveTeamMessages()) got_c.push_back(m);
@@ -396,7 +406,7 @@ TEST(Net, TeamMessagesReachTeammatesOnly) {
   until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   for (int i = 0; i < 20 || (got_a.empty() && std::chrono::steady_clock::now() < until); ++i) {
     const uint64_t now = w.controlTick();
-    server.runPeriod();
+    simulation.period();
     dds_sleepfor(DDS_MSECS(2));
     for (auto& m : a.receiveTeamMessages()) got_a.emplace_back(now, m);
   }
@@ -474,7 +484,8 @@ TEST(NetApps, BadLeaseAndMissingDdsConfigAreNamed) {
 TEST(NetApps, AnAgentProgramRefusedItsRobotGivesUpOrWaits) {
   const uint32_t domain = 124;
   world::World w(teams(1));
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess owner(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   // Runs the lockstep loop until `agent` exits (at most 25 s): its exit
@@ -483,7 +494,7 @@ TEST(NetApps, AnAgentProgramRefusedItsRobotGivesUpOrWaits) {
     const auto t0 = Clock::now();
     int status = -1;
     while (status < 0 && seconds(t0) < 25.0) {
-      server.runPeriod();
+      simulation.period();
       status = agent.exitStatus(0.0);
     }
     return std::make_pair(status, seconds(t0));
@@ -523,7 +534,8 @@ TEST(NetGameState, RefereePacketReachesAgents) {
   const uint32_t domain = 111;
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain);
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   agents::AgentClient agent(dds(domain), 0, 1);
   referee::ControlData d;
   d.state = static_cast<uint8_t>(referee::gc::State::Playing);
@@ -600,7 +612,8 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
   s.cameras.top = {true, 64, 48, 30.0};
   s.cameras.bottom = {true, 32, 24, 10.0};
   world::World w(s);
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess owner(domain, 0, 1);               // drives the robot in lockstep
   agents::AgentClient viewer(dds(domain), 0, 1);  // any participant may watch a robot's cameras
   viewer.subscribeImages();
@@ -618,10 +631,10 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
     }
   };
   for (int i = 0; i < periods; ++i) {
-    server.runPeriod();
+    simulation.period();
     take(0.0);  // as an agent would, every period (the reader keeps the last 4 per camera)
   }
-  server.flushCameras();
+  simulation.flushCameras();
   const uint64_t last = first + periods;  // the capture after the last step
   size_t expected[2] = {0, 0};
   for (uint64_t t = first + 1; t <= last; ++t) {
@@ -648,7 +661,7 @@ TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {
     EXPECT_NEAR(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3], 1.0, 1e-5);
     EXPECT_NEAR(image.intrinsics[2], 0.5 * w_px, 1e-4);
   }
-  EXPECT_EQ(server.cameras()->stats().dropped, 0u);  // lockstep waits, never drops
+  EXPECT_EQ(simulation.cameras()->stats().dropped, 0u);  // lockstep waits, never drops
 }
 
 TEST(Net, RealTimeAppliesTheLatestCommandEachPeriod) {
@@ -658,7 +671,8 @@ TEST(Net, RealTimeAppliesTheLatestCommandEachPeriod) {
   world::World w(teams(1));
   net::ServerConfig cfg = serverConfig(domain);
   cfg.lockstep = false;
-  net::SimServer server(w, cfg);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
   AgentProcess agent(domain, 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   const auto period = std::chrono::milliseconds(10);
@@ -667,7 +681,7 @@ TEST(Net, RealTimeAppliesTheLatestCommandEachPeriod) {
   for (int i = 0; i < periods; ++i) {
     due += period;
     std::this_thread::sleep_until(due);
-    server.runPeriod();
+    simulation.period();
   }
   const auto& st = server.stats(0);
   std::printf("real time: %llu commands applied in %d periods\n", (unsigned long long)st.accepted,
@@ -684,13 +698,14 @@ TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
   s.robots[0].x = -3.0;
   s.robots[0].y = 0.0;
   world::World w(s);
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess agent(domain, 0, 1, {"--mode", "walk", "--vx", "0.2"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   const engine::Vec3 start = w.torsoPose(0).translation();
   bool fell = false;
   for (int i = 0; i < 700 && !fell; ++i) {  // 1 s easing in + 6 s walking
-    server.runPeriod();
+    simulation.period();
     fell = !w.isStanding(0);
   }
   const engine::Vec3 d = w.torsoPose(0).translation() - start;
@@ -710,7 +725,8 @@ TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
   s.ball_position = {-1.0, 1.5, -1.0};  // 1 m ahead
   s.perception.enabled = true;          // as a scenario's `perception:` block does
   world::World w(s);
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess owner(domain, 0, 1);
   agents::AgentClient viewer(dds(domain), 0, 1);
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
@@ -718,7 +734,7 @@ TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
   int received = 0;
   agents::PerceptionIn p;
   for (int i = 0; i < 50; ++i) {
-    server.runPeriod();
+    simulation.period();
     const auto start = Clock::now();
     while (!viewer.perception(p) && seconds(start) < 1.0)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -743,19 +759,20 @@ TEST(NetKick, AStrikerAgentKicksTheBallTwoMetres) {
   s.ball_position = {0.4, 0.05, -1.0};  // ahead, towards the +x goal
   s.perception.enabled = true;
   world::World w(s);
-  net::SimServer server(w, serverConfig(domain, 2.0));
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
   AgentProcess agent(domain, 0, 1, {"--role", "striker"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   const engine::Vec3 start = w.ballState().pose.translation();
   double travelled = 0.0;
   bool fell = false;
   for (int i = 0; i < 2500 && travelled < 2.0; ++i) {  // up to 25 s
-    server.runPeriod();
+    simulation.period();
     fell = fell || !w.isStanding(0);
     travelled = (w.ballState().pose.translation() - start).head<2>().norm();
   }
   // Let the ball roll out.
-  for (int i = 0; i < 400; ++i) server.runPeriod();
+  for (int i = 0; i < 400; ++i) simulation.period();
   travelled = (w.ballState().pose.translation() - start).head<2>().norm();
   const engine::Vec3 d = w.ballState().pose.translation() - start;
   std::printf("ball travelled %.2f m (%.2f, %.2f); robot fell %d\n", travelled, d.x(), d.y(), fell);
@@ -779,13 +796,14 @@ TEST(NetGetUp, AnAgentProcessGetsItsRobotUpFromItsBack) {
   for (int i = 0; i < 100; ++i) w.stepControlPeriod();  // settled on its back
   ASSERT_GT(w.torsoPose(0).linear()(2, 0), 0.9);        // chest up
   net::ServerConfig config = serverConfig(domain, 2.0);
-  net::SimServer server(w, config);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, config);
   AgentProcess agent(domain, 0, 1, {"--role", "defender"});
   ASSERT_TRUE(server.waitForOwners(1, 20.0));
   double standing_for = 0.0, up_at = -1.0;
   const double dt = s.physics.control_period;
   for (int i = 0; i < 1000 && standing_for < 1.0; ++i) {  // up to 10 s
-    server.runPeriod();
+    simulation.period();
     standing_for = w.isStanding(0) ? standing_for + dt : 0.0;
     if (standing_for >= 1.0) up_at = (i + 1) * dt - 1.0;
   }
@@ -803,7 +821,8 @@ TEST(NetSit, AnAgentProcessSitsDownWhenTheGameIsOverAndStandsUpForTheNext) {
   const uint32_t domain = 119;
   world::World w(teams(1));
   net::ServerConfig config = serverConfig(domain, 2.0);
-  net::SimServer server(w, config);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, config);
   referee::ControlData d;
   d.state = static_cast<uint8_t>(referee::gc::State::Finished);
   d.teams[0].team_number = 1;
@@ -816,7 +835,7 @@ TEST(NetSit, AnAgentProcessSitsDownWhenTheGameIsOverAndStandsUpForTheNext) {
   const double standing = w.torsoPose(0).translation().z();
   double lowest = 1.0;
   for (int i = 0; i < 400; ++i) {  // 4 s: down in 1.5 s, then resting
-    server.runPeriod();
+    simulation.period();
     lowest = std::min(lowest, w.torsoPose(0).translation().z());
     ASSERT_TRUE(w.isStanding(0)) << i;
   }
@@ -831,7 +850,7 @@ TEST(NetSit, AnAgentProcessSitsDownWhenTheGameIsOverAndStandsUpForTheNext) {
   net::toMessage(d, 400, m);
   server.setGameState(m);
   for (int i = 0; i < 400; ++i) {  // up again within 4 s
-    server.runPeriod();
+    simulation.period();
     ASSERT_TRUE(w.isStanding(0)) << i;
   }
   EXPECT_NEAR(w.torsoPose(0).translation().z(), standing, 0.02);

@@ -66,7 +66,7 @@ void touchBall(world::World& w, Referee& ref, world::RobotId r) {
 
 int count(const Game& g, const std::string& type) {
   int n = 0;
-  for (const auto& e : g.events()) n += e.type == type;
+  for (const auto& e : g.events()) n += referee::eventName(e.type) == std::string(type);
   return n;
 }
 
@@ -439,7 +439,7 @@ namespace {
 
 bool hasEvent(const Game& g, const std::string& type, const std::string& detail) {
   for (const auto& e : g.events())
-    if (e.type == type && e.detail.find(detail) != std::string::npos) return true;
+    if (referee::eventName(e.type) == std::string(type) && e.detail.find(detail) != std::string::npos) return true;
   return false;
 }
 
@@ -569,7 +569,7 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
     }
     run(w, ref, 2.0);  // removal to the penalty spot, the free kick
     std::string log;
-    for (const auto& e : g.events()) log += std::to_string(e.time) + e.type + e.detail + ";";
+    for (const auto& e : g.events()) log += std::to_string(e.time) + referee::eventName(e.type) + e.detail + ";";
     return std::make_pair(w.stateHash(), log);
   };
   const auto a = play(), b = play();

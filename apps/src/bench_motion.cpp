@@ -19,17 +19,39 @@
 
 #include "bench_scene.hpp"
 #include "cli.hpp"
-#include "inprocess_agents.hpp"
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+#include "simsoccer/agents/inprocess_agents.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/fields/field_model.hpp"
+#include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/render_scene.hpp"
 #include "simsoccer/world/world.hpp"
 
 namespace simsoccer::apps {
 namespace {
+
+// The built-in agents in this process driving `world` through the period
+// pipeline (the same stages, gate and actuation timing as a match).
+struct AgentsInWorld {
+  AgentsInWorld(world::World& world, std::vector<agents::Role> roles, uint64_t seed)
+      : simulation(world, [] {
+          sim::SimulationConfig c;
+          c.mode = sim::kDefaultMode;
+          return c;
+        }()),
+        agents(world, {std::move(roles), seed, true,
+                       findConfig("", "configs/agents/soccer.yaml"),
+                       findConfig("", "configs/motions")}) {
+    simulation.addSource(agents);
+  }
+  void period() { simulation.period(); }
+  const agents::MotionController& motion(world::RobotId r) const { return agents.motion(r); }
+  const agents::SoccerBehaviour& behaviour(world::RobotId r) const { return agents.behaviour(r); }
+  sim::Simulation simulation;
+  agents::InProcessAgents agents;
+};
 
 using engine::Vec3;
 
@@ -469,12 +491,11 @@ StrikerResult strikerTrial(uint64_t seed, double limit, bool verbose) {
   } while (std::hypot(bx - s.robots[0].x, by - s.robots[0].y) < 0.6);
   s.ball_position = {bx, by, -1.0};
   world::World w(s);
-  InProcessAgents agents(w, {agents::Role::Striker}, seed);
+  AgentsInWorld agents(w, {agents::Role::Striker}, seed);
   StrikerResult r;
   const double dt = w.scenario().physics.control_period;
   for (int i = 0; i < static_cast<int>(limit / dt); ++i) {
     agents.period();
-    w.stepControlPeriod();
     if (verbose && (i % 100 == 0 || (i < 150 && i % 10 == 0)))
       std::fprintf(stderr, "t %5.2f %-10s tilt %.2f %s\n", i * dt,
                    agents::motionStateName(agents.motion(0).state()), agents.motion(0).tilt(),
@@ -513,13 +534,12 @@ PenaltyOutcome penaltyTrial(uint64_t seed, double limit, bool verbose) {
   // profile's noise, misses and false balls.
   s.perception.realistic = true;
   world::World w(s);
-  InProcessAgents agents(w, {agents::Role::PenaltyKicker, agents::Role::PenaltyGoalkeeper}, seed);
+  AgentsInWorld agents(w, {agents::Role::PenaltyKicker, agents::Role::PenaltyGoalkeeper}, seed);
   const double dt = w.scenario().physics.control_period;
   bool kicked = false;
   double still = 0.0;
   for (int i = 0; i < static_cast<int>(limit / dt); ++i) {
     agents.period();
-    w.stepControlPeriod();
     if (verbose && i % 100 == 0)
       std::fprintf(stderr, "t %5.1f kicker %s | keeper %s\n", i * dt,
                    agents.behaviour(0).status().c_str(), agents.behaviour(1).status().c_str());
@@ -566,12 +586,11 @@ BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
   s.robots[0].yaw = 0.0;
   s.ball_position = {line + 2.5, 0.0, -1.0};
   world::World w(s);
-  InProcessAgents agents(w, {shootout ? agents::Role::PenaltyGoalkeeper : agents::Role::Goalkeeper},
+  AgentsInWorld agents(w, {shootout ? agents::Role::PenaltyGoalkeeper : agents::Role::Goalkeeper},
                          seed);
   const double dt = w.scenario().physics.control_period;
   for (int i = 0; i < 200; ++i) {  // 2 s to settle into the stance
     agents.period();
-    w.stepControlPeriod();
   }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -592,7 +611,6 @@ BlockResult blockTrial(uint64_t seed, bool shootout, bool verbose) {
                (shootout ? config.dive_reach : config.block_reach);
   for (int i = 0; i < 400; ++i) {
     agents.period();
-    w.stepControlPeriod();
     if (verbose && i % 10 == 0)
       std::fprintf(stderr, "t %.2f %-10s ball %.2f %.2f torso z %.3f\n", i * dt,
                    agents::motionStateName(agents.motion(0).state()),

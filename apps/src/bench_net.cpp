@@ -12,6 +12,7 @@
 #include "cli.hpp"
 #include "process.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -78,7 +79,9 @@ int benchNet(int argc, char** argv, int first) {
     net::ServerConfig server_cfg;
     server_cfg.dds = dds;
     server_cfg.command_timeout = 1.0;
-    net::SimServer server(w, server_cfg);
+    sim::Simulation simulation(w);
+    net::SimServer server(simulation, server_cfg);
+    sim::RunLoop loop(simulation, sim::Pacing::Lockstep);
     std::vector<std::unique_ptr<ChildProcess>> agents;
     for (world::RobotId r = 0; r < w.robotCount(); ++r)
       agents.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
@@ -88,8 +91,8 @@ int benchNet(int argc, char** argv, int first) {
     if (!server.waitForOwners(w.robotCount(), 60.0))
       throw std::runtime_error("only " + std::to_string(server.ownedCount()) + " of " +
                                std::to_string(w.robotCount()) + " agents claimed their robots");
-    for (int i = 0; i < 50; ++i) server.runPeriod();  // warm-up
-    const net::ServerTimes before = server.times();
+    loop.run(50);  // warm-up
+    const sim::Profile before = simulation.profile();
     // CPU time of the simulator and of every agent process, over the timed
     // periods only (not the start-up and its discovery traffic).
     const auto cpu_now = [&] {
@@ -104,12 +107,12 @@ int benchNet(int argc, char** argv, int first) {
     const long long bytes0 = loopbackBytes(), packets0 = loopbackPackets();
     const double cpu0 = cpu_now();
     const auto t0 = Clock::now();
-    for (long i = 0; i < periods; ++i) server.runPeriod();
+    loop.run(periods);
     const double wall_net = std::chrono::duration<double>(Clock::now() - t0).count();
     const double cpu1 = cpu_now(), cpu_net = cpu0 >= 0 && cpu1 >= 0 ? cpu1 - cpu0 : -1.0;
     const long long bytes = loopbackBytes() - bytes0, packets = loopbackPackets() - packets0;
-    const auto& after = server.times();
-    const double world_s = after.physics_s - before.physics_s;
+    const sim::Profile& after = simulation.profile();
+    const double world_s = after.step_s - before.step_s;
     uint64_t missed = 0;
     for (world::RobotId r = 0; r < w.robotCount(); ++r) missed += server.stats(r).missed;
     agents.clear();
@@ -125,8 +128,8 @@ int benchNet(int argc, char** argv, int first) {
 
     const double overhead_ms = 1e3 * (wall_net - world_s) / periods;
     const double world_ms = 1e3 * wall_alone / periods;
-    const double publish_ms = 1e3 * (after.publish_s - before.publish_s) / periods;
-    const double wait_ms = 1e3 * (after.wait_s - before.wait_s) / periods;
+    const double publish_ms = 1e3 * (after.observe_s - before.observe_s) / periods;
+    const double wait_ms = 1e3 * (after.collect_s - before.collect_s) / periods;
     table.rows.push_back({std::to_string(n), fmt(overhead_ms, 3), fmt(publish_ms, 3),
                           fmt(wait_ms, 3), fmt(world_ms, 3), fmt(100.0 * overhead_ms / world_ms, 1),
                           // CPU against CPU: the world's CPU time alone, not its wall

@@ -14,18 +14,24 @@
 #include "process.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/referee.hpp"
+#include "simsoccer/sim/officials.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 
 namespace simsoccer::apps {
 namespace {
 
 const char* kHelp =
     "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--seconds S] [--cameras]\n"
-    "                               [--csv FILE] [--png FILE] [--domain D]\n"
+    "                               [--modes serial,pipelined] [--csv FILE] [--png FILE]\n"
+    "                               [--domain D]\n"
     "\n"
     "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
     "3D-league-sized field beyond), perception on, the automatic referee (simleague rule book),\n"
     "and N simsoccer-agent processes (--role auto: walking, kicking, team messages) over\n"
-    "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready.\n"
+    "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
+    "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
+    "the answers to this period's frames) and pipelined (with the answers to the last\n"
+    "period's, while the agents compute the next: physics and agents overlap).\n"
     "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
     "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
     "real-time factor and the time per control period split into physics, sensors,\n"
@@ -37,6 +43,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Row {
   int robots = 0;
+  sim::Mode mode = sim::Mode::Serial;
   double steps_per_s = 0, fps = 0, rtf = 0;
   double physics_ms = 0, sensors_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
   uint64_t missed = 0;
@@ -72,26 +79,28 @@ world::Scenario scalingScenario(int n, bool cameras) {
   return s;
 }
 
-Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
+Row runRow(int n, double seconds, bool cameras, sim::Mode mode, uint32_t domain) {
   world::Scenario s = scalingScenario(n, cameras);
   world::World w(s);
+  sim::SimulationConfig simc;
+  simc.mode = mode;
+  sim::Simulation simulation(w, simc);
   net::ServerConfig sc;
   sc.dds.domain = domain;
   sc.dds.config_file = findConfig("", "configs/dds/loopback.xml");
   sc.lockstep = true;
   sc.command_timeout = 2.0;
-  net::SimServer server(w, sc);
+  net::SimServer server(simulation, sc);
   const referee::RuleBook rules =
       referee::loadRuleBook(findConfig("", "configs/rules/simleague.yaml"));
-  std::array<referee::TeamSetup, 2> teams;
+  sim::OfficialsConfig oc;
   for (size_t t = 0; t < 2; ++t) {
-    teams[t].number = static_cast<uint8_t>(t + 1);
-    teams[t].field_player_colour = static_cast<uint8_t>(t);
+    oc.teams[t].number = static_cast<uint8_t>(t + 1);
+    oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
   }
-  referee::Referee ref(w, rules, teams, 0);
-  ref.game().standby();
-  ref.game().ready();
-  server.publishGameState(ref.game().packet(0), ref.game().leftTeam());  // before they start
+  sim::GameOfficials officials(w, rules, oc);
+  simulation.setOfficials(&officials);
+  server.publishGameState(officials.controlData(), officials.leftTeam());  // before they start
   std::vector<std::unique_ptr<ChildProcess>> agents;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
     SoccerAgentOptions ao;
@@ -107,34 +116,27 @@ Row runRow(int n, double seconds, bool cameras, uint32_t domain) {
       throw std::runtime_error("agents did not claim their robots within 60 s");
   const double period = s.physics.control_period;
   const auto periods = static_cast<long>(seconds / period);
-  const net::ServerTimes before = server.times();
   w.sensors().resetTimes();
   w.sensors().enableTimers(true);
-  double referee_s = 0.0;
-  const auto t0 = Clock::now();
-  for (long i = 0; i < periods; ++i) {
-    server.runPeriod();
-    const auto r0 = Clock::now();
-    ref.update();
-    server.publishGameState(ref.game().packet(0), ref.game().leftTeam());
-    referee_s += std::chrono::duration<double>(Clock::now() - r0).count();
-  }
-  server.flushCameras();
-  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-  const net::ServerTimes& t = server.times();
+  sim::RunLoop loop(simulation, sim::Pacing::Lockstep);
+  const sim::RunStats run = loop.run(periods);
+  simulation.flushCameras();
+  const double wall = run.wall_s;
+  const sim::Profile& t = simulation.profile();
   Row row;
   row.robots = n;
+  row.mode = mode;
   row.steps_per_s = periods * w.stepsPerControlPeriod() / wall;
   row.fps = periods / wall;
   row.rtf = periods * period / wall;
   const double per = 1e3 / static_cast<double>(periods);
   const world::SensorTimes& st = w.sensors().times();
   row.sensors_ms = (st.sonar_s + st.other_s) * per;
-  // The server times the whole world step; the sensors' part is taken out.
-  row.physics_ms = (t.physics_s - before.physics_s) * per - row.sensors_ms;
-  row.messaging_ms = (t.publish_s - before.publish_s + t.wait_s - before.wait_s) * per;
-  row.referee_ms = referee_s * per;
-  row.render_ms = (t.camera_s - before.camera_s) * per;
+  // The step stage is the whole world step; the sensors' part is taken out.
+  row.physics_ms = t.step_s * per - row.sensors_ms;
+  row.messaging_ms = (t.observe_s + t.collect_s + t.apply_s) * per;
+  row.referee_ms = t.officials_s * per;
+  row.render_ms = t.camera_s * per;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;
   for (auto& a : agents) a->stop();
   return row;
@@ -194,7 +196,7 @@ void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
 
 int benchScaling(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "cameras"},
-                    {"robots", "seconds", "csv", "png", "domain"});
+                    {"robots", "seconds", "csv", "png", "domain", "modes"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
@@ -203,6 +205,20 @@ int benchScaling(int argc, char** argv, int first) {
   const double seconds = opt.number("seconds", 20.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   const bool cameras = opt.flag("cameras");
+  std::vector<sim::Mode> modes;
+  {
+    std::string list = opt.get("modes", "serial,pipelined");
+    size_t start = 0;
+    while (start <= list.size()) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      try {
+        modes.push_back(sim::parseMode(list.substr(start, comma - start)));
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("--modes: ") + e.what());
+      }
+      start = comma + 1;
+    }
+  }
   const auto domain = static_cast<uint32_t>(opt.number("domain", 43));
   const std::filesystem::path png = opt.get("png", "scaling.png");
   std::printf(
@@ -211,25 +227,32 @@ int benchScaling(int argc, char** argv, int first) {
       cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots",     "steps_per_s",  "fps",        "rtf",       "physics_ms",
-                  "sensors_ms", "messaging_ms", "referee_ms", "render_ms", "missed"};
-  std::vector<Row> rows;
+  table.header = {"robots",     "mode",       "steps_per_s",  "fps",
+                  "rtf",        "physics_ms", "sensors_ms",   "messaging_ms",
+                  "referee_ms", "render_ms",  "missed"};
+  std::vector<Row> rows, plotted;
   for (int n : counts) {
-    const Row r = runRow(n, seconds, cameras, domain);
-    rows.push_back(r);
-    table.rows.push_back({std::to_string(n), fmt(r.steps_per_s, 0), fmt(r.fps, 0), fmt(r.rtf, 2),
-                          fmt(r.physics_ms, 2), fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2),
-                          fmt(r.referee_ms, 3), fmt(r.render_ms, 2), std::to_string(r.missed)});
-    std::fprintf(stderr, "  %d robots done\n", n);
+    for (const sim::Mode mode : modes) {
+      const Row r = runRow(n, seconds, cameras, mode, domain);
+      rows.push_back(r);
+      if (mode == modes.back()) plotted.push_back(r);
+      table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),
+                            fmt(r.fps, 0), fmt(r.rtf, 2), fmt(r.physics_ms, 2),
+                            fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
+                            fmt(r.render_ms, 2), std::to_string(r.missed)});
+      std::fprintf(stderr, "  %d robots, %s done\n", n, sim::modeName(mode));
+    }
   }
   table.finish(
       "fps: control periods (frames) per wall second, 100 per simulated second; rtf: simulated / "
-      "wall time; ms per control period: physics, sensors, messaging (perception and "
-      "frames out, waiting for and applying the agents' commands), referee, render (cameras); "
+      "wall time; mode: serial or pipelined (the world steps while the agents compute); ms "
+      "per control period: physics, sensors, messaging (perception and frames out, waiting "
+      "for and applying the agents' commands: in pipelined mode only what is left after the "
+      "step), referee, render (cameras); "
       "missed: lockstep periods an agent did not answer in time. USARSim (published): 1 Nao "
       "110 fps, 2: 55, 3: 30, 4: 10.",
       opt.get("csv", ""));
-  plot(rows, png);
+  plot(plotted, png);
   std::printf("plot: %s\n", png.string().c_str());
   return 0;
 }

@@ -27,6 +27,8 @@
 #include "simsoccer/fields/field_model.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
+#include "simsoccer/sim/log_source.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 #include "simsoccer/world/render_scene.hpp"
 
 namespace simsoccer::apps {
@@ -228,6 +230,7 @@ struct RunOptions {
   uint32_t domain = 0;
   std::filesystem::path dds_config;  // the simulator's and the agents' Cyclone configuration
   double max_seconds = 0.0;          // > 0: stop after this much simulated time
+  sim::Mode mode = sim::Mode::Serial;  // of the control period
 };
 
 struct RunResult {
@@ -244,11 +247,53 @@ struct RunResult {
   uint64_t log_bytes = 0;
 };
 
+// Stage record: each period into the match log (poses, joints, ball, the
+// commands applied, the game packet, the referee's events, the state hash).
+class LogRecorder : public sim::Recorder {
+ public:
+  LogRecorder(world::MatchLogWriter& log, RunResult& result) : log_(log), result_(result) {}
+  void record(const sim::PeriodRecord& p) override {
+    const world::World& w = *p.world;
+    positions_.resize(w.robotCount());
+    stiffness_.resize(w.robotCount());
+    commanded_.assign(p.commanded->begin(), p.commanded->end());
+    for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+      positions_[r] = (*p.commands)[r].position;
+      stiffness_[r] = (*p.commands)[r].stiffness;
+    }
+    world::LogFrame frame = world::captureFrame(w, w.controlTick(), positions_, stiffness_, commanded_);
+    if (p.game) {
+      const auto packet = referee::encode(*p.game);
+      frame.game.assign(packet.begin(), packet.end());
+    }
+    for (const sim::Event& e : *p.events) {
+      const world::LogEvent le{e.time, referee::eventName(e.type), e.team, e.player, e.detail};
+      result_.events.push_back(le);
+      frame.events.push_back(le);
+    }
+    log_.write(frame);
+    ++result_.frames;
+  }
+
+ private:
+  world::MatchLogWriter& log_;
+  RunResult& result_;
+  std::vector<std::array<double, 25>> positions_, stiffness_;
+  std::vector<bool> commanded_;
+};
+
 // Plays one session (a game, or one penalty kick) with agents, logging to `log`.
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
   world::World& w = session.world();
   const MatchConfig& c = session.config();
+  sim::SimulationConfig simc;
+  simc.mode = o.mode;
+  simc.lockstep = !o.realtime;
+  sim::Simulation simulation(w, simc);
+  session.attach(simulation);
+  LogRecorder recorder(log, result);
+  simulation.addRecorder(recorder);
   net::ServerConfig sc;
   sc.dds.domain = o.domain;
   sc.dds.config_file = o.dds_config;
@@ -256,7 +301,8 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.command_timeout = c.command_timeout;
   sc.team_message_delay = c.message_delay;
   sc.team_message_loss = c.message_loss;
-  net::SimServer server(w, sc);
+  net::SimServer server(simulation, sc);
+  // The agents find the game state when they start.
   server.publishGameState(session.controlData(), session.game().leftTeam());
   auto agentCommand = [&](int team, int number) {  // the same for a restart
     SoccerAgentOptions ao;
@@ -290,82 +336,65 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       throw std::runtime_error("agents did not claim their robots within 60 s");
   }
   const auto t0 = Clock::now();
-  const double period = w.scenario().physics.control_period;
-  std::vector<std::array<double, 25>> positions(w.robotCount()), stiffness(w.robotCount());
-  std::vector<bool> commanded(w.robotCount());
   double last_status = -1.0;
   const bool tty = !o.quiet && isatty(STDOUT_FILENO);
   long i = 0;
-  while (!session.over() && !g_interrupted) {
-    if (o.max_seconds > 0 && w.time() >= o.max_seconds - 1e-9) break;
-    if (o.realtime)
-      std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(
-                                             std::chrono::duration<double>(i * period)));
-    server.runPeriod();
-    std::vector<world::LogEvent> events;
-    session.afterStep(events);
-    const referee::ControlData game = session.controlData();  // once: to the agents and the log
-    server.publishGameState(game, session.game().leftTeam());
-    for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-      commanded[r] = server.commandApplied(r);
-      positions[r] = server.commandPosition(r);
-      stiffness[r] = server.commandStiffness(r);
-    }
-    world::LogFrame frame =
-        world::captureFrame(w, w.controlTick(), positions, stiffness, commanded);
-    const auto packet = referee::encode(game);
-    frame.game.assign(packet.begin(), packet.end());
-    result.events.insert(result.events.end(), events.begin(), events.end());
-    frame.events = std::move(events);
-    log.write(frame);
-    ++result.frames;
-    ++i;
-    // Agents that died are restarted (up to the limit); past it the match stops.
-    if (!o.external && i % 10 == 0) {
-      for (AgentSlot& a : agents) {
-        if (a.process->running()) continue;
-        char buf[200];
-        if (a.restarts >= c.restart_limit) {
-          result.aborted = true;
-          std::snprintf(buf, sizeof buf, "agent of team %d player %d exited %d times (limit %d)",
-                        a.team, a.number, a.restarts + 1, c.restart_limit);
-          result.abort_reason = buf;
-          break;
-        }
-        ++a.restarts;
-        // Its robot is free at once: a crashed process says nothing on DDS, and
-        // lockstep would wait for it every period until its lease ran out. (Not
-        // when it exited 3, not granted: then another participant owns it.)
-        if (a.process->exitStatus() != 3)
-          for (world::RobotId r = 0; r < w.robotCount(); ++r)
-            if (w.robot(r).team == a.team && w.robot(r).number == a.number) server.releaseRobot(r);
-        std::snprintf(buf, sizeof buf,
-                      "{\"time\": %s, \"team\": %d, \"player\": %d, \"exit_status\": %d, "
-                      "\"restart\": %d}",
-                      num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
-                      a.restarts);
-        result.agent_events.push_back(buf);
-        a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
+  // Agents that died are restarted (up to the limit); past it the match stops.
+  const auto superviseAgents = [&] {
+    for (AgentSlot& a : agents) {
+      if (a.process->running()) continue;
+      char buf[200];
+      if (a.restarts >= c.restart_limit) {
+        result.aborted = true;
+        std::snprintf(buf, sizeof buf, "agent of team %d player %d exited %d times (limit %d)",
+                      a.team, a.number, a.restarts + 1, c.restart_limit);
+        result.abort_reason = buf;
+        return;
       }
-      if (result.aborted) break;
+      ++a.restarts;
+      // Its robot is free at once: a crashed process says nothing on DDS, and
+      // lockstep would wait for it every period until its lease ran out. (Not
+      // when it exited 3, not granted: then another participant owns it.)
+      if (a.process->exitStatus() != 3)
+        for (world::RobotId r = 0; r < w.robotCount(); ++r)
+          if (w.robot(r).team == a.team && w.robot(r).number == a.number) server.releaseRobot(r);
+      std::snprintf(buf, sizeof buf,
+                    "{\"time\": %s, \"team\": %d, \"player\": %d, \"exit_status\": %d, "
+                    "\"restart\": %d}",
+                    num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
+                    a.restarts);
+      result.agent_events.push_back(buf);
+      a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
     }
-    if (tty && secondsSince(t0) - last_status > 0.25) {
-      last_status = secondsSince(t0);
-      const auto& g = session.game();
-      const double rtf = w.time() / std::max(1e-6, secondsSince(t0));
-      const double half = g.rules().half_duration;
-      const double left_sim =
-          std::max(0.0, g.secondsRemaining() + (g.half() == referee::Half::First ? half : 0.0));
-      std::printf("\r  %s half  %02d:%02d  %-8s  %d:%d   sim %6.1f s  RTF %4.2f  ETA %4.0f s   ",
-                  g.half() == referee::Half::First
-                      ? "1st"
-                      : (g.half() == referee::Half::Second ? "2nd" : "pso"),
-                  static_cast<int>(g.secondsRemaining()) / 60,
-                  static_cast<int>(g.secondsRemaining()) % 60, referee::stateName(g.state()),
-                  g.score(0), g.score(1), w.time(), rtf, left_sim / std::max(rtf, 1e-3));
-      std::fflush(stdout);
-    }
-  }
+  };
+  const auto status = [&] {
+    last_status = secondsSince(t0);
+    const auto& g = session.game();
+    const double rtf = w.time() / std::max(1e-6, secondsSince(t0));
+    const double half = g.rules().half_duration;
+    const double left_sim =
+        std::max(0.0, g.secondsRemaining() + (g.half() == referee::Half::First ? half : 0.0));
+    std::printf("\r  %s half  %02d:%02d  %-8s  %d:%d   sim %6.1f s  RTF %4.2f  ETA %4.0f s   ",
+                g.half() == referee::Half::First
+                    ? "1st"
+                    : (g.half() == referee::Half::Second ? "2nd" : "pso"),
+                static_cast<int>(g.secondsRemaining()) / 60,
+                static_cast<int>(g.secondsRemaining()) % 60, referee::stateName(g.state()),
+                g.score(0), g.score(1), w.time(), rtf, left_sim / std::max(rtf, 1e-3));
+    std::fflush(stdout);
+  };
+  sim::RunLoop loop(simulation, o.realtime ? sim::Pacing::RealTime : sim::Pacing::Lockstep);
+  loop.run(
+      [&] {
+        return session.over() || g_interrupted || result.aborted ||
+               (o.max_seconds > 0 && w.time() >= o.max_seconds - 1e-9);
+      },
+      -1,
+      [&] {
+        ++i;
+        if (!o.external && i % 10 == 0) superviseAgents();
+        if (tty && secondsSince(t0) - last_status > 0.25) status();
+      });
   if (tty) std::printf("\n");
   result.interrupted = g_interrupted != 0;
   result.wall = secondsSince(t0);
@@ -743,24 +772,26 @@ int replay(int argc, char** argv, int first) {
     if (h.count("half_duration")) config.half_duration = std::stod(h.at("half_duration"));
     const uint64_t seed = std::stoull(h.at("seed"));
     MatchSession session(config, seed, threads);
-    world::World& w = session.world();
-    world::MatchLogReader again(file);
+    // The recorded commands are what each period applied: replayed serially
+    // through the same pipeline (and gate) as the game, whatever its mode.
+    sim::Simulation simulation(session.world());
+    session.attach(simulation);
+    sim::LogSource recorded(file);
+    simulation.addSource(recorded);
     int checked = 0;
-    while (again.next(f)) {
-      for (world::RobotId r = 0; r < w.robotCount() && r < f.robots.size(); ++r)
-        if (f.robots[r].commanded)
-          w.setCommand(r, std::span<const double>(f.robots[r].command_position),
-                       std::span<const double>(f.robots[r].command_stiffness));
-      w.stepControlPeriod();
-      std::vector<world::LogEvent> ev;
-      session.afterStep(ev);
-      if (w.stateHash() != f.state_hash) {
-        std::printf("state hash differs at %.2f s (frame %d)\n", f.time, checked + 1);
+    while (recorded.next()) {
+      simulation.period();
+      if (session.world().stateHash() != recorded.frame().state_hash) {
+        std::printf("state hash differs at %.2f s (frame %d)\n", recorded.frame().time,
+                    checked + 1);
         status = 1;
         break;
       }
       ++checked;
     }
+    if (recorded.refused() > 0)
+      std::printf("warning: %llu recorded commands refused (not finite or out of range)\n",
+                  static_cast<unsigned long long>(recorded.refused()));
     if (status == 0)
       std::printf("physics replay: %d of %d periods, every state hash equal\n", checked, frames);
   }

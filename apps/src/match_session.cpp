@@ -124,16 +124,16 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     rules.half_time_break = *config.half_time_break;
     rules.half_time_to_initial = std::min(rules.half_time_to_initial, *config.half_time_break);
   }
-  std::array<referee::TeamSetup, 2> teams;
+  sim::OfficialsConfig oc;
   for (size_t t = 0; t < 2; ++t) {
-    teams[t].number = static_cast<uint8_t>(config.team_numbers[t]);
-    teams[t].field_player_colour = static_cast<uint8_t>(t);
+    oc.teams[t].number = static_cast<uint8_t>(config.team_numbers[t]);
+    oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
   }
-  referee::RefereeConfig rc;
-  rc.set_duration = config.set_duration;
-  rc.auto_placement = true;  // robots still walking at Set are placed, as a human referee would
-  referee_ = std::make_unique<referee::Referee>(*world_, rules, teams, 0, rc);
-  if (config.penalty_kicks > 0) referee_->game().startShootout(0, 1, seed);
+  oc.referee.set_duration = config.set_duration;
+  oc.referee.auto_placement = true;  // robots still walking at Set are placed, as a human referee would
+  oc.penalty_kick_trial = config.penalty_kicks > 0;
+  oc.seed = seed;
+  officials_ = std::make_unique<sim::GameOfficials>(*world_, rules, oc);
   for (world::RobotId r = 0; r < world_->robotCount(); ++r) {
     RobotRecord rec;
     rec.team = world_->robot(r).team;
@@ -141,49 +141,18 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     rec.last = world_->torsoPose(r).translation();
     records_.push_back(rec);
   }
-  operatorPart();
 }
 
-void MatchSession::operatorPart() {
-  referee::Game& g = referee_->game();
-  using referee::gc::State;
-  // Each half starts as soon as it can (Standby, then Ready).
-  if (g.state() == State::Initial && g.phase() == referee::gc::GamePhase::Normal && !g.gameOver()) {
-    g.standby();
-    g.ready();
-  }
-  // A drawn game goes to the shoot-out when the rule book calls for it.
-  if (g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
-      g.rules().shootout && config_.penalty_kicks == 0)
-    g.startShootout(0, std::nullopt, world_->scenario().seed);
-  // The next shoot-out kick: the kicking team's field players in turn against
-  // the other team's goalkeeper.
-  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished)) {
-    const int team = g.shotsTaken(0) <= g.shotsTaken(1) ? 0 : 1;
-    std::vector<int> strikers;
-    for (world::RobotId r = 0; r < world_->robotCount(); ++r)
-      if (world_->robot(r).team == team && world_->robot(r).number != g.goalkeeper(team))
-        strikers.push_back(world_->robot(r).number);
-    if (strikers.empty()) strikers.push_back(g.goalkeeper(team));
-    const int striker = strikers[static_cast<size_t>(next_striker_[team]++) % strikers.size()];
-    int keeper = g.goalkeeper(1 - team);
-    if (!referee_->robot(1 - team, keeper)) keeper = 0;
-    referee_->startShootoutKick(striker, keeper);
-  }
+void MatchSession::attach(sim::Simulation& sim) {
+  sim.setOfficials(officials_.get());
+  sim.addRecorder(*this);
 }
 
-bool MatchSession::over() const {
-  const referee::Game& g = referee_->game();
-  if (config_.penalty_kicks > 0) return !g.shotOutcomes(0).empty() || g.gameOver();
-  return g.gameOver() && !g.shootoutOpen() &&
-         !(g.phase() == referee::gc::GamePhase::Normal && !g.winner() && g.rules().shootout);
-}
-
-void MatchSession::record() {
+void MatchSession::record(const sim::PeriodRecord& p) {
   const double dt = world_->scenario().physics.control_period;
   const engine::Vec3 ball = world_->ballState().pose.translation();
   double nearest[2] = {1e9, 1e9};
-  const referee::Game& g = referee_->game();
+  const referee::Game& g = officials_->game();
   if (g.shootoutOpen() && g.shotKickedYet()) {
     diving_keeper_.reset();
     for (size_t i = 0; i < records_.size(); ++i)
@@ -229,28 +198,18 @@ void MatchSession::record() {
   // Possession: the team with a robot nearest the ball, within 0.5 m.
   const int team = nearest[0] <= nearest[1] ? 0 : 1;
   if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
-}
-
-void MatchSession::afterStep(std::vector<world::LogEvent>& events) {
-  referee_->update();
-  operatorPart();
-  record();
-  const auto& all = referee_->game().events();
-  for (; events_seen_ < all.size(); ++events_seen_) {
-    const referee::RefereeEvent& e = all[events_seen_];
-    events.push_back({e.time, e.type, e.team, e.player, e.detail});
-    if (e.type == "goal") {
-      Goal g{world_->time(), e.team, e.player, false};
-      if (g.scorer == 0 && e.team >= 0) {
-        // The last robot to touch the ball: the scorer, or an own goal.
-        if (const auto& touch = world_->lastBallTouch()) {
-          const auto& info = world_->robot(touch->robot);
-          g.scorer = info.number;
-          g.own_goal = info.team != e.team;
-        }
+  for (const sim::Event& e : *p.events) {
+    if (e.type != sim::EventType::Goal) continue;
+    Goal goal{world_->time(), e.team, e.player, false};
+    if (goal.scorer == 0 && e.team >= 0) {
+      // The last robot to touch the ball: the scorer, or an own goal.
+      if (const auto& touch = world_->lastBallTouch()) {
+        const auto& info = world_->robot(touch->robot);
+        goal.scorer = info.number;
+        goal.own_goal = info.team != e.team;
       }
-      goals_.push_back(g);
     }
+    goals_.push_back(goal);
   }
 }
 
@@ -258,10 +217,6 @@ std::array<double, 2> MatchSession::possession() const {
   const double total = possession_[0] + possession_[1];
   if (total <= 0) return {0.0, 0.0};
   return {possession_[0] / total, possession_[1] / total};
-}
-
-referee::ControlData MatchSession::controlData() const {
-  return referee_->game().packet(0);
 }
 
 }  // namespace simsoccer::apps

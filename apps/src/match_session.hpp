@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "simsoccer/referee/referee.hpp"
+#include "simsoccer/sim/officials.hpp"
+#include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/match_log.hpp"
 #include "simsoccer/world/world.hpp"
 
@@ -67,7 +69,10 @@ struct RobotRecord {
   engine::Vec3 last{0, 0, 0};
 };
 
-class MatchSession {
+// The world, its officials (referee and operator) and the match records
+// (falls, distance, possession, goals), which it keeps as a recorder of the
+// simulation's period.
+class MatchSession : public sim::Recorder {
  public:
   // `seed` overrides the config's. The world is built from the scenario with
   // that seed; the rule book's half duration and break as the config says.
@@ -75,14 +80,15 @@ class MatchSession {
 
   world::World& world() { return *world_; }
   const world::World& world() const { return *world_; }
-  const referee::Game& game() const { return referee_->game(); }
+  sim::GameOfficials& officials() { return *officials_; }
+  const referee::Game& game() const { return officials_->game(); }
   const MatchConfig& config() const { return config_; }
+  // Makes this session's officials and records part of `sim`'s period.
+  void attach(sim::Simulation& sim);
 
-  // After each world step: the operator (start the halves, the shoot-out
-  // kicks), the referee, and the records. New referee events since the last
-  // call are appended to `events`.
-  void afterStep(std::vector<world::LogEvent>& events);
-  bool over() const;  // the game (and any shoot-out) is decided, or the penalty kicks are done
+  // Stage record: falls, distance, possession, goals (with their scorer).
+  void record(const sim::PeriodRecord& p) override;
+  bool over() const { return officials_->over(); }
 
   const std::vector<RobotRecord>& robots() const { return records_; }
   std::array<double, 2> possession() const;  // share of the time each team had the ball
@@ -94,15 +100,12 @@ class MatchSession {
     bool own_goal;
   };
   const std::vector<Goal>& goals() const { return goals_; }
-  referee::ControlData controlData() const;
+  referee::ControlData controlData() const { return officials_->controlData(); }
 
  private:
-  void operatorPart();
-  void record();
-
   MatchConfig config_;
   std::unique_ptr<world::World> world_;
-  std::unique_ptr<referee::Referee> referee_;
+  std::unique_ptr<sim::GameOfficials> officials_;
   std::vector<RobotRecord> records_;
   // The shoot-out keeper of the last kicked shot (record index), until it goes
   // down (a dive) or the next shot is kicked: a goal ends the shot, and the
@@ -110,8 +113,6 @@ class MatchSession {
   std::optional<size_t> diving_keeper_;
   std::array<double, 2> possession_{};
   std::vector<Goal> goals_;
-  size_t events_seen_ = 0;
-  int next_striker_[2] = {0, 0};
 };
 
 }  // namespace simsoccer::apps

@@ -10,7 +10,8 @@
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/referee/referee.hpp"
-#include "simsoccer/world/realtime_driver.hpp"
+#include "simsoccer/sim/officials.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -18,6 +19,7 @@ namespace {
 const char* kHelp =
     "usage: simsoccer serve SCENARIO [--domain D] [--dds-config FILE] [--seconds S]\n"
     "                       [--agents N] [--realtime] [--timeout S] [--limp-on-release]\n"
+    "                       [--mode serial|pipelined]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]\n"
     "                        [--gc-address ADDR [--gc-port P] [--gc-return-port P]]]\n"
     "\n"
@@ -25,11 +27,15 @@ const char* kHelp =
     "claimed by agents, then runs S simulated seconds (default 60) in lockstep (each period\n"
     "waits up to --timeout s of wall time, default 0.5, for every owned robot's command) or,\n"
     "with --realtime, paced to the wall clock with the latest commands. Ctrl-C stops it.\n"
-    "Prints each robot's command counters at the end.\n"
+    "Prints each robot's command counters at the end. --mode pipelined: the world steps with\n"
+    "the answers to the previous period's frames while the agents compute (one period of\n"
+    "actuation delay; default serial).\n"
     "\n"
     "With --rules (e.g. configs/rules/spl.yaml) the automatic referee runs the game from the\n"
-    "first kick-off (team 0 kicks off; --teams gives the GameController team numbers, default\n"
-    "1,2): its state goes to agents on the GameState topic, and with --gc-address also as\n"
+    "first kick-off to the end of the game, with a shoot-out if the rule book calls for one,\n"
+    "as in `simsoccer match` (team 0 kicks off; --teams gives the GameController team numbers,\n"
+    "default 1,2); serve stops when the game is over or after S s. Its state goes to agents on\n"
+    "the GameState topic, and with --gc-address also as\n"
     "GameController packets over UDP (port 3838, every 0.5 simulated s; return packets on\n"
     "3939), so robot code written for the SPL GameController runs unchanged.\n";
 
@@ -43,10 +49,18 @@ void onSignal(int) {
 int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
-                     "gc-address", "gc-port", "gc-return-port"});
+                     "gc-address", "gc-port", "gc-return-port", "mode"});
   if (opt.help(kHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario file");
   world::World w = world::World::fromFile(opt.positional()[0]);
+  sim::SimulationConfig simc;
+  simc.lockstep = !opt.flag("realtime");
+  try {
+    simc.mode = sim::parseMode(opt.get("mode", "serial"));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--mode: ") + e.what());
+  }
+  sim::Simulation simulation(w, simc);
   net::ServerConfig cfg;
   cfg.dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
   cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
@@ -56,10 +70,10 @@ int serve(int argc, char** argv, int first) {
   const double sim_seconds = opt.number("seconds", 60.0);
   const auto wanted =
       static_cast<size_t>(opt.number("agents", static_cast<double>(w.robotCount())));
-  net::SimServer server(w, cfg);
+  net::SimServer server(simulation, cfg);
 
-  // The referee (optional): the game from the first kick-off.
-  std::unique_ptr<referee::Referee> ref;
+  // The officials (optional): the game from the first kick-off, as in a match.
+  std::unique_ptr<sim::GameOfficials> officials;
   std::unique_ptr<referee::GameControllerLink> gc_link;
   if (opt.has("rules")) {
     const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
@@ -67,14 +81,16 @@ int serve(int argc, char** argv, int first) {
     if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
         numbers[1] > 255 || numbers[0] == numbers[1])
       throw UsageError("--teams: two different team numbers 0..255");
-    std::array<referee::TeamSetup, 2> teams;
+    sim::OfficialsConfig oc;
     for (size_t t = 0; t < 2; ++t) {
-      teams[t].number = static_cast<uint8_t>(numbers[t]);
-      teams[t].field_player_colour = static_cast<uint8_t>(t);
+      oc.teams[t].number = static_cast<uint8_t>(numbers[t]);
+      oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
     }
-    referee::RefereeConfig rcfg;
-    rcfg.auto_placement = opt.flag("auto-placement");
-    ref = std::make_unique<referee::Referee>(w, rules, teams, 0, rcfg);
+    oc.referee.auto_placement = opt.flag("auto-placement");
+    oc.seed = w.scenario().seed;
+    officials = std::make_unique<sim::GameOfficials>(w, rules, oc);
+    simulation.setOfficials(officials.get());
+    server.publishGameState(officials->controlData(), officials->leftTeam());
     if (opt.has("gc-address")) {
       referee::GameControllerLinkConfig gcfg;
       gcfg.address = opt.get("gc-address", "");
@@ -85,20 +101,7 @@ int serve(int argc, char** argv, int first) {
   } else if (opt.has("gc-address")) {
     throw UsageError("--gc-address needs --rules (the referee makes the packets)");
   }
-  auto refereePeriod = [&] {
-    if (!ref) return;
-    // The operator's part: each half starts (Standby, Ready) as soon as it can.
-    referee::Game& game = ref->game();
-    if (game.state() == referee::gc::State::Initial &&
-        game.phase() == referee::gc::GamePhase::Normal && !game.gameOver()) {
-      game.standby();
-      game.ready();
-    }
-    ref->update();
-    server.publishGameState(ref->game().packet(0), ref->game().leftTeam());
-    if (gc_link) gc_link->update(ref->game());
-  };
-  refereePeriod();
+  if (gc_link) gc_link->update(officials->game());
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
@@ -108,23 +111,17 @@ int serve(int argc, char** argv, int first) {
   while (!g_stop && !server.waitForOwners(wanted, 1.0)) {
   }
   const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long i = 0; i < periods && !g_stop; ++i) {
-    if (!cfg.lockstep) {
-      // Pace each period to the wall clock.
-      const auto due =
-          t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                   std::chrono::duration<double>(i * w.scenario().physics.control_period));
-      std::this_thread::sleep_until(due);
-    }
-    server.runPeriod();
-    refereePeriod();
-  }
-  server.flushCameras();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  sim::RunLoop loop(simulation, cfg.lockstep ? sim::Pacing::Lockstep : sim::Pacing::RealTime);
+  const sim::RunStats run = loop.run(
+      [&] { return g_stop || (officials && officials->over()); }, periods,
+      [&] {
+        if (gc_link) gc_link->update(officials->game());
+      });
+  simulation.flushCameras();
+  const double wall = run.wall_s;
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), wall,
               w.time() / wall);
-  if (const world::CameraSystem* cams = server.cameras()) {
+  if (const world::CameraSystem* cams = simulation.cameras()) {
     const world::CameraStats c = cams->stats();
     std::printf(
         "cameras (%s): %llu images in %llu batched frames, %.1f ms draw + %.1f ms readback + "
@@ -142,12 +139,12 @@ int serve(int argc, char** argv, int first) {
         (unsigned long long)s.accepted, (unsigned long long)s.rejected,
         (unsigned long long)s.refused, (unsigned long long)s.missed);
   }
-  if (ref) {
-    const referee::Game& g = ref->game();
+  if (officials) {
+    const referee::Game& g = officials->game();
     std::printf("game: %s, score %d:%d, %zu referee events\n", referee::stateName(g.state()),
                 g.score(0), g.score(1), g.events().size());
     for (const auto& e : g.events())
-      std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, e.type.c_str(), e.team,
+      std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, referee::eventName(e.type), e.team,
                   e.player, e.detail.c_str());
     if (gc_link)
       std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",

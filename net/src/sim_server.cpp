@@ -234,11 +234,13 @@ struct SimServer::Impl {
   }
 };
 
-SimServer::SimServer(world::World& world, const ServerConfig& config)
-    : world_(world),
+SimServer::SimServer(sim::Simulation& sim, const ServerConfig& config)
+    : sim_(sim),
+      world_(sim.world()),
       config_(config),
       ticks_per_second_(static_cast<uint64_t>(
-          std::max(1L, std::lround(1.0 / world.scenario().physics.control_period)))) {
+          std::max(1L, std::lround(1.0 / sim.world().scenario().physics.control_period)))) {
+  world::World& world = world_;
   impl_ = std::make_unique<Impl>(config, world.scenario().seed ^ 0x7EA3u);
   if (config.world_truth)
     impl_->truth = std::make_unique<Writer<simsoccer_msg_WorldTruth>>(
@@ -251,27 +253,17 @@ SimServer::SimServer(world::World& world, const ServerConfig& config)
     robots_.push_back(slot);
     impl_->robot_writers.push_back(std::make_unique<Impl::RobotWriters>(
         impl_->participant, robotPartitionName(info.team, info.number),
-        world.scenario().perception.enabled, world.scenario().cameras.enabled));
+        sim.perception() != nullptr, world.scenario().cameras.enabled));
     publishStatus(r);
   }
-  if (world.scenario().perception.enabled)
-    perception_ = std::make_unique<world::PerceptionSystem>(world, world.scenario().perception);
-  const world::CameraSettings& cameras = world.scenario().cameras;
-  if (cameras.enabled) {
-    // The sink runs on the render thread; DDS writers are thread-safe.
-    cameras_ = std::make_unique<world::CameraSystem>(
-        world, cameras, config.lockstep ? world::BehindPolicy::Wait : world::BehindPolicy::Drop,
-        [this](const world::CameraImage& image) {
-          if (image.camera == world::CameraId::Spectator) {
-            if (config_.spectator_sink) config_.spectator_sink(image);
-            return;
-          }
-          simsoccer_msg_CameraImage m{};
-          toMessage(image, m);
-          impl_->robot_writers[image.robot]->images->write(m);
-        });
-    cameras_->capture(world_);  // the images of tick 0
-  }
+  sim.addSource(*this);
+  if (world.scenario().cameras.enabled)
+    // On the simulation's conversion thread; DDS writers are thread-safe.
+    sim.addImageSink([this](const world::CameraImage& image) {
+      simsoccer_msg_CameraImage m{};
+      toMessage(image, m);
+      impl_->robot_writers[image.robot]->images->write(m);
+    });
   // No GameState until a referee sets one: agents without one play freely.
   // Commands are taken as they arrive, in the DDS receive thread: the main
   // thread wakes once, when the last owned robot has answered.
@@ -297,16 +289,19 @@ bool SimServer::allOwnedAnswered() const {
 
 RobotNetStats SimServer::stats(world::RobotId r) const {
   std::lock_guard lock(mutex_);
-  return robots_.at(r).stats;
+  RobotNetStats st = robots_.at(r).stats;
+  const sim::CommandStats c = sim_.commandStats(r);
+  st.accepted = c.accepted;
+  st.missed = c.missed;
+  st.rejected = c.rejected + robots_.at(r).wrong_tick;
+  return st;
 }
 
 SimServer::~SimServer() {
   dds_set_listener(impl_->commands.get(), nullptr);
-  cameras_.reset();  // delivers what is queued while the writers still exist
-}
-
-void SimServer::flushCameras() {
-  if (cameras_) cameras_->flush();
+  // Images still queued in the simulation's cameras go to writers that are
+  // about to go: deliver them now.
+  sim_.flushCameras();
 }
 
 int SimServer::robotIndex(int team, int player) const {
@@ -346,15 +341,16 @@ void SimServer::publishGameState(referee::ControlData data, int left_team) {
 
 void SimServer::publishStatus(world::RobotId r) {
   const RobotSlot& s = robots_[r];
+  const sim::CommandStats c = sim_.commandStats(r);
   simsoccer_msg_RobotStatus m{};
   m.team = static_cast<uint8_t>(s.team);
   m.player = static_cast<uint8_t>(s.player);
   m.owned = s.stats.owned;
   std::memcpy(m.owner_guid, s.owner.v, sizeof m.owner_guid);
-  m.accepted = static_cast<uint32_t>(s.stats.accepted);
-  m.rejected = static_cast<uint32_t>(s.stats.rejected);
+  m.accepted = static_cast<uint32_t>(c.accepted);
+  m.rejected = static_cast<uint32_t>(c.rejected + s.wrong_tick);
   m.refused = static_cast<uint32_t>(s.stats.refused);
-  m.missed = static_cast<uint32_t>(s.stats.missed);
+  m.missed = static_cast<uint32_t>(c.missed);
   impl_->robot_writers[r]->status.write(m);
 }
 
@@ -410,26 +406,6 @@ void SimServer::checkOwners() {
       release(static_cast<world::RobotId>(r));
 }
 
-bool SimServer::validCommand(const world::RobotInfo& info,
-                             const simsoccer_msg_JointCommand& c) const {
-  if (c.position._length != world::kActuators || c.stiffness._length != world::kActuators)
-    return false;
-  const auto& actuators = info.model->actuators;
-  const auto& joints = info.model->body->joints;
-  for (size_t a = 0; a < world::kActuators; ++a) {
-    const double p = c.position._buffer[a], k = c.stiffness._buffer[a];
-    if (!std::isfinite(p) || !std::isfinite(k) || k < 0.0 || k > 1.0) return false;
-    if (actuators[a].kind == robots::Actuator::Kind::Joint) {
-      const auto& jt = joints[static_cast<size_t>(actuators[a].index)];
-      if (p < jt.lower - config_.position_margin || p > jt.upper + config_.position_margin)
-        return false;
-    } else if (std::abs(p) > 10.0) {
-      return false;
-    }
-  }
-  return true;
-}
-
 void SimServer::handleCommands() {
   const bool lockstep = config_.lockstep;
   // Lockstep: the tick just published; real time: the newest published.
@@ -451,14 +427,16 @@ void SimServer::handleCommands() {
     const bool tick_ok = lockstep
                              ? c.tick == tick
                              : (c.tick <= tick && c.tick >= s.last_tick && c.tick + window >= tick);
-    if (!tick_ok || !validCommand(world_.robot(static_cast<world::RobotId>(ri)), c)) {
-      ++s.stats.rejected;
+    if (!tick_ok) {
+      ++s.wrong_tick;
       return;
     }
-    for (size_t a = 0; a < world::kActuators; ++a) {
-      s.position[a] = world::quantizeCommand(c.position._buffer[a]);
-      s.stiffness[a] = world::quantizeStiffness(c.stiffness._buffer[a]);
-    }
+    // The one check every command goes through (counted there when refused).
+    const auto checked = sim_.gate().check(
+        static_cast<world::RobotId>(ri), std::span<const float>(c.position._buffer, c.position._length),
+        std::span<const float>(c.stiffness._buffer, c.stiffness._length));
+    if (!checked) return;
+    s.command = *checked;
     s.has_command = true;
     s.last_tick = c.tick;
   });
@@ -573,9 +551,8 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
   return ready();
 }
 
-void SimServer::runPeriod() {
-  const auto t0 = Clock::now();
-  const uint64_t tick = world_.controlTick();
+void SimServer::observe(const sim::Observation& o) {
+  const uint64_t tick = o.tick;
   {
     std::lock_guard lock(mutex_);
     handleJoins();
@@ -588,16 +565,16 @@ void SimServer::runPeriod() {
     }
     published_tick_ = tick;
   }
-
-  // Perception first, then the frames for this tick (the state the commands
-  // will answer): an agent that answers in its frame callback finds this
-  // tick's perception already there (one writer, in order, on loopback).
-  // (A frame carries the tick and time of the period it closed: this one's.)
-  if (perception_) {
-    perception_->update(world_);
+  // The game state first (when it changed), then perception, then the frames
+  // for this tick (the state the commands will answer): an agent that
+  // answers in its frame callback finds this tick's perception and game
+  // state already there (one writer, in order, on loopback). (A frame
+  // carries the tick and time of the period it closed: this one's.)
+  if (o.game) publishGameState(*o.game, o.left_team);
+  if (o.perception) {
     simsoccer_msg_Perception m{};
     for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-      toMessage(perception_->perception(r), robots_[r].team, robots_[r].player, m,
+      toMessage(o.perception->perception(r), robots_[r].team, robots_[r].player, m,
                 impl_->perceived_scratch);
       impl_->robot_writers[r]->perception->write(m);
     }
@@ -610,79 +587,67 @@ void SimServer::runPeriod() {
   impl_->clock.write(clock);
   if (impl_->game_state_set && world_.time() - impl_->game_state_published_at >= 0.5 - 1e-9)
     setGameState(impl_->game_state);
-  if (impl_->truth) {
-    simsoccer_msg_WorldTruth t{};
-    t.tick = tick;
-    t.sim_time = world_.time();
-    const auto ball = world_.ballState();
-    for (int k = 0; k < 3; ++k) {
-      t.ball_position[k] = static_cast<float>(ball.pose.translation()[k]);
-      t.ball_velocity[k] = static_cast<float>(ball.linear_velocity[k]);
-    }
-    std::vector<simsoccer_msg_RobotTruth>& rt = impl_->truth_robots;
-    rt.resize(world_.robotCount());
-    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-      const auto pose = world_.torsoPose(r);
-      const Eigen::Quaterniond q(pose.linear());
-      rt[r].team = static_cast<uint8_t>(robots_[r].team);
-      rt[r].player = static_cast<uint8_t>(robots_[r].player);
-      for (int k = 0; k < 3; ++k) rt[r].position[k] = static_cast<float>(pose.translation()[k]);
-      rt[r].orientation[0] = static_cast<float>(q.x());
-      rt[r].orientation[1] = static_cast<float>(q.y());
-      rt[r].orientation[2] = static_cast<float>(q.z());
-      rt[r].orientation[3] = static_cast<float>(q.w());
-    }
-    t.robots._buffer = rt.data();
-    t.robots._length = static_cast<uint32_t>(rt.size());
-    t.robots._maximum = static_cast<uint32_t>(rt.size());
-    t.robots._release = false;
-    impl_->truth->write(t);
+  if (impl_->truth) publishTruth(tick);
+}
+
+void SimServer::publishTruth(uint64_t tick) {
+  simsoccer_msg_WorldTruth t{};
+  t.tick = tick;
+  t.sim_time = world_.time();
+  const auto ball = world_.ballState();
+  for (int k = 0; k < 3; ++k) {
+    t.ball_position[k] = static_cast<float>(ball.pose.translation()[k]);
+    t.ball_velocity[k] = static_cast<float>(ball.linear_velocity[k]);
   }
-  const auto t1 = Clock::now();
-
-  // Commands.
-  {
-    std::unique_lock lock(mutex_);
-    if (config_.lockstep) {
-      const auto deadline = t1 + std::chrono::duration_cast<Clock::duration>(
-                                     std::chrono::duration<double>(config_.command_timeout));
-      handleCommands();  // anything the listener has not taken yet
-      answered_.wait_until(lock, deadline, [&] { return allOwnedAnswered(); });
-      expected_tick_ = UINT64_MAX;  // late answers are stale from here on
-      for (RobotSlot& s : robots_)
-        if (s.stats.owned && !s.has_command) ++s.stats.missed;  // keeps its last command
-    } else {
-      handleCommands();
-    }
-    relayTeamMessages(tick);
+  std::vector<simsoccer_msg_RobotTruth>& rt = impl_->truth_robots;
+  rt.resize(world_.robotCount());
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto pose = world_.torsoPose(r);
+    const Eigen::Quaterniond q(pose.linear());
+    rt[r].team = static_cast<uint8_t>(robots_[r].team);
+    rt[r].player = static_cast<uint8_t>(robots_[r].player);
+    for (int k = 0; k < 3; ++k) rt[r].position[k] = static_cast<float>(pose.translation()[k]);
+    rt[r].orientation[0] = static_cast<float>(q.x());
+    rt[r].orientation[1] = static_cast<float>(q.y());
+    rt[r].orientation[2] = static_cast<float>(q.z());
+    rt[r].orientation[3] = static_cast<float>(q.w());
   }
+  t.robots._buffer = rt.data();
+  t.robots._length = static_cast<uint32_t>(rt.size());
+  t.robots._maximum = static_cast<uint32_t>(rt.size());
+  t.robots._release = false;
+  impl_->truth->write(t);
+}
 
-  const auto t2 = Clock::now();
-
-  {
-    std::lock_guard lock(mutex_);
-    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-      RobotSlot& s = robots_[r];
-      s.applied = s.has_command;
-      if (!s.has_command) continue;
-      world_.setCommand(r, s.position, s.stiffness);
-      ++s.stats.accepted;
+void SimServer::collect(uint64_t tick, sim::CommandGate&, std::span<sim::CommandSlot> slots) {
+  std::unique_lock lock(mutex_);
+  if (config_.lockstep) {
+    const auto deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(config_.command_timeout));
+    handleCommands();  // anything the listener has not taken yet
+    answered_.wait_until(lock, deadline, [&] { return allOwnedAnswered(); });
+    expected_tick_ = UINT64_MAX;  // late answers are stale from here on
+  } else {
+    handleCommands();
+  }
+  relayTeamMessages(tick);
+  for (size_t r = 0; r < robots_.size() && r < slots.size(); ++r) {
+    RobotSlot& s = robots_[r];
+    if (s.has_command) {
+      slots[r] = {sim::Answer::Given, s.command};
       if (!config_.lockstep) s.has_command = false;  // applied once
+    } else if (s.stats.owned && config_.lockstep) {
+      slots[r].answer = sim::Answer::Missed;  // keeps its last command
     }
   }
-  world_.stepControlPeriod();
-  const auto t3 = Clock::now();
-  if (cameras_) cameras_->capture(world_);  // the state the next frames describe
-  times_.publish_s += seconds(t0, t1);
-  times_.wait_s += seconds(t1, t2);
-  times_.physics_s += seconds(t2, t3);
-  times_.camera_s += seconds(t3, Clock::now());
-  ++times_.periods;
+}
+
+void SimServer::afterStep(const world::World&) {
   // Status at 1 Hz of simulated time (and at every ownership change).
-  if (tick % ticks_per_second_ == 0) {
-    std::lock_guard lock(mutex_);
-    for (world::RobotId r = 0; r < world_.robotCount(); ++r) publishStatus(r);
-  }
+  if (published_tick_ % ticks_per_second_ != 0) return;
+  std::lock_guard lock(mutex_);
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r) publishStatus(r);
 }
 
 }  // namespace simsoccer::net

@@ -115,13 +115,57 @@ Game::Game(const RuleBook& rules, const std::array<TeamSetup, 2>& teams, int kic
       team[n].penalty = gc::Penalty::Substitute;  // numbers beyond the team size
 }
 
-void Game::log(const std::string& type, int team, int player, const std::string& detail) {
+const char* eventName(EventType t) {
+  switch (t) {
+    case EventType::State:
+      return "state";
+    case EventType::Half:
+      return "half";
+    case EventType::GameOver:
+      return "game_over";
+    case EventType::Shootout:
+      return "shootout";
+    case EventType::Shot:
+      return "shot";
+    case EventType::ShotOver:
+      return "shot_over";
+    case EventType::Goal:
+      return "goal";
+    case EventType::SetPlay:
+      return "set_play";
+    case EventType::Penalty:
+      return "penalty";
+    case EventType::Unpenalise:
+      return "unpenalise";
+    case EventType::Timeout:
+      return "timeout";
+    case EventType::DropBall:
+      return "drop_ball";
+    case EventType::Substitute:
+      return "substitute";
+    case EventType::Pushing:
+      return "pushing";
+    case EventType::BallContact:
+      return "ball_contact";
+    case EventType::Placement:
+      return "placement";
+    case EventType::GoalDisallowed:
+      return "goal_disallowed";
+    case EventType::IllegalPosition:
+      return "illegal_position";
+    case EventType::Inactive:
+      return "inactive";
+  }
+  return "?";
+}
+
+void Game::log(EventType type, int team, int player, const std::string& detail) {
   events_.push_back({time_, type, team, player, detail});
 }
 
 void Game::enter(gc::State s, const std::string& why) {
   state_ = s;
-  log("state", -1, 0, std::string(stateName(s)) + (why.empty() ? "" : ": " + why));
+  log(EventType::State, -1, 0, std::string(stateName(s)) + (why.empty() ? "" : ": " + why));
 }
 
 Game::Player& Game::player(int team, int number) {
@@ -208,7 +252,7 @@ void Game::advance(double dt) {
           for (int t = 0; t < 2; ++t)
             for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n)
               if (player(t, n).penalty != gc::Penalty::Substitute) player(t, n) = Player{};
-          log("half", -1, 0, "second half");
+          log(EventType::Half, -1, 0, "second half");
           enter(gc::State::Initial, "half-time");
         }
       }
@@ -233,14 +277,14 @@ void Game::endHalf() {
   for (auto& team : players_)
     for (Player& p : team)
       if (p.penalty != gc::Penalty::Substitute) p = Player{};
-  log("half", -1, 0, half_ == Half::First ? "end of the first half" : "end of the second half");
+  log(EventType::Half, -1, 0, half_ == Half::First ? "end of the first half" : "end of the second half");
   enter(gc::State::Finished, "end of half");
   if (half_ == Half::First && rules_.halves == 2) {
     secondary_ = rules_.half_time_break;
   } else {
     game_over_ = true;
     if (score_[0] != score_[1]) winner_ = score_[0] > score_[1] ? 0 : 1;
-    log("game_over", -1, 0,
+    log(EventType::GameOver, -1, 0,
         score_[0] == score_[1] ? "draw" : (score_[0] > score_[1] ? "team 0 wins" : "team 1 wins"));
   }
 }
@@ -286,7 +330,7 @@ void Game::startShootout(int first_team, std::optional<int> kicks_per_team, uint
   secondary_ = 0.0;
   half_clock_ = rules_.shootout_shot_duration;
   kicking_team_ = first_team;
-  log("shootout", first_team, 0,
+  log(EventType::Shootout, first_team, 0,
       std::to_string(shootout_kicks_) + " kicks per team, team " + std::to_string(first_team) +
           " first");
   enter(gc::State::Initial, "penalty shoot-out");
@@ -316,7 +360,7 @@ void Game::shootoutKick(int striker, int keeper) {
   shot_kicked_ = false;
   ++shots_[static_cast<size_t>(team)];
   half_clock_ = rules_.shootout_shot_duration;
-  log("shot", team, striker,
+  log(EventType::Shot, team, striker,
       "kick " + std::to_string(shots_[static_cast<size_t>(team)]) + ", keeper " +
           std::to_string(keeper));
   enter(gc::State::Set, "shoot-out kick");
@@ -336,7 +380,7 @@ void Game::finishShot(ShotOutcome outcome) {
 
 void Game::endShot(ShotOutcome outcome, const std::string& why) {
   outcomes_[static_cast<size_t>(kicking_team_)].push_back(outcome);
-  log("shot_over", kicking_team_, striker_, why);
+  log(EventType::ShotOver, kicking_team_, striker_, why);
   enter(gc::State::Finished, "shoot-out kick over");
   decideShootout();
 }
@@ -356,7 +400,7 @@ void Game::decideShootout() {
   auto decide = [&](int team, const std::string& why) {
     winner_ = team;
     game_over_ = true;
-    log("game_over", team, 0, "team " + std::to_string(team) + " wins the shoot-out (" + why + ")");
+    log(EventType::GameOver, team, 0, "team " + std::to_string(team) + " wins the shoot-out (" + why + ")");
   };
   if (na <= k && nb <= k) {
     // Regular kicks: decided once a team can no longer catch up.
@@ -366,7 +410,7 @@ void Game::decideShootout() {
     if (na < k || nb < k) return;
     if (!rules_.sudden_death) {
       game_over_ = true;
-      log("game_over", -1, 0, "draw after the shoot-out");
+      log(EventType::GameOver, -1, 0, "draw after the shoot-out");
       return;
     }
     return;  // level: sudden death
@@ -446,12 +490,12 @@ void Game::goal(int team) {
     if (team != kicking_team_)
       throw std::logic_error("in the shoot-out only the kicking team scores");
     ++score_[static_cast<size_t>(team)];
-    log("goal", team, striker_, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
+    log(EventType::Goal, team, striker_, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
     endShot(ShotOutcome::Goal, "goal");
     return;
   }
   ++score_[static_cast<size_t>(team)];
-  log("goal", team, 0, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
+  log(EventType::Goal, team, 0, std::to_string(score_[0]) + ":" + std::to_string(score_[1]));
   if (rules_.mercy_goal_difference > 0 &&
       std::abs(score_[0] - score_[1]) >= rules_.mercy_goal_difference) {
     secondary_ = 0.0;
@@ -460,7 +504,7 @@ void Game::goal(int team) {
     enter(gc::State::Finished, "mercy rule");
     game_over_ = true;
     winner_ = team;
-    log("game_over", -1, 0, "mercy rule");
+    log(EventType::GameOver, -1, 0, "mercy rule");
     return;
   }
   startKickOff(1 - team, "goal, kick-off for the other team");
@@ -469,7 +513,7 @@ void Game::goal(int team) {
 void Game::ballFree() {
   if (state_ != gc::State::Playing) return;
   if (set_play_ != gc::SetPlay::None || kicking_team_ >= 0)
-    log("set_play", kicking_team_, 0,
+    log(EventType::SetPlay, kicking_team_, 0,
         set_play_ == gc::SetPlay::None ? std::string("kick-off over")
                                        : std::string("over: ") + setPlayName(set_play_));
   set_play_ = gc::SetPlay::None;
@@ -483,7 +527,7 @@ void Game::setPlay(gc::SetPlay play, int team) {
   if (play == gc::SetPlay::None) return ballFree();
   kicking_team_ = team;
   set_play_ = play;
-  log("set_play", team, 0, setPlayName(play));
+  log(EventType::SetPlay, team, 0, setPlayName(play));
   if (play == gc::SetPlay::PenaltyKick) {
     // Ready (30 s) and Set before the kick, which then has 30 s in Playing.
     kick_off_pending_ = false;
@@ -526,7 +570,7 @@ void Game::penalise(int team, int number, gc::Penalty p) {
   }
   pl.penalty = p;
   pl.remaining = seconds;
-  log("penalty", team, number,
+  log(EventType::Penalty, team, number,
       std::to_string(static_cast<int>(p)) + " for " +
           std::to_string(static_cast<int>(std::ceil(seconds))) + " s");
 }
@@ -535,7 +579,7 @@ void Game::unpenalise(int team, int number) {
   Player& pl = player(team, number);
   if (pl.penalty == gc::Penalty::None || pl.penalty == gc::Penalty::Substitute) return;
   pl = Player{};
-  log("unpenalise", team, number, "");
+  log(EventType::Unpenalise, team, number, "");
 }
 
 void Game::timeout(std::optional<int> team) {
@@ -554,13 +598,13 @@ void Game::timeout(std::optional<int> team) {
   }
   phase_ = gc::GamePhase::Timeout;
   set_play_ = gc::SetPlay::None;
-  log("timeout", team ? *team : -1, 0, team ? "team timeout" : "referee timeout");
+  log(EventType::Timeout, team ? *team : -1, 0, team ? "team timeout" : "referee timeout");
   enter(gc::State::Initial, "timeout");
 }
 
 void Game::dropBall() {
   if (state_ != gc::State::Playing) throw std::logic_error("a drop ball restarts Playing");
-  log("drop_ball", -1, 0, "");
+  log(EventType::DropBall, -1, 0, "");
   startKickOff(-1, "drop ball");
 }
 
@@ -574,7 +618,7 @@ void Game::substitute(int team, int out, int in) {
   // The goalkeeper role goes to the incoming player (GC3).
   TeamSetup& setup = teams_[static_cast<size_t>(team)];
   if (setup.goalkeeper == out) setup.goalkeeper = static_cast<uint8_t>(in);
-  log("substitute", team, in, "for player " + std::to_string(out));
+  log(EventType::Substitute, team, in, "for player " + std::to_string(out));
 }
 
 ControlData Game::packet(uint8_t packet_number) const {

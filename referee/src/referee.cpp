@@ -162,7 +162,7 @@ void Referee::checkPushing() {
       t = 0.0;
       contact_gap_[k] = 1e9;
       game_.penalise(ip.team, ip.number, gc::Penalty::PlayerPushing);
-      game_.recordEvent("pushing", ip.team, ip.number,
+      game_.recordEvent(EventType::Pushing, ip.team, ip.number,
                         "pushed team " + std::to_string(iv.team) + " player " +
                             std::to_string(iv.number) + (fell ? " over" : ""));
       // Near the ball in open play: a foul, the other team gets a free kick
@@ -196,7 +196,7 @@ void Referee::checkArmContact() {
   if (game_.penalty(info.team, info.number) != gc::Penalty::None || !world_.isStanding(r)) return;
   if (game_.goalkeeper(info.team) == info.number && inOwnArea(r, penaltyArea())) return;
   game_.penalise(info.team, info.number, gc::Penalty::IllegalBallContact);
-  game_.recordEvent("ball_contact", info.team, info.number, "played the ball with an arm");
+  game_.recordEvent(EventType::BallContact, info.team, info.number, "played the ball with an arm");
   const Vec3 p = world_.ballState().pose.translation();
   placeBall(p.x(), p.y());
 }
@@ -305,7 +305,7 @@ void Referee::onEnterSet() {
       const Vec3 p = nearestLegalPosition(r, taken);
       taken.push_back(p);
       world_.placeRobot(r, p.x(), p.y(), teamSign(info.team) < 0 ? 0.0 : M_PI);
-      game_.recordEvent("placement", info.team, info.number, "auto-placed to a legal position");
+      game_.recordEvent(EventType::Placement, info.team, info.number, "auto-placed to a legal position");
     } else {
       game_.penalise(info.team, info.number, gc::Penalty::IllegalPositionInSet);
     }
@@ -333,7 +333,7 @@ void Referee::checkBall() {
       const bool direct = std::popcount(touched_since_restart_[static_cast<size_t>(attacker)]) < 2;
       if (game_.rules().indirect_kick && !own_goal && direct &&
           game_.currentSetPlay() != gc::SetPlay::PenaltyKick) {
-        game_.recordEvent("goal_disallowed", attacker, 0,
+        game_.recordEvent(EventType::GoalDisallowed, attacker, 0,
                           "indirect kick: fewer than two of its robots played the ball");
         awardGoalKick(defender, side, p.y());
       } else {
@@ -410,7 +410,7 @@ void Referee::checkPenalties() {
                   (ball - p).head<2>().norm() < config_.free_kick_distance;
       if (illegal) {
         game_.penalise(info.team, info.number, gc::Penalty::IllegalPosition);
-        game_.recordEvent("illegal_position", info.team, info.number,
+        game_.recordEvent(EventType::IllegalPosition, info.team, info.number,
                           play == gc::SetPlay::None ? "entered at the opponents' kick-off"
                                                     : "too close to the ball at a free kick");
         continue;
@@ -424,7 +424,7 @@ void Referee::checkPenalties() {
       idle_for_[r] = 0.0;
     } else if ((idle_for_[r] += dt) >= config_.inactive_time) {
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
-      game_.recordEvent("inactive", info.team, info.number, "stood idle next to the ball");
+      game_.recordEvent(EventType::Inactive, info.team, info.number, "stood idle next to the ball");
       idle_for_[r] = 0.0;
       continue;
     }
@@ -576,7 +576,7 @@ void Referee::checkShot() {
         first_touch_ball_ = p;
         game_.shotKicked();
       } else if ((p - first_touch_ball_).head<2>().norm() > config_.ball_replayed) {
-        game_.recordEvent("shot", kicking, game_.shootoutStriker(),
+        game_.recordEvent(EventType::Shot, kicking, game_.shootoutStriker(),
                           "striker played the ball again");
         return game_.finishShot(keeper_touched_ ? ShotOutcome::Saved : ShotOutcome::Other);
       }
@@ -590,7 +590,7 @@ void Referee::checkShot() {
     const double from_line =
         std::abs(side * f.halfLength() - world_.torsoPose(*keeper).translation().x());
     if (!world_.isStanding(*keeper) || from_line > config_.keeper_line_tolerance) {
-      game_.recordEvent("shot", 1 - kicking, game_.shootoutKeeper(),
+      game_.recordEvent(EventType::Shot, 1 - kicking, game_.shootoutKeeper(),
                         "keeper left the goal line or fell before the kick: goal awarded");
       game_.goal(kicking);
       return;
@@ -623,14 +623,14 @@ void Referee::checkShot() {
   const fields::AreaSize area = penaltyArea();
   if (x > f.halfLength() + line + r || x < f.halfLength() - area.length - r ||
       std::abs(p.y()) > 0.5 * area.width + r) {
-    game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball left the penalty area");
+    game_.recordEvent(EventType::Shot, kicking, game_.shootoutStriker(), "ball left the penalty area");
     return game_.finishShot(outcome());
   }
   // The ball came to a stop after the striker's touch.
   ball_still_for_ =
       b.linear_velocity.head<2>().norm() < config_.ball_stopped_speed ? ball_still_for_ + dt : 0.0;
   if (ball_still_for_ >= config_.ball_stopped_time) {
-    game_.recordEvent("shot", kicking, game_.shootoutStriker(), "ball stopped");
+    game_.recordEvent(EventType::Shot, kicking, game_.shootoutStriker(), "ball stopped");
     return game_.finishShot(outcome());
   }
 }

@@ -1,9 +1,12 @@
-// The simulator's side of the agent protocol: publishes every robot's
-// SensorFrame, takes JointCommands, keeps robot ownership, relays team
-// messages on simulated time, and advances the World, in lockstep (wait for
-// every owned robot's command for tick t, then step) or in real time.
+// The DDS transport of the simulation: a command source of the period
+// pipeline (sim::Simulation) that publishes every robot's SensorFrame (and
+// its perception, camera images, status, team messages) and takes the
+// agents' JointCommands, keeps robot ownership, and relays team messages on
+// simulated time. Lockstep: collect waits for every owned robot's answer to
+// the tick it published (up to the timeout); real time: the latest answer.
+// Perception and cameras belong to the simulation; this only sends them.
 //
-// Topics (names, QoS, rates and sizes: README "Agents over DDS"):
+// Topics (names, QoS, rates and sizes: docs/protocol.md):
 //   simsoccer_SensorFrame   sim -> agent, partition robot_<team>_<player>
 //   simsoccer_JointCommand  agent -> sim
 //   simsoccer_JoinRequest   agent -> sim
@@ -24,10 +27,12 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
+#include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/camera_system.hpp"
 #include "simsoccer/world/perception.hpp"
 #include "simsoccer/world/world.hpp"
@@ -43,35 +48,27 @@ struct ServerConfig {
   double team_message_delay = 0.0;  // s of simulated time (at least one control period)
   double team_message_loss = 0.0;   // probability a copy is lost
   bool world_truth = false;
-  double position_margin = 0.5;  // rad beyond a joint's limits before a target is rejected
-  // Cameras: on when the scenario's `cameras.enabled` says so. Lockstep waits
-  // for rendering when it falls behind; real time drops captures (counted).
-  // Spectator images go to this callback (on the render thread), not to DDS.
-  std::function<void(const world::CameraImage&)> spectator_sink;
 };
 
+// accepted, missed: the simulation's count (sim::CommandStats); rejected:
+// the gate's refusals and answers to the wrong tick; refused: samples from a
+// participant that does not own the robot.
 struct RobotNetStats {
   bool owned = false;
   uint64_t accepted = 0, rejected = 0, refused = 0, missed = 0;
 };
 
-struct ServerTimes {
-  double publish_s = 0.0;  // building and writing frames, clock, status
-  double wait_s = 0.0;     // waiting for and taking commands (lockstep)
-  double physics_s = 0.0;  // World steps (physics and sensors)
-  double camera_s = 0.0;   // capturing the scene for the render thread (and waiting for it)
-  uint64_t periods = 0;
-};
-
-class SimServer {
+class SimServer : public sim::CommandSource {
  public:
-  SimServer(world::World& world, const ServerConfig& config);
-  ~SimServer();
+  // Joins `sim` as a command source (and an image sink when cameras are on).
+  SimServer(sim::Simulation& sim, const ServerConfig& config);
+  ~SimServer() override;
 
-  // One control period: publish the frames for the current tick, collect
-  // commands (lockstep: wait for every owned robot, up to the timeout),
-  // apply the valid ones, step the world.
-  void runPeriod();
+  // The period's stages (sim::CommandSource): publish the frames for the
+  // tick, collect the owned robots' answers to it, status after the step.
+  void observe(const sim::Observation& o) override;
+  void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override;
+  void afterStep(const world::World& world) override;
   // Handle claims and commands for up to `seconds` of wall time without
   // stepping (while agents connect).
   void poll(double seconds);
@@ -90,20 +87,6 @@ class SimServer {
   bool releaseRobot(world::RobotId r);
   // Team messages of `team` (index) relayed so far (each sent message once).
   uint64_t teamMessagesRelayed(int team) const { return team_messages_[team == 0 ? 0 : 1]; }
-  // The command applied to robot r in the last period (quantised as the
-  // match log keeps it: world::quantizeCommand), if one was.
-  bool commandApplied(world::RobotId r) const { return robots_.at(r).applied; }
-  const std::array<double, world::kActuators>& commandPosition(world::RobotId r) const {
-    return robots_.at(r).position;
-  }
-  const std::array<double, world::kActuators>& commandStiffness(world::RobotId r) const {
-    return robots_.at(r).stiffness;
-  }
-  const ServerTimes& times() const { return times_; }
-  // Null when the scenario has no cameras.
-  const world::CameraSystem* cameras() const { return cameras_.get(); }
-  // Delivers every image captured so far (the end of a run).
-  void flushCameras();
   // The GameState published at every change and every 0.5 s (2 Hz); none is
   // published until one is set (a simulator without a referee).
   void setGameState(const simsoccer_msg_GameState& state);
@@ -121,10 +104,10 @@ class SimServer {
     RobotNetStats stats;
     dds_guid_t owner{};
     dds_instance_handle_t owner_join = 0;  // the owner's JoinRequest writer (liveness)
-    bool has_command = false;              // a valid command waits to be applied
+    bool has_command = false;              // a checked command waits to be taken
     uint64_t last_tick = 0;                // tick of the last accepted command
-    std::array<double, world::kActuators> position{}, stiffness{};
-    bool applied = false;  // a command was applied in the last period
+    uint64_t wrong_tick = 0;               // answers to a tick other than the one asked
+    sim::RobotCommand command;             // checked and quantised by the gate
   };
 
   void handleJoins();
@@ -136,10 +119,11 @@ class SimServer {
   void checkOwners();
   void relayTeamMessages(uint64_t tick);
   void publishStatus(world::RobotId r);
+  void publishTruth(uint64_t tick);
   void release(world::RobotId r);
   int robotIndex(int team, int player) const;
-  bool validCommand(const world::RobotInfo& info, const simsoccer_msg_JointCommand& c) const;
 
+  sim::Simulation& sim_;
   world::World& world_;
   ServerConfig config_;
   // Guards robots_ between the main thread and the command listener.
@@ -150,9 +134,6 @@ class SimServer {
   uint64_t published_tick_ = 0;          // the newest tick whose frames went out
   std::unique_ptr<Impl> impl_;
   std::vector<RobotSlot> robots_;
-  ServerTimes times_;
-  std::unique_ptr<world::PerceptionSystem> perception_;  // null unless the scenario turns it on
-  std::unique_ptr<world::CameraSystem> cameras_;         // declared last: stopped first
 };
 
 // The referee's GameController packet as the DDS GameState message.

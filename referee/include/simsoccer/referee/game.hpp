@@ -54,9 +54,37 @@ struct TeamSetup {
   uint8_t goalkeeper = 1;  // player number
 };
 
+// What a referee event is. eventName() gives the name logs and summaries use.
+enum class EventType : uint8_t {
+  State,       // the game state changed (detail: the new state and why)
+  Half,        // a half began or ended
+  GameOver,    // the game is decided (detail: how)
+  Shootout,    // a penalty shoot-out began
+  Shot,        // a shoot-out kick was set up
+  ShotOver,    // a shoot-out kick ended (detail: its outcome)
+  Goal,        // detail: the score after it
+  SetPlay,     // a set play was awarded or is over
+  Penalty,     // a robot was penalised (detail: the penalty)
+  Unpenalise,  // a penalised robot may play again
+  Timeout,     // a team or referee timeout
+  DropBall,    // the ball was dropped
+  Substitute,  // a substitution
+  // The referee's own calls that are not state changes:
+  Pushing,          // a robot pushed another (the penalty follows as Penalty)
+  BallContact,      // a field player played the ball with an arm
+  Placement,        // a robot was auto-placed at Set
+  GoalDisallowed,   // the ball went in but the goal does not count
+  IllegalPosition,  // a robot stood illegally at Set
+  Inactive,         // a robot stood idle next to the ball
+};
+// "state", "half", "game_over", "shootout", "shot", "shot_over", "goal",
+// "set_play", "penalty", "unpenalise", "timeout", "drop_ball", "substitute", "pushing",
+// "ball_contact", "placement", "goal_disallowed", "illegal_position", "inactive".
+const char* eventName(EventType t);
+
 struct RefereeEvent {
   double time = 0.0;  // s of simulated time
-  std::string type;   // "state", "goal", "set_play", "penalty", "unpenalise", "half", ...
+  EventType type = EventType::State;
   int team = -1;      // team index, -1 none
   int player = 0;     // player number, 0 none
   std::string detail;
@@ -139,7 +167,7 @@ class Game {
   const RuleBook& rules() const { return rules_; }
 
   // A referee decision that is not a state change (placement, ...).
-  void recordEvent(const std::string& type, int team, int player, const std::string& detail) {
+  void recordEvent(EventType type, int team, int player, const std::string& detail) {
     log(type, team, player, detail);
   }
 
@@ -156,7 +184,7 @@ class Game {
   void endHalf();
   void endShot(ShotOutcome outcome, const std::string& why);
   void decideShootout();
-  void log(const std::string& type, int team, int player, const std::string& detail);
+  void log(EventType type, int team, int player, const std::string& detail);
   bool halfClockRuns() const;
   Player& player(int team, int number);
   const Player& player(int team, int number) const;

@@ -1,0 +1,50 @@
+// The officials of a game: the automatic referee and the operator's part
+// (starting each half as soon as it can, the shoot-out when a drawn game
+// needs one, each shoot-out kick in turn). One order for every program:
+// after the step, the referee judges, then the operator acts.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "simsoccer/referee/referee.hpp"
+#include "simsoccer/sim/simulation.hpp"
+
+namespace simsoccer::sim {
+
+struct OfficialsConfig {
+  std::array<referee::TeamSetup, 2> teams;
+  referee::RefereeConfig referee;
+  int kick_off_team = 0;
+  // A penalty-kick trial: one shoot-out kick from the start, team 0 kicking.
+  bool penalty_kick_trial = false;
+  uint64_t seed = 1;  // the shoot-out's coin toss
+};
+
+class GameOfficials : public Officials {
+ public:
+  GameOfficials(world::World& world, const referee::RuleBook& rules, const OfficialsConfig& config);
+
+  void afterStep(std::vector<Event>& events) override;
+  referee::ControlData controlData() const override { return referee_->game().packet(0); }
+  int leftTeam() const override { return referee_->game().leftTeam(); }
+
+  referee::Referee& referee() { return *referee_; }
+  const referee::Game& game() const { return referee_->game(); }
+  // The game (and any shoot-out it needs) is decided; a penalty-kick trial:
+  // its kick is over.
+  bool over() const;
+
+ private:
+  void operatorPart();
+
+  world::World& world_;
+  OfficialsConfig config_;
+  std::unique_ptr<referee::Referee> referee_;
+  size_t events_seen_ = 0;
+  std::array<int, 2> next_striker_{0, 0};
+};
+
+}  // namespace simsoccer::sim

@@ -1,0 +1,169 @@
+// One control period of the simulation as named stages, in one place:
+//
+//   observe    perception, then every source gets the state of this tick
+//              (frames out, in-process agents run)
+//   collect    every source's answers to this tick (a lockstep source waits)
+//   check      every command through the one CommandGate (sources check as
+//              they receive; nothing reaches the world unchecked)
+//   apply      the checked commands set on the world
+//   step       World::stepControlPeriod (physics and sensors)
+//   officials  the referee and the operator (Officials), events read after it
+//   record     the period's record to every Recorder (log, statistics)
+//   cameras    captures due at the new tick go to the render thread
+//
+// Serial mode runs them in that order: the command answering tick t acts in
+// period t. Pipelined mode applies the answers to tick t-1, steps, and then
+// collects the answers to tick t, so the drivers compute while the world
+// steps: a fixed one-period actuation delay, the same for every source, as
+// on the real Nao where a command from cycle k acts in a later cycle.
+// Both are deterministic: the period never depends on when an answer came.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "simsoccer/sim/command.hpp"
+#include "simsoccer/sim/events.hpp"
+#include "simsoccer/world/camera_system.hpp"
+#include "simsoccer/world/perception.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::sim {
+
+enum class Mode : uint8_t { Serial, Pipelined };
+// The mode of matches, benchmarks and in-process agents unless they are told otherwise.
+inline constexpr Mode kDefaultMode = Mode::Serial;
+const char* modeName(Mode m);
+// "serial" or "pipelined"; throws std::invalid_argument naming the value.
+Mode parseMode(const std::string& name);
+
+struct SimulationConfig {
+  Mode mode = Mode::Serial;
+  // Lockstep: cameras wait for the renderer when it falls behind. Real
+  // time: captures are dropped (and counted) instead.
+  bool lockstep = true;
+  double position_margin = 0.5;  // rad beyond a joint's limits before a target is refused
+  // Spectator camera images (on the conversion thread); robots' images go
+  // to the image sinks of the sources.
+  std::function<void(const world::CameraImage&)> spectator_sink;
+};
+
+// Wall time per stage, summed over the periods run (the per-period report of
+// every program and benchmark).
+struct Profile {
+  double observe_s = 0.0;    // perception and sending the state
+  double collect_s = 0.0;    // waiting for and taking the answers
+  double apply_s = 0.0;      // setting the checked commands
+  double step_s = 0.0;       // physics and sensors
+  double officials_s = 0.0;  // referee and operator
+  double record_s = 0.0;     // recorders (log, statistics)
+  double camera_s = 0.0;     // capturing for the render thread (and waiting for it)
+  uint64_t periods = 0;
+  double total() const {
+    return observe_s + collect_s + apply_s + step_s + officials_s + record_s + camera_s;
+  }
+};
+
+// Per robot: commands applied, refused by the gate, and periods its driver
+// did not answer in time.
+struct CommandStats {
+  uint64_t accepted = 0, rejected = 0, missed = 0;
+};
+
+// The referee and the operator: run once per period after the step.
+class Officials {
+ public:
+  virtual ~Officials() = default;
+  // New events since the last call are appended.
+  virtual void afterStep(std::vector<Event>& events) = 0;
+  virtual referee::ControlData controlData() const = 0;
+  virtual int leftTeam() const = 0;  // the team index controlData().teams[0] describes
+};
+
+// What a period did, for the recorders.
+struct PeriodRecord {
+  uint64_t tick = 0;  // the period just completed (World::controlTick() before the step)
+  const world::World* world = nullptr;
+  // Per robot: the command applied in this period (quantised), if one was.
+  const std::vector<RobotCommand>* commands = nullptr;
+  const std::vector<bool>* commanded = nullptr;
+  const std::vector<Event>* events = nullptr;     // this period's, from the officials
+  const referee::ControlData* game = nullptr;     // after the officials (null: none)
+};
+
+class Recorder {
+ public:
+  virtual ~Recorder() = default;
+  virtual void record(const PeriodRecord& p) = 0;
+};
+
+class Simulation {
+ public:
+  // The world must outlive the simulation. Perception and cameras are on
+  // when the world's scenario turns them on.
+  Simulation(world::World& world, const SimulationConfig& config = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  // Wiring, before the first period. Sources answer for disjoint robots (a
+  // later source's answer for the same robot wins).
+  void addSource(CommandSource& source);
+  // The referee and operator (none: no game state). Takes its game state at once.
+  void setOfficials(Officials* officials);
+  void addRecorder(Recorder& recorder);
+  // Robot camera images (on the conversion thread). Before the first period.
+  void addImageSink(std::function<void(const world::CameraImage&)> sink);
+
+  // One control period (the stages above).
+  void period();
+
+  world::World& world() { return world_; }
+  const world::World& world() const { return world_; }
+  const SimulationConfig& config() const { return config_; }
+  Mode mode() const { return config_.mode; }
+  CommandGate& gate() { return gate_; }
+  const world::PerceptionSystem* perception() const { return perception_.get(); }
+  const world::CameraSystem* cameras() const { return cameras_.get(); }
+  // Delivers every image captured so far.
+  void flushCameras();
+  const Profile& profile() const { return profile_; }
+  CommandStats commandStats(world::RobotId r) const;
+  // The command applied to robot r in the last period, if one was.
+  bool commandApplied(world::RobotId r) const { return commanded_.at(r); }
+  const RobotCommand& appliedCommand(world::RobotId r) const { return applied_.at(r); }
+  // The game state now (after the last officials stage), if officials run.
+  std::optional<referee::ControlData> game() const;
+
+ private:
+  void observe(uint64_t tick);
+  void collect(uint64_t tick);
+  void apply();
+  void ensureCameras();
+
+  world::World& world_;
+  SimulationConfig config_;
+  CommandGate gate_;
+  std::vector<CommandSource*> sources_;
+  std::vector<Recorder*> recorders_;
+  Officials* officials_ = nullptr;
+  std::unique_ptr<world::PerceptionSystem> perception_;
+  std::vector<std::function<void(const world::CameraImage&)>> image_sinks_;
+  std::vector<CommandSlot> slots_;       // this period's answers
+  std::vector<CommandSlot> pending_;     // pipelined: the answers to the last tick
+  bool pending_valid_ = false;
+  std::vector<RobotCommand> applied_;    // per robot, the last applied
+  std::vector<bool> commanded_;          // per robot, applied in the last period
+  std::vector<uint64_t> accepted_, missed_;
+  std::optional<referee::ControlData> game_;
+  std::vector<Event> events_;
+  Profile profile_;
+  bool cameras_started_ = false;
+  std::unique_ptr<world::CameraSystem> cameras_;  // declared last: stopped first
+};
+
+}  // namespace simsoccer::sim

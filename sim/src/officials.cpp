@@ -1,0 +1,58 @@
+#include "simsoccer/sim/officials.hpp"
+
+namespace simsoccer::sim {
+
+GameOfficials::GameOfficials(world::World& world, const referee::RuleBook& rules,
+                             const OfficialsConfig& config)
+    : world_(world), config_(config) {
+  referee_ = std::make_unique<referee::Referee>(world, rules, config.teams, config.kick_off_team,
+                                                config.referee);
+  if (config.penalty_kick_trial) referee_->game().startShootout(0, 1, config.seed);
+  operatorPart();
+}
+
+void GameOfficials::operatorPart() {
+  referee::Game& g = referee_->game();
+  using referee::gc::State;
+  // Each half starts as soon as it can (Standby, then Ready).
+  if (g.state() == State::Initial && g.phase() == referee::gc::GamePhase::Normal && !g.gameOver()) {
+    g.standby();
+    g.ready();
+  }
+  // A drawn game goes to the shoot-out when the rule book calls for it.
+  if (g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
+      g.rules().shootout && !config_.penalty_kick_trial)
+    g.startShootout(0, std::nullopt, world_.scenario().seed);
+  // The next shoot-out kick: the kicking team's field players in turn against
+  // the other team's goalkeeper.
+  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished)) {
+    const int team = g.shotsTaken(0) <= g.shotsTaken(1) ? 0 : 1;
+    std::vector<int> strikers;
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r)
+      if (world_.robot(r).team == team && world_.robot(r).number != g.goalkeeper(team))
+        strikers.push_back(world_.robot(r).number);
+    if (strikers.empty()) strikers.push_back(g.goalkeeper(team));
+    const int striker =
+        strikers[static_cast<size_t>(next_striker_[static_cast<size_t>(team)]++) %
+                 strikers.size()];
+    int keeper = g.goalkeeper(1 - team);
+    if (!referee_->robot(1 - team, keeper)) keeper = 0;
+    referee_->startShootoutKick(striker, keeper);
+  }
+}
+
+void GameOfficials::afterStep(std::vector<Event>& events) {
+  referee_->update();
+  operatorPart();
+  const auto& all = referee_->game().events();
+  for (; events_seen_ < all.size(); ++events_seen_) events.push_back(all[events_seen_]);
+}
+
+bool GameOfficials::over() const {
+  const referee::Game& g = referee_->game();
+  if (config_.penalty_kick_trial) return !g.shotOutcomes(0).empty() || g.gameOver();
+  return g.gameOver() && !g.shootoutOpen() &&
+         !(g.phase() == referee::gc::GamePhase::Normal && !g.winner() && g.rules().shootout);
+}
+
+}  // namespace simsoccer::sim

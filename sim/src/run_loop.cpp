@@ -1,0 +1,42 @@
+#include "simsoccer/sim/run_loop.hpp"
+
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+namespace simsoccer::sim {
+
+RunLoop::RunLoop(Simulation& sim, Pacing pacing, double speed)
+    : sim_(sim), pacing_(pacing), speed_(speed) {
+  if (!(speed > 0.0)) throw std::invalid_argument("real-time speed must be > 0");
+}
+
+RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
+                      const std::function<void()>& after_period) {
+  using Clock = std::chrono::steady_clock;
+  const double period = sim_.world().scenario().physics.control_period;
+  const auto start = Clock::now();
+  const auto due = [&](long i) {
+    return start + std::chrono::duration_cast<Clock::duration>(
+                       std::chrono::duration<double>(static_cast<double>(i) * period / speed_));
+  };
+  RunStats stats;
+  for (long i = 0; max_periods < 0 || i < max_periods; ++i) {
+    if (stop()) break;
+    if (pacing_ == Pacing::RealTime) {
+      if (Clock::now() > due(i) + std::chrono::milliseconds(1))
+        ++stats.late;
+      else
+        std::this_thread::sleep_until(due(i));
+    }
+    sim_.period();
+    ++stats.periods;
+    if (after_period) after_period();
+  }
+  // Paced: the run ends when its last period's simulated time is due.
+  if (pacing_ == Pacing::RealTime) std::this_thread::sleep_until(due(stats.periods));
+  stats.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace simsoccer::sim
