@@ -10,12 +10,15 @@
 
 #include "bench_scene.hpp"
 #include "cli.hpp"
-#include "process.hpp"
+#include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/sim/run_loop.hpp"
 
 namespace simsoccer::apps {
 namespace {
+
+// Agent processes and what they cost, from the match runner library.
+using namespace simsoccer::match;
 
 const char* kHelp =
     "usage: simsoccer bench net [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"

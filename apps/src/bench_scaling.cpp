@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "process.hpp"
+#include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/referee.hpp"
 #include "simsoccer/sim/officials.hpp"
@@ -19,6 +19,9 @@
 
 namespace simsoccer::apps {
 namespace {
+
+// Agent processes and what they cost, from the match runner library.
+using namespace simsoccer::match;
 
 const char* kHelp =
     "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--seconds S] [--cameras]\n"

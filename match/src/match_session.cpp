@@ -1,4 +1,4 @@
-#include "match_session.hpp"
+#include "simsoccer/match/match_session.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,7 @@
 #include "simsoccer/engine/state_hash.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 
-namespace simsoccer::apps {
+namespace simsoccer::match {
 namespace {
 
 std::string fileBytes(const std::filesystem::path& p) {
@@ -219,4 +219,4 @@ std::array<double, 2> MatchSession::possession() const {
   return {possession_[0] / total, possession_[1] / total};
 }
 
-}  // namespace simsoccer::apps
+}  // namespace simsoccer::match

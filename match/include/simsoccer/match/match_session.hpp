@@ -16,7 +16,7 @@
 #include "simsoccer/world/match_log.hpp"
 #include "simsoccer/world/world.hpp"
 
-namespace simsoccer::apps {
+namespace simsoccer::match {
 
 struct VideoSettings {
   bool enabled = true;
@@ -115,4 +115,4 @@ class MatchSession : public sim::Recorder {
   std::vector<Goal> goals_;
 };
 
-}  // namespace simsoccer::apps
+}  // namespace simsoccer::match

@@ -1,4 +1,4 @@
-#include "process.hpp"
+#include "simsoccer/match/agent_process.hpp"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 
 extern char** environ;
 
-namespace simsoccer::apps {
+namespace simsoccer::match {
 
 ChildProcess::ChildProcess(std::vector<std::string> args) {
   std::vector<char*> argv;
@@ -130,4 +130,4 @@ double threadCpuSeconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-}  // namespace simsoccer::apps
+}  // namespace simsoccer::match

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace simsoccer::apps {
+namespace simsoccer::match {
 
 // A child process, killed (SIGTERM, then SIGKILL) when this goes.
 class ChildProcess {
@@ -62,4 +62,4 @@ double processCpuSeconds(pid_t pid);
 // CPU time the calling thread has used so far, in seconds.
 double threadCpuSeconds();
 
-}  // namespace simsoccer::apps
+}  // namespace simsoccer::match

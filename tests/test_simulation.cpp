@@ -1,0 +1,293 @@
+// The control period pipeline (sim::Simulation): stage order, the one-period
+// actuation delay of pipelined mode, and the one check every command goes
+// through whatever its source (scripted, in-process agents, a match log).
+// Real Bullet, real referee, real match log files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "simsoccer/agents/inprocess_agents.hpp"
+#include "simsoccer/sim/log_source.hpp"
+#include "simsoccer/sim/officials.hpp"
+#include "simsoccer/sim/run_loop.hpp"
+#include "simsoccer/sim/simulation.hpp"
+#include "test_support.hpp"
+
+using namespace simsoccer;
+
+namespace {
+
+// What happened, in order: "observe 3", "collect 3", "step 4" (a recorder
+// sees the tick after the step), "officials", "record 3".
+using Trace = std::vector<std::string>;
+
+// Answers every tick for every robot with the stand pose plus `offset(tick)`
+// on the head yaw; logs its stages.
+class ScriptedSource : public sim::CommandSource {
+ public:
+  ScriptedSource(const world::World& w, Trace& trace) : world_(w), trace_(trace) {}
+  void observe(const sim::Observation& o) override {
+    trace_.push_back("observe " + std::to_string(o.tick));
+    observed_game_ = o.game != nullptr;
+  }
+  void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override {
+    trace_.push_back("collect " + std::to_string(tick));
+    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+      std::vector<double> position(world::kActuators, 0.0), stiffness(world::kActuators, 1.0);
+      position[0] = headYaw(tick);
+      if (poison_tick_ == tick) position[3] = std::numeric_limits<double>::quiet_NaN();
+      if (auto c = gate.check(r, std::span<const double>(position),
+                              std::span<const double>(stiffness)))
+        slots[r] = {sim::Answer::Given, *c};
+    }
+  }
+  static double headYaw(uint64_t tick) { return 0.001 * static_cast<double>(tick); }
+  void poison(uint64_t tick) { poison_tick_ = tick; }
+  bool observedGame() const { return observed_game_; }
+
+ private:
+  const world::World& world_;
+  Trace& trace_;
+  uint64_t poison_tick_ = UINT64_MAX;
+  bool observed_game_ = false;
+};
+
+class TraceRecorder : public sim::Recorder {
+ public:
+  explicit TraceRecorder(Trace& trace) : trace_(trace) {}
+  void record(const sim::PeriodRecord& p) override {
+    trace_.push_back("step " + std::to_string(p.world->controlTick()));
+    trace_.push_back("record " + std::to_string(p.tick));
+  }
+
+ private:
+  Trace& trace_;
+};
+
+class TraceOfficials : public sim::Officials {
+ public:
+  explicit TraceOfficials(Trace& trace) : trace_(trace) {}
+  void afterStep(std::vector<sim::Event>&) override { trace_.push_back("officials"); }
+  referee::ControlData controlData() const override { return {}; }
+  int leftTeam() const override { return 0; }
+
+ private:
+  Trace& trace_;
+};
+
+sim::SimulationConfig modeConfig(sim::Mode mode) {
+  sim::SimulationConfig c;
+  c.mode = mode;
+  return c;
+}
+
+}  // namespace
+
+TEST(Simulation, SerialStagesRunInOrderAndTheAnswerActsInItsOwnPeriod) {
+  world::World w(test::scenario(1));
+  sim::Simulation simulation(w, modeConfig(sim::Mode::Serial));
+  Trace trace;
+  ScriptedSource source(w, trace);
+  TraceOfficials officials(trace);
+  TraceRecorder recorder(trace);
+  simulation.addSource(source);
+  simulation.setOfficials(&officials);
+  simulation.addRecorder(recorder);
+  simulation.period();
+  simulation.period();
+  const Trace expected = {"observe 0", "collect 0", "officials", "step 1",    "record 0",
+                          "observe 1", "collect 1", "officials", "step 2", "record 1"};
+  EXPECT_EQ(trace, expected);
+  EXPECT_TRUE(source.observedGame());  // officials run: sources see the game state
+  // The answer to tick 1 was applied in period 1.
+  ASSERT_TRUE(simulation.commandApplied(0));
+  EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0], ScriptedSource::headYaw(1));
+  EXPECT_EQ(simulation.commandStats(0).accepted, 2u);
+  EXPECT_EQ(simulation.profile().periods, 2u);
+}
+
+TEST(Simulation, PipelinedModeStepsWithTheLastPeriodsAnswers) {
+  world::World w(test::scenario(1));
+  sim::Simulation simulation(w, modeConfig(sim::Mode::Pipelined));
+  Trace trace;
+  ScriptedSource source(w, trace);
+  TraceRecorder recorder(trace);
+  simulation.addSource(source);
+  simulation.addRecorder(recorder);
+  simulation.period();
+  // Period 0 had no answers yet: the world stepped with its initial command.
+  EXPECT_FALSE(simulation.commandApplied(0));
+  simulation.period();
+  simulation.period();
+  // Observe, then the step, then the answers to the tick just observed
+  // (collected after the step: the drivers computed while it ran).
+  const Trace expected = {"observe 0", "collect 0", "step 1", "record 0",
+                          "observe 1", "collect 1", "step 2", "record 1",
+                          "observe 2", "collect 2", "step 3", "record 2"};
+  EXPECT_EQ(trace, expected);
+  // Period 2 applied the answer to tick 1: one period of actuation delay.
+  ASSERT_TRUE(simulation.commandApplied(0));
+  EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0], ScriptedSource::headYaw(1));
+  EXPECT_EQ(simulation.commandStats(0).accepted, 2u);
+}
+
+TEST(Simulation, PipelinedModeIsDeterministicAndDiffersFromSerial) {
+  // The built-in agents in this process: a striker and a keeper playing.
+  const auto run = [](sim::Mode mode) {
+    world::Scenario s = test::scenario(2, 5);
+    s.robots[1].team = 1;
+    s.robots[1].number = 1;
+    s.robots[1].x = 2.0;
+    s.robots[1].yaw = M_PI;
+    s.ball_position = {-1.0, 0.0, -1.0};
+    world::World w(s);
+    sim::Simulation simulation(w, modeConfig(mode));
+    agents::InProcessAgents agents(
+        w, {{agents::Role::Striker, agents::Role::Goalkeeper}, 5, true,
+            test::sourceDir() / "configs" / "agents" / "soccer.yaml",
+            test::sourceDir() / "configs" / "motions"});
+    simulation.addSource(agents);
+    sim::RunLoop(simulation, sim::Pacing::Lockstep).run(300);
+    // Every in-process command went through the gate: quantised to its resolution.
+    for (const double p : simulation.appliedCommand(0).position)
+      EXPECT_NEAR(p / world::kCommandResolution, std::round(p / world::kCommandResolution), 1e-6);
+    EXPECT_EQ(simulation.commandStats(0).accepted, mode == sim::Mode::Serial ? 300u : 299u);
+    return w.stateHash();
+  };
+  const uint64_t pipelined = run(sim::Mode::Pipelined);
+  EXPECT_EQ(pipelined, run(sim::Mode::Pipelined));
+  EXPECT_NE(pipelined, run(sim::Mode::Serial));
+}
+
+TEST(Simulation, ANaNFromAScriptedSourceIsRefusedAndTheRobotHoldsItsCommand) {
+  world::World w(test::scenario(1));
+  sim::Simulation simulation(w);
+  Trace trace;
+  ScriptedSource source(w, trace);
+  simulation.addSource(source);
+  source.poison(3);
+  for (int i = 0; i < 6; ++i) {
+    simulation.period();
+    if (i == 3) {
+      EXPECT_FALSE(simulation.commandApplied(0));
+      // Still the answer to tick 2.
+      EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0], ScriptedSource::headYaw(2));
+    }
+  }
+  const sim::CommandStats st = simulation.commandStats(0);
+  EXPECT_EQ(st.accepted, 5u);
+  EXPECT_EQ(st.rejected, 1u);
+  EXPECT_EQ(simulation.gate().lastFault(0), sim::CommandFault::NotFinite);
+  for (int j = 0; j < static_cast<int>(w.robot(0).model->body->joints.size()); ++j)
+    EXPECT_TRUE(std::isfinite(w.jointPosition(0, j)));
+}
+
+TEST(Simulation, TheGateNamesWhatIsWrongWithACommand) {
+  world::World w(test::scenario(1));
+  sim::CommandGate gate(w, 0.5);
+  std::vector<float> position(world::kActuators, 0.0f), stiffness(world::kActuators, 0.5f);
+  const auto fault = [&] {
+    sim::CommandFault f = sim::CommandFault::None;
+    gate.check(0, std::span<const float>(position), std::span<const float>(stiffness), &f);
+    return f;
+  };
+  EXPECT_EQ(fault(), sim::CommandFault::None);
+  stiffness[4] = 1.5f;
+  EXPECT_EQ(fault(), sim::CommandFault::StiffnessRange);
+  stiffness[4] = 0.5f;
+  position[0] = 40.0f;  // HeadYaw, far beyond its limits
+  EXPECT_EQ(fault(), sim::CommandFault::PositionRange);
+  position[0] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(fault(), sim::CommandFault::NotFinite);
+  position[0] = 0.0f;
+  position.pop_back();
+  EXPECT_EQ(fault(), sim::CommandFault::WrongSize);
+  EXPECT_EQ(gate.rejected(0), 4u);
+  EXPECT_STREQ(sim::faultName(sim::CommandFault::NotFinite), "a value is not finite");
+}
+
+TEST(Simulation, AReplayedNaNIsRefusedLikeAnyOther) {
+  const test::TempDir dir("replay_nan");
+  const auto file = dir / "poisoned.log";
+  world::World w(test::scenario(1));
+  {
+    world::MatchLogHeader h;
+    h.robots.push_back({0, 1, static_cast<int>(w.robot(0).model->body->joints.size())});
+    world::MatchLogWriter log(file, h);
+    for (uint64_t tick = 1; tick <= 4; ++tick) {
+      std::vector<std::array<double, 25>> position(1), stiffness(1);
+      position[0].fill(0.0);
+      stiffness[0].fill(1.0);
+      if (tick == 2) position[0][7] = std::numeric_limits<double>::quiet_NaN();
+      log.write(world::captureFrame(w, tick, position, stiffness, {true}));
+    }
+  }
+  sim::Simulation simulation(w);
+  sim::LogSource recorded(file);
+  simulation.addSource(recorded);
+  int periods = 0;
+  while (recorded.next()) {
+    simulation.period();
+    ++periods;
+  }
+  EXPECT_EQ(periods, 4);
+  EXPECT_EQ(recorded.refused(), 1u);
+  EXPECT_EQ(simulation.commandStats(0).rejected, 1u);
+  EXPECT_EQ(simulation.commandStats(0).accepted, 3u);
+  for (int j = 0; j < static_cast<int>(w.robot(0).model->body->joints.size()); ++j)
+    EXPECT_TRUE(std::isfinite(w.jointPosition(0, j)));
+}
+
+TEST(Simulation, ModesAreNamedAndABadOneIsRefused) {
+  EXPECT_EQ(sim::parseMode("serial"), sim::Mode::Serial);
+  EXPECT_EQ(sim::parseMode("pipelined"), sim::Mode::Pipelined);
+  try {
+    sim::parseMode("parallel");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("parallel"), std::string::npos);
+  }
+}
+
+TEST(Simulation, GameOfficialsStartTheGameAndTheirEventsAreReadAfterTheStep) {
+  world::World w(test::scenario(2));
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  sim::OfficialsConfig oc;
+  oc.teams[0].number = 1;
+  oc.teams[1].number = 2;
+  oc.teams[1].field_player_colour = 1;
+  sim::GameOfficials officials(w, rules, oc);
+  // The operator started the first half at once.
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Ready);
+  sim::Simulation simulation(w);
+  simulation.setOfficials(&officials);
+  ASSERT_TRUE(simulation.game().has_value());
+  EXPECT_EQ(simulation.game()->state, static_cast<uint8_t>(referee::gc::State::Ready));
+  EXPECT_FALSE(officials.over());
+  // Its events are read after the step, typed: the first period reports the
+  // state changes of the start (Standby, then Ready).
+  struct EventRecorder : sim::Recorder {
+    std::vector<sim::Event> events;
+    void record(const sim::PeriodRecord& p) override {
+      events.insert(events.end(), p.events->begin(), p.events->end());
+    }
+  } recorder;
+  simulation.addRecorder(recorder);
+  simulation.period();
+  ASSERT_GE(recorder.events.size(), 2u);
+  EXPECT_EQ(recorder.events[0].type, sim::EventType::State);
+  EXPECT_NE(recorder.events[0].detail.find("STANDBY"), std::string::npos) << recorder.events[0].detail;
+  EXPECT_NE(recorder.events[1].detail.find("READY"), std::string::npos) << recorder.events[1].detail;
+  simulation.period();
+  // Each event once: the start is not reported again.
+  EXPECT_EQ(std::count_if(recorder.events.begin(), recorder.events.end(),
+                          [](const sim::Event& e) {
+                            return e.detail.find("STANDBY") != std::string::npos;
+                          }),
+            1);
+}
