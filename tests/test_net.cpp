@@ -857,3 +857,24 @@ TEST(NetSit, AnAgentProcessSitsDownWhenTheGameIsOverAndStandsUpForTheNext) {
   EXPECT_GT(w.sensorFrame(0).stiffness[10], 0.9f);
   EXPECT_EQ(server.stats(0).missed, 0u);
 }
+
+// The agent program is built from the agent side alone: the protocol, the DDS
+// layer, the robot and field descriptions and the agents library; no physics,
+// renderer, world or referee (checked on the built binary, as `ldd` and `nm`
+// show it).
+TEST(NetApps, TheAgentProgramLinksNoPhysicsRendererWorldOrReferee) {
+  int status = -1;
+  const std::string libraries =
+      runCommand(std::string("ldd ") + SIMSOCCER_AGENT_BIN + " 2>&1", status);
+  ASSERT_EQ(status, 0) << libraries;
+  ASSERT_NE(libraries.find("libddsc"), std::string::npos) << libraries;  // it does speak DDS
+  for (const char* lib : {"Bullet", "opencv", "libEGL", "libGL", "libOpenGL"})
+    EXPECT_EQ(libraries.find(lib), std::string::npos) << lib << " in\n" << libraries;
+  const std::string symbols =
+      runCommand(std::string("nm -C ") + SIMSOCCER_AGENT_BIN + " 2>&1", status);
+  ASSERT_EQ(status, 0);
+  ASSERT_NE(symbols.find("simsoccer::agents::"), std::string::npos);
+  for (const char* part : {"simsoccer::world::", "simsoccer::referee::", "simsoccer::sim::",
+                           "simsoccer::engine::PhysicsWorld"})
+    EXPECT_EQ(symbols.find(part), std::string::npos) << part;
+}

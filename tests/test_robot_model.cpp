@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "simsoccer/engine/physics_world.hpp"
+#include "simsoccer/protocol/wire.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 #include "test_support.hpp"
 
@@ -39,6 +40,15 @@ TEST(RobotModel, H25TotalMassMatchesReferenceSum) {
   EXPECT_EQ(nao.body->joints.size(), 24u);
   EXPECT_EQ(nao.actuators.size(), 25u);  // LoLA arrays
   EXPECT_EQ(nao.hands.size(), 2u);
+}
+
+// The Nao description's actuator list is the command order of the protocol
+// (LoLA's), entry for entry: agents index commands by protocol::kNaoActuatorOrder.
+TEST(RobotModel, H25ActuatorsAreInTheProtocolsOrder) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  ASSERT_EQ(nao.actuators.size(), protocol::kActuators);
+  for (size_t a = 0; a < protocol::kActuators; ++a)
+    EXPECT_EQ(nao.actuators[a].name, protocol::kNaoActuatorOrder[a]) << "entry " << a;
 }
 
 TEST(RobotModel, H21TotalMassMatchesReference) {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "simsoccer/agents/inprocess_agents.hpp"
+#include "simsoccer/match/inprocess_agents.hpp"
 #include "simsoccer/sim/log_source.hpp"
 #include "simsoccer/sim/officials.hpp"
 #include "simsoccer/sim/run_loop.hpp"
@@ -146,7 +146,7 @@ TEST(Simulation, PipelinedModeIsDeterministicAndDiffersFromSerial) {
     s.ball_position = {-1.0, 0.0, -1.0};
     world::World w(s);
     sim::Simulation simulation(w, modeConfig(mode));
-    agents::InProcessAgents agents(
+    match::InProcessAgents agents(
         w, {{agents::Role::Striker, agents::Role::Goalkeeper}, 5, true,
             test::sourceDir() / "configs" / "agents" / "soccer.yaml",
             test::sourceDir() / "configs" / "motions"});

@@ -162,17 +162,19 @@ bool AgentClient::receive(simsoccer_msg_SensorFrame& frame, double timeout_secon
 
 void AgentClient::send(uint64_t tick, std::span<const float> position,
                        std::span<const float> stiffness) {
-  if (position.size() != 25 || stiffness.size() != 25)
-    throw std::invalid_argument("a joint command has 25 positions and 25 stiffnesses");
+  constexpr auto n = protocol::kActuators;
+  if (position.size() != n || stiffness.size() != n)
+    throw std::invalid_argument("a joint command has " + std::to_string(n) + " positions and " +
+                                std::to_string(n) + " stiffnesses");
   simsoccer_msg_JointCommand c{};
   c.team = static_cast<uint8_t>(team_);
   c.player = static_cast<uint8_t>(player_);
   c.tick = tick;
   c.serial = ++serial_;
   c.position._buffer = const_cast<float*>(position.data());
-  c.position._length = c.position._maximum = 25;
+  c.position._length = c.position._maximum = n;
   c.stiffness._buffer = const_cast<float*>(stiffness.data());
-  c.stiffness._length = c.stiffness._maximum = 25;
+  c.stiffness._length = c.stiffness._maximum = n;
   impl_->command.write(c);
 }
 

@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
     }
     const bool verbose = opt.flag("verbose");
     const auto& stand = model.pose("stand");
-    std::vector<float> position(25, 0.0f), stiffness(25, 1.0f);
+    std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);
     int head_pitch = -1;
     for (size_t a = 0; a < model.actuators.size() && a < 25; ++a) {
       const auto& act = model.actuators[a];
@@ -241,9 +241,9 @@ int main(int argc, char** argv) {
         bad.tick = frame.tick;
         std::vector<float> p = position, k = stiffness;
         bad.position._buffer = p.data();
-        bad.position._length = bad.position._maximum = 25;
+        bad.position._length = bad.position._maximum = protocol::kActuators;
         bad.stiffness._buffer = k.data();
-        bad.stiffness._length = bad.stiffness._maximum = 25;
+        bad.stiffness._length = bad.stiffness._maximum = protocol::kActuators;
         switch (garbage++ % 5) {
           case 0:
             p[3] = std::nanf("");

@@ -20,7 +20,7 @@
 #include "bench_scene.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
-#include "simsoccer/agents/inprocess_agents.hpp"
+#include "simsoccer/match/inprocess_agents.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
@@ -50,7 +50,7 @@ struct AgentsInWorld {
   const agents::MotionController& motion(world::RobotId r) const { return agents.motion(r); }
   const agents::SoccerBehaviour& behaviour(world::RobotId r) const { return agents.behaviour(r); }
   sim::Simulation simulation;
-  agents::InProcessAgents agents;
+  match::InProcessAgents agents;
 };
 
 using engine::Vec3;

@@ -137,10 +137,4 @@ FieldModel loadFieldModel(const std::filesystem::path& file) {
   return f;
 }
 
-void addFieldToPhysics(engine::PhysicsWorld& physics, const FieldModel& field) {
-  physics.addGround(field.carpet);
-  for (int side : {-1, 1})
-    for (const Shape& s : field.goalShapes(side)) physics.addStaticShape(s, field.goal.material);
-}
-
 }  // namespace simsoccer::fields

@@ -52,7 +52,11 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   settings.gravity = Vec3(0, 0, pc.gravity);
   settings.solver_threads = solverThreads(pc);
   physics_ = std::make_unique<engine::PhysicsWorld>(settings);
-  fields::addFieldToPhysics(*physics_, *field_);
+  // The field's ground plane and both goals.
+  physics_->addGround(field_->carpet);
+  for (int side : {-1, 1})
+    for (const engine::Shape& s : field_->goalShapes(side))
+      physics_->addStaticShape(s, field_->goal.material);
 
   // Ball.
   const fields::BallModel& bm = field_->ball;

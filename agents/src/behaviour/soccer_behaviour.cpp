@@ -6,15 +6,22 @@
 #include <numbers>
 
 #include "simsoccer/engine/config.hpp"
+#include "simsoccer/protocol/gamecontroller.hpp"
 
 namespace simsoccer::agents {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// gc::State / gc::SetPlay / gc::GamePhase numbering (the GameController's).
-constexpr int kInitial = 0, kReady = 1, kSet = 2, kPlaying = 3, kFinished = 4, kStandby = 5;
-constexpr int kPhasePenaltyShoot = 1;
-constexpr uint8_t kNoTeam = 255;
+// The GameController's numbering, from the protocol.
+namespace gc = protocol::gc;
+constexpr int kInitial = static_cast<int>(gc::State::Initial);
+constexpr int kReady = static_cast<int>(gc::State::Ready);
+constexpr int kSet = static_cast<int>(gc::State::Set);
+constexpr int kPlaying = static_cast<int>(gc::State::Playing);
+constexpr int kFinished = static_cast<int>(gc::State::Finished);
+constexpr int kStandby = static_cast<int>(gc::State::Standby);
+constexpr int kPhasePenaltyShoot = static_cast<int>(gc::GamePhase::PenaltyShoot);
+constexpr uint8_t kNoTeam = gc::kKickingTeamNone;
 
 double wrap(double a) {
   while (a > kPi) a -= 2 * kPi;

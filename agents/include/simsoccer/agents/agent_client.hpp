@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
+#include "simsoccer/protocol/wire.hpp"
 #include "simsoccer_msgs.h"
 
 namespace simsoccer::agents {

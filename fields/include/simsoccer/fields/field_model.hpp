@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "simsoccer/engine/model.hpp"
-#include "simsoccer/engine/physics_world.hpp"
 
 namespace simsoccer::fields {
 
@@ -73,8 +72,5 @@ struct FieldModel {
 };
 
 FieldModel loadFieldModel(const std::filesystem::path& file);
-
-// Ground plane and both goals into the physics world.
-void addFieldToPhysics(engine::PhysicsWorld& physics, const FieldModel& field);
 
 }  // namespace simsoccer::fields

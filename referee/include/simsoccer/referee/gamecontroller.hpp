@@ -12,52 +12,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "simsoccer/protocol/gamecontroller.hpp"
+
 namespace simsoccer::referee {
 
-namespace gc {
-
-constexpr uint16_t kControlPort = 3838;
-constexpr uint16_t kReturnPort = 3939;
-constexpr uint8_t kControlVersion = 18;
-constexpr uint8_t kReturnVersion = 4;
-constexpr size_t kMaxPlayers = 20;
-constexpr uint8_t kKickingTeamNone = 255;
-
-enum class GamePhase : uint8_t { Normal = 0, PenaltyShoot = 1, Overtime = 2, Timeout = 3 };
-enum class State : uint8_t {
-  Initial = 0,
-  Ready = 1,
-  Set = 2,
-  Playing = 3,
-  Finished = 4,
-  Standby = 5
-};
-enum class SetPlay : uint8_t {
-  None = 0,
-  GoalKick = 1,
-  PushingFreeKick = 2,
-  CornerKick = 3,
-  KickIn = 4,
-  PenaltyKick = 5
-};
-enum class Penalty : uint8_t {
-  None = 0,
-  IllegalBallContact = 1,
-  PlayerPushing = 2,
-  IllegalMotionInSet = 3,
-  InactivePlayer = 4,
-  IllegalPosition = 5,
-  LeavingTheField = 6,
-  RequestForPickup = 7,
-  LocalGameStuck = 8,
-  IllegalPositionInSet = 9,
-  PlayerStance = 10,
-  IllegalMotionInStandby = 11,
-  Substitute = 14,
-  Manual = 15
-};
-
-}  // namespace gc
+// The GameController's enums and constants are the protocol's (shared with
+// the agents).
+namespace gc = protocol::gc;
 
 struct RobotInfo {
   uint8_t penalty = 0;                // gc::Penalty

@@ -11,12 +11,15 @@
 #include <array>
 #include <cstdint>
 
+#include "simsoccer/protocol/wire.hpp"
+
 namespace simsoccer::world {
 
-constexpr std::size_t kActuators = 25;
-constexpr std::size_t kFsrs = 8;  // L FL, FR, RL, RR, R FL, FR, RL, RR
-constexpr std::size_t kTouchSensors = 14;
-constexpr std::size_t kSonarEchoes = 10;
+// The protocol's layout (a frame goes to the agents as it is).
+constexpr std::size_t kActuators = protocol::kActuators;
+constexpr std::size_t kFsrs = protocol::kFsrs;  // L FL, FR, RL, RR, R FL, FR, RL, RR
+constexpr std::size_t kTouchSensors = protocol::kTouchSensors;
+constexpr std::size_t kSonarEchoes = protocol::kSonarEchoes;
 
 // LoLA `Touch` order.
 enum class Touch : uint8_t {

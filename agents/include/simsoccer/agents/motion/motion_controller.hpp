@@ -17,6 +17,7 @@
 #include "simsoccer/agents/motion/keyframe_motion.hpp"
 #include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/protocol/wire.hpp"
 
 namespace simsoccer::agents {
 
@@ -161,7 +162,7 @@ class MotionController {
 template <class Frame>
 MotionSensors motionSensors(const Frame& f) {
   MotionSensors s;
-  s.position = std::span<const float>(&f.position[0], 25);
+  s.position = std::span<const float>(&f.position[0], protocol::kActuators);
   s.gyro = Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]);
   s.accel = Vec3(f.accelerometer[0], f.accelerometer[1], f.accelerometer[2]);
   s.roll = f.angles[0];

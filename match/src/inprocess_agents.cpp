@@ -1,8 +1,10 @@
-#include "simsoccer/agents/inprocess_agents.hpp"
+#include "simsoccer/match/inprocess_agents.hpp"
 
 #include "simsoccer/net/sim_server.hpp"
 
-namespace simsoccer::agents {
+namespace simsoccer::match {
+
+using namespace simsoccer::agents;
 
 InProcessAgents::InProcessAgents(const world::World& world, const InProcessSetup& setup)
     : world_(world),
@@ -72,4 +74,4 @@ void InProcessAgents::collect(uint64_t, sim::CommandGate& gate, std::span<sim::C
       slots[r] = {sim::Answer::Given, *c};
 }
 
-}  // namespace simsoccer::agents
+}  // namespace simsoccer::match

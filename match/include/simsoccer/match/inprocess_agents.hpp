@@ -1,5 +1,5 @@
 // The built-in agents in this process, without DDS (benchmarks, learning):
-// a command source of the period pipeline. Per robot the same SoccerAgent an
+// a command source of the period pipeline. Per robot the same agents::SoccerAgent an
 // agent process runs, fed the same inputs (its SensorFrame and Perception,
 // the GameState, teammates' messages one period late) and answering with
 // joint targets, which go through the simulation's CommandGate like any
@@ -15,10 +15,10 @@
 #include "simsoccer/world/perception.hpp"
 #include "simsoccer/world/world.hpp"
 
-namespace simsoccer::agents {
+namespace simsoccer::match {
 
 struct InProcessSetup {
-  std::vector<Role> roles;  // one per robot (world order); missing: Role::Auto
+  std::vector<agents::Role> roles;  // one per robot (world order); missing: agents::Role::Auto
   uint64_t seed = 1;
   bool get_up = true;
   std::filesystem::path behaviour_config;  // configs/agents/soccer.yaml
@@ -37,17 +37,17 @@ class InProcessAgents : public sim::CommandSource {
   // Stage collect: the answers computed in observe, through the gate.
   void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override;
 
-  const MotionController& motion(world::RobotId r) const { return agents_[r]->motion(); }
-  const SoccerBehaviour& behaviour(world::RobotId r) const { return agents_[r]->behaviour(); }
+  const agents::MotionController& motion(world::RobotId r) const { return agents_[r]->motion(); }
+  const agents::SoccerBehaviour& behaviour(world::RobotId r) const { return agents_[r]->behaviour(); }
 
  private:
   const world::World& world_;
   std::unique_ptr<world::PerceptionSystem> own_perception_;  // when the simulation has none
-  std::vector<std::unique_ptr<SoccerAgent>> agents_;
-  std::vector<std::pair<int, TeamMessageIn>> outbox_;  // (team, message)
+  std::vector<std::unique_ptr<agents::SoccerAgent>> agents_;
+  std::vector<std::pair<int, agents::TeamMessageIn>> outbox_;  // (team, message)
   std::vector<simsoccer_msg_PerceivedObject> scratch_;
   // Per robot, the answer computed in observe.
   std::vector<std::vector<float>> position_, stiffness_;
 };
 
-}  // namespace simsoccer::agents
+}  // namespace simsoccer::match
