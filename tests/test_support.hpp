@@ -163,6 +163,18 @@ inline void putBallOnCarpet(world::World& w, double x, double y) {
 }
 
 // The lines of a file (a benchmark's CSV: the header first); empty if it is missing.
+// The cells of one CSV line (no quoting: the benches write plain cells).
+inline std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> cells;
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = line.find(',', start);
+    cells.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return cells;
+    start = comma + 1;
+  }
+}
+
 inline std::vector<std::string> readLines(const std::filesystem::path& file) {
   std::ifstream f(file);
   std::vector<std::string> lines;

@@ -1,6 +1,8 @@
 // simsoccer bench scaling: the full pipeline per robot count (physics,
 // sensors, perception, DDS with real agent processes playing soccer, the
 // referee; cameras with --cameras), against the published USARSim figures.
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -25,8 +27,8 @@ using namespace simsoccer::match;
 
 const char* kHelp =
     "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--seconds S] [--cameras]\n"
-    "                               [--modes serial,pipelined] [--csv FILE] [--png FILE]\n"
-    "                               [--domain D]\n"
+    "                               [--modes serial,pipelined] [--threads N] [--csv FILE]\n"
+    "                               [--png FILE] [--domain D]\n"
     "\n"
     "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
     "3D-league-sized field beyond), perception on, the automatic referee (simleague rule book),\n"
@@ -34,7 +36,8 @@ const char* kHelp =
     "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
     "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
     "the answers to this period's frames) and pipelined (with the answers to the last\n"
-    "period's, while the agents compute the next: physics and agents overlap).\n"
+    "period's, while the agents compute the next: physics and agents overlap). --threads N:\n"
+    "the physics' solver threads (default: one per core, up to 4).\n"
     "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
     "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
     "real-time factor and the time per control period split into physics, sensors,\n"
@@ -50,9 +53,10 @@ struct Row {
   double steps_per_s = 0, fps = 0, rtf = 0;
   double physics_ms = 0, sensors_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
   uint64_t missed = 0;
+  double cpu_ms = -1;  // CPU time of the simulator and all agents per period (-1: unknown)
 };
 
-world::Scenario scalingScenario(int n, bool cameras) {
+world::Scenario scalingScenario(int n, bool cameras, int threads) {
   world::Scenario s;
   s.name = "bench_scaling";
   const bool large = n > 14;
@@ -62,6 +66,7 @@ world::Scenario scalingScenario(int n, bool cameras) {
   s.perception.enabled = true;
   s.perception.realistic = true;
   s.cameras.enabled = cameras;
+  s.physics.threads = threads;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
   const double hl = f.halfLength(), hw = f.halfWidth();
   // The behaviour's kick-off formation (shares of the half-length / half-width).
@@ -82,8 +87,8 @@ world::Scenario scalingScenario(int n, bool cameras) {
   return s;
 }
 
-Row runRow(int n, double seconds, bool cameras, sim::Mode mode, uint32_t domain) {
-  world::Scenario s = scalingScenario(n, cameras);
+Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uint32_t domain) {
+  world::Scenario s = scalingScenario(n, cameras, threads);
   world::World w(s);
   sim::SimulationConfig simc;
   simc.mode = mode;
@@ -121,8 +126,20 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, uint32_t domain)
   const auto periods = static_cast<long>(seconds / period);
   w.sensors().resetTimes();
   w.sensors().enableTimers(true);
+  // CPU time of every process, over the timed periods only.
+  const auto cpu_now = [&] {
+    double total = processCpuSeconds(getpid());
+    for (const auto& a : agents) {
+      const double c = processCpuSeconds(a->pid());
+      if (c < 0 || total < 0) return -1.0;
+      total += c;
+    }
+    return total;
+  };
+  const double cpu0 = cpu_now();
   sim::RunLoop loop(simulation, sim::Pacing::Lockstep);
   const sim::RunStats run = loop.run(periods);
+  const double cpu1 = cpu_now();
   simulation.flushCameras();
   const double wall = run.wall_s;
   const sim::Profile& t = simulation.profile();
@@ -141,6 +158,7 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, uint32_t domain)
   row.referee_ms = t.officials_s * per;
   row.render_ms = t.camera_s * per;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;
+  if (cpu0 >= 0 && cpu1 >= 0) row.cpu_ms = (cpu1 - cpu0) * per;
   for (auto& a : agents) a->stop();
   return row;
 }
@@ -199,7 +217,7 @@ void plot(const std::vector<Row>& rows, const std::filesystem::path& file) {
 
 int benchScaling(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "cameras"},
-                    {"robots", "seconds", "csv", "png", "domain", "modes"});
+                    {"robots", "seconds", "csv", "png", "domain", "modes", "threads"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
@@ -208,6 +226,7 @@ int benchScaling(int argc, char** argv, int first) {
   const double seconds = opt.number("seconds", 20.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   const bool cameras = opt.flag("cameras");
+  const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
   std::vector<sim::Mode> modes;
   {
     std::string list = opt.get("modes", "serial,pipelined");
@@ -232,17 +251,18 @@ int benchScaling(int argc, char** argv, int first) {
   Table table;
   table.header = {"robots",     "mode",       "steps_per_s",  "fps",
                   "rtf",        "physics_ms", "sensors_ms",   "messaging_ms",
-                  "referee_ms", "render_ms",  "missed"};
+                  "referee_ms", "render_ms",  "missed",       "cpu_ms"};
   std::vector<Row> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {
-      const Row r = runRow(n, seconds, cameras, mode, domain);
+      const Row r = runRow(n, seconds, cameras, mode, threads, domain);
       rows.push_back(r);
       if (mode == modes.back()) plotted.push_back(r);
       table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),
                             fmt(r.fps, 0), fmt(r.rtf, 2), fmt(r.physics_ms, 2),
                             fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
-                            fmt(r.render_ms, 2), std::to_string(r.missed)});
+                            fmt(r.render_ms, 2), std::to_string(r.missed),
+                            r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a"});
       std::fprintf(stderr, "  %d robots, %s done\n", n, sim::modeName(mode));
     }
   }
@@ -252,7 +272,9 @@ int benchScaling(int argc, char** argv, int first) {
       "per control period: physics, sensors, messaging (perception and frames out, waiting "
       "for and applying the agents' commands: in pipelined mode only what is left after the "
       "step), referee, render (cameras); "
-      "missed: lockstep periods an agent did not answer in time. USARSim (published): 1 Nao "
+      "missed: lockstep periods an agent did not answer in time; cpu_ms: CPU time of the "
+      "simulator and all agent processes per period (against cores x wall ms per period: how "
+      "full the machine was). USARSim (published): 1 Nao "
       "110 fps, 2: 55, 3: 30, 4: 10.",
       opt.get("csv", ""));
   plot(plotted, png);
