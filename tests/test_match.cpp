@@ -14,6 +14,8 @@
 #include <regex>
 #include <thread>
 
+#include "simsoccer/match/agent_process.hpp"
+#include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/world/match_log.hpp"
 #include "test_support.hpp"
 
@@ -367,4 +369,43 @@ TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
     EXPECT_EQ(cells[static_cast<size_t>(missed)], "0") << lines[i];
   }
   EXPECT_GT(std::filesystem::file_size(dir / "scaling.png"), 1000u);
+}
+
+// `serve` given a match config, with the agents the match would start (the
+// match library's command lines), plays the same game as `match`: the same
+// config and seed give the same final state hash, and twice the same.
+TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
+  const std::string config = (test::sourceDir() / "configs/match_2v2.yaml").string();
+  const uint64_t seed = 5;
+  const ShortMatch m = shortMatch("serve_vs_match", 137, "--seed 5 --max-seconds 4 --no-video");
+  ASSERT_EQ(m.status, 0) << m.out;
+  const std::string summary = test::readFile(m.dir / "summary.json");
+  const std::string match_hash = jsonValue(summary, "final_state_hash");
+  ASSERT_EQ(match_hash.size(), 18u) << summary;  // "%016x" in quotes
+  EXPECT_EQ(jsonValue(summary, "simulated_seconds"), "4.00");
+  for (int run = 0; run < 2; ++run) {
+    match::MatchConfig mc = match::loadMatchConfig(config);
+    mc.half_duration = 15;  // as shortMatch plays it
+    const match::MatchSession session(mc, seed);
+    match::RunOptions o;
+    o.seed = seed;
+    o.domain = 138;
+    o.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+    std::vector<std::unique_ptr<match::ChildProcess>> agents;
+    for (world::RobotId r = 0; r < session.world().robotCount(); ++r) {
+      auto command = match::agentCommand(session, o, session.world().robot(r).team,
+                                         session.world().robot(r).number);
+      command[0] = SIMSOCCER_AGENT_BIN;  // beside the programs, not this test
+      agents.push_back(std::make_unique<match::ChildProcess>(command));
+    }
+    int status = -1;
+    const std::string out = test::runCommand(
+        kBin + " serve " + config + " --half 15 --seed 5 --seconds 4 --domain 138 2>&1", status);
+    ASSERT_EQ(status, 0) << out;
+    std::smatch hash;
+    ASSERT_TRUE(std::regex_search(out, hash, std::regex("final state hash ([0-9a-f]{16})"))) << out;
+    EXPECT_EQ("\"" + hash[1].str() + "\"", match_hash) << "serve run " << run + 1 << ":\n" << out;
+    EXPECT_EQ(out.find("missed 0"), out.find("missed "));  // every robot: missed 0
+    EXPECT_NE(out.find("simulated 4.00 s"), std::string::npos) << out;
+  }
 }

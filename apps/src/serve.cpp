@@ -1,15 +1,15 @@
-// simsoccer serve: a scenario as a DDS simulator, for agents started
-// elsewhere (on this machine or others).
-#include <algorithm>
-#include <chrono>
+// simsoccer serve: a scenario (or a whole match) as a DDS simulator, for
+// agents started elsewhere (on this machine or others).
 #include <csignal>
 #include <cstdio>
-#include <thread>
+#include <memory>
+#include <optional>
 
 #include "cli.hpp"
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/match/match_session.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
-#include "simsoccer/referee/referee.hpp"
 #include "simsoccer/sim/officials.hpp"
 #include "simsoccer/sim/run_loop.hpp"
 
@@ -17,31 +17,59 @@ namespace simsoccer::apps {
 namespace {
 
 const char* kHelp =
-    "usage: simsoccer serve SCENARIO [--domain D] [--dds-config FILE] [--seconds S]\n"
-    "                       [--agents N] [--realtime] [--timeout S] [--limp-on-release]\n"
-    "                       [--mode serial|pipelined]\n"
-    "                       [--rules FILE [--teams A,B] [--auto-placement]\n"
-    "                        [--gc-address ADDR [--gc-port P] [--gc-return-port P]]]\n"
+    "usage: simsoccer serve SCENARIO|MATCH [--domain D] [--dds-config FILE] [--seconds S]\n"
+    "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
+    "                       [--limp-on-release] [--mode serial|pipelined]\n"
+    "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
+    "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
-    "Runs the scenario's world as a DDS simulator: waits until N robots (default: all) are\n"
-    "claimed by agents, then runs S simulated seconds (default 60) in lockstep (each period\n"
-    "waits up to --timeout s of wall time, default 0.5, for every owned robot's command) or,\n"
-    "with --realtime, paced to the wall clock with the latest commands. Ctrl-C stops it.\n"
-    "Prints each robot's command counters at the end. --mode pipelined: the world steps with\n"
-    "the answers to the previous period's frames while the agents compute (one period of\n"
-    "actuation delay; default serial).\n"
+    "Runs the world as a DDS simulator: waits until N robots (default: all) are claimed by\n"
+    "agents, then runs S simulated seconds (default 60) in lockstep (each period waits up to\n"
+    "--timeout s of wall time, default 0.5, for every owned robot's command) or, with\n"
+    "--realtime, paced to the wall clock with the latest commands. Ctrl-C stops it. Prints\n"
+    "each robot's command counters and the final state hash at the end. --seed overrides the\n"
+    "file's seed. --mode pipelined: the world steps with the answers to the previous period's\n"
+    "frames while the agents compute (one period of actuation delay; default serial).\n"
     "\n"
-    "With --rules (e.g. configs/rules/spl.yaml) the automatic referee runs the game from the\n"
-    "first kick-off to the end of the game, with a shoot-out if the rule book calls for one,\n"
-    "as in `simsoccer match` (team 0 kicks off; --teams gives the GameController team numbers,\n"
-    "default 1,2); serve stops when the game is over or after S s. Its state goes to agents on\n"
-    "the GameState topic, and with --gc-address also as\n"
-    "GameController packets over UDP (port 3838, every 0.5 simulated s; return packets on\n"
-    "3939), so robot code written for the SPL GameController runs unchanged.\n";
+    "Given a match config (configs/match_5v5.yaml...), it serves that match: its scenario,\n"
+    "rule book, halves, teams, team-message delay and loss and lockstep timeout, with the\n"
+    "officials of `simsoccer match` (the whole game, a shoot-out if the rule book calls for\n"
+    "one), until the game is over or S s have passed (--half S: the half duration). Agents\n"
+    "started as the match starts them\n"
+    "play the same game: the same seed gives the same final state hash.\n"
+    "\n"
+    "Given a scenario, --rules (e.g. configs/rules/spl.yaml) adds the same officials (team 0\n"
+    "kicks off; --teams gives the GameController team numbers, default 1,2). The game state\n"
+    "goes to agents on the GameState topic, and with --gc-address also as GameController\n"
+    "packets over UDP (port 3838, every 0.5 simulated s; return packets on 3939), so robot\n"
+    "code written for the SPL GameController runs unchanged.\n";
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
   g_stop = 1;
+}
+
+bool isMatchConfig(const std::filesystem::path& file) {
+  return engine::ConfigNode::loadFile(file).has("match");
+}
+
+void printCounters(const world::World& w, const net::SimServer& server) {
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    const auto& s = server.stats(r);
+    std::printf(
+        "  team %d player %d: %s, accepted %llu, rejected %llu, refused %llu, missed %llu\n",
+        w.robot(r).team, w.robot(r).number, s.owned ? "owned" : "free",
+        (unsigned long long)s.accepted, (unsigned long long)s.rejected,
+        (unsigned long long)s.refused, (unsigned long long)s.missed);
+  }
+}
+
+void printGame(const referee::Game& g) {
+  std::printf("game: %s, score %d:%d, %zu referee events\n", referee::stateName(g.state()),
+              g.score(0), g.score(1), g.events().size());
+  for (const auto& e : g.events())
+    std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, referee::eventName(e.type),
+                e.team, e.player, e.detail.c_str());
 }
 
 }  // namespace
@@ -49,68 +77,100 @@ void onSignal(int) {
 int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
-                     "gc-address", "gc-port", "gc-return-port", "mode"});
+                     "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half"});
   if (opt.help(kHelp)) return 0;
-  if (opt.positional().size() != 1) throw UsageError("expected one scenario file");
-  world::World w = world::World::fromFile(opt.positional()[0]);
+  if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
+  const std::filesystem::path file = opt.positional()[0];
+  net::ServerConfig cfg;
+  cfg.dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
+  cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
+  cfg.lockstep = !opt.flag("realtime");
+  cfg.hold_on_release = !opt.flag("limp-on-release");
+
+  // The world and its officials: a match's, or a scenario's with optional rules.
+  std::unique_ptr<match::MatchSession> session;
+  std::unique_ptr<world::World> own_world;
+  std::unique_ptr<sim::GameOfficials> own_officials;
+  sim::GameOfficials* officials = nullptr;
+  if (isMatchConfig(file)) {
+    if (opt.has("rules")) throw UsageError("--rules: a match config names its own rule book");
+    match::MatchConfig mc = match::loadMatchConfig(file);
+    if (opt.has("half")) {
+      const double h = opt.number("half", 0);
+      if (!(h > 0)) throw UsageError("--half must be > 0 s");
+      mc.half_duration = h;
+    }
+    session = std::make_unique<match::MatchSession>(
+        mc, static_cast<uint64_t>(opt.number("seed", static_cast<double>(mc.seed))));
+    officials = &session->officials();
+    cfg.command_timeout = mc.command_timeout;
+    cfg.team_message_delay = mc.message_delay;
+    cfg.team_message_loss = mc.message_loss;
+  } else {
+    if (opt.has("half")) throw UsageError("--half goes with a match config");
+    world::Scenario scenario = world::loadScenario(file);
+    if (opt.has("seed")) scenario.seed = static_cast<uint64_t>(opt.number("seed", 0));
+    own_world = std::make_unique<world::World>(scenario);
+    if (opt.has("rules")) {
+      const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
+      const std::vector<int> numbers = opt.intList("teams", {1, 2});
+      if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
+          numbers[1] > 255 || numbers[0] == numbers[1])
+        throw UsageError("--teams: two different team numbers 0..255");
+      sim::OfficialsConfig oc;
+      for (size_t t = 0; t < 2; ++t) {
+        oc.teams[t].number = static_cast<uint8_t>(numbers[t]);
+        oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
+      }
+      oc.referee.auto_placement = opt.flag("auto-placement");
+      oc.seed = scenario.seed;
+      own_officials = std::make_unique<sim::GameOfficials>(*own_world, rules, oc);
+      officials = own_officials.get();
+    }
+  }
+  if (opt.has("timeout")) cfg.command_timeout = opt.number("timeout", 0.5);
+  if (opt.has("gc-address") && !officials)
+    throw UsageError("--gc-address needs --rules or a match config (the referee makes the packets)");
+  world::World& w = session ? session->world() : *own_world;
+
   sim::SimulationConfig simc;
-  simc.lockstep = !opt.flag("realtime");
+  simc.lockstep = cfg.lockstep;
   try {
     simc.mode = sim::parseMode(opt.get("mode", "serial"));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }
   sim::Simulation simulation(w, simc);
-  net::ServerConfig cfg;
-  cfg.dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
-  cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
-  cfg.lockstep = !opt.flag("realtime");
-  cfg.command_timeout = opt.number("timeout", 0.5);
-  cfg.hold_on_release = !opt.flag("limp-on-release");
-  const double sim_seconds = opt.number("seconds", 60.0);
-  const auto wanted =
-      static_cast<size_t>(opt.number("agents", static_cast<double>(w.robotCount())));
+  if (session)
+    session->attach(simulation);
+  else
+    simulation.setOfficials(officials);
   net::SimServer server(simulation, cfg);
-
-  // The officials (optional): the game from the first kick-off, as in a match.
-  std::unique_ptr<sim::GameOfficials> officials;
   std::unique_ptr<referee::GameControllerLink> gc_link;
-  if (opt.has("rules")) {
-    const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
-    const std::vector<int> numbers = opt.intList("teams", {1, 2});
-    if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
-        numbers[1] > 255 || numbers[0] == numbers[1])
-      throw UsageError("--teams: two different team numbers 0..255");
-    sim::OfficialsConfig oc;
-    for (size_t t = 0; t < 2; ++t) {
-      oc.teams[t].number = static_cast<uint8_t>(numbers[t]);
-      oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
-    }
-    oc.referee.auto_placement = opt.flag("auto-placement");
-    oc.seed = w.scenario().seed;
-    officials = std::make_unique<sim::GameOfficials>(w, rules, oc);
-    simulation.setOfficials(officials.get());
-    server.publishGameState(officials->controlData(), officials->leftTeam());
+  if (officials) {
+    server.publishGameState(officials->controlData(), officials->leftTeam());  // before agents
     if (opt.has("gc-address")) {
       referee::GameControllerLinkConfig gcfg;
       gcfg.address = opt.get("gc-address", "");
       gcfg.control_port = static_cast<uint16_t>(opt.number("gc-port", 3838));
       gcfg.return_port = static_cast<uint16_t>(opt.number("gc-return-port", 3939));
       gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
+      gc_link->update(officials->game());
     }
-  } else if (opt.has("gc-address")) {
-    throw UsageError("--gc-address needs --rules (the referee makes the packets)");
   }
-  if (gc_link) gc_link->update(officials->game());
 
+  const double sim_seconds = opt.number("seconds", 60.0);
+  const auto wanted =
+      static_cast<size_t>(opt.number("agents", static_cast<double>(w.robotCount())));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  std::printf("simsoccer serve: %zu robots on DDS domain %u, waiting for %zu agents...\n",
-              w.robotCount(), cfg.dds.domain, wanted);
+  std::printf("simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",
+              w.robotCount(), cfg.dds.domain,
+              static_cast<unsigned long long>(w.scenario().seed), wanted);
   std::fflush(stdout);
   while (!g_stop && !server.waitForOwners(wanted, 1.0)) {
   }
-  const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period);
+  const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period + 0.5);
   sim::RunLoop loop(simulation, cfg.lockstep ? sim::Pacing::Lockstep : sim::Pacing::RealTime);
   const sim::RunStats run = loop.run(
       [&] { return g_stop || (officials && officials->over()); }, periods,
@@ -118,9 +178,8 @@ int serve(int argc, char** argv, int first) {
         if (gc_link) gc_link->update(officials->game());
       });
   simulation.flushCameras();
-  const double wall = run.wall_s;
-  std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), wall,
-              w.time() / wall);
+  std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), run.wall_s,
+              w.time() / run.wall_s);
   if (const world::CameraSystem* cams = simulation.cameras()) {
     const world::CameraStats c = cams->stats();
     std::printf(
@@ -131,29 +190,17 @@ int serve(int argc, char** argv, int first) {
         c.readback_ms / std::max<double>(1, c.captures),
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
-  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-    const auto& s = server.stats(r);
-    std::printf(
-        "  team %d player %d: %s, accepted %llu, rejected %llu, refused %llu, missed %llu\n",
-        w.robot(r).team, w.robot(r).number, s.owned ? "owned" : "free",
-        (unsigned long long)s.accepted, (unsigned long long)s.rejected,
-        (unsigned long long)s.refused, (unsigned long long)s.missed);
-  }
-  if (officials) {
-    const referee::Game& g = officials->game();
-    std::printf("game: %s, score %d:%d, %zu referee events\n", referee::stateName(g.state()),
-                g.score(0), g.score(1), g.events().size());
-    for (const auto& e : g.events())
-      std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, referee::eventName(e.type), e.team,
-                  e.player, e.detail.c_str());
-    if (gc_link)
-      std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",
-                  (unsigned long long)gc_link->packetsSent(),
-                  (unsigned long long)gc_link->returnsAccepted(),
-                  (unsigned long long)gc_link->returnsRejected());
-    if (gc_link && gc_link->returnsRejected() > 0)
+  printCounters(w, server);
+  if (officials) printGame(officials->game());
+  if (gc_link) {
+    std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",
+                (unsigned long long)gc_link->packetsSent(),
+                (unsigned long long)gc_link->returnsAccepted(),
+                (unsigned long long)gc_link->returnsRejected());
+    if (gc_link->returnsRejected() > 0)
       std::printf("last rejected return packet: %s\n", gc_link->lastReturnError().c_str());
   }
+  std::printf("final state hash %016llx\n", static_cast<unsigned long long>(w.stateHash()));
   return 0;
 }
 

@@ -72,6 +72,23 @@ class LogRecorder : public sim::Recorder {
 
 }  // namespace
 
+std::vector<std::string> agentCommand(const MatchSession& session, const RunOptions& o, int team,
+                                      int number) {
+  const MatchConfig& c = session.config();
+  SoccerAgentOptions ao;
+  ao.team = team;
+  ao.player = number;
+  ao.domain = static_cast<int>(o.domain);
+  ao.dds_config = o.dds_config;
+  ao.role = c.role;
+  ao.field = session.world().scenario().field_file;
+  ao.config = c.agent_config;
+  ao.team_number = c.team_numbers[static_cast<size_t>(team)];
+  ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);
+  ao.get_up = c.get_up;
+  return soccerAgentCommand(ao);
+}
+
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
   world::World& w = session.world();
@@ -94,18 +111,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   // The agents find the game state when they start.
   server.publishGameState(session.controlData(), session.game().leftTeam());
   auto agentCommand = [&](int team, int number) {  // the same for a restart
-    SoccerAgentOptions ao;
-    ao.team = team;
-    ao.player = number;
-    ao.domain = o.domain;
-    ao.dds_config = o.dds_config;
-    ao.role = c.role;
-    ao.field = w.scenario().field_file;
-    ao.config = c.agent_config;
-    ao.team_number = c.team_numbers[static_cast<size_t>(team)];
-    ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);
-    ao.get_up = c.get_up;
-    return soccerAgentCommand(ao);
+    return match::agentCommand(session, o, team, number);
   };
   std::vector<AgentSlot> agents;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {

@@ -50,6 +50,13 @@ struct RunResult {
 // The match log's header for a session (config, scenario, seed, robots).
 world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o);
 
+// The command line of the agent process a match starts for robot (team,
+// number): the config's role, behaviour and team number, the run's domain
+// and DDS configuration, a seed from the run's seed and the robot. The same
+// for a restart, and for agents started by hand for `simsoccer serve`.
+std::vector<std::string> agentCommand(const MatchSession& session, const RunOptions& o, int team,
+                                      int number);
+
 // Plays one session (a game, or one penalty kick) with agents, logging to `log`.
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log);
 
