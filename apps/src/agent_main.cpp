@@ -8,11 +8,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <numbers>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "agent_modes.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
@@ -136,22 +136,10 @@ int main(int argc, char** argv) {
           apps::findConfig("", "configs/motions"), setup);
     }
     const bool verbose = opt.flag("verbose");
-    const auto& stand = model.pose("stand");
     std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);
-    int head_pitch = -1;
-    for (size_t a = 0; a < model.actuators.size() && a < 25; ++a) {
-      const auto& act = model.actuators[a];
-      if (act.kind == robots::Actuator::Kind::Joint)
-        position[a] = static_cast<float>(stand[static_cast<size_t>(act.index)]);
-      if (act.name == "HeadPitch") head_pitch = static_cast<int>(a);
-    }
-
-    // Walk mode: the walk engine writes the legs' targets (body joint order).
-    agents::WalkEngine walk(model);
-    std::vector<double> targets = stand;
-    const double vx = opt.number("vx", 0.2), vy = opt.number("vy", 0.0),
-                 turn = opt.number("turn", 0.0);
-    double start_time = -1.0, last_time = 0.0;
+    apps::SimpleModes simple(model, mode, opt.number("vx", 0.2), opt.number("vy", 0.0),
+                             opt.number("turn", 0.0));
+    double last_time = 0.0;
 
     agents::AgentClient client(dds, team, player);
     simsoccer_msg_GameState game{};
@@ -175,7 +163,6 @@ int main(int argc, char** argv) {
     // thread hop between a frame arriving and its command leaving.
     std::atomic<long> answered{0};
     std::atomic<int64_t> last_frame_ns{0};
-    long garbage = 0;
     auto now_ns = [] {
       return std::chrono::duration_cast<std::chrono::nanoseconds>(
                  std::chrono::steady_clock::now().time_since_epoch())
@@ -213,57 +200,7 @@ int main(int argc, char** argv) {
         ++answered;
         return;
       }
-      if (mode == "walk") {
-        if (start_time < 0) start_time = last_time = frame.sim_time;
-        const double t = frame.sim_time - start_time, dt = frame.sim_time - last_time;
-        last_time = frame.sim_time;
-        if (t < 1.0) {  // ease from the stand pose into the walk's stance, then hold it
-          walk.easeIn(stand, t, targets);
-        } else {
-          walk.setVelocity(vx, vy, turn);
-          walk.update(dt > 0 ? dt : 0.01,
-                      engine::Vec3(frame.gyroscope[0], frame.gyroscope[1], frame.gyroscope[2]),
-                      frame.angles[2], targets);
-        }
-        for (size_t a = 0; a < model.actuators.size() && a < 25; ++a)
-          if (model.actuators[a].kind == robots::Actuator::Kind::Joint)
-            position[a] =
-                static_cast<float>(targets[static_cast<size_t>(model.actuators[a].index)]);
-      } else if (head_pitch >= 0) {
-        position[static_cast<size_t>(head_pitch)] =
-            static_cast<float>(0.2 * std::sin(2.0 * std::numbers::pi * 0.5 * frame.sim_time));
-      }
-      if (mode == "garbage") {
-        // One invalid command of each kind in turn, then the valid answer.
-        simsoccer_msg_JointCommand bad{};
-        bad.team = static_cast<uint8_t>(team);
-        bad.player = static_cast<uint8_t>(player);
-        bad.tick = frame.tick;
-        std::vector<float> p = position, k = stiffness;
-        bad.position._buffer = p.data();
-        bad.position._length = bad.position._maximum = protocol::kActuators;
-        bad.stiffness._buffer = k.data();
-        bad.stiffness._length = bad.stiffness._maximum = protocol::kActuators;
-        switch (garbage++ % 5) {
-          case 0:
-            p[3] = std::nanf("");
-            break;  // NaN
-          case 1:
-            bad.position._length = 24;
-            break;  // wrong count
-          case 2:
-            bad.tick = frame.tick > 0 ? frame.tick - 1 : frame.tick + 7;
-            break;  // stale
-          case 3:
-            bad.tick = frame.tick + 5;
-            break;  // future
-          case 4:
-            k[10] = 3.0f;
-            break;  // stiffness out of range
-        }
-        client.sendRaw(bad);
-      }
-      client.send(frame.tick, position, stiffness);
+      simple.answer(frame, client, team, player);
       ++answered;
     });
     for (;;) {

@@ -98,15 +98,7 @@ int benchNet(int argc, char** argv, int first) {
     const sim::Profile before = simulation.profile();
     // CPU time of the simulator and of every agent process, over the timed
     // periods only (not the start-up and its discovery traffic).
-    const auto cpu_now = [&] {
-      double total = processCpuSeconds(getpid());
-      for (const auto& a : agents) {
-        const double c = processCpuSeconds(a->pid());
-        if (c < 0 || total < 0) return -1.0;
-        total += c;
-      }
-      return total;
-    };
+    const auto cpu_now = [&] { return cpuSecondsWithChildren(agents); };
     const long long bytes0 = loopbackBytes(), packets0 = loopbackPackets();
     const double cpu0 = cpu_now();
     const auto t0 = Clock::now();

@@ -127,15 +127,7 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uin
   w.sensors().resetTimes();
   w.sensors().enableTimers(true);
   // CPU time of every process, over the timed periods only.
-  const auto cpu_now = [&] {
-    double total = processCpuSeconds(getpid());
-    for (const auto& a : agents) {
-      const double c = processCpuSeconds(a->pid());
-      if (c < 0 || total < 0) return -1.0;
-      total += c;
-    }
-    return total;
-  };
+  const auto cpu_now = [&] { return cpuSecondsWithChildren(agents); };
   const double cpu0 = cpu_now();
   sim::RunLoop loop(simulation, sim::Pacing::Lockstep);
   const sim::RunStats run = loop.run(periods);

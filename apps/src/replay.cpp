@@ -6,6 +6,7 @@
 #include "simsoccer/match/match_session.hpp"
 #include "simsoccer/match/outputs.hpp"
 #include "simsoccer/sim/log_source.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -72,16 +73,18 @@ int replay(int argc, char** argv, int first) {
     sim::LogSource recorded(file);
     simulation.addSource(recorded);
     int checked = 0;
-    while (recorded.next()) {
-      simulation.period();
-      if (session.world().stateHash() != recorded.frame().state_hash) {
-        std::printf("state hash differs at %.2f s (frame %d)\n", recorded.frame().time,
-                    checked + 1);
-        status = 1;
-        break;
-      }
-      ++checked;
-    }
+    // Period after period as long as the log has one and every hash agrees.
+    sim::RunLoop(simulation, sim::Pacing::Lockstep)
+        .run([&] { return status != 0 || !recorded.next(); }, -1,
+             [&] {
+               if (session.world().stateHash() != recorded.frame().state_hash) {
+                 std::printf("state hash differs at %.2f s (frame %d)\n", recorded.frame().time,
+                             checked + 1);
+                 status = 1;
+                 return;
+               }
+               ++checked;
+             });
     if (recorded.refused() > 0)
       std::printf("warning: %llu recorded commands refused (not finite or out of range)\n",
                   static_cast<unsigned long long>(recorded.refused()));

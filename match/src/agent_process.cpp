@@ -124,6 +124,16 @@ double processCpuSeconds(pid_t pid) {
   return any && !ec ? total : -1.0;
 }
 
+double cpuSecondsWithChildren(const std::vector<std::unique_ptr<ChildProcess>>& children) {
+  double total = processCpuSeconds(getpid());
+  for (const auto& c : children) {
+    const double s = processCpuSeconds(c->pid());
+    if (s < 0 || total < 0) return -1.0;
+    total += s;
+  }
+  return total;
+}
+
 double threadCpuSeconds() {
   timespec t{};
   if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) != 0) return -1.0;

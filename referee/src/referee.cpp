@@ -312,6 +312,12 @@ void Referee::onEnterSet() {
   }
 }
 
+int ballInGoal(const fields::FieldModel& f, const Vec3& p) {
+  if (std::abs(p.x()) <= f.halfLength() + 0.5 * f.line_width + f.ball.radius) return 0;
+  if (std::abs(p.y()) >= 0.5 * f.goal.inner_width || p.z() >= f.goal.clear_height) return 0;
+  return p.x() > 0 ? 1 : -1;
+}
+
 void Referee::checkBall() {
   const auto& f = world_.field();
   const engine::RigidBodyState b = world_.ballState();
@@ -325,7 +331,7 @@ void Referee::checkBall() {
     const int side = p.x() > 0 ? 1 : -1;
     const int defender = defenderOfSide(side);
     const int attacker = 1 - defender;
-    if (std::abs(p.y()) < 0.5 * f.goal.inner_width && p.z() < f.goal.clear_height) {
+    if (ballInGoal(f, p) == side) {
       // Indirect kick: after a restart a goal needs two robots of the scoring
       // team to have played the ball (own goals always count; a penalty kick
       // may score directly). A direct goal becomes a goal kick.
@@ -600,7 +606,7 @@ void Referee::checkShot() {
   // A goal: the whole ball over the line between the posts, under the bar.
   const double line = 0.5 * f.line_width;
   if (x > f.halfLength() + line + r) {
-    if (std::abs(p.y()) < 0.5 * f.goal.inner_width && p.z() < f.goal.clear_height) {
+    if (ballInGoal(f, p) == side) {
       game_.goal(kicking);
       return;
     }

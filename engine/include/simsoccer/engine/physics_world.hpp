@@ -16,13 +16,14 @@
 #include <span>
 #include <vector>
 
+#include "simsoccer/engine/id.hpp"
 #include "simsoccer/engine/joint_servo.hpp"
 #include "simsoccer/engine/model.hpp"
 
 namespace simsoccer::engine {
 
-using ArticulationId = uint32_t;
-using BodyId = uint32_t;
+using ArticulationId = Id<struct ArticulationTag>;  // a robot's articulated body in the engine
+using BodyId = Id<struct BodyTag>;                  // a free rigid body (the ball)
 
 struct PhysicsSettings {
   double dt = 0.005;            // s, physics step

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,9 @@ long long loopbackPackets();
 // CPU time (user + system) the threads of a process have used so far, in
 // seconds (/proc/PID/task/*/schedstat), or -1 when it cannot be read.
 double processCpuSeconds(pid_t pid);
+// CPU time this process and `children` have used so far, in seconds, or -1
+// when one cannot be read.
+double cpuSecondsWithChildren(const std::vector<std::unique_ptr<ChildProcess>>& children);
 // CPU time the calling thread has used so far, in seconds.
 double threadCpuSeconds();
 

@@ -43,6 +43,11 @@ struct RefereeConfig {
   double ball_replayed = 0.3;          // m: the striker touching it again after this ends the kick
 };
 
+// The rule for a goal: the whole ball over the goal line (past its far edge)
+// between the posts and under the crossbar. +1 / -1: in the goal at +x / -x;
+// 0: not in a goal. The referee's own rule, for anyone who judges goals.
+int ballInGoal(const fields::FieldModel& field, const engine::Vec3& ball);
+
 class Referee {
  public:
   Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,

@@ -24,7 +24,8 @@
 
 namespace simsoccer::world {
 
-using RobotId = uint32_t;
+// A robot of the world, in scenario order (not its articulation in the engine).
+using RobotId = engine::Id<struct RobotTag>;
 using engine::Pose;
 using engine::Vec3;
 

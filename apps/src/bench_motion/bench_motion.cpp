@@ -1,0 +1,152 @@
+// simsoccer bench motion: the agents' motion on an empty field, in this
+// process on the real physics, through the same period pipeline as a match.
+// The options and the one-trial tuning modes; the trials are one file each,
+// the table is motion_table.cpp.
+#include <cstdio>
+
+#include "cli.hpp"
+#include "motion_table.hpp"
+#include "trial.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer bench motion [--random-minutes M] [--seed N] [--csv FILE]\n"
+    "       simsoccer bench motion --vx V [--vy V] [--turn W] [--seconds S] [--verbose]\n"
+    "\n"
+    "One Nao on an empty SPL field, driven by the walk engine at the control rate through\n"
+    "joint targets only (the agents' motion, in this process). Per test: commanded and achieved\n"
+    "speed, path deviation, falls: forward 0.25 m/s over 5 m, sideways 0.1 m/s, turning 0.8\n"
+    "rad/s, and M minutes (default 10) of random velocity commands.\n"
+    "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
+    "[--ball-gap M]:\n"
+    "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
+    "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
+    "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
+    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height).\n"
+    "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
+    "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
+    "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
+    "play: it blocks; in the shoot-out: it also dives).\n"
+    "  --get-up-trials N, --sit-trials N  get-up trials per side, sit trials, in the table\n"
+    "                (default 20, 20)\n"
+    "  --motions DIR the motions from DIR (default configs/motions; for tuning them): all of\n"
+    "                get_up_front, get_up_back, block, dive_left, dive_right, sit_down, stand_up\n"
+    "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
+    "                7.2 s), tiled\n"
+    "  --striker-trials N, --penalty-trials N, --block-trials N  trials in the table (default\n"
+    "                20, 50, 20)\n"
+    "  --mode M      the control period: serial or pipelined (one period of actuation delay,\n"
+    "                as in a match of that mode); default: the matches' (%s)\n"
+    "  --csv FILE    also write the table as CSV\n";
+
+}  // namespace
+
+int benchMotion(int argc, char** argv, int first) {
+  // Tuning knobs: the walk's and the kick's parameters by name.
+  agents::WalkParameters wp;
+  agents::KickParameters kp;
+  const std::vector<std::pair<std::string, double*>> knobs{
+      {"sway", &wp.sway},
+      {"lift", &wp.foot_lift},
+      {"period", &wp.step_period},
+      {"torso-offset", &wp.torso_offset},
+      {"height", &wp.ankle_height},
+      {"ankle-pitch-gyro", &wp.ankle_pitch_gyro},
+      {"ankle-roll-gyro", &wp.ankle_roll_gyro},
+      {"lean", &wp.torso_lean},
+      {"hip-roll", &wp.hip_roll_compensation},
+      {"heading-gain", &wp.heading_gain},
+      {"kick-reach", &kp.reach},
+      {"kick-swing", &kp.swing_time},
+      {"kick-shift", &kp.shift},
+      {"kick-lift", &kp.lift},
+      {"kick-draw-back", &kp.draw_back},
+      {"kick-hip-roll", &kp.hip_roll_compensation},
+      {"kick-swing-height", &kp.swing_height}};
+  std::vector<std::string> valued{"seconds",
+                                  "csv",
+                                  "vx",
+                                  "vy",
+                                  "turn",
+                                  "random-minutes",
+                                  "seed",
+                                  "foot",
+                                  "ball-offset",
+                                  "ball-gap",
+                                  "get-up",
+                                  "get-up-trials",
+                                  "sit-trials",
+                                  "striker-trials",
+                                  "penalty-trials",
+                                  "motions",
+                                  "snapshots",
+                                  "block-trials",
+                                  "mode"};
+  for (const auto& k : knobs) valued.push_back(k.first);
+  const Options opt(argc, argv, first,
+                    {"help", "verbose", "kick", "striker", "penalty", "block", "shootout"}, valued);
+  char help[8192];
+  std::snprintf(help, sizeof help, kHelp, sim::modeName(sim::kDefaultMode));
+  if (opt.help(help)) return 0;
+  opt.noPositional();
+  for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
+  motion::TrialContext c;
+  c.walk = wp;
+  c.kick = kp;
+  c.verbose = opt.flag("verbose");
+  // Another motions folder (same file names) for tuning get-up motions.
+  c.motions_dir =
+      opt.has("motions") ? opt.get("motions", "") : findConfig("", "configs/motions").string();
+  try {
+    c.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--mode: ") + e.what());
+  }
+  const auto seed = static_cast<uint64_t>(opt.number("seed", 1));
+  if (opt.has("get-up")) {  // one get-up, for tuning
+    const std::string side = opt.get("get-up", "");
+    if (side != "front" && side != "back") throw UsageError("--get-up must be front or back");
+    const motion::GetUpResult r =
+        motion::getUpTrial(c, side == "front", seed, opt.get("snapshots", ""));
+    std::printf("get-up from the %s: %s in %.2f s, %d attempts\n", side.c_str(),
+                r.success ? "standing" : "FAILED", r.seconds, r.attempts);
+    return 0;
+  }
+  if (opt.flag("striker")) {  // one striker trial, for tuning
+    const motion::StrikerResult r = motion::strikerTrial(c, seed, 60.0);
+    std::printf("striker: %s in %.1f s, %d falls\n", r.scored ? "scored" : "no goal", r.seconds,
+                r.falls);
+    return 0;
+  }
+  if (opt.flag("block")) {  // one ball at the goalkeeper, for tuning
+    const motion::BlockResult r = motion::blockTrial(c, seed, opt.flag("shootout"));
+    std::printf("block: %s (%s), %d blocks/dives, %d falls\n", r.saved ? "saved" : "not saved",
+                r.in_reach ? "in reach" : "out of reach", r.blocks, r.falls);
+    return 0;
+  }
+  if (opt.flag("penalty")) {  // one penalty, for tuning
+    std::printf("penalty: %s\n", motion::penaltyOutcomeName(motion::penaltyTrial(c, seed, 30.0)));
+    return 0;
+  }
+  if (opt.flag("kick")) {  // one kick, for tuning
+    const motion::KickResult r =
+        motion::kickTrial(c, opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
+                          opt.number("ball-offset", 0), 1, opt.number("ball-gap", 0.015));
+    std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
+    return 0;
+  }
+  if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning
+    const Eigen::Vector3d v(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0));
+    const motion::WalkResult r =
+        motion::walkTrial(c, [&](double) { return v; }, opt.number("seconds", 10.0));
+    std::printf(
+        "distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",
+        r.distance, r.speed, r.lateral, r.turned, r.fell, r.fell_at);
+    return 0;
+  }
+  return motion::printMotionTable(c, opt, seed);
+}
+
+}  // namespace simsoccer::apps

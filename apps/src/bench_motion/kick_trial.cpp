@@ -1,0 +1,90 @@
+// Kicking: one kick from the walk's stance with the ball in front of the
+// kicking foot; the ball's travel after 6 s.
+#include <cmath>
+#include <cstdio>
+
+#include "trial.hpp"
+
+namespace simsoccer::apps::motion {
+namespace {
+
+// For tuning a kick: while the kicking foot is near the ball, its speed along
+// the kick (from `last_foot`, a control period ago), its height and its
+// sole's lowest corner, and the ball's speed and spin; `start`: the ball's
+// start.
+void traceKick(const world::World& w, int foot_link, const Vec3& start, double dt, double t,
+               Vec3& last_foot) {
+  const auto foot_pose = w.linkPose(0, foot_link);
+  const Vec3 foot = foot_pose.translation();
+  const engine::RigidBodyState ball = w.ballState();
+  if ((foot - ball.pose.translation()).norm() < 0.4 && t < 3.5) {
+    double sole = 1e9;  // the bottom corners of the foot's collision box
+    const auto& model = *w.robot(0).model;
+    const engine::Shape& box = model.body->links[static_cast<size_t>(foot_link)].shapes.front();
+    for (double cx : {-0.5, 0.5})
+      for (double cy : {-0.5, 0.5})
+        sole = std::min(sole,
+                        (foot_pose * box.pose *
+                         Vec3(cx * box.extents.x(), cy * box.extents.y(), -0.5 * box.extents.z()))
+                            .z());
+    std::fprintf(stderr,
+                 "t %.2f foot x %+.3f z %.3f sole %.3f speed %+.2f m/s | ball x %+.3f speed %.2f "
+                 "m/s spin %+.1f rad/s (rolling %+.1f)\n",
+                 t, foot.x() - start.x(), foot.z(), sole, (foot.x() - last_foot.x()) / dt,
+                 ball.pose.translation().x() - start.x(), ball.linear_velocity.norm(),
+                 ball.angular_velocity.y(), ball.linear_velocity.x() / w.field().ball.radius);
+  }
+  last_foot = foot;
+}
+
+}  // namespace
+
+KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
+                     double gap) {
+  world::Scenario s = emptyField();
+  s.seed = seed;
+  TrialWorld t(s, c);
+  world::World& w = t.world;
+  const auto& model = *w.robot(0).model;
+  agents::WalkEngine walk(model, c.walk);
+  agents::KickEngine engine(model, c.walk, c.kick);
+  std::vector<double> targets = model.pose("stand");
+  // 1 s from the stand pose into the walk's stance.
+  int i = 0;
+  t.driver.setControl([&](const world::World&, std::span<float> p, std::span<float> k) {
+    walk.easeIn(model.pose("stand"), i * t.dt(), targets);
+    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    return true;
+  });
+  for (i = 0; i < 100; ++i) t.period();
+  const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
+  const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
+  engine::RigidBodyState b;
+  b.pose.translation() = Vec3(f.x() + 0.1025 + w.field().ball.radius + gap, f.y() + ball_offset,
+                              w.field().ball.radius);
+  w.setBallState(b);
+  const Vec3 start = b.pose.translation();
+  engine.start(foot);
+  KickResult r;
+  const double dt = t.dt();
+  t.driver.setControl([&](const world::World& world, std::span<float> p, std::span<float> k) {
+    if (!engine.active()) return false;  // the last targets hold
+    const auto& fr = world.sensorFrame(0);
+    engine.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
+    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    return true;
+  });
+  const int foot_link = model.body->linkIndex(link);
+  Vec3 last_foot = w.linkPose(0, foot_link).translation();  // for the trace
+  for (i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
+    t.period();
+    r.fell = r.fell || !w.isStanding(0);
+    if (c.verbose) traceKick(w, foot_link, start, dt, (i + 1) * dt, last_foot);
+  }
+  const Vec3 d = w.ballState().pose.translation() - start;
+  r.distance = std::hypot(d.x(), d.y());
+  r.direction = std::atan2(d.y(), d.x());
+  return r;
+}
+
+}  // namespace simsoccer::apps::motion

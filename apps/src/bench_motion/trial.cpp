@@ -1,0 +1,89 @@
+#include "trial.hpp"
+
+#include <algorithm>
+
+#include "cli.hpp"
+#include "simsoccer/referee/referee.hpp"
+
+namespace simsoccer::apps::motion {
+
+world::Scenario emptyField() {
+  world::Scenario s;
+  s.name = "bench_motion";
+  s.field_file = findConfig("", "fields/spl.yaml");
+  s.robot_model_file = findConfig("", "robots/nao_v6_h25.yaml");
+  s.ball_position = {4.0, 2.5, -1.0};
+  world::RobotPlacement p;
+  p.x = -3.0;
+  s.robots.push_back(p);
+  return s;
+}
+
+void DriverSource::observe(const sim::Observation& o) {
+  has_ = control_ && control_(*o.world, position_, stiffness_);
+}
+
+void DriverSource::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
+  if (!has_) return;
+  if (auto c = gate.check(0, std::span<const float>(position_), std::span<const float>(stiffness_)))
+    slots[0] = {sim::Answer::Given, *c};
+}
+
+namespace {
+sim::SimulationConfig simulationConfig(sim::Mode mode) {
+  sim::SimulationConfig c;
+  c.mode = mode;
+  return c;
+}
+}  // namespace
+
+TrialWorld::TrialWorld(const world::Scenario& scenario, const TrialContext& context)
+    : world(scenario), simulation(world, simulationConfig(context.mode)) {
+  simulation.addSource(driver);
+}
+
+void TrialWorld::addAgents(std::vector<agents::Role> roles, uint64_t seed) {
+  agents = std::make_unique<match::InProcessAgents>(
+      world, match::InProcessSetup{std::move(roles), seed, true,
+                                   findConfig("", "configs/agents/soccer.yaml"),
+                                   findConfig("", "configs/motions")});
+  simulation.addSource(*agents);
+}
+
+void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<double>& targets,
+                          double stiffness, std::span<float> position,
+                          std::span<float> stiffness_out) {
+  // Zeroed first, then filled: one loop that zeroes both arrays and then
+  // conditionally overwrites them is miscompiled by Debian 12's GCC 12.2 at
+  // -O3 (its loop distribution moves the second array's zeroing after the
+  // conditional store: every stiffness came out 0).
+  std::fill(position.begin(), position.end(), 0.0f);
+  std::fill(stiffness_out.begin(), stiffness_out.end(), 0.0f);
+  const size_t n = std::min({position.size(), stiffness_out.size(), model.actuators.size()});
+  for (size_t a = 0; a < n; ++a) {
+    const robots::Actuator& actuator = model.actuators[a];
+    if (actuator.kind != robots::Actuator::Kind::Joint) continue;
+    position[a] = static_cast<float>(targets.at(static_cast<size_t>(actuator.index)));
+    stiffness_out[a] = static_cast<float>(stiffness);
+  }
+}
+
+int goalScored(const world::World& w) {
+  return referee::ballInGoal(w.field(), w.ballState().pose.translation());
+}
+
+const char* penaltyOutcomeName(PenaltyOutcome o) {
+  switch (o) {
+    case PenaltyOutcome::Goal:
+      return "goal";
+    case PenaltyOutcome::Saved:
+      return "saved";
+    case PenaltyOutcome::Missed:
+      return "missed";
+    case PenaltyOutcome::Timeout:
+      return "timeout";
+  }
+  return "?";
+}
+
+}  // namespace simsoccer::apps::motion

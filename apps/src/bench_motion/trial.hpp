@@ -1,0 +1,134 @@
+// bench motion's trials: one Nao (or a striker and a keeper) on an empty SPL
+// field, driven through the same period pipeline as a match (the gate, the
+// quantisation and the mode's actuation timing), one file per trial.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
+#include "simsoccer/agents/motion/kick_engine.hpp"
+#include "simsoccer/agents/motion/leg_kinematics.hpp"
+#include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/match/inprocess_agents.hpp"
+#include "simsoccer/sim/simulation.hpp"
+#include "simsoccer/world/world.hpp"
+
+namespace simsoccer::apps::motion {
+
+using engine::Vec3;
+
+// What every trial shares: the period mode, the motions, the tuning knobs.
+struct TrialContext {
+  sim::Mode mode = sim::kDefaultMode;
+  std::string motions_dir;  // configs/motions, or another folder for tuning
+  agents::WalkParameters walk;
+  agents::KickParameters kick;
+  bool verbose = false;  // a trace on stderr, for tuning
+};
+
+// One Nao at (-3, 0) facing +x on an empty SPL field, the ball out of the way.
+world::Scenario emptyField();
+
+// Robot 0 driven by code in this process: at each period's observe stage,
+// `control` computes the robot's command (actuator order) from the state of
+// the tick; false: no new command (the last one holds).
+class DriverSource : public sim::CommandSource {
+ public:
+  using Control = std::function<bool(const world::World&, std::span<float> position,
+                                     std::span<float> stiffness)>;
+  void setControl(Control control) { control_ = std::move(control); }
+  void observe(const sim::Observation& o) override;
+  void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override;
+
+ private:
+  Control control_;
+  bool has_ = false;
+  std::vector<float> position_ = std::vector<float>(world::kActuators),
+                     stiffness_ = std::vector<float>(world::kActuators);
+};
+
+// A trial's world and its period pipeline, with robot 0's driver or the
+// built-in agents in this process.
+struct TrialWorld {
+  TrialWorld(const world::Scenario& scenario, const TrialContext& context);
+  // The built-in agents drive the robots instead of the driver.
+  void addAgents(std::vector<agents::Role> roles, uint64_t seed);
+  void period() { simulation.period(); }
+  double dt() const { return world.scenario().physics.control_period; }
+
+  world::World world;
+  sim::Simulation simulation;
+  DriverSource driver;
+  std::unique_ptr<match::InProcessAgents> agents;
+};
+
+// Body joint targets as robot 0's command in actuator order at one stiffness
+// (a mimic joint follows its master; hands at stiffness 0).
+void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<double>& targets,
+                          double stiffness, std::span<float> position,
+                          std::span<float> stiffness_out);
+
+// The goal the ball is in by the referee's rule (+1 / -1 for +x / -x, 0 none).
+int goalScored(const world::World& w);
+
+// --- the trials (one file each) ---------------------------------------------------------------
+
+// Commands (vx, vy, omega) as a function of time since the walk began.
+using Schedule = std::function<Eigen::Vector3d(double)>;
+struct WalkResult {
+  double distance = 0.0, speed = 0.0, lateral = 0.0, turned = 0.0;
+  bool fell = false;
+  double fell_at = -1.0;
+};
+// The walk engine alone for `seconds`; with `falls`, the robot is put back up
+// after each fall (counted) and walks on.
+WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds,
+                     int* falls = nullptr);
+
+struct KickResult {
+  double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)
+  bool fell = false;
+};
+KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
+                     double gap = 0.015);
+
+struct GetUpResult {
+  bool success = false;
+  double seconds = 0.0;
+  int attempts = 0;
+};
+GetUpResult getUpTrial(const TrialContext& c, bool front, uint64_t seed,
+                       const std::string& snapshots = "");
+
+struct SitResult {
+  bool success = false;
+  double seated_height = 0.0;  // m, the torso after 5 s of sitting
+  double up_seconds = -1.0;    // from the stand request to the stance
+  int falls = 0;
+};
+SitResult sitTrial(const TrialContext& c, uint64_t seed);
+
+struct StrikerResult {
+  bool scored = false;
+  double seconds = 0.0;
+  int falls = 0;
+};
+StrikerResult strikerTrial(const TrialContext& c, uint64_t seed, double limit);
+
+enum class PenaltyOutcome { Goal, Saved, Missed, Timeout };
+const char* penaltyOutcomeName(PenaltyOutcome o);
+PenaltyOutcome penaltyTrial(const TrialContext& c, uint64_t seed, double limit);
+
+struct BlockResult {
+  bool saved = false, in_reach = false;
+  int blocks = 0, falls = 0;
+};
+BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout);
+
+}  // namespace simsoccer::apps::motion

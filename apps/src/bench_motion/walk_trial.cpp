@@ -1,0 +1,90 @@
+// Walking: the walk engine alone at a commanded velocity (or a schedule of
+// them), from the stand pose eased into the walk's stance.
+#include <cmath>
+#include <cstdio>
+
+#include "trial.hpp"
+
+namespace simsoccer::apps::motion {
+namespace {
+
+// 1 s from the stand pose into the walk's stance (eased in, then held).
+void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<double>& targets) {
+  const auto& model = *t.world.robot(0).model;
+  const std::vector<double>& stand = model.pose("stand");
+  int i = 0;
+  t.driver.setControl([&](const world::World&, std::span<float> p, std::span<float> k) {
+    engine.easeIn(stand, i * t.dt(), targets);
+    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    return true;
+  });
+  for (i = 0; i < 100; ++i) t.period();
+}
+
+}  // namespace
+
+WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds, int* falls) {
+  TrialWorld t(emptyField(), c);
+  world::World& w = t.world;
+  const auto& model = *w.robot(0).model;
+  agents::WalkEngine engine(model, c.walk);
+  std::vector<double> targets = model.pose("stand");
+  const double dt = t.dt();
+  settleIntoStance(t, engine, targets);
+  const engine::Pose start = w.torsoPose(0);
+  const Eigen::Vector3d first = schedule(0.0);
+  const double vx = first.x(), vy = first.y();
+  WalkResult r;
+  const long periods = static_cast<long>(seconds / dt);
+  long i = 0;
+  const auto walkControl = [&](const world::World& world, std::span<float> p,
+                               std::span<float> k) {
+    const Eigen::Vector3d v = schedule(static_cast<double>(i) * dt);
+    engine.setVelocity(v.x(), v.y(), v.z());
+    const auto& f = world.sensorFrame(0);
+    engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
+    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    return true;
+  };
+  t.driver.setControl(walkControl);
+  for (i = 0; i < periods; ++i) {
+    t.period();
+    if (!w.isStanding(0)) {
+      r.fell = true;
+      r.fell_at = static_cast<double>(i) * dt;
+      if (!falls) break;
+      // Counting falls: put the robot back up where it fell and walk on.
+      ++*falls;
+      if (c.verbose) {
+        const Eigen::Vector3d now = schedule(r.fell_at),
+                              before = schedule(std::max(0.0, r.fell_at - 2.0));
+        std::fprintf(stderr, "fall at %.2f s, command %.2f %.2f %.2f (before: %.2f %.2f %.2f)\n",
+                     r.fell_at, now.x(), now.y(), now.z(), before.x(), before.y(), before.z());
+      }
+      const engine::Pose p = w.torsoPose(0);
+      w.placeRobot(0, p.translation().x(), p.translation().y(),
+                   std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
+      engine = agents::WalkEngine(model, c.walk);
+      settleIntoStance(t, engine, targets);  // as at the start, then on
+      t.driver.setControl(walkControl);
+      continue;
+    }
+    if (c.verbose && i % 25 == 0) {  // a trace every 0.25 s, for tuning
+      const Vec3 p = w.torsoPose(0).translation();
+      const auto& f = w.sensorFrame(0);
+      std::fprintf(stderr, "t %.2f torso %.3f %.3f %.3f  odometry %.3f  feet %.1f / %.1f N\n",
+                   static_cast<double>(i) * dt, p.x(), p.y(), p.z(), engine.odometry().x,
+                   f.foot_weight[0], f.foot_weight[1]);
+    }
+  }
+  const engine::Pose end = w.torsoPose(0);
+  const Vec3 d = start.linear().transpose() * (end.translation() - start.translation());
+  r.distance = std::hypot(d.x(), d.y());
+  r.speed = (vx != 0 || vy == 0 ? d.x() : d.y()) / seconds;
+  r.lateral = vx != 0 || vy == 0 ? d.y() : d.x();
+  const Eigen::Matrix3d rel = start.linear().transpose() * end.linear();
+  r.turned = std::atan2(rel(1, 0), rel(0, 0));
+  return r;
+}
+
+}  // namespace simsoccer::apps::motion
