@@ -135,6 +135,25 @@ TEST(Simulation, PipelinedModeStepsWithTheLastPeriodsAnswers) {
   EXPECT_EQ(simulation.commandStats(0).accepted, 2u);
 }
 
+// A transport that frees a robot (its driver crashed) drops the answer
+// waiting for the next period: the freed robot's hold is not overridden.
+TEST(Simulation, APendingAnswerOfAFreedRobotIsNotApplied) {
+  world::World w(test::scenario(1));
+  sim::Simulation simulation(w, modeConfig(sim::Mode::Pipelined));
+  Trace trace;
+  ScriptedSource source(w, trace);
+  simulation.addSource(source);
+  simulation.period();
+  simulation.period();
+  ASSERT_TRUE(simulation.commandApplied(0));
+  simulation.dropPending(0);
+  simulation.period();
+  EXPECT_FALSE(simulation.commandApplied(0));  // the answer to tick 1 was dropped
+  simulation.period();
+  EXPECT_TRUE(simulation.commandApplied(0));  // the next answers act again
+  EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0], ScriptedSource::headYaw(2));
+}
+
 TEST(Simulation, PipelinedModeIsDeterministicAndDiffersFromSerial) {
   // The built-in agents in this process: a striker and a keeper playing.
   const auto run = [](sim::Mode mode) {

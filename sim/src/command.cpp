@@ -67,7 +67,9 @@ std::optional<RobotCommand> CommandGate::checkAny(world::RobotId r, std::span<co
         why = CommandFault::NotFinite;
       else if (k < 0.0 || k > 1.0)
         why = CommandFault::StiffnessRange;
-      else if (p < l.lower[a] || p > l.upper[a])
+      else if (const double q = world::quantizeCommand(p); q < l.lower[a] || q > l.upper[a])
+        // The quantised target, as it will be applied (and logged): a logged
+        // command always passes this check again when it is replayed.
         why = l.joint[a] ? CommandFault::PositionRange : CommandFault::ActuatorRange;
     }
   }

@@ -19,6 +19,7 @@ void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<dou
     return true;
   });
   for (i = 0; i < 100; ++i) t.period();
+  t.driver.setControl({});  // its captures end here
 }
 
 }  // namespace

@@ -360,6 +360,7 @@ void SimServer::release(world::RobotId r) {
   s.owner = {};
   s.owner_join = 0;
   s.has_command = false;
+  sim_.dropPending(r);
   const auto& info = world_.robot(r);
   const auto& joints = info.model->body->joints;
   for (size_t j = 0; j < joints.size(); ++j) {

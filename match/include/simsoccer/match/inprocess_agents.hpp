@@ -1,9 +1,12 @@
 // The built-in agents in this process, without DDS (benchmarks, learning):
-// a command source of the period pipeline. Per robot the same agents::SoccerAgent an
-// agent process runs, fed the same inputs (its SensorFrame and Perception,
-// the GameState, teammates' messages one period late) and answering with
-// joint targets, which go through the simulation's CommandGate like any
-// other source's.
+// a command source of the period pipeline. Per robot the same
+// agents::SoccerAgent an agent process runs, fed its SensorFrame and
+// Perception as an agent process gets them, and answering with joint
+// targets, which go through the simulation's CommandGate like any other
+// source's. Two inputs differ from a match over DDS: the GameState's message
+// budget is the referee's (DDS subtracts the messages relayed so far), and a
+// teammate's message arrives in the next period (DDS relays it one period
+// later still).
 #pragma once
 
 #include <filesystem>

@@ -59,7 +59,7 @@ struct Profile {
   double collect_s = 0.0;    // waiting for and taking the answers
   double apply_s = 0.0;      // setting the checked commands
   double step_s = 0.0;       // physics and sensors
-  double officials_s = 0.0;  // referee and operator
+  double officials_s = 0.0;  // the sources' after-step bookkeeping, referee and operator
   double record_s = 0.0;     // recorders (log, statistics)
   double camera_s = 0.0;     // capturing for the render thread (and waiting for it)
   uint64_t periods = 0;
@@ -69,7 +69,8 @@ struct Profile {
 };
 
 // Per robot: commands applied, refused by the gate, and periods its driver
-// did not answer in time.
+// did not answer in time. (Applied and missed are kept by the period, on the
+// thread that runs it: read them there.)
 struct CommandStats {
   uint64_t accepted = 0, rejected = 0, missed = 0;
 };
@@ -131,6 +132,10 @@ class Simulation {
   const world::CameraSystem* cameras() const { return cameras_.get(); }
   // Delivers every image captured so far.
   void flushCameras();
+  // Forgets robot r's answer waiting for the next period (pipelined mode): a
+  // transport that frees a robot (its driver crashed) calls it, so the freed
+  // robot's hold or limp targets are not overridden by its last answer.
+  void dropPending(world::RobotId r);
   const Profile& profile() const { return profile_; }
   CommandStats commandStats(world::RobotId r) const;
   // The command applied to robot r in the last period, if one was.
