@@ -276,10 +276,7 @@ TEST(Simulation, GameOfficialsStartTheGameAndTheirEventsAreReadAfterTheStep) {
   world::World w(test::scenario(2));
   const referee::RuleBook rules =
       referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
-  sim::OfficialsConfig oc;
-  oc.teams[0].number = 1;
-  oc.teams[1].number = 2;
-  oc.teams[1].field_player_colour = 1;
+  const sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(1, 2);
   sim::GameOfficials officials(w, rules, oc);
   // The operator started the first half at once.
   EXPECT_EQ(officials.game().state(), referee::gc::State::Ready);

@@ -100,11 +100,7 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uin
   net::SimServer server(simulation, sc);
   const referee::RuleBook rules =
       referee::loadRuleBook(findConfig("", "configs/rules/simleague.yaml"));
-  sim::OfficialsConfig oc;
-  for (size_t t = 0; t < 2; ++t) {
-    oc.teams[t].number = static_cast<uint8_t>(t + 1);
-    oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
-  }
+  const sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(1, 2);
   sim::GameOfficials officials(w, rules, oc);
   simulation.setOfficials(&officials);
   server.publishGameState(officials.controlData(), officials.leftTeam());  // before they start

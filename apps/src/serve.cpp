@@ -117,11 +117,8 @@ int serve(int argc, char** argv, int first) {
       if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
           numbers[1] > 255 || numbers[0] == numbers[1])
         throw UsageError("--teams: two different team numbers 0..255");
-      sim::OfficialsConfig oc;
-      for (size_t t = 0; t < 2; ++t) {
-        oc.teams[t].number = static_cast<uint8_t>(numbers[t]);
-        oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
-      }
+      sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(static_cast<uint8_t>(numbers[0]),
+                                                               static_cast<uint8_t>(numbers[1]));
       oc.referee.auto_placement = opt.flag("auto-placement");
       oc.seed = scenario.seed;
       own_officials = std::make_unique<sim::GameOfficials>(*own_world, rules, oc);

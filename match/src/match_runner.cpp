@@ -23,12 +23,6 @@ double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-std::string num(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, std::isfinite(v) ? v : 0.0);
-  return buf;
-}
-
 struct AgentSlot {
   int team = 0, number = 0;
   std::unique_ptr<ChildProcess> process;
@@ -156,7 +150,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       std::snprintf(buf, sizeof buf,
                     "{\"time\": %s, \"team\": %d, \"player\": %d, \"exit_status\": %d, "
                     "\"restart\": %d}",
-                    num(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
+                    fixedNumber(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
                     a.restarts);
       result.agent_events.push_back(buf);
       a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
@@ -195,8 +189,8 @@ world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o) {
   h.values["config_hash"] = s.config().hash;
   h.values["scenario"] = std::filesystem::absolute(s.config().scenario).string();
   h.values["seed"] = std::to_string(o.seed);
-  h.values["control_period"] = num(w.scenario().physics.control_period, 6);
-  if (s.config().half_duration) h.values["half_duration"] = num(*s.config().half_duration, 3);
+  h.values["control_period"] = fixedNumber(w.scenario().physics.control_period, 6);
+  if (s.config().half_duration) h.values["half_duration"] = fixedNumber(*s.config().half_duration, 3);
   for (world::RobotId r = 0; r < w.robotCount(); ++r)
     h.robots.push_back({w.robot(r).team, w.robot(r).number,
                         static_cast<int>(w.robot(r).model->body->joints.size())});
@@ -284,8 +278,8 @@ PenaltyResult playPenalties(
   const Proportion p = wilsonInterval(result.goals, n);
   std::ofstream out(o.out / "penalty.json");
   out << "{\n  \"config\": " << jsonString(config.file) << ",\n  \"seed\": " << o.seed
-      << ",\n  \"kicks\": " << n << ",\n  \"scoring_rate\": " << num(p.rate, 3)
-      << ",\n  \"ci95\": [" << num(p.low, 3) << ", " << num(p.high, 3)
+      << ",\n  \"kicks\": " << n << ",\n  \"scoring_rate\": " << fixedNumber(p.rate, 3)
+      << ",\n  \"ci95\": [" << fixedNumber(p.low, 3) << ", " << fixedNumber(p.high, 3)
       << "],\n  \"counts\": {\"goal\": " << result.goals << ", \"saved\": " << result.saved
       << ", \"missed\": " << result.missed << ", \"timeout\": " << result.timeout
       << "},\n  \"outcomes\": [";

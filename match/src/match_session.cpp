@@ -124,11 +124,8 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     rules.half_time_break = *config.half_time_break;
     rules.half_time_to_initial = std::min(rules.half_time_to_initial, *config.half_time_break);
   }
-  sim::OfficialsConfig oc;
-  for (size_t t = 0; t < 2; ++t) {
-    oc.teams[t].number = static_cast<uint8_t>(config.team_numbers[t]);
-    oc.teams[t].field_player_colour = static_cast<uint8_t>(t);
-  }
+  sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(
+      static_cast<uint8_t>(config.team_numbers[0]), static_cast<uint8_t>(config.team_numbers[1]));
   oc.referee.set_duration = config.set_duration;
   oc.referee.auto_placement = true;  // robots still walking at Set are placed, as a human referee would
   oc.penalty_kick_trial = config.penalty_kicks > 0;

@@ -14,16 +14,11 @@
 #include "simsoccer/world/render_scene.hpp"
 
 namespace simsoccer::match {
-namespace {
-
-// A finite number with `decimals` decimals (JSON has no NaN).
-std::string num(double v, int decimals = 3) {
+std::string fixedNumber(double v, int decimals) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, std::isfinite(v) ? v : 0.0);
   return buf;
 }
-
-}  // namespace
 
 std::string jsonString(const std::string& s) {
   std::string o = "\"";
@@ -71,7 +66,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"goals\": [";
   for (size_t i = 0; i < s.goals().size(); ++i) {
     const auto& goal = s.goals()[i];
-    out << (i ? ", " : "") << "{\"time\": " << num(goal.time, 2) << ", \"team\": " << goal.team
+    out << (i ? ", " : "") << "{\"time\": " << fixedNumber(goal.time, 2) << ", \"team\": " << goal.team
         << ", \"scorer\": " << goal.scorer
         << ", \"own_goal\": " << (goal.own_goal ? "true" : "false") << "}";
   }
@@ -79,7 +74,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"referee_events\": [\n";
   for (size_t i = 0; i < r.events.size(); ++i) {
     const auto& e = r.events[i];
-    out << "    {\"time\": " << num(e.time, 2) << ", \"type\": " << jsonString(e.type)
+    out << "    {\"time\": " << fixedNumber(e.time, 2) << ", \"type\": " << jsonString(e.type)
         << ", \"team\": " << e.team << ", \"player\": " << e.player
         << ", \"detail\": " << jsonString(e.detail) << "}" << (i + 1 < r.events.size() ? "," : "")
         << "\n";
@@ -89,7 +84,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   bool first = true;
   for (const auto& e : r.events)
     if (e.type == "penalty") {
-      out << (first ? "" : ", ") << "{\"time\": " << num(e.time, 2) << ", \"team\": " << e.team
+      out << (first ? "" : ", ") << "{\"time\": " << fixedNumber(e.time, 2) << ", \"team\": " << e.team
           << ", \"player\": " << e.player << ", \"penalty\": " << jsonString(e.detail) << "}";
       first = false;
     }
@@ -101,31 +96,31 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
         << ", \"falls\": " << rec.falls.size() << ", \"get_ups\": "
         << std::count_if(rec.falls.begin(), rec.falls.end(),
                          [](const FallRecord& f) { return f.up_after.has_value(); })
-        << ", \"keeper_dives\": " << rec.dives << ", \"distance_walked\": " << num(rec.distance, 2)
+        << ", \"keeper_dives\": " << rec.dives << ", \"distance_walked\": " << fixedNumber(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
         << ", \"fall_records\": [";
     for (size_t k = 0; k < rec.falls.size(); ++k) {
       const FallRecord& f = rec.falls[k];
-      out << (k ? ", " : "") << "{\"time\": " << num(f.time, 2) << ", \"x\": " << num(f.x, 2)
-          << ", \"y\": " << num(f.y, 2) << ", \"nearest_robot\": "
-          << (f.nearest_robot ? num(*f.nearest_robot, 2) : std::string("null"))
-          << ", \"ball\": " << num(f.ball, 2)
-          << ", \"up_after\": " << (f.up_after ? num(*f.up_after, 2) : std::string("null")) << "}";
+      out << (k ? ", " : "") << "{\"time\": " << fixedNumber(f.time, 2) << ", \"x\": " << fixedNumber(f.x, 2)
+          << ", \"y\": " << fixedNumber(f.y, 2) << ", \"nearest_robot\": "
+          << (f.nearest_robot ? fixedNumber(*f.nearest_robot, 2) : std::string("null"))
+          << ", \"ball\": " << fixedNumber(f.ball, 2)
+          << ", \"up_after\": " << (f.up_after ? fixedNumber(*f.up_after, 2) : std::string("null")) << "}";
     }
     out << "]}" << (i + 1 < s.robots().size() ? "," : "") << "\n";
   }
   out << "  ],\n";
   const auto p = s.possession();
-  out << "  \"possession\": [" << num(p[0], 3) << ", " << num(p[1], 3) << "],\n";
+  out << "  \"possession\": [" << fixedNumber(p[0], 3) << ", " << fixedNumber(p[1], 3) << "],\n";
   out << "  \"agent_restarts\": [";
   for (size_t i = 0; i < r.agent_events.size(); ++i) out << (i ? ", " : "") << r.agent_events[i];
   out << "],\n";
   if (!extra.empty()) out << extra;
   out << "  \"interrupted\": " << (r.interrupted ? "true" : "false") << ",\n";
   out << "  \"aborted\": " << (r.aborted ? jsonString(r.abort_reason) : "null") << ",\n";
-  out << "  \"simulated_seconds\": " << num(w.time(), 2) << ",\n";
-  out << "  \"wall_seconds\": " << num(r.wall, 2) << ",\n";
-  out << "  \"real_time_factor\": " << num(w.time() / std::max(r.wall, 1e-9), 3) << ",\n";
+  out << "  \"simulated_seconds\": " << fixedNumber(w.time(), 2) << ",\n";
+  out << "  \"wall_seconds\": " << fixedNumber(r.wall, 2) << ",\n";
+  out << "  \"real_time_factor\": " << fixedNumber(w.time() / std::max(r.wall, 1e-9), 3) << ",\n";
   char hash[32];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.final_hash));
   out << "  \"final_state_hash\": \"" << hash << "\",\n";
@@ -172,7 +167,7 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
     cv::Mat rgba = renderer.image(0), bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
     // Overlay: score, game clock and state from the frame's GameController packet.
-    std::string text = "t " + num(f.time, 1) + " s";
+    std::string text = "t " + fixedNumber(f.time, 1) + " s";
     if (f.game.size() == referee::kControlSize) {
       const referee::ControlData d = referee::decodeControl(f.game);
       char buf[160];

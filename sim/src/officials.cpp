@@ -2,6 +2,14 @@
 
 namespace simsoccer::sim {
 
+OfficialsConfig OfficialsConfig::forTeams(uint8_t team0, uint8_t team1) {
+  OfficialsConfig c;
+  c.teams[0].number = team0;
+  c.teams[1].number = team1;
+  for (size_t t = 0; t < 2; ++t) c.teams[t].field_player_colour = static_cast<uint8_t>(t);
+  return c;
+}
+
 GameOfficials::GameOfficials(world::World& world, const referee::RuleBook& rules,
                              const OfficialsConfig& config)
     : world_(world), config_(config) {

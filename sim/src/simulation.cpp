@@ -25,8 +25,8 @@ Simulation::Simulation(world::World& world, const SimulationConfig& config)
     : world_(world),
       config_(config),
       gate_(world, config.position_margin),
-      slots_(world.robotCount()),
-      pending_(world.robotCount()),
+      due_(world.robotCount()),
+      collected_(world.robotCount()),
       applied_(world.robotCount()),
       commanded_(world.robotCount(), false),
       accepted_(world.robotCount(), 0),
@@ -85,7 +85,7 @@ void Simulation::ensureCameras() {
 }
 
 void Simulation::dropPending(world::RobotId r) {
-  pending_.at(r).answer = Answer::None;
+  due_.at(r).answer = Answer::None;
 }
 
 void Simulation::flushCameras() {
@@ -109,16 +109,15 @@ void Simulation::observe(uint64_t tick) {
 }
 
 void Simulation::collect(uint64_t tick) {
-  for (CommandSlot& s : slots_) s.answer = Answer::None;
-  for (CommandSource* s : sources_) s->collect(tick, gate_, slots_);
+  for (CommandSlot& s : collected_) s.answer = Answer::None;
+  for (CommandSource* s : sources_) s->collect(tick, gate_, collected_);
+  std::swap(collected_, due_);  // the answers the next apply() takes
 }
 
 void Simulation::apply() {
-  const std::vector<CommandSlot>& answers = config_.mode == Mode::Serial ? slots_ : pending_;
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
     commanded_[r] = false;
-    if (config_.mode == Mode::Pipelined && !pending_valid_) continue;  // none yet
-    const CommandSlot& s = answers[r];
+    const CommandSlot& s = due_[r];
     if (s.answer == Answer::Missed) ++missed_[r];
     if (s.answer != Answer::Given) continue;
     world_.setCommand(r, std::span<const double>(s.command.position),
@@ -149,8 +148,6 @@ void Simulation::period() {
     // The drivers computed their answers to `tick` while the world stepped;
     // they act in the next period.
     collect(tick);
-    pending_ = slots_;
-    pending_valid_ = true;
     t5 = Clock::now();
   }
   for (CommandSource* s : sources_) s->afterStep(world_);

@@ -49,14 +49,7 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
   agents::WalkEngine walk(model, c.walk);
   agents::KickEngine engine(model, c.walk, c.kick);
   std::vector<double> targets = model.pose("stand");
-  // 1 s from the stand pose into the walk's stance.
-  int i = 0;
-  t.driver.setControl([&](const world::World&, std::span<float> p, std::span<float> k) {
-    walk.easeIn(model.pose("stand"), i * t.dt(), targets);
-    bodyTargetsToCommand(model, targets, 1.0, p, k);
-    return true;
-  });
-  for (i = 0; i < 100; ++i) t.period();
+  settleIntoStance(t, walk, targets);
   const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
   const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
   engine::RigidBodyState b;
@@ -76,7 +69,7 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
   });
   const int foot_link = model.body->linkIndex(link);
   Vec3 last_foot = w.linkPose(0, foot_link).translation();  // for the trace
-  for (i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
+  for (int i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
     t.period();
     r.fell = r.fell || !w.isStanding(0);
     if (c.verbose) traceKick(w, foot_link, start, dt, (i + 1) * dt, last_foot);

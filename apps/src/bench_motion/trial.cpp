@@ -68,6 +68,20 @@ void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<dou
   }
 }
 
+void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<double>& targets) {
+  const auto& model = *t.world.robot(0).model;
+  const std::vector<double>& stand = model.pose("stand");
+  int i = 0;
+  t.driver.setControl([&](const world::World&, std::span<float> p, std::span<float> k) {
+    engine.easeIn(stand, i * t.dt(), targets);
+    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    return true;
+  });
+  for (i = 0; i < 100; ++i) t.period();
+  t.driver.setControl({});  // its captures end here
+}
+
+
 int goalScored(const world::World& w) {
   return referee::ballInGoal(w.field(), w.ballState().pose.translation());
 }

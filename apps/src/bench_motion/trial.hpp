@@ -74,6 +74,10 @@ void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<dou
                           double stiffness, std::span<float> position,
                           std::span<float> stiffness_out);
 
+// Robot 0 for 1 s from the stand pose into the walk's stance (eased in,
+// then held); `targets` (body joint order) end in the stance.
+void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<double>& targets);
+
 // The goal the ball is in by the referee's rule (+1 / -1 for +x / -x, 0 none).
 int goalScored(const world::World& w);
 

@@ -6,24 +6,6 @@
 #include "trial.hpp"
 
 namespace simsoccer::apps::motion {
-namespace {
-
-// 1 s from the stand pose into the walk's stance (eased in, then held).
-void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<double>& targets) {
-  const auto& model = *t.world.robot(0).model;
-  const std::vector<double>& stand = model.pose("stand");
-  int i = 0;
-  t.driver.setControl([&](const world::World&, std::span<float> p, std::span<float> k) {
-    engine.easeIn(stand, i * t.dt(), targets);
-    bodyTargetsToCommand(model, targets, 1.0, p, k);
-    return true;
-  });
-  for (i = 0; i < 100; ++i) t.period();
-  t.driver.setControl({});  // its captures end here
-}
-
-}  // namespace
-
 WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds, int* falls) {
   TrialWorld t(emptyField(), c);
   world::World& w = t.world;

@@ -35,6 +35,10 @@ struct Proportion {
 };
 Proportion wilsonInterval(int successes, int trials);
 
+// A finite number with `decimals` decimals (0 for a NaN or an infinity: JSON
+// has none), as the summary and the log header write numbers.
+std::string fixedNumber(double v, int decimals = 3);
+
 // A string as a JSON string literal.
 std::string jsonString(const std::string& s);
 

@@ -15,6 +15,8 @@
 namespace simsoccer::sim {
 
 struct OfficialsConfig {
+  // Teams by GameController team number; team index t plays in colour t.
+  static OfficialsConfig forTeams(uint8_t team0, uint8_t team1);
   std::array<referee::TeamSetup, 2> teams;
   referee::RefereeConfig referee;
   int kick_off_team = 0;

@@ -158,9 +158,10 @@ class Simulation {
   Officials* officials_ = nullptr;
   std::unique_ptr<world::PerceptionSystem> perception_;
   std::vector<std::function<void(const world::CameraImage&)>> image_sinks_;
-  std::vector<CommandSlot> slots_;       // this period's answers
-  std::vector<CommandSlot> pending_;     // pipelined: the answers to the last tick
-  bool pending_valid_ = false;
+  // The answers the next apply() takes (serial: to this tick; pipelined: to
+  // the last one; none before the first collect), and the buffer collect()
+  // fills before the two are swapped.
+  std::vector<CommandSlot> due_, collected_;
   std::vector<RobotCommand> applied_;    // per robot, the last applied
   std::vector<bool> commanded_;          // per robot, applied in the last period
   std::vector<uint64_t> accepted_, missed_;
