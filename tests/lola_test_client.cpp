@@ -1,0 +1,243 @@
+// A LoLA client written for the tests and the docs' worked example, strict
+// like the strictest team code: connects to the socket (default
+// /tmp/robocup, retrying as team code does), reads each sensor map with one
+// recv of 896 bytes and checks every key, type and length (lola_reader.hpp),
+// and answers with actuator maps packed by msgpack-c (whole-number floats
+// become integers, as in NaoTH, rUNSWift and nao_lola). Modes play the
+// behaviours and faults the simulator must survive.
+//
+//   simsoccer-lola-test-client [--socket P] [--mode M] [--cycles N] [--after K]
+//       [--joint NAME=RAD]... [--stiffness S] [--expect-chest] [--print-id]
+// modes: hold (answer every map, full), partial (full once, then Position
+// alone, split over two writes, LEDs in a second map), probe (read one map,
+// disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
+// (unknown keys in every map), silent (stop answering for K cycles after K),
+// bump (hold, chest LEDs changing each cycle).
+// Exit: 0 done, 1 expectation not met, 2 usage, 3 protocol violation, 4 no server.
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <msgpack.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lola_reader.hpp"
+#include "simsoccer/protocol/wire.hpp"
+
+namespace {
+using simsoccer::protocol::kNaoActuatorOrder;
+
+int connectTo(const std::string& path) {
+  sockaddr_un a{};
+  a.sun_family = AF_UNIX;
+  std::snprintf(a.sun_path, sizeof a.sun_path, "%s", path.c_str());
+  for (int attempt = 0; attempt < 200; ++attempt) {  // 10 s, as team code retries
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) return fd;
+    ::close(fd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return -1;
+}
+
+bool writeAll(int fd, const char* data, std::size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::send(fd, data, n, MSG_NOSIGNAL);
+    if (w <= 0) return false;
+    data += w;
+    n -= static_cast<std::size_t>(w);
+  }
+  return true;
+}
+
+struct Options {
+  std::string socket = "/tmp/robocup", mode = "hold";
+  long cycles = 0, after = 50;
+  std::vector<std::pair<int, float>> joints;
+  float stiffness = 1.0f;
+  bool expect_chest = false, print_id = false;
+};
+
+template <typename Values>
+void packFloats(msgpack::packer<msgpack::sbuffer>& p, const char* key, const Values& v) {
+  p.pack(std::string(key));
+  p.pack_array(static_cast<uint32_t>(v.size()));
+  for (float x : v) p.pack_float(x);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--socket") o.socket = value();
+    else if (a == "--mode") o.mode = value();
+    else if (a == "--cycles") o.cycles = std::stol(value());
+    else if (a == "--after") o.after = std::stol(value());
+    else if (a == "--stiffness") o.stiffness = std::stof(value());
+    else if (a == "--expect-chest") o.expect_chest = true;
+    else if (a == "--print-id") o.print_id = true;
+    else if (a == "--joint") {
+      const std::string v = value();
+      const auto eq = v.find('=');
+      int index = -1;
+      for (std::size_t j = 0; j < kNaoActuatorOrder.size(); ++j)
+        if (eq != std::string::npos && v.substr(0, eq) == kNaoActuatorOrder[j]) index = static_cast<int>(j);
+      if (index < 0) {
+        std::fprintf(stderr, "--joint %s: not NAME=RAD with a LoLA joint name\n", v.c_str());
+        return 2;
+      }
+      o.joints.emplace_back(index, std::stof(v.substr(eq + 1)));
+    } else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  int fd = connectTo(o.socket);
+  if (fd < 0) {
+    std::fprintf(stderr, "lola client: no server at %s\n", o.socket.c_str());
+    return 4;
+  }
+  std::vector<float> hold;  // targets: the first map's positions, with --joint overrides
+  long cycle = 0, silent_until = -1;
+  bool probed = false, faulted = false, reconnected = false;
+  std::vector<uint8_t> packet(896);
+  for (; o.cycles == 0 || cycle < o.cycles; ++cycle) {
+    const ssize_t n = ::recv(fd, packet.data(), packet.size(), 0);
+    if (n <= 0) {
+      if (faulted && !reconnected && (o.mode == "garbage" || o.mode == "huge")) {
+        // The server ended the session over the fault: reconnect, as team code does.
+        reconnected = true;
+        ::close(fd);
+        fd = connectTo(o.socket);
+        if (fd < 0) return 4;
+        std::printf("lola client: reconnected after the %s in map %ld\n", o.mode.c_str(), cycle);
+        --cycle;
+        continue;
+      }
+      std::printf("lola client: server closed after %ld cycles\n", cycle);
+      break;
+    }
+    simsoccer::test::LolaSensors s;
+    try {
+      s = simsoccer::test::readLolaSensors(std::span<const uint8_t>(packet.data(), static_cast<std::size_t>(std::max<ssize_t>(n, 0))));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "lola client: protocol violation in map %ld: %s\n", cycle, e.what());
+      return 3;
+    }
+    if (cycle == 0 && o.print_id) {
+      std::printf("body id %s head id %s\n", s.robot_config[0].c_str(), s.robot_config[2].c_str());
+      std::fflush(stdout);
+    }
+    if (o.expect_chest && s["Touch"][0] == 1.0f) {
+      std::printf("lola client: chest button pressed in map %ld\n", cycle);
+      return 0;
+    }
+    if (hold.empty()) {
+      hold = s["Position"];
+      for (auto [j, rad] : o.joints) hold[static_cast<std::size_t>(j)] = rad;
+    }
+    if (o.mode == "probe" && !probed) {  // B-Human reads the body id and reconnects
+      probed = true;
+      ::close(fd);
+      fd = connectTo(o.socket);
+      if (fd < 0) return 4;
+      continue;
+    }
+    const bool fault_now = cycle >= o.after && !faulted;
+    if (o.mode == "silent" && fault_now) {
+      faulted = true;
+      silent_until = cycle + o.after;
+    }
+    if (cycle < silent_until) continue;  // reads, does not answer
+    if (o.mode == "garbage" && fault_now) {
+      faulted = true;
+      const char junk[] = "\xc1\xc1\xc1 not msgpack";
+      writeAll(fd, junk, sizeof junk);
+      continue;
+    }
+    if (o.mode == "huge" && fault_now) {
+      faulted = true;
+      msgpack::sbuffer big;
+      msgpack::packer<msgpack::sbuffer> p(big);
+      p.pack_map(1);
+      p.pack(std::string("Position"));
+      p.pack_array(10 * 1024 * 1024 / 5);
+      for (int i = 0; i < 10 * 1024 * 1024 / 5; ++i) p.pack_float(0.5f);
+      writeAll(fd, big.data(), big.size());  // fails: the server ends the session at the header
+      continue;
+    }
+    msgpack::sbuffer out;
+    msgpack::packer<msgpack::sbuffer> p(out);
+    std::vector<float> position = hold, stiffness(25, o.stiffness);
+    if (o.mode == "nan" && fault_now) {
+      faulted = true;
+      position[0] = std::numeric_limits<float>::quiet_NaN();
+    }
+    const bool partial = o.mode == "partial" && cycle > 0;
+    const bool unknown = o.mode == "unknown";
+    p.pack_map(partial ? 1 : 11 + (unknown ? 2 : 0));
+    packFloats(p, "Position", position);
+    if (!partial) {
+      packFloats(p, "Stiffness", stiffness);
+      const float blue = o.mode == "bump" ? static_cast<float>(cycle % 2) : 1.0f;
+      packFloats(p, "Chest", std::vector<float>{0.0f, 0.0f, blue});
+      packFloats(p, "LEye", std::vector<float>(24, 0.5f));
+      packFloats(p, "REye", std::vector<float>(24, 0.5f));
+      packFloats(p, "LEar", std::vector<float>(10, 1.0f));
+      packFloats(p, "REar", std::vector<float>(10, 1.0f));
+      packFloats(p, "LFoot", std::vector<float>(3, 0.0f));
+      packFloats(p, "RFoot", std::vector<float>(3, 0.0f));
+      packFloats(p, "Skull", std::vector<float>(12, 0.0f));
+      p.pack(std::string("Sonar"));
+      p.pack_array(2);
+      p.pack(true);
+      p.pack(true);
+      if (unknown) {
+        packFloats(p, "Fan", std::vector<float>{1.0f});
+        p.pack(std::string("SimulationTime"));
+        p.pack(12.5);
+      }
+    }
+    bool ok = true;
+    if (partial) {  // split the map over two writes, then a second map (LEDs only)
+      const std::size_t half = out.size() / 2;
+      ok = writeAll(fd, out.data(), half);
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      ok = ok && writeAll(fd, out.data() + half, out.size() - half);
+      msgpack::sbuffer leds;
+      msgpack::packer<msgpack::sbuffer> q(leds);
+      q.pack_map(1);
+      packFloats(q, "Chest", std::vector<float>{1.0f, 0.0f, 0.0f});
+      ok = ok && writeAll(fd, leds.data(), leds.size());
+    } else {
+      ok = writeAll(fd, out.data(), out.size());
+    }
+    if (!ok) {
+      std::fprintf(stderr, "lola client: write failed in map %ld\n", cycle);
+      return 1;
+    }
+  }
+  ::close(fd);
+  if (o.expect_chest) {
+    std::fprintf(stderr, "lola client: the chest button was never pressed\n");
+    return 1;
+  }
+  std::printf("lola client: %ld cycles\n", cycle);
+  return 0;
+}
