@@ -8,6 +8,7 @@
 //
 //   simsoccer-lola-test-client [--socket P] [--mode M] [--cycles N] [--after K]
 //       [--joint NAME=RAD]... [--stiffness S] [--expect-chest] [--print-id]
+//       [--expect-id BODY_ID]
 // modes: hold (answer every map, full), partial (full once, then Position
 // alone, split over two writes, LEDs in a second map), probe (read one map,
 // disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
@@ -64,6 +65,7 @@ struct Options {
   std::vector<std::pair<int, float>> joints;
   float stiffness = 1.0f;
   bool expect_chest = false, print_id = false;
+  std::string expect_id;  // the body id the robot must report
 };
 
 template <typename Values>
@@ -92,6 +94,7 @@ int main(int argc, char** argv) {
     else if (a == "--stiffness") o.stiffness = std::stof(value());
     else if (a == "--expect-chest") o.expect_chest = true;
     else if (a == "--print-id") o.print_id = true;
+    else if (a == "--expect-id") o.expect_id = value();
     else if (a == "--joint") {
       const std::string v = value();
       const auto eq = v.find('=');
@@ -143,6 +146,11 @@ int main(int argc, char** argv) {
     if (cycle == 0 && o.print_id) {
       std::printf("body id %s head id %s\n", s.robot_config[0].c_str(), s.robot_config[2].c_str());
       std::fflush(stdout);
+    }
+    if (cycle == 0 && !o.expect_id.empty() && s.robot_config[0] != o.expect_id) {
+      std::fprintf(stderr, "lola client: robot %s, expected %s\n", s.robot_config[0].c_str(),
+                   o.expect_id.c_str());
+      return 1;
     }
     if (o.expect_chest && s["Touch"][0] == 1.0f) {
       std::printf("lola client: chest button pressed in map %ld\n", cycle);

@@ -172,3 +172,35 @@ TEST(LolaEndpoint, ARobotThatIsNoNaoOrAWrongPeriodIsRefusedWithTheReason) {
     EXPECT_NE(std::string(e.what()).find("at most"), std::string::npos) << e.what();
   }
 }
+
+// Two team binaries at once, each in its own mount namespace through
+// `simsoccer lola-run`, each finds its own robot at /tmp/robocup.
+TEST(LolaRun, TwoBinariesAtOnceEachSeeTheirOwnRobotAtTmpRobocup) {
+  test::TempDir dir("lola_run");
+  world::World world(lolaScenario());
+  sim::Simulation sim(world);
+  lola::EndpointConfig c;
+  for (world::RobotId r = 0; r < 2; ++r) {
+    lola::RobotSocket rs;
+    rs.robot = r;
+    rs.socket = dir.path() / ("robot_" + std::to_string(r) + ".sock");
+    rs.identity = lola::defaultIdentity(5, static_cast<int>(r) + 1);
+    c.robots.push_back(rs);
+  }
+  lola::Endpoint endpoint(world, c);
+  sim.addSource(endpoint);
+  std::vector<std::unique_ptr<match::ChildProcess>> clients;
+  for (world::RobotId r = 0; r < 2; ++r)
+    clients.push_back(std::make_unique<match::ChildProcess>(std::vector<std::string>{
+        SIMSOCCER_BIN, "lola-run", "--socket", c.robots[r].socket.string(), "--",
+        SIMSOCCER_LOLA_CLIENT, "--expect-id", c.robots[r].identity.body_id, "--cycles", "50"}));
+  ASSERT_TRUE(endpoint.waitForClients(20.0)) << "the clients did not connect through lola-run";
+  for (int i = 0; i < 500 && (clients[0]->running() || clients[1]->running()); ++i) sim.period();
+  for (auto& client : clients) {
+    for (int i = 0; i < 200 && client->running(); ++i) usleep(10000);
+    EXPECT_FALSE(client->running());
+    EXPECT_EQ(client->exitStatus(), 0) << "a client saw another robot, or none";
+  }
+  EXPECT_EQ(endpoint.stats(0).answered, 50u);
+  EXPECT_EQ(endpoint.stats(1).answered, 50u);
+}

@@ -26,6 +26,7 @@ const char* kUsage =
     "  bench motion    the agents' motion and behaviour: walk, kick, get-up, striker, penalty\n"
     "  bench scaling   the full pipeline with agent processes, 1..22 robots, vs USARSim\n"
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
+    "  lola-run        start a team's robot binary with a simulated Nao's LoLA socket\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
 
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
     if (cmd == "match") return match(argc, argv, 2);
     if (cmd == "penalty") return penalty(argc, argv, 2);
     if (cmd == "replay") return replay(argc, argv, 2);
+    if (cmd == "lola-run") return lolaRun(argc, argv, 2);
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);

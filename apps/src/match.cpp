@@ -8,6 +8,7 @@
 #include <ctime>
 
 #include "cli.hpp"
+#include "lola_option.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/match/outputs.hpp"
 
@@ -33,7 +34,8 @@ std::filesystem::path defaultOut() {
 const char* kMatchHelp =
     "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
     "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
-    "                       [--dds-config FILE] [--mode serial|pipelined] [--quiet]\n"
+    "                       [--dds-config FILE] [--mode serial|pipelined] [--lola T:P,...]\n"
+    "                       [--quiet]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -61,6 +63,9 @@ const char* kMatchHelp =
     "  --mode M            the control period: serial (the world steps with the answers to\n"
     "                      this period's frames) or pipelined (with the last period's, while\n"
     "                      the agents compute: one period of actuation delay); default %s\n"
+    "  --lola T:P,...      drive these robots (GameController team number:player) through\n"
+    "                      LoLA sockets under DIR/lola/ instead of agents: a team's robot\n"
+    "                      binary plays them (simsoccer lola-run); 12 ms control period\n"
     "  --no-video          skip the video\n"
     "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
 
@@ -90,6 +95,10 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
                          : "the default DDS configuration " + o.dds_config.string() +
                                " is missing (give one with --dds-config)");
   o.stop_requested = [] { return g_interrupted != 0; };
+  o.notice = [](const std::string& line) {
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  };
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   return o;
@@ -118,7 +127,8 @@ void printStatus(const MatchSession& session, double wall) {
 int match(int argc, char** argv, int first) {
   const Options opt(
       argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
-      {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode"});
+      {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
+       "lola"});
   char help[4096];
   std::snprintf(help, sizeof help, kMatchHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -136,6 +146,7 @@ int match(int argc, char** argv, int first) {
     if (!(t > 0)) throw UsageError("--lockstep-timeout must be > 0 s");
     config.command_timeout = t;
   }
+  addLolaRobots(opt, config);
   RunOptions o = runOptions(opt, config);
   o.realtime = opt.flag("realtime");
   o.external = opt.flag("external-agents");
@@ -170,6 +181,14 @@ int match(int argc, char** argv, int first) {
                 goal.own_goal ? " (own goal)" : "");
   if (r.video_frames > 0)
     std::printf("video: %s, %d frames\n", (o.out / "match.mp4").string().c_str(), r.video_frames);
+  for (const match::LolaResult& l : r.lola)
+    std::printf("LoLA robot %d:%d: %llu sessions, %llu maps, %llu missed, %llu faults\n",
+                l.player.team_number, l.player.player,
+                static_cast<unsigned long long>(l.stats.sessions),
+                static_cast<unsigned long long>(l.stats.maps),
+                static_cast<unsigned long long>(l.stats.missed),
+                static_cast<unsigned long long>(l.stats.bad_maps + l.stats.stream_errors +
+                                                l.stats.refused));
   std::printf("wrote %s\n", (o.out / "summary.json").string().c_str());
   return r.aborted ? 3 : (r.interrupted ? 130 : 0);
 }

@@ -6,8 +6,9 @@
 #include <optional>
 
 #include "cli.hpp"
+#include "lola_option.hpp"
 #include "simsoccer/engine/config.hpp"
-#include "simsoccer/match/match_session.hpp"
+#include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/sim/officials.hpp"
@@ -20,6 +21,7 @@ const char* kHelp =
     "usage: simsoccer serve SCENARIO|MATCH [--domain D] [--dds-config FILE] [--seconds S]\n"
     "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
     "                       [--limp-on-release] [--mode serial|pipelined]\n"
+    "                       [--lola T:P,... [--out DIR]]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
     "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
@@ -42,7 +44,10 @@ const char* kHelp =
     "kicks off; --teams gives the GameController team numbers, default 1,2). The game state\n"
     "goes to agents on the GameState topic, and with --gc-address also as GameController\n"
     "packets over UDP (port 3838, every 0.5 simulated s; return packets on 3939), so robot\n"
-    "code written for the SPL GameController runs unchanged.\n";
+    "code written for the SPL GameController runs unchanged.\n"
+    "\n"
+    "--lola T:P,... (with a match config): these robots are driven through LoLA sockets under\n"
+    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run).\n";
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
@@ -77,7 +82,8 @@ void printGame(const referee::Game& g) {
 int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
-                     "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half"});
+                     "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
+                     "out"});
   if (opt.help(kHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
@@ -100,6 +106,7 @@ int serve(int argc, char** argv, int first) {
       if (!(h > 0)) throw UsageError("--half must be > 0 s");
       mc.half_duration = h;
     }
+    addLolaRobots(opt, mc);
     session = std::make_unique<match::MatchSession>(
         mc, static_cast<uint64_t>(opt.number("seed", static_cast<double>(mc.seed))));
     officials = &session->officials();
@@ -107,7 +114,8 @@ int serve(int argc, char** argv, int first) {
     cfg.team_message_delay = mc.message_delay;
     cfg.team_message_loss = mc.message_loss;
   } else {
-    if (opt.has("half")) throw UsageError("--half goes with a match config");
+    if (opt.has("half") || opt.has("lola"))
+      throw UsageError("--half and --lola go with a match config");
     world::Scenario scenario = world::loadScenario(file);
     if (opt.has("seed")) scenario.seed = static_cast<uint64_t>(opt.number("seed", 0));
     own_world = std::make_unique<world::World>(scenario);
@@ -142,6 +150,14 @@ int serve(int argc, char** argv, int first) {
     session->attach(simulation);
   else
     simulation.setOfficials(officials);
+  std::unique_ptr<lola::Endpoint> lola_endpoint;
+  if (session) {
+    lola_endpoint = match::openLolaEndpoint(
+        *session, opt.get("out", "runs/serve"), cfg.lockstep,
+        [](const std::string& line) { std::printf("%s\n", line.c_str()); });
+    if (lola_endpoint) simulation.addSource(*lola_endpoint);
+    cfg.not_served = session->lolaRobots();
+  }
   net::SimServer server(simulation, cfg);
   std::unique_ptr<referee::GameControllerLink> gc_link;
   if (officials) {
@@ -157,8 +173,9 @@ int serve(int argc, char** argv, int first) {
   }
 
   const double sim_seconds = opt.number("seconds", 60.0);
-  const auto wanted =
-      static_cast<size_t>(opt.number("agents", static_cast<double>(w.robotCount())));
+  const size_t lola_robots = cfg.not_served.size();
+  const auto wanted = static_cast<size_t>(
+      opt.number("agents", static_cast<double>(w.robotCount() - lola_robots)));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::printf("simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",
@@ -166,6 +183,8 @@ int serve(int argc, char** argv, int first) {
               static_cast<unsigned long long>(w.scenario().seed), wanted);
   std::fflush(stdout);
   while (!g_stop && !server.waitForOwners(wanted, 1.0)) {
+  }
+  while (lola_endpoint && !g_stop && !lola_endpoint->waitForClients(1.0)) {
   }
   const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period + 0.5);
   sim::RunLoop loop(simulation, cfg.lockstep ? sim::Pacing::Lockstep : sim::Pacing::RealTime);
@@ -188,6 +207,14 @@ int serve(int argc, char** argv, int first) {
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
   printCounters(w, server);
+  for (size_t i = 0; lola_endpoint && i < lola_robots; ++i) {
+    const lola::RobotLolaStats l = lola_endpoint->stats(i);
+    std::printf("  LoLA %s: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
+                lola_endpoint->config().robots[i].socket.filename().c_str(),
+                (unsigned long long)l.sessions, (unsigned long long)l.maps,
+                (unsigned long long)l.missed, (unsigned long long)l.bad_maps,
+                (unsigned long long)l.refused);
+  }
   if (officials) printGame(officials->game());
   if (gc_link) {
     std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",

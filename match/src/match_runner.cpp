@@ -83,6 +83,34 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
   return soccerAgentCommand(ao);
 }
 
+std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p) {
+  return out / "lola" /
+         ("robot_" + std::to_string(p.team_number) + "_" + std::to_string(p.player) + ".sock");
+}
+
+std::unique_ptr<lola::Endpoint> openLolaEndpoint(
+    const MatchSession& session, const std::filesystem::path& out, bool lockstep,
+    const std::function<void(const std::string&)>& notice) {
+  if (session.lolaRobots().empty()) return nullptr;
+  const MatchConfig& c = session.config();
+  lola::EndpointConfig ec;
+  ec.lockstep = lockstep;
+  ec.answer_timeout = c.command_timeout;
+  for (size_t i = 0; i < session.lolaRobots().size(); ++i) {
+    const LolaPlayer& p = c.lola.robots[i];
+    lola::RobotSocket rs;
+    rs.robot = session.lolaRobots()[i];
+    rs.socket = std::filesystem::absolute(lolaSocketPath(out, p));
+    rs.identity = lola::defaultIdentity(p.team_number, p.player);
+    ec.robots.push_back(rs);
+  }
+  auto endpoint = std::make_unique<lola::Endpoint>(session.world(), ec);
+  for (size_t i = 0; notice && i < ec.robots.size(); ++i)
+    notice("LoLA robot " + std::to_string(c.lola.robots[i].team_number) + ":" +
+           std::to_string(c.lola.robots[i].player) + " at " + ec.robots[i].socket.string());
+  return endpoint;
+}
+
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
   world::World& w = session.world();
@@ -101,6 +129,27 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.command_timeout = c.command_timeout;
   sc.team_message_delay = c.message_delay;
   sc.team_message_loss = c.message_loss;
+  sc.not_served = session.lolaRobots();
+  // LoLA robots: one socket each under the run's folder, a command source
+  // beside DDS; their clients are started here if the config names one.
+  std::unique_ptr<lola::Endpoint> endpoint =
+      openLolaEndpoint(session, o.out, !o.realtime, o.notice);
+  std::vector<std::unique_ptr<ChildProcess>> lola_clients;
+  if (endpoint) {
+    simulation.addSource(*endpoint);
+    for (const lola::RobotSocket& rs : endpoint->config().robots) {
+      if (c.lola.client.empty()) break;
+      std::vector<std::string> args;
+      for (std::string a : c.lola.client) {
+        for (size_t at = a.find("{socket}"); at != std::string::npos; at = a.find("{socket}"))
+          a.replace(at, 8, rs.socket.string());
+        args.push_back(a);
+      }
+      lola_clients.push_back(std::make_unique<ChildProcess>(args));
+      if (!lola_clients.back()->started())
+        throw std::runtime_error("cannot start the LoLA client " + args[0]);
+    }
+  }
   net::SimServer server(simulation, sc);
   // The agents find the game state when they start.
   server.publishGameState(session.controlData(), session.game().leftTeam());
@@ -108,7 +157,12 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     return match::agentCommand(session, o, team, number);
   };
   std::vector<AgentSlot> agents;
+  const auto isLola = [&](world::RobotId r) {
+    return std::find(session.lolaRobots().begin(), session.lolaRobots().end(), r) !=
+           session.lolaRobots().end();
+  };
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    if (isLola(r)) continue;
     AgentSlot a;
     a.team = w.robot(r).team;
     a.number = w.robot(r).number;
@@ -121,9 +175,20 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   }
   const auto t_wait = Clock::now();
   const auto stopRequested = [&] { return o.stop_requested && o.stop_requested(); };
-  while (!stopRequested() && !server.waitForOwners(w.robotCount(), 0.5)) {
+  const size_t dds_robots = w.robotCount() - session.lolaRobots().size();
+  while (!stopRequested() && !server.waitForOwners(dds_robots, 0.5)) {
     if (secondsSince(t_wait) > 60.0)
       throw std::runtime_error("agents did not claim their robots within 60 s");
+  }
+  if (endpoint) {
+    const auto t_lola = Clock::now();
+    while (!stopRequested() && !endpoint->waitForClients(0.5))
+      if (secondsSince(t_lola) > c.lola.connect_timeout) {
+        if (o.notice)
+          o.notice("not every LoLA client connected within " +
+                   fixedNumber(c.lola.connect_timeout, 0) + " s: the match starts, their robots hold");
+        break;
+      }
   }
   const auto t0 = Clock::now();
   double last_progress = -1.0;
@@ -176,8 +241,11 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   result.final_hash = w.stateHash();
   for (world::RobotId r = 0; r < w.robotCount(); ++r)
     result.missed_commands.push_back(server.stats(r).missed);
+  for (size_t i = 0; endpoint && i < session.lolaRobots().size(); ++i)
+    result.lola.push_back({c.lola.robots[i], endpoint->config().robots[i].socket, endpoint->stats(i)});
   for (AgentSlot& a : agents)
     if (a.process) a.process->stop();
+  for (auto& client : lola_clients) client->stop();
   log.flush();
   return result;
 }

@@ -1,5 +1,6 @@
 #include "simsoccer/match/match_session.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,11 +22,30 @@ std::string fileBytes(const std::filesystem::path& p) {
 
 }  // namespace
 
+std::vector<LolaPlayer> parseLolaPlayers(const std::string& list) {
+  std::vector<LolaPlayer> out;
+  std::size_t at = 0;
+  while (at <= list.size()) {
+    const std::size_t end = std::min(list.find(',', at), list.size());
+    const std::string entry = list.substr(at, end - at);
+    LolaPlayer p;
+    char rest = 0;
+    if (std::sscanf(entry.c_str(), "%d:%d%c", &p.team_number, &p.player, &rest) != 2 ||
+        p.team_number < 0 || p.team_number > 254 || p.player < 1 || p.player > 20)
+      throw std::invalid_argument("'" + entry +
+                                  "' is not TEAM:PLAYER (a GameController team number 0..254 and "
+                                  "a player number 1..20)");
+    out.push_back(p);
+    at = end + 1;
+  }
+  return out;
+}
+
 MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   root.allowOnly({"match", "penalty", "scenario", "rules", "half_duration", "half_time_break",
                   "teams", "agents", "team_messages", "lockstep", "set_duration", "video", "seed",
-                  "kicks"});
+                  "kicks", "lola"});
   MatchConfig c;
   c.file = file.string();
   if (root.has("match"))
@@ -93,6 +113,20 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (v->has("look_at")) c.video.look_at = (*v)["look_at"].vec3();
     if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
   }
+  if (auto l = root.optional("lola")) {
+    l->allowOnly({"robots", "client", "connect_timeout"});
+    for (const engine::ConfigNode& r : (*l)["robots"].items()) {
+      try {
+        const auto players = parseLolaPlayers(r.string());
+        c.lola.robots.insert(c.lola.robots.end(), players.begin(), players.end());
+      } catch (const std::invalid_argument& e) {
+        r.fail(e.what());
+      }
+    }
+    if (l->has("client"))
+      for (const engine::ConfigNode& a : (*l)["client"].items()) c.lola.client.push_back(a.string());
+    if (l->has("connect_timeout")) c.lola.connect_timeout = (*l)["connect_timeout"].positive();
+  }
   c.seed = static_cast<uint64_t>(root.integer("seed", 1));
   if (root.has("penalty")) {
     c.penalty_kicks = root.integer("kicks", 5);
@@ -114,6 +148,13 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
   world::Scenario s = world::loadScenario(config.scenario);
   s.seed = seed;
   if (solver_threads > 0) s.physics.threads = solver_threads;
+  if (!config.lola.robots.empty()) {
+    // LoLA's cycle is 12 ms; the physics step must divide it.
+    const double cycle = 0.012;
+    const double steps = cycle / s.physics.dt;
+    if (std::abs(steps - std::round(steps)) > 1e-6) s.physics.dt = 0.004;
+    s.physics.control_period = cycle;
+  }
   if (!s.perception.enabled)  // not switched on behind the scenario's back
     throw engine::ConfigError(config.scenario.string(), "perception",
                               "a match's agents see through perception: turn it on");
@@ -137,6 +178,26 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     rec.number = world_->robot(r).number;
     rec.last = world_->torsoPose(r).translation();
     records_.push_back(rec);
+  }
+  for (const LolaPlayer& p : config.lola.robots) {
+    int team = -1;
+    for (int t = 0; t < 2; ++t)
+      if (config.team_numbers[static_cast<size_t>(t)] == p.team_number) team = t;
+    std::optional<world::RobotId> found;
+    for (world::RobotId r = 0; r < world_->robotCount(); ++r)
+      if (world_->robot(r).team == team && world_->robot(r).number == p.player) found = r;
+    if (!found)
+      throw engine::ConfigError(config.file, "lola.robots",
+                                "no robot " + std::to_string(p.team_number) + ":" +
+                                    std::to_string(p.player) + " in the match (teams " +
+                                    std::to_string(config.team_numbers[0]) + " and " +
+                                    std::to_string(config.team_numbers[1]) + ")");
+    for (world::RobotId r : lola_robots_)
+      if (r == *found)
+        throw engine::ConfigError(config.file, "lola.robots",
+                                  "robot " + std::to_string(p.team_number) + ":" +
+                                      std::to_string(p.player) + " is named twice");
+    lola_robots_.push_back(*found);
   }
 }
 

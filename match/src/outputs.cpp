@@ -115,6 +115,23 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"agent_restarts\": [";
   for (size_t i = 0; i < r.agent_events.size(); ++i) out << (i ? ", " : "") << r.agent_events[i];
   out << "],\n";
+  // LoLA robots: the socket and every fault their clients made (the robot held its last command).
+  out << "  \"lola\": [";
+  for (size_t i = 0; i < r.lola.size(); ++i) {
+    const LolaResult& l = r.lola[i];
+    const lola::RobotLolaStats& st = l.stats;
+    out << (i ? "," : "") << "\n    {\"team\": " << l.player.team_number
+        << ", \"player\": " << l.player.player << ", \"socket\": " << jsonString(l.socket.string())
+        << ", \"sessions\": " << st.sessions << ", \"packets_sent\": " << st.packets_sent
+        << ", \"packets_dropped\": " << st.packets_dropped << ", \"answered\": " << st.answered
+        << ", \"missed\": " << st.missed << ", \"no_client\": " << st.no_client
+        << ", \"maps\": " << st.maps << ", \"bad_maps\": " << st.bad_maps
+        << ", \"unknown_keys\": " << st.unknown_keys << ", \"stream_errors\": " << st.stream_errors
+        << ", \"refused_commands\": " << st.refused << ", \"bytes_received\": " << st.bytes_received
+        << "}";
+  }
+  out << (r.lola.empty() ? "" : "\n  ") << "],\n";
+  out << "  \"control_period\": " << fixedNumber(w.scenario().physics.control_period, 3) << ",\n";
   if (!extra.empty()) out << extra;
   out << "  \"interrupted\": " << (r.interrupted ? "true" : "false") << ",\n";
   out << "  \"aborted\": " << (r.aborted ? jsonString(r.abort_reason) : "null") << ",\n";

@@ -306,7 +306,11 @@ SimServer::~SimServer() {
 
 int SimServer::robotIndex(int team, int player) const {
   for (size_t i = 0; i < robots_.size(); ++i)
-    if (robots_[i].team == team && robots_[i].player == player) return static_cast<int>(i);
+    if (robots_[i].team == team && robots_[i].player == player) {
+      for (world::RobotId r : config_.not_served)
+        if (r == i) return -1;
+      return static_cast<int>(i);
+    }
   return -1;
 }
 

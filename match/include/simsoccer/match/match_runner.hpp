@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "simsoccer/lola/endpoint.hpp"
 #include "simsoccer/match/match_session.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/match_log.hpp"
@@ -30,7 +32,23 @@ struct RunOptions {
   std::function<bool()> stop_requested;
   // Called about every 0.25 s of wall time with the wall seconds so far.
   std::function<void(const MatchSession&, double wall)> progress;
+  // Told what a person starting clients by hand needs to know (LoLA sockets).
+  std::function<void(const std::string&)> notice;
 };
+
+// A LoLA robot's socket and what its clients did.
+struct LolaResult {
+  LolaPlayer player;
+  std::filesystem::path socket;
+  lola::RobotLolaStats stats;
+};
+// Where a LoLA robot's socket is in a run's folder.
+std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p);
+// The LoLA endpoint of a session's LoLA robots (none: null), sockets under
+// `out`; `notice` hears each robot's socket path.
+std::unique_ptr<lola::Endpoint> openLolaEndpoint(
+    const MatchSession& session, const std::filesystem::path& out, bool lockstep,
+    const std::function<void(const std::string&)>& notice);
 
 struct RunResult {
   bool interrupted = false, aborted = false;
@@ -45,6 +63,7 @@ struct RunResult {
   int frames = 0;
   uint64_t log_bytes = 0;
   int video_frames = 0;  // playMatch: frames of match.mp4 (0: none written)
+  std::vector<LolaResult> lola;  // per LoLA robot, in the config's order
 };
 
 // The match log's header for a session (config, scenario, seed, robots).

@@ -26,6 +26,23 @@ struct VideoSettings {
   double horizontal_fov = 1.1;                                    // rad
 };
 
+// A robot driven through LoLA (a team's robot binary) instead of a built-in agent.
+struct LolaPlayer {
+  int team_number = 0, player = 0;  // GameController team number, player number
+};
+// "1:3,2:1" (team number:player, comma separated); throws std::invalid_argument
+// naming the entry that is not one.
+std::vector<LolaPlayer> parseLolaPlayers(const std::string& list);
+
+struct LolaSettings {
+  std::vector<LolaPlayer> robots;
+  // Started once per LoLA robot with "{socket}" replaced by its socket path
+  // (e.g. `simsoccer lola-run --socket {socket} -- ./team-binary`); empty:
+  // the clients are started by hand.
+  std::vector<std::string> client;
+  double connect_timeout = 60.0;  // s the match waits for every LoLA client before it starts
+};
+
 struct MatchConfig {
   std::string file, name;
   std::filesystem::path scenario, rules, agent_config;
@@ -40,6 +57,9 @@ struct MatchConfig {
   VideoSettings video;
   uint64_t seed = 1;
   int penalty_kicks = 0;  // > 0: a penalty-kick scenario (simsoccer penalty)
+  // With LoLA robots the control period is LoLA's 12 ms (and the physics
+  // step 4 ms when the scenario's does not divide it).
+  LolaSettings lola;
   std::string hash;       // of the config and scenario files' bytes
 };
 // Reads a match or penalty config; throws engine::ConfigError (file, key, reason).
@@ -101,6 +121,8 @@ class MatchSession : public sim::Recorder {
   };
   const std::vector<Goal>& goals() const { return goals_; }
   referee::ControlData controlData() const { return officials_->controlData(); }
+  // The robots driven through LoLA, in the order of config().lola.robots.
+  const std::vector<world::RobotId>& lolaRobots() const { return lola_robots_; }
 
  private:
   MatchConfig config_;
@@ -113,6 +135,7 @@ class MatchSession : public sim::Recorder {
   std::optional<size_t> diving_keeper_;
   std::array<double, 2> possession_{};
   std::vector<Goal> goals_;
+  std::vector<world::RobotId> lola_robots_;
 };
 
 }  // namespace simsoccer::match

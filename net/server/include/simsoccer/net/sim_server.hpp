@@ -48,6 +48,8 @@ struct ServerConfig {
   double team_message_delay = 0.0;  // s of simulated time (at least one control period)
   double team_message_loss = 0.0;   // probability a copy is lost
   bool world_truth = false;
+  // Robots another transport drives (LoLA): claims and commands for them are ignored.
+  std::vector<world::RobotId> not_served;
 };
 
 // accepted, missed: the simulation's count (sim::CommandStats); rejected:

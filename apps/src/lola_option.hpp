@@ -1,0 +1,20 @@
+// The `--lola T:P,...` option of match and serve: robots a team's binary
+// drives through LoLA instead of a built-in agent.
+#pragma once
+
+#include "cli.hpp"
+#include "simsoccer/match/match_session.hpp"
+
+namespace simsoccer::apps {
+
+inline void addLolaRobots(const Options& opt, match::MatchConfig& config) {
+  if (!opt.has("lola")) return;
+  try {
+    const auto players = match::parseLolaPlayers(opt.get("lola", ""));
+    config.lola.robots.insert(config.lola.robots.end(), players.begin(), players.end());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--lola: ") + e.what());
+  }
+}
+
+}  // namespace simsoccer::apps
