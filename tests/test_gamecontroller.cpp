@@ -3,11 +3,15 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <thread>
 #include <vector>
 
+#include "gc_reader.hpp"
+#include "simsoccer/referee/game.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
 
 using namespace simsoccer::referee;
 
@@ -213,4 +217,86 @@ TEST(GameControllerUdp, BroadcastToLoopbackIsReceivedAndDecoded) {
   }
   EXPECT_EQ(good, 3);
   EXPECT_EQ(bad, 1);
+}
+
+// The HSL GameController's packet (v19, 198 bytes), read at the official
+// offsets by the tests' own reader: competitionType and `stopped` where v18
+// had competitionPhase and competitionType, 4-byte RobotInfo, the HSL codes.
+TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
+  ControlData d = knownState();
+  d.competition_type = 1;  // MIDDLE
+  d.stopped = 1;
+  d.teams[0].players[2].warnings = 1;
+  d.teams[0].players[2].cautions = 1;
+  const auto bytes = encodeHsl(d);
+  ASSERT_EQ(bytes.size(), 198u);
+  const simsoccer::test::GcPacket p = simsoccer::test::readGcPacket(bytes);
+  EXPECT_EQ(p.version, 19);
+  EXPECT_EQ(p.packet_number, 42);
+  EXPECT_EQ(p.competition_type, 1);
+  EXPECT_EQ(p.stopped, 1);
+  EXPECT_EQ(p.game_phase, 1);
+  EXPECT_EQ(p.state, 3);
+  EXPECT_EQ(p.set_play, 6);  // CORNER_KICK in the HSL's codes (SPL: 3)
+  EXPECT_EQ(p.kicking_team, 13);
+  EXPECT_EQ(p.secs_remaining, 600);
+  EXPECT_EQ(p.secondary_time, -3);
+  EXPECT_EQ(p.teams[0].number, 13);
+  EXPECT_EQ(p.teams[0].goalkeeper_colour, 2);
+  EXPECT_EQ(p.teams[0].single_shots, 0x0105);
+  EXPECT_EQ(p.teams[0].message_budget, 1200);
+  EXPECT_EQ(p.teams[0].players[2].penalty, 9);  // PUSHING (SPL: 2)
+  EXPECT_EQ(p.teams[0].players[2].secs_till_unpenalised, 45);
+  EXPECT_EQ(p.teams[0].players[2].warnings, 1);
+  EXPECT_EQ(p.teams[0].players[2].cautions, 1);
+  EXPECT_EQ(p.teams[1].number, 5);
+  EXPECT_EQ(p.teams[1].message_budget, 0x0102);
+  EXPECT_EQ(p.teams[1].players[19].penalty, 11);  // SUBSTITUTE (SPL: 14)
+  // Decoded back into the SPL's codes.
+  const ControlData back = decodeAnyControl(bytes);
+  EXPECT_EQ(back.set_play, d.set_play);
+  EXPECT_EQ(back.teams[0].players[2], d.teams[0].players[2]);
+  EXPECT_EQ(back.teams[1].players[19], d.teams[1].players[19]);
+  EXPECT_EQ(back.stopped, 1);
+  // Standby does not exist in v19: a robot sees Initial.
+  d.state = static_cast<uint8_t>(gc::State::Standby);
+  EXPECT_EQ(simsoccer::test::readGcPacket(encodeHsl(d)).state, 0);
+  // A v18 packet is still told apart.
+  int version = 0;
+  decodeAnyControl(encode(knownState()), &version);
+  EXPECT_EQ(version, 18);
+  EXPECT_THROW(decodeAnyControl(std::span<const uint8_t>(bytes.data(), 118)), PacketError);
+}
+
+// The link sends the rule book's version, with the message budget going down
+// as the team sends messages.
+TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
+  for (const char* book : {"spl.yaml", "hsl_small_foundation.yaml"}) {
+    const RuleBook rules = loadRuleBook(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs" /
+                                        "rules" / book);
+    Game game(rules, {TeamSetup{7, 0, 2, 1}, TeamSetup{9, 1, 3, 1}}, 0);
+    UdpReceiver robot(0, "127.0.0.1");
+    GameControllerLinkConfig c;
+    c.address = "127.0.0.1";
+    c.control_port = robot.port();
+    c.return_port = 0;
+    GameControllerLink link(c);
+    std::array<uint8_t, 512> buf{};
+    std::vector<int> budgets;
+    for (uint64_t sent : {0, 10, 25}) {
+      game.setTeamMessagesSent(0, sent);
+      link.update(game);
+      game.advance(0.5);
+      const size_t n = robot.receive(buf, 1.0);
+      ASSERT_GT(n, 0u) << book;
+      const auto p = simsoccer::test::readGcPacket(std::span<const uint8_t>(buf.data(), n));
+      EXPECT_EQ(p.version, rules.gc_version) << book;
+      EXPECT_EQ(p.teams[0].number, 7);
+      budgets.push_back(p.teams[0].message_budget);
+      EXPECT_EQ(p.teams[1].message_budget, rules.message_budget);
+    }
+    EXPECT_EQ(budgets, (std::vector<int>{rules.message_budget, rules.message_budget - 10,
+                                         rules.message_budget - 25}))
+        << book;
+  }
 }

@@ -12,12 +12,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "gc_reader.hpp"
 #include "test_support.hpp"
 
 extern char** environ;
@@ -564,6 +566,9 @@ TEST(NetGameState, RefereePacketReachesAgents) {
 
 // The real program with the referee: its decisions reach agents on the
 // GameState topic and robot code as GameController packets over UDP.
+// The game over UDP as GameController3 sends it, read by the tests' own
+// reader (gc_reader.hpp): every state the operator passes through, four
+// different team colours, the message budget.
 TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
   const uint32_t domain = 112;
   referee::UdpReceiver robot(0, "127.0.0.1");
@@ -573,7 +578,7 @@ TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
   std::atomic<bool> done{false};
   std::thread serve([&] {
     out = runCommand(std::string(SIMSOCCER_BIN) + " serve " + SIMSOCCER_SOURCE_DIR +
-                         "/configs/scenarios/lineup_5v5.yaml --agents 0 --seconds 8 --domain " +
+                         "/configs/scenarios/lineup_5v5.yaml --agents 0 --seconds 10 --domain " +
                          std::to_string(domain) + " --rules " + SIMSOCCER_SOURCE_DIR +
                          "/configs/rules/spl.yaml --teams 13,5 --gc-address 127.0.0.1 --gc-port " +
                          std::to_string(robot.port()) + " --gc-return-port 0",
@@ -581,12 +586,12 @@ TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
     done = true;
   });
   std::array<uint8_t, 512> buf{};
-  std::vector<referee::ControlData> packets;
+  std::vector<test::GcPacket> packets;
   uint8_t dds_state = 0;
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < until) {
     const size_t n = robot.receive(buf, 0.5);
-    if (n > 0) packets.push_back(referee::decodeControl(std::span<const uint8_t>(buf.data(), n)));
+    if (n > 0) packets.push_back(test::readGcPacket(std::span<const uint8_t>(buf.data(), n)));
     simsoccer_msg_GameState m{};
     if (agent.gameState(m) && m.state == 3) dds_state = 3;
     if (n == 0 && done) break;  // serve is done and nothing is left
@@ -595,13 +600,25 @@ TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
   std::printf("%s", out.c_str());
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("game: PLAYING"), std::string::npos) << out;
-  // 8 simulated s at 2 Hz: 16 packets, numbered in order, Ready -> Set -> Playing.
-  ASSERT_GE(packets.size(), 15u);
-  for (size_t i = 0; i < packets.size(); ++i) EXPECT_EQ(packets[i].packet_number, i);
-  EXPECT_EQ(packets.front().state, static_cast<uint8_t>(referee::gc::State::Ready));
-  EXPECT_EQ(packets.back().state, static_cast<uint8_t>(referee::gc::State::Playing));
-  EXPECT_EQ(packets.back().teams[0].team_number, 13);
-  EXPECT_EQ(packets.back().kicking_team, 13);
+  // 10 simulated s at 2 Hz: 20 packets, numbered in order, Initial (1 s) ->
+  // Standby (1 s) -> Ready -> Set -> Playing.
+  ASSERT_GE(packets.size(), 19u);
+  std::vector<int> states;
+  for (size_t i = 0; i < packets.size(); ++i) {
+    EXPECT_EQ(packets[i].version, 18);
+    EXPECT_EQ(packets[i].packet_number, static_cast<int>(i));
+    if (states.empty() || states.back() != packets[i].state) states.push_back(packets[i].state);
+  }
+  EXPECT_EQ(states, (std::vector<int>{0, 5, 1, 2, 3}));  // INITIAL STANDBY READY SET PLAYING
+  const test::GcPacket& last = packets.back();
+  EXPECT_EQ(last.teams[0].number, 13);
+  EXPECT_EQ(last.kicking_team, 13);
+  EXPECT_EQ(last.competition_phase, 0);  // round robin
+  // GameController3 refuses a colour clash: four different colours.
+  const std::set<int> colours = {last.teams[0].field_player_colour, last.teams[0].goalkeeper_colour,
+                                 last.teams[1].field_player_colour, last.teams[1].goalkeeper_colour};
+  EXPECT_EQ(colours.size(), 4u);
+  EXPECT_EQ(last.teams[0].message_budget, 1200);  // no agents, no messages
   EXPECT_EQ(dds_state, 3);  // the agent saw Playing on the GameState topic
 }
 

@@ -278,32 +278,55 @@ TEST(Simulation, GameOfficialsStartTheGameAndTheirEventsAreReadAfterTheStep) {
       referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
   const sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(1, 2);
   sim::GameOfficials officials(w, rules, oc);
-  // The operator started the first half at once.
-  EXPECT_EQ(officials.game().state(), referee::gc::State::Ready);
+  // The operator starts the first half after his pauses: Initial for 1 s,
+  // Standby for 1 s (long enough for two 2 Hz GameController packets each), Ready.
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Initial);
   sim::Simulation simulation(w);
   simulation.setOfficials(&officials);
   ASSERT_TRUE(simulation.game().has_value());
-  EXPECT_EQ(simulation.game()->state, static_cast<uint8_t>(referee::gc::State::Ready));
+  EXPECT_EQ(simulation.game()->state, static_cast<uint8_t>(referee::gc::State::Initial));
   EXPECT_FALSE(officials.over());
-  // Its events are read after the step, typed: the first period reports the
-  // state changes of the start (Standby, then Ready).
+  // Its events are read after the step, typed.
   struct EventRecorder : sim::Recorder {
-    std::vector<sim::Event> events;
+    std::vector<std::pair<double, sim::Event>> events;  // with the world time of the period
     void record(const sim::PeriodRecord& p) override {
-      events.insert(events.end(), p.events->begin(), p.events->end());
+      for (const sim::Event& e : *p.events) events.emplace_back(p.world->time(), e);
     }
   } recorder;
   simulation.addRecorder(recorder);
-  simulation.period();
+  for (int i = 0; i < 250; ++i) simulation.period();  // 2.5 s
   ASSERT_GE(recorder.events.size(), 2u);
-  EXPECT_EQ(recorder.events[0].type, sim::EventType::State);
-  EXPECT_NE(recorder.events[0].detail.find("STANDBY"), std::string::npos) << recorder.events[0].detail;
-  EXPECT_NE(recorder.events[1].detail.find("READY"), std::string::npos) << recorder.events[1].detail;
-  simulation.period();
+  EXPECT_EQ(recorder.events[0].second.type, sim::EventType::State);
+  EXPECT_NE(recorder.events[0].second.detail.find("STANDBY"), std::string::npos)
+      << recorder.events[0].second.detail;
+  EXPECT_NEAR(recorder.events[0].first, 1.0, 0.011);
+  EXPECT_NE(recorder.events[1].second.detail.find("READY"), std::string::npos)
+      << recorder.events[1].second.detail;
+  EXPECT_NEAR(recorder.events[1].first, 2.0, 0.011);
+  EXPECT_EQ(simulation.game()->state, static_cast<uint8_t>(referee::gc::State::Ready));
   // Each event once: the start is not reported again.
   EXPECT_EQ(std::count_if(recorder.events.begin(), recorder.events.end(),
-                          [](const sim::Event& e) {
-                            return e.detail.find("STANDBY") != std::string::npos;
+                          [](const auto& e) {
+                            return e.second.detail.find("STANDBY") != std::string::npos;
                           }),
             1);
+}
+
+// The HSL's GameController has no Standby: the operator goes from Initial to Ready.
+TEST(Simulation, UnderHslRulesTheOperatorSkipsStandby) {
+  world::World w(test::scenario(2));
+  const referee::RuleBook rules = referee::loadRuleBook(test::sourceDir() / "configs" / "rules" /
+                                                        "hsl_small_foundation.yaml");
+  sim::GameOfficials officials(w, rules, sim::OfficialsConfig::forTeams(1, 2));
+  sim::Simulation simulation(w);
+  simulation.setOfficials(&officials);
+  std::vector<referee::gc::State> states = {officials.game().state()};
+  for (int i = 0; i < 150; ++i) {
+    simulation.period();
+    if (officials.game().state() != states.back()) states.push_back(officials.game().state());
+  }
+  EXPECT_EQ(states, (std::vector<referee::gc::State>{referee::gc::State::Initial,
+                                                     referee::gc::State::Ready}));
+  EXPECT_EQ(simulation.game()->competition_type, 0);  // SMALL
+  EXPECT_EQ(officials.game().messageBudget(0), 12000);
 }

@@ -53,9 +53,11 @@ bool readBools(const msgpack::object& o, std::array<bool, 2>& out) {
 
 // Merges one map into `values` if every known key in it is well formed
 // (a map is taken whole or not at all). Unknown keys are counted.
-bool merge(const msgpack::object& map, ActuatorValues& values, uint64_t& unknown_keys) {
+bool merge(const msgpack::object& map, ActuatorValues& values, uint64_t& unknown_keys,
+           bool& joints) {
   ActuatorValues next = values;
   uint64_t unknown = 0;
+  joints = false;
   for (uint32_t i = 0; i < map.via.map.size; ++i) {
     const msgpack::object& k = map.via.map.ptr[i].key;
     const msgpack::object& v = map.via.map.ptr[i].val;
@@ -67,8 +69,8 @@ bool merge(const msgpack::object& map, ActuatorValues& values, uint64_t& unknown
     else
       return false;
     bool ok = true;
-    if (key == "Position") ok = readFloats(v, next.position);
-    else if (key == "Stiffness") ok = readFloats(v, next.stiffness);
+    if (key == "Position") ok = readFloats(v, next.position), joints = true;
+    else if (key == "Stiffness") ok = readFloats(v, next.stiffness), joints = true;
     else if (key == "Chest") ok = readFloats(v, next.chest);
     else if (key == "LFoot") ok = readFloats(v, next.lfoot);
     else if (key == "RFoot") ok = readFloats(v, next.rfoot);
@@ -129,8 +131,10 @@ std::size_t ActuatorStream::feed(std::span<const uint8_t> bytes) {
         const msgpack::object& o = handle.get();
         if (o.type != msgpack::type::MAP)
           throw StreamError("lola: an actuator message is not a map");
-        if (merge(o, values_, counts_.unknown_keys)) {
+        bool joints = false;
+        if (merge(o, values_, counts_.unknown_keys, joints)) {
           ++counts_.maps;
+          counts_.joint_maps += joints;
           ++maps;
         } else {
           ++counts_.bad_maps;

@@ -24,7 +24,7 @@ struct Endpoint::Client {
   bool has_latest = false;
   bool latest_sent = false;      // this period's map went out (or was dropped)
   BatteryModel battery;
-  uint64_t maps_seen = 0;        // stream maps counted when the period's map went out
+  uint64_t maps_seen = 0;        // the stream's joint maps when the period's map went out
   int missed_in_row = 0;
   std::array<float, kJoints> accepted_position{}, accepted_stiffness{};
   RobotLolaStats stats;
@@ -191,7 +191,7 @@ void Endpoint::send(Client& c) {
   c.unsent.assign(c.latest.begin(), c.latest.end());
   flush(c);
   ++c.stats.packets_sent;
-  c.maps_seen = c.stream.counts().maps;
+  c.maps_seen = c.stream.counts().joint_maps;
 }
 
 bool Endpoint::receive(Client& c) {
@@ -263,7 +263,12 @@ void Endpoint::observe(const sim::Observation& o) {
 }
 
 void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
-  const auto answered = [](const Client& c) { return c.stream.counts().maps > c.maps_seen; };
+  // An answer sets joints: maps of LEDs or sonars alone (rUNSWift sends its
+  // sonar map after its joint map) merge in but do not answer a cycle, so a
+  // late one cannot stand in for the next cycle's joints.
+  const auto answered = [](const Client& c) {
+    return c.stream.counts().joint_maps > c.maps_seen;
+  };
   const auto awaited = [&](const Client& c) {
     return c.fd >= 0 && c.missed_in_row < config_.unresponsive_after && !answered(c);
   };
@@ -293,7 +298,7 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
     }
     ++c.stats.answered;
     c.missed_in_row = 0;
-    c.maps_seen = c.stream.counts().maps;
+    c.maps_seen = c.stream.counts().joint_maps;
     const ActuatorValues& v = c.stream.values();
     auto command = gate.check(c.config.robot, std::span<const float>(v.position),
                               std::span<const float>(v.stiffness));

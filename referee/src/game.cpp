@@ -16,7 +16,8 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
                   "half_time_to_initial", "clock_in_ready_and_set", "ready_duration",
                   "ready_penalty_kick_duration", "kick_off_ball_free", "set_play_duration",
                   "penalty_kick_duration", "mercy_goal_difference", "game_stuck_duration",
-                  "goal_area_max_robots", "indirect_kick", "timeouts", "penalties", "shootout"});
+                  "goal_area_max_robots", "indirect_kick", "timeouts", "penalties", "shootout",
+                  "message_budget", "gamecontroller"});
   RuleBook r;
   r.name = root["rules"].string();
   r.indirect_kick = root["indirect_kick"].boolean();
@@ -63,6 +64,24 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   r.sudden_death = s["sudden_death"].boolean();
   r.sudden_death_rounds = s["sudden_death_rounds"].integer();
   if (r.sudden_death_rounds < 1) s.failKey("sudden_death_rounds", "must be >= 1");
+  if (auto g = root.optional("gamecontroller")) {
+    g->allowOnly({"version", "competition_type"});
+    r.gc_version = g->integer("version", 18);
+    if (r.gc_version != 18 && r.gc_version != 19)
+      g->failKey("version", "must be 18 (SPL, GameController3) or 19 (HSL)");
+    r.standby = r.gc_version == 18;
+    if (g->has("competition_type")) {
+      const std::string t = (*g)["competition_type"].string();
+      if (r.gc_version != 19) g->failKey("competition_type", "goes with version 19 (HSL)");
+      if (t == "small") r.competition_type = 0;
+      else if (t == "middle") r.competition_type = 1;
+      else if (t == "large") r.competition_type = 2;
+      else g->failKey("competition_type", "must be small, middle or large");
+    }
+  }
+  r.message_budget = root.integer("message_budget", r.message_budget);
+  if (r.message_budget < 0 || r.message_budget > 65535)
+    root.failKey("message_budget", "must be 0..65535 (a u16 in the packet)");
   return r;
 }
 
@@ -433,6 +452,7 @@ void Game::decideShootout() {
 
 void Game::standby() {
   if (phase_ == gc::GamePhase::PenaltyShoot) throw std::logic_error("no Standby in the shoot-out");
+  if (!rules_.standby) throw std::logic_error("this league's GameController has no Standby");
   if (state_ != gc::State::Initial && phase_ != gc::GamePhase::Timeout)
     throw std::logic_error("Standby comes from Initial or a timeout");
   phase_ = gc::GamePhase::Normal;
@@ -621,9 +641,24 @@ void Game::substitute(int team, int out, int in) {
   log(EventType::Substitute, team, in, "for player " + std::to_string(out));
 }
 
+void Game::setTeamMessagesSent(int team, uint64_t total) {
+  messages_sent_.at(static_cast<size_t>(team)) = total;
+}
+
+int Game::messageBudget(int team) const {
+  const uint64_t sent = messages_sent_.at(static_cast<size_t>(team));
+  const auto budget = static_cast<uint64_t>(rules_.message_budget);
+  return static_cast<int>(sent >= budget ? 0 : budget - sent);
+}
+
 ControlData Game::packet(uint8_t packet_number) const {
   ControlData d;
   d.packet_number = packet_number;
+  // A play-off ("long") game stops the clock in Ready and Set.
+  d.competition_phase = rules_.clock_in_ready_and_set ? 0 : 1;
+  d.competition_type = rules_.competition_type;
+  // The simulator's referee places the ball at once: play is never stopped.
+  d.stopped = 0;
   d.players_per_team = static_cast<uint8_t>(rules_.players_per_team);
   d.game_phase = static_cast<uint8_t>(phase_);
   d.state = static_cast<uint8_t>(state_);
@@ -658,7 +693,7 @@ ControlData Game::packet(uint8_t packet_number) const {
         if (player(t, n).penalty == gc::Penalty::Substitute) gk = static_cast<uint8_t>(n);
       if (striker_ > 0) info.goalkeeper = gk;
     }
-    info.message_budget = 1200;
+    info.message_budget = static_cast<uint16_t>(messageBudget(t));
     for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n) {
       const Player& p = player(t, n);
       info.players[static_cast<size_t>(n - 1)] = {

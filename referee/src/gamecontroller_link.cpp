@@ -1,5 +1,6 @@
 #include "simsoccer/referee/gamecontroller_link.hpp"
 
+#include <algorithm>
 #include <array>
 
 namespace simsoccer::referee {
@@ -19,8 +20,11 @@ uint16_t GameControllerLink::returnPort() const {
 void GameControllerLink::update(const Game& game) {
   if (sent_ == 0 || game.time() >= next_send_ - 1e-9) {
     // The packet number is a u8 that wraps at 256, as the GameController's.
-    sender_->send(encode(game.packet(static_cast<uint8_t>(sent_))));
-    next_send_ = (sent_ == 0 ? game.time() : next_send_) + config_.period;
+    const ControlData d = game.packet(static_cast<uint8_t>(sent_));
+    sender_->send(encodeControl(d, game.rules().gc_version));
+    // The HSL GameController sends at 5 Hz while play is stopped.
+    const double period = d.stopped ? std::min(config_.period, 0.2) : config_.period;
+    next_send_ = (sent_ == 0 ? game.time() : next_send_) + period;
     ++sent_;
   }
   receiveReturns(game);

@@ -6,7 +6,13 @@ OfficialsConfig OfficialsConfig::forTeams(uint8_t team0, uint8_t team1) {
   OfficialsConfig c;
   c.teams[0].number = team0;
   c.teams[1].number = team1;
-  for (size_t t = 0; t < 2; ++t) c.teams[t].field_player_colour = static_cast<uint8_t>(t);
+  // Four different colours (a GameController refuses a clash): team 0 blue
+  // with a yellow goalkeeper, team 1 red with a black one.
+  using protocol::gc::Colour;
+  c.teams[0].field_player_colour = static_cast<uint8_t>(Colour::Blue);
+  c.teams[0].goalkeeper_colour = static_cast<uint8_t>(Colour::Yellow);
+  c.teams[1].field_player_colour = static_cast<uint8_t>(Colour::Red);
+  c.teams[1].goalkeeper_colour = static_cast<uint8_t>(Colour::Black);
   return c;
 }
 
@@ -22,10 +28,28 @@ GameOfficials::GameOfficials(world::World& world, const referee::RuleBook& rules
 void GameOfficials::operatorPart() {
   referee::Game& g = referee_->game();
   using referee::gc::State;
-  // Each half starts as soon as it can (Standby, then Ready).
+  // Each half starts after the operator's pauses: Initial, Standby (not in
+  // the HSL, whose GameController has none), then Ready.
+  const auto waited = [&](std::optional<double>& since, double seconds) {
+    if (!since) since = g.time();
+    if (g.time() - *since < seconds - 1e-9) return false;
+    since.reset();
+    return true;
+  };
   if (g.state() == State::Initial && g.phase() == referee::gc::GamePhase::Normal && !g.gameOver()) {
-    g.standby();
-    g.ready();
+    if (waited(initial_since_, config_.initial_seconds)) {
+      if (g.rules().standby)
+        g.standby();
+      else
+        g.ready();
+    }
+  } else {
+    initial_since_.reset();
+  }
+  if (g.state() == State::Standby && g.phase() == referee::gc::GamePhase::Normal) {
+    if (waited(standby_since_, config_.standby_seconds)) g.ready();
+  } else {
+    standby_since_.reset();
   }
   // A drawn game goes to the shoot-out when the rule book calls for it.
   if (g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&

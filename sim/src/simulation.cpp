@@ -153,6 +153,11 @@ void Simulation::period() {
   for (CommandSource* s : sources_) s->afterStep(world_);
   events_.clear();
   if (officials_) {
+    for (int team = 0; team < 2; ++team) {
+      uint64_t sent = 0;
+      for (const CommandSource* s : sources_) sent += s->teamMessagesSent(team);
+      officials_->teamMessages(team, sent);
+    }
     officials_->afterStep(events_);
     game_ = officials_->controlData();
   }

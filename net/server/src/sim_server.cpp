@@ -329,13 +329,7 @@ void SimServer::setGameState(const simsoccer_msg_GameState& state) {
   impl_->game_state_published_at = world_.time();
 }
 
-void SimServer::publishGameState(referee::ControlData data, int left_team) {
-  for (int side = 0; side < 2; ++side) {
-    const int team = side == 0 ? left_team : 1 - left_team;
-    auto& budget = data.teams[static_cast<size_t>(side)].message_budget;
-    budget = static_cast<uint16_t>(std::max<int64_t>(
-        0, static_cast<int64_t>(budget) - static_cast<int64_t>(teamMessagesRelayed(team))));
-  }
+void SimServer::publishGameState(referee::ControlData data, int /*left_team*/) {
   if (published_game_ && data == *published_game_) return;  // SimServer repeats it at 2 Hz
   simsoccer_msg_GameState m{};
   toMessage(data, world_.controlTick(), m);

@@ -32,6 +32,7 @@ struct ActuatorValues {
 
 struct StreamCounts {
   uint64_t maps = 0;          // complete maps taken
+  uint64_t joint_maps = 0;    // of them, maps that set Position or Stiffness (an answer to a cycle)
   uint64_t bad_maps = 0;      // maps refused whole: a known key with a wrong type or length
   uint64_t unknown_keys = 0;  // ignored keys
   uint64_t bytes = 0;

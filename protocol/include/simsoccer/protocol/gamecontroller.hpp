@@ -19,6 +19,18 @@ constexpr uint8_t kReturnVersion = 4;
 constexpr size_t kMaxPlayers = protocol::kMaxPlayers;
 constexpr uint8_t kKickingTeamNone = 255;
 
+enum class Colour : uint8_t {
+  Blue = 0,
+  Red = 1,
+  Yellow = 2,
+  Black = 3,
+  White = 4,
+  Green = 5,
+  Orange = 6,
+  Purple = 7,
+  Brown = 8,
+  Gray = 9
+};
 enum class GamePhase : uint8_t { Normal = 0, PenaltyShoot = 1, Overtime = 2, Timeout = 3 };
 enum class State : uint8_t {
   Initial = 0,

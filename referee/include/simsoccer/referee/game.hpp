@@ -42,6 +42,12 @@ struct RuleBook {
   double shootout_shot_duration = 30;
   bool sudden_death = true;
   int sudden_death_rounds = 3;  // then a coin decides
+  int message_budget = 1200;    // team messages per team per game (GameController: messagesPerTeam)
+  // The GameController whose packets the game goes out as: 18 (SPL,
+  // GameController3) or 19 (HSL); the HSL has no Standby state.
+  int gc_version = 18;
+  bool standby = true;
+  uint8_t competition_type = 0;  // v19: 0 SMALL, 1 MIDDLE, 2 LARGE (v18: 0 NORMAL)
 };
 
 // Reads and checks a rule book; throws engine::ConfigError (file, key, reason).
@@ -122,6 +128,10 @@ class Game {
   void timeout(std::optional<int> team);  // a team timeout, or a referee timeout (nullopt)
   void dropBall();  // restart without a kicking team (after a global game stuck)
   void substitute(int team, int player_out, int player_in);
+  // The team messages `team` has sent so far (the GameController counts them
+  // on the team port): its packets' message budget is what is left.
+  void setTeamMessagesSent(int team, uint64_t total);
+  int messageBudget(int team) const;
 
   // --- penalty shoot-out (spl-rules.md section 6) ---------------------------------------
   // Starts the shoot-out: after a drawn game, or from Initial before any
@@ -204,6 +214,7 @@ class Game {
   std::array<int, 2> score_{};
   std::array<int, 2> incremental_{};  // incremental penalties so far, per team
   std::array<int, 2> timeouts_left_{1, 1};
+  std::array<uint64_t, 2> messages_sent_{};
   double half_clock_ = 0.0, secondary_ = 0.0, time_ = 0.0;
   // Shoot-out.
   int first_shooter_ = 0, shootout_kicks_ = 3, striker_ = 0, keeper_ = 0;

@@ -11,6 +11,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "simsoccer/protocol/gamecontroller.hpp"
 
@@ -23,6 +24,7 @@ namespace gc = protocol::gc;
 struct RobotInfo {
   uint8_t penalty = 0;                // gc::Penalty
   uint8_t secs_till_unpenalised = 0;  // rounded up, clamped to 0..255
+  uint8_t warnings = 0, cautions = 0;  // v19 (HSL) only
   bool operator==(const RobotInfo&) const = default;
 };
 
@@ -39,14 +41,17 @@ struct TeamInfo {
   bool operator==(const TeamInfo&) const = default;
 };
 
-// RoboCupGameControlData v18.
+// RoboCupGameControlData, in the SPL's v18 codes (the simulator's and the
+// agents' vocabulary, also when the game runs under HSL rules: the v19
+// functions below map the codes on the wire).
 struct ControlData {
   bool true_data = false;  // "RGTD" (to monitors) instead of "RGme"
   uint8_t packet_number = 0;
   uint8_t players_per_team = 5;
   uint8_t competition_phase = 0;
-  uint8_t competition_type = 0;
-  uint8_t game_phase = 0;  // gc::GamePhase
+  uint8_t competition_type = 0;  // v18: 0 NORMAL, 1 MOST_PASSES; v19: 0 SMALL, 1 MIDDLE, 2 LARGE
+  uint8_t stopped = 0;           // v19 only: play is stopped
+  uint8_t game_phase = 0;        // gc::GamePhase
   uint8_t state = 0;       // gc::State
   uint8_t set_play = 0;    // gc::SetPlay
   uint8_t first_half = 1;
@@ -85,6 +90,29 @@ class PacketError : public std::runtime_error {
 
 std::array<uint8_t, kControlSize> encode(const ControlData& data);
 ControlData decodeControl(std::span<const uint8_t> bytes);  // throws PacketError
+
+// The HSL GameController's RoboCupGameControlData v19 (2026-; 198 bytes):
+// byte 7 competitionType (SMALL/MIDDLE/LARGE), byte 8 `stopped`, no
+// competitionPhase, no Standby, RobotInfo of 4 bytes (penalty,
+// secsTillUnpenalised, warnings, cautions), the HSL's set-play and penalty
+// codes (mapped from and to the SPL's here; docs/referee.md).
+namespace hsl {
+constexpr uint8_t kControlVersion = 19;
+constexpr size_t kRobotInfoSize = 4;
+constexpr size_t kTeamInfoSize = 6 + 2 + 2 + gc::kMaxPlayers * kRobotInfoSize;
+constexpr size_t kControlSize = kControlHeaderSize + 2 * kTeamInfoSize;
+static_assert(kTeamInfoSize == 90 && kControlSize == 198, "RoboCupGameControlData v19 is 198 bytes");
+uint8_t setPlayFromSpl(uint8_t spl);
+uint8_t setPlayToSpl(uint8_t hsl);
+uint8_t penaltyFromSpl(uint8_t spl);
+uint8_t penaltyToSpl(uint8_t hsl);
+}  // namespace hsl
+std::array<uint8_t, hsl::kControlSize> encodeHsl(const ControlData& data);
+ControlData decodeHsl(std::span<const uint8_t> bytes);  // throws PacketError
+// The packet as the given GameController version sends it (18 or 19).
+std::vector<uint8_t> encodeControl(const ControlData& data, int version);
+// A v18 or v19 packet, told apart by its version byte (and checked for its size).
+ControlData decodeAnyControl(std::span<const uint8_t> bytes, int* version = nullptr);
 std::array<uint8_t, kReturnSize> encode(const ReturnData& data);
 ReturnData decodeReturn(std::span<const uint8_t> bytes);  // throws PacketError (GC3's checks)
 

@@ -1,5 +1,7 @@
 // The simulator as a GameController on the network: the referee's game
-// state broadcast as RoboCupGameControlData every 0.5 s to port 3838, and
+// state broadcast as RoboCupGameControlData (the rule book's version: 18,
+// GameController3; 19, the HSL's) every 0.5 s of simulated time to port
+// 3838 (0.2 s while play is stopped, as the HSL's), and
 // RoboCupGameControlReturnData received on port 3939, so robot software
 // written against the real GameController runs against the simulator.
 #pragma once

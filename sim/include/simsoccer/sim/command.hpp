@@ -102,6 +102,9 @@ class CommandSource {
   virtual void collect(uint64_t tick, CommandGate& gate, std::span<CommandSlot> slots) = 0;
   // After the step (commands applied, world stepped): per-period bookkeeping.
   virtual void afterStep(const world::World&) {}
+  // Team messages the robots this source drives have sent for team index
+  // `team` so far (the officials count them against the message budget).
+  virtual uint64_t teamMessagesSent(int /*team*/) const { return 0; }
 };
 
 }  // namespace simsoccer::sim

@@ -23,6 +23,10 @@ struct OfficialsConfig {
   // A penalty-kick trial: one shoot-out kick from the start, team 0 kicking.
   bool penalty_kick_trial = false;
   uint64_t seed = 1;  // the shoot-out's coin toss
+  // The operator's pauses before each half: Initial, then Standby (in
+  // leagues that have it), then Ready; long enough for robots to see each
+  // state in the 2 Hz GameController packets.
+  double initial_seconds = 1.0, standby_seconds = 1.0;
 };
 
 class GameOfficials : public Officials {
@@ -32,6 +36,9 @@ class GameOfficials : public Officials {
   void afterStep(std::vector<Event>& events) override;
   referee::ControlData controlData() const override { return referee_->game().packet(0); }
   int leftTeam() const override { return referee_->game().leftTeam(); }
+  void teamMessages(int team, uint64_t total) override {
+    referee_->game().setTeamMessagesSent(team, total);
+  }
 
   referee::Referee& referee() { return *referee_; }
   const referee::Game& game() const { return referee_->game(); }
@@ -47,6 +54,7 @@ class GameOfficials : public Officials {
   std::unique_ptr<referee::Referee> referee_;
   size_t events_seen_ = 0;
   std::array<int, 2> next_striker_{0, 0};
+  std::optional<double> initial_since_, standby_since_;  // game time the state began
 };
 
 }  // namespace simsoccer::sim

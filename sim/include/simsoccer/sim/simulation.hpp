@@ -83,6 +83,8 @@ class Officials {
   virtual void afterStep(std::vector<Event>& events) = 0;
   virtual referee::ControlData controlData() const = 0;
   virtual int leftTeam() const = 0;  // the team index controlData().teams[0] describes
+  // Before afterStep: the team messages each team (index) has sent so far.
+  virtual void teamMessages(int /*team*/, uint64_t /*total*/) {}
 };
 
 // What a period did, for the recorders.

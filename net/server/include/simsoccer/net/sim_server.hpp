@@ -89,11 +89,12 @@ class SimServer : public sim::CommandSource {
   bool releaseRobot(world::RobotId r);
   // Team messages of `team` (index) relayed so far (each sent message once).
   uint64_t teamMessagesRelayed(int team) const { return team_messages_[team == 0 ? 0 : 1]; }
+  uint64_t teamMessagesSent(int team) const override { return teamMessagesRelayed(team); }
   // The GameState published at every change and every 0.5 s (2 Hz); none is
   // published until one is set (a simulator without a referee).
   void setGameState(const simsoccer_msg_GameState& state);
-  // The referee's state, published when it changed (and at 2 Hz), with each
-  // team's message budget less the team messages relayed for it so far.
+  // The referee's state, published when it changed (and at 2 Hz); the
+  // officials count the team messages relayed against the budget.
   // `left_team`: the team index that teams[0] describes (Game::leftTeam()).
   void publishGameState(referee::ControlData data, int left_team);
 
