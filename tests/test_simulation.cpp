@@ -330,3 +330,90 @@ TEST(Simulation, UnderHslRulesTheOperatorSkipsStandby) {
   EXPECT_EQ(simulation.game()->competition_type, 0);  // SMALL
   EXPECT_EQ(officials.game().messageBudget(0), 12000);
 }
+
+// An external GameController runs the game: packets sent from the test (as
+// GameController3 would broadcast them) and the simulated game follows its
+// states, scores and penalties; a penalised robot leaves the field and comes
+// back; the referee's own calls are only reported.
+TEST(Simulation, AnExternalGameControllerRunsTheGame) {
+  world::World w(test::scenario(4));
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(13, 5);
+  oc.external_gc_port = 0;  // any free port
+  sim::GameOfficials officials(w, rules, oc);
+  sim::Simulation simulation(w);
+  simulation.setOfficials(&officials);
+  ASSERT_NE(officials.externalGameController(), nullptr);
+  referee::UdpSender gc("127.0.0.1", officials.externalGameController()->port());
+
+  referee::ControlData d;  // as GameController3 fills it
+  d.players_per_team = 5;
+  d.secs_remaining = 600;
+  d.teams[0].team_number = 5;  // team 5 (index 1) defends the left goal: the sides follow
+  d.teams[1].team_number = 13;
+  for (referee::TeamInfo& t : d.teams)
+    for (size_t n = 5; n < t.players.size(); ++n)
+      t.players[n].penalty = static_cast<uint8_t>(referee::gc::Penalty::Substitute);
+  d.kicking_team = 13;
+  const auto send = [&](referee::gc::State state, int periods) {
+    d.state = static_cast<uint8_t>(state);
+    gc.send(referee::encode(d));
+    ++d.packet_number;
+    for (int i = 0; i < periods; ++i) simulation.period();
+  };
+  // Nothing happens on its own: no operator, no pauses.
+  for (int i = 0; i < 300; ++i) simulation.period();
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Initial);
+  send(referee::gc::State::Ready, 20);
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Ready);
+  EXPECT_EQ(officials.game().leftTeam(), 1);
+  EXPECT_EQ(officials.game().kickingTeam(), 0);
+  send(referee::gc::State::Set, 20);
+  send(referee::gc::State::Playing, 20);
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Playing);
+  // A goal for team 13 and a penalty for team 5's player 2.
+  d.teams[1].score = 1;
+  d.teams[0].players[1] = {static_cast<uint8_t>(referee::gc::Penalty::RequestForPickup), 45};
+  send(referee::gc::State::Playing, 20);
+  EXPECT_EQ(officials.game().score(0), 1);
+  EXPECT_EQ(officials.game().penalty(1, 2), referee::gc::Penalty::RequestForPickup);
+  const world::RobotId penalised = *officials.referee().robot(1, 2);
+  EXPECT_GT(std::abs(w.torsoPose(penalised).translation().y()), w.field().halfWidth())
+      << "a penalised robot leaves the field";
+  d.teams[0].players[1] = {};
+  send(referee::gc::State::Playing, 20);
+  EXPECT_EQ(officials.game().penalty(1, 2), referee::gc::Penalty::None);
+  EXPECT_NEAR(std::abs(w.torsoPose(penalised).translation().y()), w.field().halfWidth(), 0.1)
+      << "it comes back on the touchline";
+  // The ball goes out: the referee would award a kick-in, but only says so.
+  test::putBallOnCarpet(w, 1.0, w.field().halfWidth() + 0.3);
+  for (int i = 0; i < 20; ++i) simulation.period();
+  EXPECT_EQ(officials.game().currentSetPlay(), referee::gc::SetPlay::None);
+  const auto& all = officials.game().events();
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const referee::RefereeEvent& e) {
+    return e.type == referee::EventType::Advisory && e.detail.find("set_play") == 0;
+  })) << "no advisory kick-in";
+  // The game's events: the GameController's states and goal, typed.
+  const auto& events = officials.game().events();
+  EXPECT_EQ(std::count_if(events.begin(), events.end(),
+                          [](const referee::RefereeEvent& e) {
+                            return e.type == referee::EventType::Goal;
+                          }),
+            1);
+  // A packet for another game is not followed; a malformed one is counted.
+  referee::ControlData other = d;
+  other.teams[0].team_number = 99;
+  gc.send(referee::encode(other));
+  const std::array<uint8_t, 7> junk = {'R', 'G', 'm', 'e', 18, 0, 0};
+  gc.send(junk);
+  for (int i = 0; i < 20; ++i) simulation.period();
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Playing);
+  EXPECT_EQ(officials.externalGameController()->rejected(), 1u);
+  // Finished in the second half: over once the GameController has said nothing new for 30 s.
+  d.first_half = 0;
+  send(referee::gc::State::Finished, 100);
+  EXPECT_FALSE(officials.over());
+  for (int i = 0; i < 3000; ++i) simulation.period();
+  EXPECT_TRUE(officials.over());
+}

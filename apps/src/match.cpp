@@ -35,7 +35,7 @@ const char* kMatchHelp =
     "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
     "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
     "                       [--dds-config FILE] [--mode serial|pipelined] [--lola T:P,...]\n"
-    "                       [--quiet]\n"
+    "                       [--external-gc PORT] [--quiet]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -66,6 +66,8 @@ const char* kMatchHelp =
     "  --lola T:P,...      drive these robots (GameController team number:player) through\n"
     "                      LoLA sockets under DIR/lola/ instead of agents: a team's robot\n"
     "                      binary plays them (simsoccer lola-run); 12 ms control period\n"
+    "  --external-gc PORT  a real GameController runs the game (its packets on UDP PORT,\n"
+    "                      3838 on a field; 3939 stays free for it); real time\n"
     "  --no-video          skip the video\n"
     "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
 
@@ -128,7 +130,7 @@ int match(int argc, char** argv, int first) {
   const Options opt(
       argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
       {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
-       "lola"});
+       "lola", "external-gc"});
   char help[4096];
   std::snprintf(help, sizeof help, kMatchHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -147,8 +149,10 @@ int match(int argc, char** argv, int first) {
     config.command_timeout = t;
   }
   addLolaRobots(opt, config);
+  if (opt.has("external-gc"))
+    config.external_gc_port = static_cast<uint16_t>(opt.wholeNumber("external-gc", 3838, 1, 65535));
   RunOptions o = runOptions(opt, config);
-  o.realtime = opt.flag("realtime");
+  o.realtime = opt.flag("realtime") || config.external_gc_port.has_value();
   o.external = opt.flag("external-agents");
   o.video = config.video.enabled && !opt.flag("no-video");
   o.max_seconds = opt.number("max-seconds", 0);

@@ -21,7 +21,7 @@ const char* kHelp =
     "usage: simsoccer serve SCENARIO|MATCH [--domain D] [--dds-config FILE] [--seconds S]\n"
     "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
     "                       [--limp-on-release] [--mode serial|pipelined]\n"
-    "                       [--lola T:P,... [--out DIR]]\n"
+    "                       [--lola T:P,... [--out DIR]] [--external-gc PORT]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
     "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
@@ -47,7 +47,10 @@ const char* kHelp =
     "code written for the SPL GameController runs unchanged.\n"
     "\n"
     "--lola T:P,... (with a match config): these robots are driven through LoLA sockets under\n"
-    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run).\n";
+    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run).\n"
+    "--external-gc PORT (with a match config or --rules): a real GameController runs the game;\n"
+    "its packets arrive on UDP PORT (3838), the simulator follows them in real time and\n"
+    "leaves 3939 to it; the automatic referee's calls are only reported.\n";
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
@@ -83,14 +86,20 @@ int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
                      "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
-                     "out"});
+                     "out", "external-gc"});
   if (opt.help(kHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;
   cfg.dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
   cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
-  cfg.lockstep = !opt.flag("realtime");
+  std::optional<uint16_t> external_gc;
+  if (opt.has("external-gc")) {
+    external_gc = static_cast<uint16_t>(opt.wholeNumber("external-gc", 3838, 1, 65535));
+    if (opt.has("gc-address"))
+      throw UsageError("--external-gc: an external GameController sends the packets, not --gc-address");
+  }
+  cfg.lockstep = !opt.flag("realtime") && !external_gc;
   cfg.hold_on_release = !opt.flag("limp-on-release");
 
   // The world and its officials: a match's, or a scenario's with optional rules.
@@ -107,6 +116,7 @@ int serve(int argc, char** argv, int first) {
       mc.half_duration = h;
     }
     addLolaRobots(opt, mc);
+    mc.external_gc_port = external_gc;
     session = std::make_unique<match::MatchSession>(
         mc, static_cast<uint64_t>(opt.number("seed", static_cast<double>(mc.seed))));
     officials = &session->officials();
@@ -129,11 +139,14 @@ int serve(int argc, char** argv, int first) {
                                                                static_cast<uint8_t>(numbers[1]));
       oc.referee.auto_placement = opt.flag("auto-placement");
       oc.seed = scenario.seed;
+      oc.external_gc_port = external_gc;
       own_officials = std::make_unique<sim::GameOfficials>(*own_world, rules, oc);
       officials = own_officials.get();
     }
   }
   if (opt.has("timeout")) cfg.command_timeout = opt.number("timeout", 0.5);
+  if (external_gc && !officials)
+    throw UsageError("--external-gc needs --rules or a match config (the game it runs)");
   if (opt.has("gc-address") && !officials)
     throw UsageError("--gc-address needs --rules or a match config (the referee makes the packets)");
   world::World& w = session ? session->world() : *own_world;

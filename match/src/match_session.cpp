@@ -171,6 +171,7 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
   oc.referee.auto_placement = true;  // robots still walking at Set are placed, as a human referee would
   oc.penalty_kick_trial = config.penalty_kicks > 0;
   oc.seed = seed;
+  oc.external_gc_port = config.external_gc_port;
   officials_ = std::make_unique<sim::GameOfficials>(*world_, rules, oc);
   for (world::RobotId r = 0; r < world_->robotCount(); ++r) {
     RobotRecord rec;

@@ -174,6 +174,8 @@ const char* eventName(EventType t) {
       return "illegal_position";
     case EventType::Inactive:
       return "inactive";
+    case EventType::Advisory:
+      return "advisory";
   }
   return "?";
 }
@@ -639,6 +641,65 @@ void Game::substitute(int team, int out, int in) {
   TeamSetup& setup = teams_[static_cast<size_t>(team)];
   if (setup.goalkeeper == out) setup.goalkeeper = static_cast<uint8_t>(in);
   log(EventType::Substitute, team, in, "for player " + std::to_string(out));
+}
+
+void Game::follow(const ControlData& d) {
+  const auto index = [&](uint8_t number) {
+    for (int t = 0; t < 2; ++t)
+      if (teams_[static_cast<size_t>(t)].number == number) return t;
+    return -1;
+  };
+  const int left = index(d.teams[0].team_number);
+  if (left < 0 || index(d.teams[1].team_number) != 1 - left)
+    throw PacketError("GameController packet for teams " + std::to_string(d.teams[0].team_number) +
+                      " and " + std::to_string(d.teams[1].team_number) + ", this game has " +
+                      std::to_string(teams_[0].number) + " and " + std::to_string(teams_[1].number));
+  sides_swapped_ = left == 1;
+  const auto phase = static_cast<gc::GamePhase>(std::min<uint8_t>(d.game_phase, 3));
+  const auto state = static_cast<gc::State>(std::min<uint8_t>(d.state, 5));
+  const auto set_play = static_cast<gc::SetPlay>(std::min<uint8_t>(d.set_play, 5));
+  const Half half = phase == gc::GamePhase::PenaltyShoot
+                        ? Half::PenaltyShootout
+                        : (d.first_half ? Half::First : Half::Second);
+  if (half != half_) log(EventType::Half, -1, 0, "from the GameController");
+  half_ = half;
+  phase_ = phase;
+  const int kicking = d.kicking_team == gc::kKickingTeamNone ? -1 : index(d.kicking_team);
+  if (set_play != set_play_ && set_play != gc::SetPlay::None)
+    log(EventType::SetPlay, kicking, 0, std::string(setPlayName(set_play)) + " (GameController)");
+  set_play_ = set_play;
+  kicking_team_ = kicking;
+  if (state != state_) enter(state, "GameController");
+  half_clock_ = d.secs_remaining;
+  secondary_ = d.secondary_time;
+  for (int side = 0; side < 2; ++side) {
+    const TeamInfo& info = d.teams[static_cast<size_t>(side)];
+    const int t = side == 0 ? left : 1 - left;
+    for (int goal = score_[static_cast<size_t>(t)]; goal < info.score; ++goal)
+      log(EventType::Goal, t, 0, "GameController");
+    score_[static_cast<size_t>(t)] = info.score;
+    if (info.goalkeeper > 0) teams_[static_cast<size_t>(t)].goalkeeper = info.goalkeeper;
+    for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n) {
+      Player& p = player(t, n);
+      const RobotInfo& r = info.players[static_cast<size_t>(n - 1)];
+      const auto penalty = static_cast<gc::Penalty>(r.penalty);
+      if (penalty != p.penalty) {
+        if (penalty == gc::Penalty::None)
+          log(EventType::Unpenalise, t, n, "GameController");
+        else if (penalty != gc::Penalty::Substitute)
+          log(EventType::Penalty, t, n, "GameController: penalty " + std::to_string(r.penalty));
+      }
+      p.penalty = penalty;
+      p.remaining = r.secs_till_unpenalised;
+    }
+  }
+  // The game is over when the GameController finishes the second half (a
+  // shoot-out it starts later opens it again).
+  game_over_ = state_ == gc::State::Finished && phase_ == gc::GamePhase::Normal &&
+               half_ == Half::Second;
+  if (game_over_) {
+    if (score_[0] != score_[1]) winner_ = score_[0] > score_[1] ? 0 : 1;
+  }
 }
 
 void Game::setTeamMessagesSent(int team, uint64_t total) {

@@ -55,4 +55,22 @@ std::optional<ReturnData> GameControllerLink::lastReturn(uint8_t team_number,
   return it->second;
 }
 
+GameControllerListener::GameControllerListener(uint16_t port, const std::string& bind)
+    : receiver_(std::make_unique<UdpReceiver>(port, bind)) {}
+
+std::optional<ControlData> GameControllerListener::poll() {
+  std::optional<ControlData> latest;
+  std::array<uint8_t, 512> buffer{};
+  for (size_t n; (n = receiver_->receive(buffer, 0.0)) > 0;) {
+    try {
+      latest = decodeAnyControl(std::span<const uint8_t>(buffer.data(), n));
+      ++accepted_;
+    } catch (const PacketError& e) {
+      ++rejected_;
+      last_error_ = e.what();
+    }
+  }
+  return latest;
+}
+
 }  // namespace simsoccer::referee

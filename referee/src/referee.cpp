@@ -658,8 +658,42 @@ void Referee::enterState(gc::State s) {
   }
 }
 
+void Referee::follow(const ControlData& packet) {
+  game_.follow(packet);
+  following_ = true;
+}
+
 void Referee::update() {
   const double dt = world_.scenario().physics.control_period;
+  if (!following_) {
+    judge(dt);
+    removePenalised();
+    return;
+  }
+  // The external GameController's game is the truth; the automatic referee
+  // judges a copy of it, and its calls are reported only.
+  Game truth = game_;
+  truth.followTime(dt);
+  const size_t seen = game_.events().size();
+  judge(dt);
+  std::vector<RefereeEvent> calls(game_.events().begin() + static_cast<long>(seen),
+                                  game_.events().end());
+  game_ = std::move(truth);
+  // A call the referee keeps making (the GameController has not followed it)
+  // is reported when it is first made, not every period.
+  std::vector<std::string> made;
+  for (const RefereeEvent& e : calls) {
+    made.push_back(std::to_string(e.team) + " " + std::to_string(e.player) + " " +
+                   eventName(e.type) + (e.detail.empty() ? "" : ": " + e.detail));
+    if (std::find(advised_.begin(), advised_.end(), made.back()) == advised_.end())
+      game_.recordEvent(EventType::Advisory, e.team, e.player,
+                        std::string(eventName(e.type)) + (e.detail.empty() ? "" : ": " + e.detail));
+  }
+  advised_ = std::move(made);
+  removePenalised();
+}
+
+void Referee::judge(double dt) {
   game_.advance(dt);
   clock_ += dt;
   if (game_.currentSetPlay() != last_set_play_) {
@@ -714,7 +748,6 @@ void Referee::update() {
       if (game_.state() == gc::State::Playing) checkGameStuck();
     }
   }
-  removePenalised();
 }
 
 }  // namespace simsoccer::referee

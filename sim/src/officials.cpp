@@ -21,6 +21,10 @@ GameOfficials::GameOfficials(world::World& world, const referee::RuleBook& rules
     : world_(world), config_(config) {
   referee_ = std::make_unique<referee::Referee>(world, rules, config.teams, config.kick_off_team,
                                                 config.referee);
+  if (config.external_gc_port) {
+    listener_ = std::make_unique<referee::GameControllerListener>(*config.external_gc_port);
+    return;  // the external GameController's operator starts the game
+  }
   if (config.penalty_kick_trial) referee_->game().startShootout(0, 1, config.seed);
   operatorPart();
 }
@@ -74,14 +78,32 @@ void GameOfficials::operatorPart() {
 }
 
 void GameOfficials::afterStep(std::vector<Event>& events) {
-  referee_->update();
-  operatorPart();
+  if (listener_) {
+    if (const auto packet = listener_->poll()) {
+      const referee::ControlData before = referee_->game().packet(0);
+      try {
+        referee_->follow(*packet);
+      } catch (const referee::PacketError&) {
+        // Another game's GameController on the network: not ours to follow.
+      }
+      const referee::ControlData after = referee_->game().packet(0);
+      if (after.state != before.state || after.game_phase != before.game_phase ||
+          after.first_half != before.first_half)
+        last_change_ = referee_->game().time();
+    }
+    referee_->update();
+  } else {
+    referee_->update();
+    operatorPart();
+  }
   const auto& all = referee_->game().events();
   for (; events_seen_ < all.size(); ++events_seen_) events.push_back(all[events_seen_]);
 }
 
 bool GameOfficials::over() const {
   const referee::Game& g = referee_->game();
+  if (listener_)
+    return g.gameOver() && g.time() - last_change_ >= config_.external_end_wait - 1e-9;
   if (config_.penalty_kick_trial) return !g.shotOutcomes(0).empty() || g.gameOver();
   return g.gameOver() && !g.shootoutOpen() &&
          !(g.phase() == referee::gc::GamePhase::Normal && !g.winner() && g.rules().shootout);

@@ -60,6 +60,9 @@ struct MatchConfig {
   // With LoLA robots the control period is LoLA's 12 ms (and the physics
   // step 4 ms when the scenario's does not divide it).
   LolaSettings lola;
+  // An external GameController runs the game (its packets on this UDP port,
+  // normally 3838); the match then runs in real time.
+  std::optional<uint16_t> external_gc_port;
   std::string hash;       // of the config and scenario files' bytes
 };
 // Reads a match or penalty config; throws engine::ConfigError (file, key, reason).

@@ -82,10 +82,13 @@ enum class EventType : uint8_t {
   GoalDisallowed,   // the ball went in but the goal does not count
   IllegalPosition,  // a robot stood illegally at Set
   Inactive,         // a robot stood idle next to the ball
+  // An external GameController runs the game: what the automatic referee
+  // would have called (detail: the call), reported only.
+  Advisory,
 };
 // "state", "half", "game_over", "shootout", "shot", "shot_over", "goal",
 // "set_play", "penalty", "unpenalise", "timeout", "drop_ball", "substitute", "pushing",
-// "ball_contact", "placement", "goal_disallowed", "illegal_position", "inactive".
+// "ball_contact", "placement", "goal_disallowed", "illegal_position", "inactive", "advisory".
 const char* eventName(EventType t);
 
 struct RefereeEvent {
@@ -183,6 +186,15 @@ class Game {
 
   // The GameController packet for this state (teams[0]: the left team).
   ControlData packet(uint8_t packet_number) const;
+
+  // --- an external GameController runs the game ---------------------------------------
+  // Takes the state, set play, kicking team, clocks, scores, goalkeepers and
+  // penalties of an external GameController's packet, with an event for each
+  // change (goals, penalties, states). Throws PacketError when the packet's
+  // teams are not this game's.
+  void follow(const ControlData& packet);
+  // Simulated time passes between packets (the followed clocks stay as sent).
+  void followTime(double dt) { time_ += dt; }
 
  private:
   struct Player {

@@ -56,4 +56,25 @@ class GameControllerLink {
   std::map<std::pair<uint8_t, uint8_t>, ReturnData> returns_;  // ordered: deterministic iteration
 };
 
+// An external GameController's packets (v18 or v19) received on its port
+// (3838, shared with robot software on the same host: SO_REUSEADDR, and the
+// GameController broadcasts). The simulator then does not bind 3939, so a
+// GameController on the same host can. Malformed packets are counted and
+// dropped; never blocks.
+class GameControllerListener {
+ public:
+  explicit GameControllerListener(uint16_t port = 3838, const std::string& bind = "0.0.0.0");
+  uint16_t port() const { return receiver_->port(); }
+  // The newest valid packet received since the last call, if any.
+  std::optional<ControlData> poll();
+  uint64_t accepted() const { return accepted_; }
+  uint64_t rejected() const { return rejected_; }
+  const std::string& lastError() const { return last_error_; }
+
+ private:
+  std::unique_ptr<UdpReceiver> receiver_;
+  uint64_t accepted_ = 0, rejected_ = 0;
+  std::string last_error_;
+};
+
 }  // namespace simsoccer::referee

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "simsoccer/referee/game.hpp"
@@ -57,6 +58,12 @@ class Referee {
   const Game& game() const { return game_; }
   // Once per control period, after the world stepped.
   void update();
+  // From now on an external GameController runs the game: `packet` is its
+  // latest. The referee still removes penalised robots and brings them back
+  // and places the ball as the rules say, but its own calls change nothing:
+  // they are reported as Advisory events.
+  void follow(const ControlData& packet);
+  bool following() const { return following_; }
 
   // The world's robot for (team, player number), if there is one.
   std::optional<world::RobotId> robot(int team, int number) const;
@@ -95,6 +102,10 @@ class Referee {
   double depthInOwnGoalArea(world::RobotId r) const;     // distance to the area's open border (m)
   void placeBall(double x, double y);
   void removePenalised();
+  void judge(double dt);  // the automatic referee's rules, applied to game_
+
+  bool following_ = false;
+  std::vector<std::string> advised_;  // the calls reported in the last period (following)
 
   world::World& world_;
   RefereeConfig config_;

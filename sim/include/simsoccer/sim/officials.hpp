@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/referee/referee.hpp"
 #include "simsoccer/sim/simulation.hpp"
 
@@ -27,6 +28,13 @@ struct OfficialsConfig {
   // leagues that have it), then Ready; long enough for robots to see each
   // state in the 2 Hz GameController packets.
   double initial_seconds = 1.0, standby_seconds = 1.0;
+  // An external GameController runs the game: its packets are received on
+  // this UDP port (0: any free one, for tests), the operator does nothing,
+  // and the referee's own calls are reported only (referee::Referee::follow).
+  std::optional<uint16_t> external_gc_port;
+  // With an external GameController the game is over this many seconds
+  // after the GameController finished it (it may still start a shoot-out).
+  double external_end_wait = 30.0;
 };
 
 class GameOfficials : public Officials {
@@ -41,6 +49,8 @@ class GameOfficials : public Officials {
   }
 
   referee::Referee& referee() { return *referee_; }
+  // The external GameController's listener (null: the simulator runs the game).
+  const referee::GameControllerListener* externalGameController() const { return listener_.get(); }
   const referee::Game& game() const { return referee_->game(); }
   // The game (and any shoot-out it needs) is decided; a penalty-kick trial:
   // its kick is over.
@@ -55,6 +65,8 @@ class GameOfficials : public Officials {
   size_t events_seen_ = 0;
   std::array<int, 2> next_striker_{0, 0};
   std::optional<double> initial_since_, standby_since_;  // game time the state began
+  std::unique_ptr<referee::GameControllerListener> listener_;
+  double last_change_ = 0.0;  // game time of the external GameController's last new state
 };
 
 }  // namespace simsoccer::sim
