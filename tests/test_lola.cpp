@@ -5,11 +5,21 @@
 // stops the simulation or moves the robot.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+
 #include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "simsoccer/lola/endpoint.hpp"
+#include "simsoccer/lola/image_stream.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "test_support.hpp"
@@ -203,4 +213,82 @@ TEST(LolaRun, TwoBinariesAtOnceEachSeeTheirOwnRobotAtTmpRobocup) {
   }
   EXPECT_EQ(endpoint.stats(0).answered, 50u);
   EXPECT_EQ(endpoint.stats(1).answered, 50u);
+}
+
+// A LoLA robot's top camera as the Webots LoLA controller streams it: every
+// frame read from the TCP stream is the image the camera system rendered for
+// that tick (real EGL), and in lockstep it is out before the world steps on.
+TEST(LolaImages, AFrameFromTheStreamIsTheImageTheCameraSystemRendered) {
+  world::Scenario s = lolaScenario();
+  s.cameras.enabled = true;
+  s.cameras.top = {true, 64, 48, 30.0};
+  s.cameras.bottom = {true, 32, 24, 30.0};
+  world::World w(s);
+  sim::Simulation simulation(w);
+  std::mutex mutex;
+  std::map<uint64_t, std::vector<uint8_t>> rendered;  // robot 0's top images by tick
+  simulation.addImageSink([&](const world::CameraImage& image) {
+    if (image.robot != 0 || image.camera != world::CameraId::Top) return;
+    std::lock_guard lock(mutex);
+    rendered[image.tick] = image.data;
+  });
+  lola::ImageStreams streams(simulation, {lola::ImagePorts{0, 0, 0}});
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(streams.port(0, world::CameraId::Top));
+  ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  const auto readExactly = [&](uint8_t* out, size_t n) {
+    while (n > 0) {
+      const ssize_t got = ::recv(fd, out, n, 0);
+      if (got <= 0) return false;
+      out += got;
+      n -= static_cast<size_t>(got);
+    }
+    return true;
+  };
+  int frames = 0;
+  uint64_t last_tick = 0;
+  std::set<uint64_t> seen;
+  for (int i = 0; i < 60; ++i) {
+    const uint64_t tick = w.controlTick();
+    simulation.period();
+    // Every frame of this tick is already in the socket (a lockstep period
+    // flushes the cameras before it steps): read what is there.
+    pollfd p{fd, POLLIN, 0};
+    while (::poll(&p, 1, i == 0 ? 200 : 0) > 0) {
+      std::array<uint8_t, 16> h{};
+      ASSERT_TRUE(readExactly(h.data(), h.size()));
+      ASSERT_EQ(std::memcmp(h.data(), "wbimage", 8), 0);
+      const uint64_t frame_tick = h[8] | (h[9] << 8);
+      EXPECT_EQ(h[10], 0);  // top
+      EXPECT_EQ(h[11], 2);  // bytes per pixel
+      const int width = h[12] | (h[13] << 8), height = h[14] | (h[15] << 8);
+      ASSERT_EQ(width, 64);
+      ASSERT_EQ(height, 48);
+      std::vector<uint8_t> data(static_cast<size_t>(width * height * 2));
+      ASSERT_TRUE(readExactly(data.data(), data.size()));
+      EXPECT_LE(frame_tick, tick + 1);  // not from the future
+      seen.insert(frame_tick);
+      std::lock_guard lock(mutex);
+      ASSERT_TRUE(rendered.count(frame_tick)) << "tick " << frame_tick;
+      EXPECT_EQ(data, rendered[frame_tick]) << "tick " << frame_tick;
+      EXPECT_TRUE(frames == 0 || frame_tick > last_tick);
+      last_tick = frame_tick;
+      ++frames;
+    }
+    // Lockstep: every image of a tick up to this period's was written
+    // before the world stepped past it.
+    std::lock_guard lock(mutex);
+    for (const auto& [t, image] : rendered) {
+      if (t <= tick) {
+        EXPECT_TRUE(seen.count(t)) << "the frame of tick " << t << " was late";
+      }
+    }
+  }
+  ::close(fd);
+  // 60 periods of 12 ms at 30 fps: about 21 frames, none dropped.
+  EXPECT_GE(frames, 18);
+  EXPECT_EQ(streams.stats(0, world::CameraId::Top).frames_dropped, 0u);
 }
