@@ -164,7 +164,10 @@ int serve(int argc, char** argv, int first) {
   else
     simulation.setOfficials(officials);
   std::unique_ptr<lola::Endpoint> lola_endpoint;
+  std::unique_ptr<lola::ImageStreams> lola_images;
   if (session) {
+    lola_images = match::openLolaImages(
+        *session, simulation, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
     lola_endpoint = match::openLolaEndpoint(
         *session, opt.get("out", "runs/serve"), cfg.lockstep,
         [](const std::string& line) { std::printf("%s\n", line.c_str()); });

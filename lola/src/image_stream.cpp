@@ -126,7 +126,10 @@ ImageStreams::ImageStreams(sim::Simulation& sim, const std::vector<ImagePorts>& 
   sim.addSource(*this);
 }
 
-ImageStreams::~ImageStreams() = default;
+ImageStreams::~ImageStreams() {
+  // Images still queued are delivered now, while this sink exists.
+  sim_.flushCameras();
+}
 
 void ImageStreams::deliver(const world::CameraImage& image) {
   if (image.encoding != world::ImageEncoding::Yuyv || image.camera == world::CameraId::Spectator)

@@ -111,6 +111,23 @@ std::unique_ptr<lola::Endpoint> openLolaEndpoint(
   return endpoint;
 }
 
+std::unique_ptr<lola::ImageStreams> openLolaImages(
+    const MatchSession& session, sim::Simulation& sim,
+    const std::function<void(const std::string&)>& notice) {
+  if (session.lolaRobots().empty() || !session.world().scenario().cameras.enabled) return nullptr;
+  const MatchConfig& c = session.config();
+  std::vector<lola::ImagePorts> ports;
+  for (size_t k = 0; k < session.lolaRobots().size(); ++k) {
+    const auto top = static_cast<uint16_t>(c.lola.image_port + 2 * k);
+    ports.push_back({session.lolaRobots()[k], top, static_cast<uint16_t>(top + 1)});
+    if (notice)
+      notice("LoLA robot " + std::to_string(c.lola.robots[k].team_number) + ":" +
+             std::to_string(c.lola.robots[k].player) + " images on TCP ports " +
+             std::to_string(top) + " (top) and " + std::to_string(top + 1) + " (bottom)");
+  }
+  return std::make_unique<lola::ImageStreams>(sim, ports);
+}
+
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
   world::World& w = session.world();
@@ -135,6 +152,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   std::unique_ptr<lola::Endpoint> endpoint =
       openLolaEndpoint(session, o.out, !o.realtime, o.notice);
   std::vector<std::unique_ptr<ChildProcess>> lola_clients;
+  const std::unique_ptr<lola::ImageStreams> images = openLolaImages(session, simulation, o.notice);
   if (endpoint) {
     simulation.addSource(*endpoint);
     for (const lola::RobotSocket& rs : endpoint->config().robots) {

@@ -114,7 +114,12 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
   }
   if (auto l = root.optional("lola")) {
-    l->allowOnly({"robots", "client", "connect_timeout"});
+    l->allowOnly({"robots", "client", "connect_timeout", "image_port"});
+    if (l->has("image_port")) {
+      const int port = (*l)["image_port"].integer();
+      if (port < 1 || port > 65000) (*l)["image_port"].fail("must be 1..65000");
+      c.lola.image_port = static_cast<uint16_t>(port);
+    }
     for (const engine::ConfigNode& r : (*l)["robots"].items()) {
       try {
         const auto players = parseLolaPlayers(r.string());

@@ -39,7 +39,7 @@ struct ImageStreamStats {
 class ImageStreams : public sim::CommandSource {
  public:
   // Opens a server per camera of each robot and joins `sim` as an image
-  // sink. Throws std::runtime_error naming a port that cannot be bound, or
+  // sink and a source (it must outlive the periods it is part of). Throws std::runtime_error naming a port that cannot be bound, or
   // std::invalid_argument when the scenario's cameras are off or not YUYV.
   ImageStreams(sim::Simulation& sim, const std::vector<ImagePorts>& robots,
                const std::string& bind = "127.0.0.1");

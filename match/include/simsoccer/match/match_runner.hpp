@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "simsoccer/lola/endpoint.hpp"
+#include "simsoccer/lola/image_stream.hpp"
 #include "simsoccer/match/match_session.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/match_log.hpp"
@@ -48,6 +49,11 @@ std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const Lol
 // `out`; `notice` hears each robot's socket path.
 std::unique_ptr<lola::Endpoint> openLolaEndpoint(
     const MatchSession& session, const std::filesystem::path& out, bool lockstep,
+    const std::function<void(const std::string&)>& notice);
+// The LoLA robots' camera streams when the scenario's cameras are on (else
+// null), joined to `sim`; `notice` hears the ports.
+std::unique_ptr<lola::ImageStreams> openLolaImages(
+    const MatchSession& session, sim::Simulation& sim,
     const std::function<void(const std::string&)>& notice);
 
 struct RunResult {

@@ -41,6 +41,10 @@ struct LolaSettings {
   // the clients are started by hand.
   std::vector<std::string> client;
   double connect_timeout = 60.0;  // s the match waits for every LoLA client before it starts
+  // With the scenario's cameras on: the k-th LoLA robot's images on TCP
+  // ports image_port + 2k (top) and + 2k + 1 (bottom), as the Webots LoLA
+  // controller's 10001/10002 for one robot.
+  uint16_t image_port = 10001;
 };
 
 struct MatchConfig {
