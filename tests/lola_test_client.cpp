@@ -13,8 +13,14 @@
 // alone, split over two writes, LEDs in a second map), probe (read one map,
 // disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
 // (unknown keys in every map), silent (stop answering for K cycles after K),
-// bump (hold, chest LEDs changing each cycle).
+// bump (hold, chest LEDs changing each cycle), gc (no LoLA: on a field
+// network, receive a GameController packet on 3838, send a status packet to
+// --gc-host:3939, broadcast team messages to --broadcast:10000+team until
+// one from a teammate arrives; --team-number, --player).
 // Exit: 0 done, 1 expectation not met, 2 usage, 3 protocol violation, 4 no server.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
@@ -30,6 +36,7 @@
 #include <thread>
 #include <vector>
 
+#include "gc_reader.hpp"
 #include "lola_reader.hpp"
 #include "simsoccer/protocol/wire.hpp"
 
@@ -66,6 +73,8 @@ struct Options {
   float stiffness = 1.0f;
   bool expect_chest = false, print_id = false;
   std::string expect_id;  // the body id the robot must report
+  int team_number = 0, player = 0;
+  std::string gc_host, broadcast;
 };
 
 template <typename Values>
@@ -73,6 +82,83 @@ void packFloats(msgpack::packer<msgpack::sbuffer>& p, const char* key, const Val
   p.pack(std::string(key));
   p.pack_array(static_cast<uint32_t>(v.size()));
   for (float x : v) p.pack_float(x);
+}
+int udpSocket(uint16_t port) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  const int yes = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  ::setsockopt(fd, SOL_SOCKET, SO_BROADCAST, &yes, sizeof yes);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(port);
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return -1;
+  return fd;
+}
+
+void sendTo(int fd, const std::string& host, uint16_t port, const void* data, std::size_t n) {
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(port);
+  ::inet_pton(AF_INET, host.c_str(), &a.sin_addr);
+  ::sendto(fd, data, n, 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
+}
+
+// What a team binary does on a field network, with the ports as on a field.
+int fieldNetwork(const Options& o) {
+  const int gc = udpSocket(3838);
+  const auto team_port = static_cast<uint16_t>(10000 + o.team_number);
+  const int team = udpSocket(team_port);
+  if (gc < 0 || team < 0) {
+    std::fprintf(stderr, "lola client: cannot bind 3838 and %u\n", team_port);
+    return 4;
+  }
+  uint8_t buffer[1024];
+  pollfd p{gc, POLLIN, 0};
+  if (::poll(&p, 1, 10000) <= 0) {
+    std::fprintf(stderr, "lola client: no GameController packet in 10 s\n");
+    return 1;
+  }
+  const ssize_t n = ::recv(gc, buffer, sizeof buffer, 0);
+  simsoccer::test::GcPacket packet;
+  try {
+    packet = simsoccer::test::readGcPacket(std::span<const uint8_t>(buffer, static_cast<std::size_t>(n)));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lola client: bad GameController packet: %s\n", e.what());
+    return 3;
+  }
+  if (packet.teams[0].number != o.team_number && packet.teams[1].number != o.team_number) {
+    std::fprintf(stderr, "lola client: my team %d is not playing\n", o.team_number);
+    return 1;
+  }
+  std::printf("lola client: GameController packet v%d, state %d\n", packet.version, packet.state);
+  // RoboCupGameControlReturnData v4: "RGrt", 4, player, team, fallen, pose, ballAge, ball.
+  uint8_t status[32] = {'R', 'G', 'r', 't', 4};
+  status[5] = static_cast<uint8_t>(o.player);
+  status[6] = static_cast<uint8_t>(o.team_number);
+  const float ball_age = -1.0f;
+  std::memcpy(status + 20, &ball_age, 4);
+  sendTo(gc, o.gc_host, 3939, status, sizeof status);
+  const std::string hello = "hello from " + std::to_string(o.player);
+  for (int attempt = 0; attempt < 40; ++attempt) {
+    sendTo(team, o.broadcast, team_port, hello.data(), hello.size());
+    pollfd t{team, POLLIN, 0};
+    while (::poll(&t, 1, 250) > 0) {
+      const ssize_t m = ::recv(team, buffer, sizeof buffer, 0);
+      const std::string got(reinterpret_cast<char*>(buffer), static_cast<std::size_t>(std::max<ssize_t>(m, 0)));
+      if (got.rfind("hello from ", 0) == 0 && got != hello) {
+        std::printf("lola client: teammate said '%s'\n", got.c_str());
+        // A few more, so the teammate hears this one too.
+        for (int k = 0; k < 4; ++k) {
+          sendTo(team, o.broadcast, team_port, hello.data(), hello.size());
+          std::this_thread::sleep_for(std::chrono::milliseconds(250));
+        }
+        return 0;
+      }
+    }
+  }
+  std::fprintf(stderr, "lola client: no teammate heard\n");
+  return 1;
 }
 }  // namespace
 
@@ -95,6 +181,10 @@ int main(int argc, char** argv) {
     else if (a == "--expect-chest") o.expect_chest = true;
     else if (a == "--print-id") o.print_id = true;
     else if (a == "--expect-id") o.expect_id = value();
+    else if (a == "--team-number") o.team_number = std::stoi(value());
+    else if (a == "--player") o.player = std::stoi(value());
+    else if (a == "--gc-host") o.gc_host = value();
+    else if (a == "--broadcast") o.broadcast = value();
     else if (a == "--joint") {
       const std::string v = value();
       const auto eq = v.find('=');
@@ -111,6 +201,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (o.mode == "gc") return fieldNetwork(o);
   int fd = connectTo(o.socket);
   if (fd < 0) {
     std::fprintf(stderr, "lola client: no server at %s\n", o.socket.c_str());

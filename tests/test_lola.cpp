@@ -10,7 +10,9 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -19,6 +21,8 @@
 #include <vector>
 
 #include "simsoccer/lola/endpoint.hpp"
+#include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/lola/image_stream.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
@@ -291,4 +295,65 @@ TEST(LolaImages, AFrameFromTheStreamIsTheImageTheCameraSystemRendered) {
   // 60 periods of 12 ms at 30 fps: about 21 frames, none dropped.
   EXPECT_GE(frames, 18);
   EXPECT_EQ(streams.stats(0, world::CameraId::Top).frames_dropped, 0u);
+}
+
+// Two team binaries on the field network, each in its own namespace through
+// `simsoccer lola-run --net`: each binds 3838 and its team port for itself,
+// receives the simulator's broadcast GameController packets, sends its
+// status packet to the simulator, and hears its teammate's broadcast team
+// messages, which the simulator counts. Needs root (network namespaces).
+TEST(LolaRun, TeamBinariesOnTheFieldNetworkGetTheGameAndTalk) {
+  const bool ip = std::filesystem::exists("/usr/sbin/ip") || std::filesystem::exists("/sbin/ip") ||
+                  std::filesystem::exists("/bin/ip");
+  if (::geteuid() != 0 || !ip) GTEST_SKIP() << "needs root and iproute2";
+  test::TempDir dir("lola_net");
+  lola::FieldNetwork net;
+  net.bridge = "sst" + std::to_string(::getpid() % 100000);
+  net.prefix = "10.78";
+  net.link_prefix = "st";
+  lola::FieldBridge bridge(net);
+  world::World world(lolaScenario());
+  lola::EndpointConfig c;
+  for (world::RobotId r = 0; r < 2; ++r) {
+    lola::RobotSocket rs;
+    rs.robot = r;
+    rs.socket = dir.path() / ("robot_" + std::to_string(r) + ".sock");
+    rs.identity = lola::defaultIdentity(5, static_cast<int>(r) + 1);
+    c.robots.push_back(rs);
+  }
+  lola::Endpoint endpoint(world, c);  // the sockets lola-run binds
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  referee::Game game(rules, {referee::TeamSetup{5, 0, 2, 1}, referee::TeamSetup{9, 1, 3, 1}}, 0);
+  referee::GameControllerLinkConfig gc;
+  gc.address = net.broadcast();
+  gc.return_bind = net.hostAddress();
+  gc.team_message_bind = net.broadcast();
+  referee::GameControllerLink link(gc);
+  std::vector<std::unique_ptr<match::ChildProcess>> binaries;
+  for (int player = 1; player <= 2; ++player)
+    binaries.push_back(std::make_unique<match::ChildProcess>(std::vector<std::string>{
+        SIMSOCCER_BIN, "lola-run", "--robot", "5:" + std::to_string(player), "--socket",
+        c.robots[static_cast<size_t>(player - 1)].socket.string(), "--net", "--bridge", net.bridge,
+        "--prefix", net.prefix, "--", SIMSOCCER_LOLA_CLIENT, "--mode", "gc", "--team-number", "5",
+        "--player", std::to_string(player), "--gc-host", net.hostAddress(), "--broadcast",
+        net.broadcast()}));
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while ((binaries[0]->running() || binaries[1]->running()) &&
+         std::chrono::steady_clock::now() < until) {
+    link.update(game);
+    game.advance(0.05);
+    usleep(50000);
+  }
+  link.update(game);
+  for (auto& b : binaries) {
+    EXPECT_FALSE(b->running());
+    EXPECT_EQ(b->exitStatus(), 0);
+  }
+  EXPECT_TRUE(link.lastReturn(5, 1).has_value()) << "player 1's status did not arrive";
+  EXPECT_TRUE(link.lastReturn(5, 2).has_value()) << "player 2's status did not arrive";
+  EXPECT_GE(link.teamMessages(5), 2u);
+  EXPECT_EQ(link.teamMessages(9), 0u);
+  // The namespaces are gone with the binaries.
+  EXPECT_FALSE(std::filesystem::exists("/run/netns/" + net.namespaceName(5, 1)));
 }

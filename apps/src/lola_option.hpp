@@ -1,5 +1,6 @@
-// The `--lola T:P,...` option of match and serve: robots a team's binary
-// drives through LoLA instead of a built-in agent.
+// The `--lola T:P,...` and `--lola-net` options of match and serve: robots a
+// team's binary drives through LoLA instead of a built-in agent, and the
+// field's network for those binaries.
 #pragma once
 
 #include "cli.hpp"
@@ -8,6 +9,7 @@
 namespace simsoccer::apps {
 
 inline void addLolaRobots(const Options& opt, match::MatchConfig& config) {
+  if (opt.flag("lola-net")) config.lola.network = true;
   if (!opt.has("lola")) return;
   try {
     const auto players = match::parseLolaPlayers(opt.get("lola", ""));

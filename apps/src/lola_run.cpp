@@ -4,24 +4,33 @@
 // namespace (bubblewrap, from Debian) in which that robot's socket is
 // /tmp/robocup and /tmp is its own. The rest of the file system, the
 // network and the user are the machine's.
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "cli.hpp"
-#include "simsoccer/match/match_runner.hpp"
+#include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/match/lola_robots.hpp"
+
+extern char** environ;
 
 namespace simsoccer::apps {
 namespace {
 
 const char* kHelp =
     "usage: simsoccer lola-run (--socket PATH | --robot T:P [--run DIR]) [--wait S]\n"
-    "                          -- PROGRAM [ARGS...]\n"
+    "                          [--net [--bridge NAME] [--prefix A.B]] -- PROGRAM [ARGS...]\n"
     "\n"
     "Runs PROGRAM with a simulated robot's LoLA socket at /tmp/robocup, as on a Nao, in a\n"
     "private mount namespace (bubblewrap): its /tmp is its own, so several team binaries run\n"
@@ -29,10 +38,20 @@ const char* kHelp =
     "number:player) of the match writing to DIR (default runs/serve; the socket is\n"
     "DIR/lola/robot_T_P.sock), --socket gives the socket itself. Waits up to S s (default\n"
     "60) for the simulator to open the socket. The program's exit status is lola-run's.\n"
+    "--net (root; needs --robot, and the simulator started with --lola-net): the program also\n"
+    "gets a network namespace of its own on the field network, address PREFIX.T.P (default\n"
+    "10.77.T.P, as 10.0.T.P on a field): it binds 3838 and 10000+T for itself, receives the\n"
+    "simulator's GameController packets, sends status to PREFIX.0.1:3939 and broadcasts team\n"
+    "messages to its teammates, unmodified.\n"
     "Example, a match with two LoLA robots and two binaries:\n"
     "  simsoccer match configs/match_2v2.yaml --lola 2:1,2:2 --out runs/lola &\n"
     "  simsoccer lola-run --robot 2:1 --run runs/lola -- ./team-binary &\n"
     "  simsoccer lola-run --robot 2:2 --run runs/lola -- ./team-binary\n";
+
+volatile pid_t g_child = -1;
+void forward(int signal) {
+  if (g_child > 0) ::kill(g_child, signal);
+}
 
 std::string findBwrap() {
   for (const char* dir : {"/usr/bin", "/bin", "/usr/local/bin"}) {
@@ -52,24 +71,25 @@ int lolaRun(int argc, char** argv, int first) {
       split = i;
       break;
     }
-  const Options opt(split, argv, first, {"help"}, {"socket", "robot", "run", "wait"});
+  const Options opt(split, argv, first, {"help", "net"},
+                    {"socket", "robot", "run", "wait", "bridge", "prefix"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
-  if (opt.has("socket") == opt.has("robot")) throw UsageError("give --socket or --robot");
-  std::filesystem::path socket;
-  if (opt.has("socket")) {
-    socket = opt.get("socket", "");
-  } else {
-    std::vector<match::LolaPlayer> players;
+  if (!opt.has("socket") && !opt.has("robot")) throw UsageError("give --socket or --robot");
+  if (opt.flag("net") && !opt.has("robot")) throw UsageError("--net: give --robot T:P (its address)");
+  std::vector<match::LolaPlayer> players;
+  if (opt.has("robot")) {
     try {
       players = match::parseLolaPlayers(opt.get("robot", ""));
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--robot: ") + e.what());
     }
     if (players.size() != 1) throw UsageError("--robot: one robot");
-    socket = match::lolaSocketPath(opt.get("run", "runs/serve"), players[0]);
   }
+  std::filesystem::path socket = opt.has("socket")
+                                     ? std::filesystem::path(opt.get("socket", ""))
+                                     : match::lolaSocketPath(opt.get("run", "runs/serve"), players[0]);
   socket = std::filesystem::absolute(socket);
   const double wait = opt.number("wait", 60.0);
   if (!(wait >= 0)) throw UsageError("--wait must be >= 0 s");
@@ -81,19 +101,49 @@ int lolaRun(int argc, char** argv, int first) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   const std::string bwrap = findBwrap();
-  std::vector<std::string> args = {bwrap,
+  std::vector<std::string> args;
+  std::unique_ptr<lola::RobotNamespace> netns;
+  if (opt.flag("net")) {
+    lola::FieldNetwork net;
+    net.bridge = opt.get("bridge", net.bridge);
+    net.prefix = opt.get("prefix", net.prefix);
+    if (!std::filesystem::exists("/sys/class/net/" + net.bridge))
+      throw std::runtime_error("no field network '" + net.bridge +
+                               "': start the simulator with --lola-net first");
+    netns = std::make_unique<lola::RobotNamespace>(net, players[0].team_number, players[0].player);
+    std::printf("lola-run: %s in network namespace %s\n", netns->address().c_str(),
+                netns->name().c_str());
+    args = {"ip", "netns", "exec", netns->name()};
+  }
+  const std::vector<std::string> sandbox = {bwrap,
                                    "--dev-bind", "/", "/",             // the machine as it is
                                    "--tmpfs", "/tmp",                  // but a /tmp of its own
                                    "--bind", socket.string(), "/tmp/robocup",
                                    "--chdir", std::filesystem::current_path().string(),
                                    "--unshare-pid", "--die-with-parent", "--"};
+  args.insert(args.end(), sandbox.begin(), sandbox.end());
   for (int i = split + 1; i < argc; ++i) args.push_back(argv[i]);
   std::vector<char*> cargs;
   for (std::string& a : args) cargs.push_back(a.data());
   cargs.push_back(nullptr);
   std::fflush(stdout);
-  ::execv(bwrap.c_str(), cargs.data());
-  throw std::runtime_error("cannot run " + bwrap);
+  if (!netns) {
+    ::execvp(cargs[0], cargs.data());
+    throw std::runtime_error("cannot run " + args[0]);
+  }
+  // With a namespace lola-run stays to remove it when the program ends, and
+  // passes the signals that end it on.
+  pid_t pid = -1;
+  if (posix_spawnp(&pid, cargs[0], nullptr, nullptr, cargs.data(), environ) != 0)
+    throw std::runtime_error("cannot run " + args[0]);
+  g_child = pid;
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, forward);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  g_child = -1;
+  netns.reset();
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
 }  // namespace simsoccer::apps

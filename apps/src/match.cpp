@@ -35,7 +35,7 @@ const char* kMatchHelp =
     "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
     "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
     "                       [--dds-config FILE] [--mode serial|pipelined] [--lola T:P,...]\n"
-    "                       [--external-gc PORT] [--quiet]\n"
+    "                       [--lola-net] [--external-gc PORT] [--quiet]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -66,6 +66,8 @@ const char* kMatchHelp =
     "  --lola T:P,...      drive these robots (GameController team number:player) through\n"
     "                      LoLA sockets under DIR/lola/ instead of agents: a team's robot\n"
     "                      binary plays them (simsoccer lola-run); 12 ms control period\n"
+    "  --lola-net          and a field network for those binaries (root): GameController\n"
+    "                      packets, status and team messages over UDP (lola-run --net)\n"
     "  --external-gc PORT  a real GameController runs the game (its packets on UDP PORT,\n"
     "                      3838 on a field; 3939 stays free for it); real time\n"
     "  --no-video          skip the video\n"
@@ -128,7 +130,7 @@ void printStatus(const MatchSession& session, double wall) {
 
 int match(int argc, char** argv, int first) {
   const Options opt(
-      argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet"},
+      argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net"},
       {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
        "lola", "external-gc"});
   char help[4096];

@@ -21,7 +21,7 @@ const char* kHelp =
     "usage: simsoccer serve SCENARIO|MATCH [--domain D] [--dds-config FILE] [--seconds S]\n"
     "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
     "                       [--limp-on-release] [--mode serial|pipelined]\n"
-    "                       [--lola T:P,... [--out DIR]] [--external-gc PORT]\n"
+    "                       [--lola T:P,... [--lola-net] [--out DIR]] [--external-gc PORT]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
     "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
@@ -47,7 +47,8 @@ const char* kHelp =
     "code written for the SPL GameController runs unchanged.\n"
     "\n"
     "--lola T:P,... (with a match config): these robots are driven through LoLA sockets under\n"
-    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run).\n"
+    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run); --lola-net\n"
+    "adds the field network for them (GameController packets, status, team messages; root).\n"
     "--external-gc PORT (with a match config or --rules): a real GameController runs the game;\n"
     "its packets arrive on UDP PORT (3838), the simulator follows them in real time and\n"
     "leaves 3939 to it; the automatic referee's calls are only reported.\n";
@@ -83,7 +84,8 @@ void printGame(const referee::Game& g) {
 }  // namespace
 
 int serve(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "realtime", "limp-on-release", "auto-placement"},
+  const Options opt(argc, argv, first,
+                    {"help", "realtime", "limp-on-release", "auto-placement", "lola-net"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
                      "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
                      "out", "external-gc"});
@@ -163,15 +165,11 @@ int serve(int argc, char** argv, int first) {
     session->attach(simulation);
   else
     simulation.setOfficials(officials);
-  std::unique_ptr<lola::Endpoint> lola_endpoint;
-  std::unique_ptr<lola::ImageStreams> lola_images;
+  std::unique_ptr<match::LolaRobots> lola_robots;
   if (session) {
-    lola_images = match::openLolaImages(
-        *session, simulation, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
-    lola_endpoint = match::openLolaEndpoint(
-        *session, opt.get("out", "runs/serve"), cfg.lockstep,
+    lola_robots = match::openLolaRobots(
+        *session, simulation, opt.get("out", "runs/serve"), cfg.lockstep,
         [](const std::string& line) { std::printf("%s\n", line.c_str()); });
-    if (lola_endpoint) simulation.addSource(*lola_endpoint);
     cfg.not_served = session->lolaRobots();
   }
   net::SimServer server(simulation, cfg);
@@ -189,9 +187,8 @@ int serve(int argc, char** argv, int first) {
   }
 
   const double sim_seconds = opt.number("seconds", 60.0);
-  const size_t lola_robots = cfg.not_served.size();
   const auto wanted = static_cast<size_t>(
-      opt.number("agents", static_cast<double>(w.robotCount() - lola_robots)));
+      opt.number("agents", static_cast<double>(w.robotCount() - cfg.not_served.size())));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::printf("simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",
@@ -200,7 +197,7 @@ int serve(int argc, char** argv, int first) {
   std::fflush(stdout);
   while (!g_stop && !server.waitForOwners(wanted, 1.0)) {
   }
-  while (lola_endpoint && !g_stop && !lola_endpoint->waitForClients(1.0)) {
+  while (lola_robots && !g_stop && !lola_robots->endpoint().waitForClients(1.0)) {
   }
   const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period + 0.5);
   sim::RunLoop loop(simulation, cfg.lockstep ? sim::Pacing::Lockstep : sim::Pacing::RealTime);
@@ -208,6 +205,7 @@ int serve(int argc, char** argv, int first) {
       [&] { return g_stop || (officials && officials->over()); }, periods,
       [&] {
         if (gc_link) gc_link->update(officials->game());
+        if (lola_robots) lola_robots->afterPeriod();
       });
   simulation.flushCameras();
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), run.wall_s,
@@ -223,14 +221,12 @@ int serve(int argc, char** argv, int first) {
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
   printCounters(w, server);
-  for (size_t i = 0; lola_endpoint && i < lola_robots; ++i) {
-    const lola::RobotLolaStats l = lola_endpoint->stats(i);
-    std::printf("  LoLA %s: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
-                lola_endpoint->config().robots[i].socket.filename().c_str(),
-                (unsigned long long)l.sessions, (unsigned long long)l.maps,
-                (unsigned long long)l.missed, (unsigned long long)l.bad_maps,
-                (unsigned long long)l.refused);
-  }
+  for (const match::LolaResult& l : lola_robots ? lola_robots->results()
+                                                 : std::vector<match::LolaResult>{})
+    std::printf("  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
+                l.player.team_number, l.player.player, (unsigned long long)l.stats.sessions,
+                (unsigned long long)l.stats.maps, (unsigned long long)l.stats.missed,
+                (unsigned long long)l.stats.bad_maps, (unsigned long long)l.stats.refused);
   if (officials) printGame(officials->game());
   if (gc_link) {
     std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",

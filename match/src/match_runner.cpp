@@ -83,51 +83,6 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
   return soccerAgentCommand(ao);
 }
 
-std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p) {
-  return out / "lola" /
-         ("robot_" + std::to_string(p.team_number) + "_" + std::to_string(p.player) + ".sock");
-}
-
-std::unique_ptr<lola::Endpoint> openLolaEndpoint(
-    const MatchSession& session, const std::filesystem::path& out, bool lockstep,
-    const std::function<void(const std::string&)>& notice) {
-  if (session.lolaRobots().empty()) return nullptr;
-  const MatchConfig& c = session.config();
-  lola::EndpointConfig ec;
-  ec.lockstep = lockstep;
-  ec.answer_timeout = c.command_timeout;
-  for (size_t i = 0; i < session.lolaRobots().size(); ++i) {
-    const LolaPlayer& p = c.lola.robots[i];
-    lola::RobotSocket rs;
-    rs.robot = session.lolaRobots()[i];
-    rs.socket = std::filesystem::absolute(lolaSocketPath(out, p));
-    rs.identity = lola::defaultIdentity(p.team_number, p.player);
-    ec.robots.push_back(rs);
-  }
-  auto endpoint = std::make_unique<lola::Endpoint>(session.world(), ec);
-  for (size_t i = 0; notice && i < ec.robots.size(); ++i)
-    notice("LoLA robot " + std::to_string(c.lola.robots[i].team_number) + ":" +
-           std::to_string(c.lola.robots[i].player) + " at " + ec.robots[i].socket.string());
-  return endpoint;
-}
-
-std::unique_ptr<lola::ImageStreams> openLolaImages(
-    const MatchSession& session, sim::Simulation& sim,
-    const std::function<void(const std::string&)>& notice) {
-  if (session.lolaRobots().empty() || !session.world().scenario().cameras.enabled) return nullptr;
-  const MatchConfig& c = session.config();
-  std::vector<lola::ImagePorts> ports;
-  for (size_t k = 0; k < session.lolaRobots().size(); ++k) {
-    const auto top = static_cast<uint16_t>(c.lola.image_port + 2 * k);
-    ports.push_back({session.lolaRobots()[k], top, static_cast<uint16_t>(top + 1)});
-    if (notice)
-      notice("LoLA robot " + std::to_string(c.lola.robots[k].team_number) + ":" +
-             std::to_string(c.lola.robots[k].player) + " images on TCP ports " +
-             std::to_string(top) + " (top) and " + std::to_string(top + 1) + " (bottom)");
-  }
-  return std::make_unique<lola::ImageStreams>(sim, ports);
-}
-
 RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter& log) {
   RunResult result;
   world::World& w = session.world();
@@ -148,25 +103,21 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.team_message_loss = c.message_loss;
   sc.not_served = session.lolaRobots();
   // LoLA robots: one socket each under the run's folder, a command source
-  // beside DDS; their clients are started here if the config names one.
-  std::unique_ptr<lola::Endpoint> endpoint =
-      openLolaEndpoint(session, o.out, !o.realtime, o.notice);
+  // beside DDS, their cameras and field network; their clients are started
+  // here if the config names one.
+  const std::unique_ptr<LolaRobots> lola_robots = openLolaRobots(session, simulation, o.out,
+                                                                 !o.realtime, o.notice);
   std::vector<std::unique_ptr<ChildProcess>> lola_clients;
-  const std::unique_ptr<lola::ImageStreams> images = openLolaImages(session, simulation, o.notice);
-  if (endpoint) {
-    simulation.addSource(*endpoint);
-    for (const lola::RobotSocket& rs : endpoint->config().robots) {
-      if (c.lola.client.empty()) break;
-      std::vector<std::string> args;
-      for (std::string a : c.lola.client) {
-        for (size_t at = a.find("{socket}"); at != std::string::npos; at = a.find("{socket}"))
-          a.replace(at, 8, rs.socket.string());
-        args.push_back(a);
-      }
-      lola_clients.push_back(std::make_unique<ChildProcess>(args));
-      if (!lola_clients.back()->started())
-        throw std::runtime_error("cannot start the LoLA client " + args[0]);
+  for (size_t i = 0; lola_robots && i < c.lola.robots.size() && !c.lola.client.empty(); ++i) {
+    std::vector<std::string> args;
+    for (std::string a : c.lola.client) {
+      for (size_t at = a.find("{socket}"); at != std::string::npos; at = a.find("{socket}"))
+        a.replace(at, 8, lolaSocketPath(o.out, c.lola.robots[i]).string());
+      args.push_back(a);
     }
+    lola_clients.push_back(std::make_unique<ChildProcess>(args));
+    if (!lola_clients.back()->started())
+      throw std::runtime_error("cannot start the LoLA client " + args[0]);
   }
   net::SimServer server(simulation, sc);
   // The agents find the game state when they start.
@@ -198,9 +149,9 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     if (secondsSince(t_wait) > 60.0)
       throw std::runtime_error("agents did not claim their robots within 60 s");
   }
-  if (endpoint) {
+  if (lola_robots) {
     const auto t_lola = Clock::now();
-    while (!stopRequested() && !endpoint->waitForClients(0.5))
+    while (!stopRequested() && !lola_robots->endpoint().waitForClients(0.5))
       if (secondsSince(t_lola) > c.lola.connect_timeout) {
         if (o.notice)
           o.notice("not every LoLA client connected within " +
@@ -248,6 +199,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       -1,
       [&] {
         ++i;
+        if (lola_robots) lola_robots->afterPeriod();
         if (!o.external && i % 10 == 0) superviseAgents();
         if (o.progress && secondsSince(t0) - last_progress > 0.25) {
           last_progress = secondsSince(t0);
@@ -259,8 +211,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   result.final_hash = w.stateHash();
   for (world::RobotId r = 0; r < w.robotCount(); ++r)
     result.missed_commands.push_back(server.stats(r).missed);
-  for (size_t i = 0; endpoint && i < session.lolaRobots().size(); ++i)
-    result.lola.push_back({c.lola.robots[i], endpoint->config().robots[i].socket, endpoint->stats(i)});
+  if (lola_robots) result.lola = lola_robots->results();
   for (AgentSlot& a : agents)
     if (a.process) a.process->stop();
   for (auto& client : lola_clients) client->stop();

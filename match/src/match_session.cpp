@@ -114,7 +114,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
   }
   if (auto l = root.optional("lola")) {
-    l->allowOnly({"robots", "client", "connect_timeout", "image_port"});
+    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network"});
+    c.lola.network = l->boolean("network", false);
     if (l->has("image_port")) {
       const int port = (*l)["image_port"].integer();
       if (port < 1 || port > 65000) (*l)["image_port"].fail("must be 1..65000");

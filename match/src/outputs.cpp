@@ -122,6 +122,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
     const lola::RobotLolaStats& st = l.stats;
     out << (i ? "," : "") << "\n    {\"team\": " << l.player.team_number
         << ", \"player\": " << l.player.player << ", \"socket\": " << jsonString(l.socket.string())
+        << ", \"address\": " << (l.address.empty() ? "null" : jsonString(l.address))
         << ", \"sessions\": " << st.sessions << ", \"packets_sent\": " << st.packets_sent
         << ", \"packets_dropped\": " << st.packets_dropped << ", \"answered\": " << st.answered
         << ", \"missed\": " << st.missed << ", \"no_client\": " << st.no_client

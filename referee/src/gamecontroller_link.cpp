@@ -28,6 +28,37 @@ void GameControllerLink::update(const Game& game) {
     ++sent_;
   }
   receiveReturns(game);
+  countTeamMessages(game);
+}
+
+void GameControllerLink::countTeamMessages(const Game& game) {
+  if (config_.team_message_bind.empty()) return;
+  if (team_ports_.empty())
+    for (int t = 0; t < 2; ++t) {
+      TeamPort p;
+      p.team_number = game.teamNumber(t);
+      p.receiver = std::make_unique<UdpReceiver>(static_cast<uint16_t>(10000 + p.team_number),
+                                                 config_.team_message_bind);
+      team_ports_.push_back(std::move(p));
+    }
+  std::array<uint8_t, 1024> buffer{};
+  for (TeamPort& p : team_ports_)
+    for (size_t n; (n = p.receiver->receive(buffer, 0.0)) > 0;) {
+      ++p.messages;
+      p.oversized += n > 128;  // illegal on the field (the GameController reads 129 to tell)
+    }
+}
+
+uint64_t GameControllerLink::teamMessages(uint8_t team_number) const {
+  for (const TeamPort& p : team_ports_)
+    if (p.team_number == team_number) return p.messages;
+  return 0;
+}
+
+uint64_t GameControllerLink::oversizedTeamMessages(uint8_t team_number) const {
+  for (const TeamPort& p : team_ports_)
+    if (p.team_number == team_number) return p.oversized;
+  return 0;
 }
 
 void GameControllerLink::receiveReturns(const Game& game) {

@@ -11,8 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "simsoccer/lola/endpoint.hpp"
-#include "simsoccer/lola/image_stream.hpp"
+#include "simsoccer/match/lola_robots.hpp"
 #include "simsoccer/match/match_session.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/match_log.hpp"
@@ -37,24 +36,7 @@ struct RunOptions {
   std::function<void(const std::string&)> notice;
 };
 
-// A LoLA robot's socket and what its clients did.
-struct LolaResult {
-  LolaPlayer player;
-  std::filesystem::path socket;
-  lola::RobotLolaStats stats;
-};
-// Where a LoLA robot's socket is in a run's folder.
-std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p);
-// The LoLA endpoint of a session's LoLA robots (none: null), sockets under
-// `out`; `notice` hears each robot's socket path.
-std::unique_ptr<lola::Endpoint> openLolaEndpoint(
-    const MatchSession& session, const std::filesystem::path& out, bool lockstep,
-    const std::function<void(const std::string&)>& notice);
-// The LoLA robots' camera streams when the scenario's cameras are on (else
-// null), joined to `sim`; `notice` hears the ports.
-std::unique_ptr<lola::ImageStreams> openLolaImages(
-    const MatchSession& session, sim::Simulation& sim,
-    const std::function<void(const std::string&)>& notice);
+
 
 struct RunResult {
   bool interrupted = false, aborted = false;

@@ -45,6 +45,9 @@ struct LolaSettings {
   // ports image_port + 2k (top) and + 2k + 1 (bottom), as the Webots LoLA
   // controller's 10001/10002 for one robot.
   uint16_t image_port = 10001;
+  // The field's network for the binaries (needs root): GameController
+  // packets, status and team messages over UDP as on a field.
+  bool network = false;
 };
 
 struct MatchConfig {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "simsoccer/referee/game.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
@@ -24,6 +25,10 @@ struct GameControllerLinkConfig {
   uint16_t return_port = 3939;  // 0: any free port (tests)
   std::string return_bind = "0.0.0.0";
   double period = 0.5;  // s of simulated time between control packets (GC3: 500 ms)
+  // Count the playing teams' messages, as the GameController does, on their
+  // team ports (10000 + team number) at this address (the field's broadcast
+  // address; empty: not counted).
+  std::string team_message_bind;
 };
 
 class GameControllerLink {
@@ -43,9 +48,20 @@ class GameControllerLink {
   const std::string& lastReturnError() const { return last_error_; }
   // The latest valid return packet from (team number, player number).
   std::optional<ReturnData> lastReturn(uint8_t team_number, uint8_t player) const;
+  // Team messages counted on team `team_number`'s port so far (and those
+  // over the 128-byte limit among them).
+  uint64_t teamMessages(uint8_t team_number) const;
+  uint64_t oversizedTeamMessages(uint8_t team_number) const;
 
  private:
   void receiveReturns(const Game& game);
+  void countTeamMessages(const Game& game);
+  struct TeamPort {
+    uint8_t team_number = 0;
+    std::unique_ptr<UdpReceiver> receiver;
+    uint64_t messages = 0, oversized = 0;
+  };
+  std::vector<TeamPort> team_ports_;
 
   GameControllerLinkConfig config_;
   std::unique_ptr<UdpSender> sender_;

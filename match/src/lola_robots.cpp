@@ -1,0 +1,102 @@
+#include "simsoccer/match/lola_robots.hpp"
+
+namespace simsoccer::match {
+
+std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p) {
+  return out / "lola" /
+         ("robot_" + std::to_string(p.team_number) + "_" + std::to_string(p.player) + ".sock");
+}
+
+// The team messages the binaries broadcast on the field network, counted
+// against each team's budget like the DDS agents' (a command source without robots).
+struct LolaRobots::FieldTeamMessages : sim::CommandSource {
+  FieldTeamMessages(const referee::GameControllerLink& link, const MatchSession& session)
+      : link(link), session(session) {}
+  void observe(const sim::Observation&) override {}
+  void collect(uint64_t, sim::CommandGate&, std::span<sim::CommandSlot>) override {}
+  uint64_t teamMessagesSent(int team) const override {
+    return link.teamMessages(session.game().teamNumber(team));
+  }
+  const referee::GameControllerLink& link;
+  const MatchSession& session;
+};
+
+LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
+                       const std::filesystem::path& out, bool lockstep,
+                       const std::function<void(const std::string&)>& notice)
+    : session_(session) {
+  const MatchConfig& c = session.config();
+  const auto say = [&](const std::string& line) {
+    if (notice) notice(line);
+  };
+  const auto name = [&](size_t i) {
+    return std::to_string(c.lola.robots[i].team_number) + ":" +
+           std::to_string(c.lola.robots[i].player);
+  };
+  lola::EndpointConfig ec;
+  ec.lockstep = lockstep;
+  ec.answer_timeout = c.command_timeout;
+  for (size_t i = 0; i < session.lolaRobots().size(); ++i) {
+    lola::RobotSocket rs;
+    rs.robot = session.lolaRobots()[i];
+    rs.socket = std::filesystem::absolute(lolaSocketPath(out, c.lola.robots[i]));
+    rs.identity = lola::defaultIdentity(c.lola.robots[i].team_number, c.lola.robots[i].player);
+    ec.robots.push_back(rs);
+  }
+  endpoint_ = std::make_unique<lola::Endpoint>(session.world(), ec);
+  sim.addSource(*endpoint_);
+  for (size_t i = 0; i < ec.robots.size(); ++i)
+    say("LoLA robot " + name(i) + " at " + ec.robots[i].socket.string());
+
+  if (session.world().scenario().cameras.enabled) {
+    std::vector<lola::ImagePorts> ports;
+    for (size_t k = 0; k < ec.robots.size(); ++k) {
+      const auto top = static_cast<uint16_t>(c.lola.image_port + 2 * k);
+      ports.push_back({ec.robots[k].robot, top, static_cast<uint16_t>(top + 1)});
+      say("LoLA robot " + name(k) + " images on TCP ports " + std::to_string(top) + " (top) and " +
+          std::to_string(top + 1) + " (bottom)");
+    }
+    images_ = std::make_unique<lola::ImageStreams>(sim, ports);
+  }
+
+  if (c.lola.network) {
+    const lola::FieldNetwork net;
+    bridge_ = std::make_unique<lola::FieldBridge>(net);
+    referee::GameControllerLinkConfig gc;
+    gc.address = net.broadcast();
+    gc.return_bind = net.hostAddress();
+    gc.team_message_bind = net.broadcast();
+    link_ = std::make_unique<referee::GameControllerLink>(gc);
+    team_messages_ = std::make_unique<FieldTeamMessages>(*link_, session);
+    sim.addSource(*team_messages_);
+    say("field network " + net.bridge + ": GameController packets to " + net.broadcast() +
+        ":3838, status to " + net.hostAddress() + ":3939; robots at " + net.prefix +
+        ".TEAM.PLAYER (simsoccer lola-run --net)");
+  }
+}
+
+LolaRobots::~LolaRobots() = default;
+
+void LolaRobots::afterPeriod() {
+  if (link_) link_->update(session_.game());
+}
+
+std::vector<LolaResult> LolaRobots::results() const {
+  std::vector<LolaResult> out;
+  const MatchConfig& c = session_.config();
+  const lola::FieldNetwork net;
+  for (size_t i = 0; i < c.lola.robots.size(); ++i)
+    out.push_back({c.lola.robots[i], endpoint_->config().robots[i].socket, endpoint_->stats(i),
+                   link_ ? net.robotAddress(c.lola.robots[i].team_number, c.lola.robots[i].player)
+                         : std::string()});
+  return out;
+}
+
+std::unique_ptr<LolaRobots> openLolaRobots(const MatchSession& session, sim::Simulation& sim,
+                                           const std::filesystem::path& out, bool lockstep,
+                                           const std::function<void(const std::string&)>& notice) {
+  if (session.lolaRobots().empty()) return nullptr;
+  return std::make_unique<LolaRobots>(session, sim, out, lockstep, notice);
+}
+
+}  // namespace simsoccer::match
