@@ -13,6 +13,7 @@ PACKAGES=(
   cyclonedds-dev cyclonedds-tools  # DDS transport and its IDL compiler (idlc)
   libmsgpack-cxx-dev            # LoLA actuator maps (parsed only: sensor maps are hand-encoded)
   bubblewrap                    # lola-run: a private /tmp/robocup per team binary
+  iproute2                      # lola-run --net: the field network (bridge, namespaces)
   libgtest-dev libgmock-dev     # tests
   libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # off-screen EGL rendering (Mesa llvmpipe on CPU)
 )

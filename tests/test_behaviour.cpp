@@ -766,6 +766,7 @@ TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
       world::LogFrame f = world::captureFrame(w, static_cast<uint64_t>(i + 1), pos, stiff,
                                               std::vector<bool>(w.robotCount(), i % 2 == 0));
       if (i == 7) f.events.push_back({0.08, "goal", 1, 3, "0:1"});
+      if (i % 3 == 0) f.robots[1].leds = std::array<uint8_t, 9>{0, 0, 255, 10, 20, 30, 40, 50, 60};
       f.game = {1, 2, 3};
       log.write(f);
       written.push_back(f);
@@ -787,6 +788,8 @@ TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
     EXPECT_EQ(f.robots[0].command_position[3], o.robots[0].command_position[3]);  // exact
     EXPECT_EQ(f.robots[0].command_stiffness[3], o.robots[0].command_stiffness[3]);
     EXPECT_EQ(f.robots[0].commanded, o.robots[0].commanded);
+    EXPECT_EQ(f.robots[0].leds, o.robots[0].leds);
+    EXPECT_EQ(f.robots[1].leds, o.robots[1].leds);
     EXPECT_EQ(f.events.size(), o.events.size());
     ++n;
   }

@@ -14,6 +14,7 @@
 #include "lola_reader.hpp"
 #include "simsoccer/lola/actuator_stream.hpp"
 #include "simsoccer/lola/sensor_packet.hpp"
+#include "simsoccer/world/render_scene.hpp"
 #include "test_support.hpp"
 
 using namespace simsoccer;
@@ -202,4 +203,28 @@ TEST(LolaWire, AnUnreadableStreamEndsWithoutBufferingWhatItClaims) {
   EXPECT_TRUE(fails(big));
   // Nested deeper than a map of arrays.
   EXPECT_TRUE(fails({0x81, 0xa5, 'C', 'h', 'e', 's', 't', 0x91, 0x91, 0x01}));
+}
+
+// The LED colours a LoLA client set are drawn for the spectator: the chest
+// and both eyes as small spheres in those colours, on the robot.
+TEST(LolaWire, LedColoursAreDrawnOnTheRobot) {
+  world::World w(test::scenario(2));
+  std::vector<engine::DrawItem> plain, lit;
+  world::buildRenderScene(w, plain);
+  world::SceneColours c;
+  c.leds.resize(2);
+  c.leds[1] = world::SceneColours::Leds{{0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}};
+  world::buildRenderScene(w, lit, c);
+  ASSERT_EQ(lit.size(), plain.size() + 3);
+  std::vector<Eigen::Vector3f> colours;
+  for (const engine::DrawItem& item : lit)
+    if (item.shape == engine::Primitive::Sphere && item.colour != c.ball) colours.push_back(item.colour);
+  ASSERT_EQ(colours.size(), 3u);
+  EXPECT_EQ(colours[0], c.leds[1]->chest);
+  // On robot 1: within 0.25 m of its torso (the eyes are 0.2 m above it).
+  for (const engine::DrawItem& item : lit)
+    if (item.shape == engine::Primitive::Sphere && item.colour != c.ball) {
+      EXPECT_LT((item.transform.block<3, 1>(0, 3).cast<double>() - w.torsoPose(1).translation()).norm(),
+                0.25);
+    }
 }

@@ -415,3 +415,50 @@ TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
     EXPECT_NE(out.find("simulated 4.00 s"), std::string::npos) << out;
   }
 }
+
+// The worked example's shape, small: a 2 v 2 whose robot 2:1 a LoLA client
+// drives through `simsoccer lola-run` (its socket at /tmp/robocup in a
+// private namespace), the others built-in agents over DDS. The robot plays
+// the whole game at LoLA's 12 ms cycle, the summary counts the client's maps
+// (and its unknown keys), and the log keeps the LED colours it set.
+TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
+  BackgroundMatch m("match_lola",
+                    "--lola 2:1 --half 5 --max-seconds 20 --no-video --quiet --domain 97");
+  const auto socket = m.dir / "lola" / "robot_2_1.sock";
+  bool up = false;
+  for (int i = 0; i < 600 && !up; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    up = std::filesystem::is_socket(socket);
+  }
+  ASSERT_TRUE(up) << "no LoLA socket at " << socket;
+  match::ChildProcess client({kBin, "lola-run", "--robot", "2:1", "--run", m.dir.path().string(),
+                              "--", SIMSOCCER_LOLA_CLIENT, "--mode", "unknown", "--joint",
+                              "HeadYaw=0.4"});
+  m.join();
+  for (int i = 0; i < 500 && client.running(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_FALSE(client.running());
+  EXPECT_EQ(client.exitStatus(), 0) << "the strict client refused a sensor map";
+  ASSERT_EQ(m.status, 0) << m.out;
+  EXPECT_NE(m.out.find("LoLA robot 2:1 at"), std::string::npos) << m.out;
+  const std::string summary = test::readFile(m.dir / "summary.json");
+  EXPECT_EQ(jsonValue(summary, "control_period"), "0.012");
+  const std::regex lola("\"lola\": \\[\\s*\\{\"team\": 2, \"player\": 1, \"socket\": \"[^\"]+\", "
+                        "\"address\": null, \"sessions\": 1, \"packets_sent\": ([0-9]+), "
+                        "\"packets_dropped\": 0, \"answered\": ([0-9]+), \"missed\": 0, "
+                        "\"no_client\": [0-9]+, \"maps\": [0-9]+, \"bad_maps\": 0, "
+                        "\"unknown_keys\": ([0-9]+)");
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(summary, match, lola)) << summary;
+  EXPECT_GE(std::stoi(match[1].str()), 1000);  // 20 s at 12 ms, less the wait
+  EXPECT_EQ(match[1].str(), match[2].str());   // every map answered
+  EXPECT_GT(std::stoi(match[3].str()), 0);
+  // The log: the client's blue chest on robot 2:1 (world index 2), none on the others.
+  world::MatchLogReader log(m.dir / "match.log");
+  world::LogFrame f, last;
+  while (log.next(f)) last = f;
+  ASSERT_EQ(last.robots.size(), 4u);
+  ASSERT_TRUE(last.robots[2].leds.has_value());
+  EXPECT_EQ((*last.robots[2].leds)[2], 255);
+  EXPECT_FALSE(last.robots[0].leds.has_value());
+}

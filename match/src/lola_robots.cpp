@@ -1,5 +1,8 @@
 #include "simsoccer/match/lola_robots.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace simsoccer::match {
 
 std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const LolaPlayer& p) {
@@ -79,6 +82,28 @@ LolaRobots::~LolaRobots() = default;
 
 void LolaRobots::afterPeriod() {
   if (link_) link_->update(session_.game());
+}
+
+std::optional<std::array<uint8_t, 9>> LolaRobots::leds(world::RobotId r) const {
+  const auto& robots = session_.lolaRobots();
+  for (size_t i = 0; i < robots.size(); ++i) {
+    if (robots[i] != r) continue;
+    if (endpoint_->stats(i).maps == 0) return std::nullopt;
+    const lola::ActuatorValues& v = endpoint_->actuators(i);
+    const auto byte = [](double x) {
+      return static_cast<uint8_t>(std::lround(std::clamp(x, 0.0, 1.0) * 255.0));
+    };
+    // An eye is 8 segments: 8 reds, 8 greens, 8 blues; the spectator sees their mean.
+    const auto eye = [&](const std::array<float, 24>& e, int channel) {
+      double sum = 0.0;
+      for (int k = 0; k < 8; ++k) sum += e[static_cast<size_t>(8 * channel + k)];
+      return byte(sum / 8.0);
+    };
+    return std::array<uint8_t, 9>{byte(v.chest[0]), byte(v.chest[1]), byte(v.chest[2]),
+                                  eye(v.leye, 0),   eye(v.leye, 1),   eye(v.leye, 2),
+                                  eye(v.reye, 0),   eye(v.reye, 1),   eye(v.reye, 2)};
+  }
+  return std::nullopt;
 }
 
 std::vector<LolaResult> LolaRobots::results() const {

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/outputs.hpp"
@@ -34,6 +36,8 @@ struct AgentSlot {
 class LogRecorder : public sim::Recorder {
  public:
   LogRecorder(world::MatchLogWriter& log, RunResult& result) : log_(log), result_(result) {}
+  // Robots' LED colours (LoLA robots), if any.
+  std::function<std::optional<std::array<uint8_t, 9>>(world::RobotId)> leds;
   void record(const sim::PeriodRecord& p) override {
     const world::World& w = *p.world;
     positions_.resize(w.robotCount());
@@ -44,6 +48,8 @@ class LogRecorder : public sim::Recorder {
       stiffness_[r] = (*p.commands)[r].stiffness;
     }
     world::LogFrame frame = world::captureFrame(w, w.controlTick(), positions_, stiffness_, commanded_);
+    if (leds)
+      for (world::RobotId r = 0; r < w.robotCount(); ++r) frame.robots[r].leds = leds(r);
     if (p.game) {
       const auto packet = referee::encode(*p.game);
       frame.game.assign(packet.begin(), packet.end());
@@ -107,6 +113,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   // here if the config names one.
   const std::unique_ptr<LolaRobots> lola_robots = openLolaRobots(session, simulation, o.out,
                                                                  !o.realtime, o.notice);
+  if (lola_robots) recorder.leds = [&](world::RobotId r) { return lola_robots->leds(r); };
   std::vector<std::unique_ptr<ChildProcess>> lola_clients;
   for (size_t i = 0; lola_robots && i < c.lola.robots.size() && !c.lola.client.empty(); ++i) {
     std::vector<std::string> args;

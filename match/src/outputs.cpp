@@ -173,6 +173,7 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
   world::LogFrame f;
   double next = -1.0;
   std::vector<engine::DrawItem> scene;
+  world::SceneColours colours;
   while (log.next(f)) {
     if (f.time < from - 1e-9) continue;
     if (f.time > to + 1e-9) break;
@@ -180,7 +181,15 @@ VideoResult renderVideo(const std::filesystem::path& log_file, const std::filesy
     next = (next < 0 ? f.time : next) + 1.0 / v.fps;
     world::applyFrame(w, f);
     scene.clear();
-    world::buildRenderScene(w, scene);
+    colours.leds.assign(f.robots.size(), std::nullopt);
+    for (size_t r = 0; r < f.robots.size(); ++r)
+      if (const auto& l = f.robots[r].leds) {
+        const auto rgb = [&](size_t k) {
+          return Eigen::Vector3f((*l)[k] / 255.0f, (*l)[k + 1] / 255.0f, (*l)[k + 2] / 255.0f);
+        };
+        colours.leds[r] = world::SceneColours::Leds{rgb(0), rgb(3), rgb(6)};
+      }
+    world::buildRenderScene(w, scene, colours);
     renderer.render(scene, std::span<const engine::RenderView>(&view, 1));
     cv::Mat rgba = renderer.image(0), bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);

@@ -104,6 +104,9 @@ void MatchLogWriter::write(const LogFrame& f) {
     for (double q : r.command_position) o.i16(q, kCommandResolution);
     o.raw(static_cast<uint8_t>(r.commanded));
     for (double s : r.command_stiffness) o.raw(static_cast<uint8_t>(std::lround(s * 255.0)));
+    o.raw(static_cast<uint8_t>(r.leds.has_value()));
+    if (r.leds)
+      for (uint8_t v : *r.leds) o.raw(v);
   }
   o.raw(static_cast<uint16_t>(f.events.size()));
   for (const LogEvent& e : f.events) {
@@ -200,6 +203,12 @@ bool MatchLogReader::next(LogFrame& f) {
     for (double& q : r.command_position) q = in.i16(kCommandResolution);
     r.commanded = in.raw<uint8_t>() != 0;
     for (double& s : r.command_stiffness) s = in.raw<uint8_t>() / 255.0;
+    r.leds.reset();
+    if (in.raw<uint8_t>() != 0) {
+      std::array<uint8_t, 9> leds{};
+      for (uint8_t& v : leds) v = in.raw<uint8_t>();
+      r.leds = leds;
+    }
   }
   const auto events = in.raw<uint16_t>();
   for (int i = 0; i < events; ++i) {

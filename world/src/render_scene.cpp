@@ -104,6 +104,24 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
       const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
       for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
     }
+    // LEDs: the chest button (nao.md 5.4: 49.9, 1.6, 55.2 mm in the torso
+    // frame) and the eyes on the face, beside the top camera, a little
+    // proud of the shells so the spectator sees them.
+    if (r < c.leds.size() && c.leds[r]) {
+      const engine::Pose torso = world.linkPose(r, 0);
+      engine::Pose at = torso;
+      at.translation() = torso * Vec3(0.058, 0.0016, 0.0552);
+      add(items, Primitive::Sphere, at, Vec3::Constant(0.014), c.leds[r]->chest, false);
+      if (const robots::SensorFrame* cam = info.model->sensor("CameraTop")) {
+        const engine::Pose head = world.linkPose(r, cam->link);
+        for (int side : {1, -1}) {
+          at = head;
+          at.translation() = head * Vec3(0.056, side * 0.034, 0.071);
+          add(items, Primitive::Sphere, at, Vec3::Constant(0.010),
+              side > 0 ? c.leds[r]->left_eye : c.leds[r]->right_eye, false);
+        }
+      }
+    }
   }
   // The ball.
   const engine::RigidBodyState ball = world.ballState();

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,9 @@ class LolaRobots {
   void afterPeriod();
   lola::Endpoint& endpoint() { return *endpoint_; }
   std::vector<LolaResult> results() const;
+  // The chest, left eye and right eye colours (RGB 0..255) robot r's client
+  // set, for the match log and the video; none: not a LoLA robot, or no LEDs set yet.
+  std::optional<std::array<uint8_t, 9>> leds(world::RobotId r) const;
 
  private:
   struct FieldTeamMessages;

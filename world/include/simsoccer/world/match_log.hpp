@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
@@ -27,7 +28,8 @@
 
 namespace simsoccer::world {
 
-constexpr uint32_t kMatchLogVersion = 1;
+// 2: per robot the LED colours a LoLA client set (chest, left eye, right eye).
+constexpr uint32_t kMatchLogVersion = 2;
 // Joint commands are applied at this resolution (rad; stiffness in 1/255),
 // so that the log holds exactly what the physics got.
 constexpr double kCommandResolution = 1e-4;
@@ -53,6 +55,9 @@ struct LoggedRobot {
   std::array<double, 25> command_position{};  // rad, actuator order, as applied
   std::array<double, 25> command_stiffness{};
   bool commanded = false;  // a command was applied this period
+  // The chest, left eye and right eye colours (RGB 0..255) a robot's
+  // software set through LoLA; none: no LED commands (drawn grey).
+  std::optional<std::array<uint8_t, 9>> leds;
 };
 
 struct LogFrame {

@@ -2,6 +2,7 @@
 // instanced unit primitives, and the robots' camera views.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@ struct SceneColours {
   Eigen::Vector3f robot{0.78f, 0.78f, 0.80f};
   Eigen::Vector3f ball{0.97f, 0.97f, 0.97f};
   std::vector<Eigen::Vector3f> jerseys{{0.10f, 0.20f, 0.90f}, {0.90f, 0.10f, 0.10f}};  // per team
+  // Per robot (RobotId), the LED colours its software set: chest, left eye,
+  // right eye (none or a missing entry: the LEDs are not drawn).
+  struct Leds {
+    Eigen::Vector3f chest, left_eye, right_eye;
+  };
+  std::vector<std::optional<Leds>> leds;
 };
 
 // The whole scene of the world's current state (appends to `items`).
