@@ -39,6 +39,8 @@ const char* kHelp =
     "                20, 50, 20)\n"
     "  --mode M      the control period: serial or pipelined (one period of actuation delay,\n"
     "                as in a match of that mode); default: the matches' (%s)\n"
+    "  --dt S, --control-period S  the physics step and control period (default 0.005 and\n"
+    "                0.010; a LoLA match runs 0.004 and 0.012)\n"
     "  --csv FILE    also write the table as CSV\n";
 
 }  // namespace
@@ -83,7 +85,9 @@ int benchMotion(int argc, char** argv, int first) {
                                   "motions",
                                   "snapshots",
                                   "block-trials",
-                                  "mode"};
+                                  "mode",
+                                  "dt",
+                                  "control-period"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first,
                     {"help", "verbose", "kick", "striker", "penalty", "block", "shootout"}, valued);
@@ -104,6 +108,9 @@ int benchMotion(int argc, char** argv, int first) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }
+  c.dt = opt.number("dt", 0.0);
+  c.control_period = opt.number("control-period", 0.0);
+  if (c.dt < 0 || c.control_period < 0) throw UsageError("--dt and --control-period must be > 0");
   const auto seed = static_cast<uint64_t>(opt.number("seed", 1));
   if (opt.has("get-up")) {  // one get-up, for tuning
     const std::string side = opt.get("get-up", "");

@@ -35,10 +35,16 @@ sim::SimulationConfig simulationConfig(sim::Mode mode) {
   c.mode = mode;
   return c;
 }
+
+world::Scenario withTiming(world::Scenario s, const TrialContext& c) {
+  if (c.dt > 0) s.physics.dt = c.dt;
+  if (c.control_period > 0) s.physics.control_period = c.control_period;
+  return s;
+}
 }  // namespace
 
 TrialWorld::TrialWorld(const world::Scenario& scenario, const TrialContext& context)
-    : world(scenario), simulation(world, simulationConfig(context.mode)) {
+    : world(withTiming(scenario, context)), simulation(world, simulationConfig(context.mode)) {
   simulation.addSource(driver);
 }
 
