@@ -8,6 +8,7 @@
 #include <ctime>
 
 #include "cli.hpp"
+#include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/match/outputs.hpp"
@@ -31,61 +32,7 @@ std::filesystem::path defaultOut() {
   return std::filesystem::path("runs") / buf;
 }
 
-const char* kMatchHelp =
-    "usage: simsoccer match CONFIG [--out DIR] [--seed N] [--realtime] [--external-agents]\n"
-    "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
-    "                       [--dds-config FILE] [--mode serial|pipelined] [--lola T:P,...]\n"
-    "                       [--lola-net] [--external-gc PORT] [--quiet]\n"
-    "\n"
-    "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
-    "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
-    "shoot-out if the rule book calls for it) and one simsoccer-agent process per robot over\n"
-    "DDS, in lockstep (--realtime: paced to the wall clock). Agents that exit are restarted\n"
-    "(agents.restart_limit times each); past that the match stops. Ctrl-C stops it too; what\n"
-    "was recorded is kept. Writes to DIR (default runs/<date-time>/):\n"
-    "  summary.json  teams, score, goals (time, scorer), referee events, penalties, falls,\n"
-    "                shoot-out keeper dives (down once the shot is kicked: not falls) and\n"
-    "                distance walked per robot, possession, agent restarts, simulated and\n"
-    "                wall time, real-time factor, seed, config hash, final state hash\n"
-    "  match.log     every control period (poses, joints, ball, game state, commands, state\n"
-    "                hash) and the referee events; `simsoccer replay` reads it\n"
-    "  match.mp4     the spectator camera rendered from the log, score and clock on top\n"
-    "  heatmap.png   ball and team positions over the game\n"
-    "  --half S            half duration in s (overrides the config)\n"
-    "  --max-seconds S     stop after S simulated seconds (a partial game, for trials)\n"
-    "  --lockstep-timeout S  wall seconds a period waits for the agents (overrides the\n"
-    "                config's lockstep.timeout; a missed answer changes the game, and\n"
-    "                summary.json counts them per robot: raise it on a loaded machine)\n"
-    "  --domain D          DDS domain id (default 0): one per match running side by side\n"
-    "  --external-agents   start no agents: wait for agents started elsewhere (same domain)\n"
-    "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"
-    "                configs/dds/loopback.xml; configs/dds/lan.xml for agents on other machines)\n"
-    "  --mode M            the control period: serial (the world steps with the answers to\n"
-    "                      this period's frames) or pipelined (with the last period's, while\n"
-    "                      the agents compute: one period of actuation delay); default %s\n"
-    "  --lola T:P,...      drive these robots (GameController team number:player) through\n"
-    "                      LoLA sockets under DIR/lola/ instead of agents: a team's robot\n"
-    "                      binary plays them (simsoccer lola-run); 12 ms control period\n"
-    "  --lola-net          and a field network for those binaries (root): GameController\n"
-    "                      packets, status and team messages over UDP (lola-run --net)\n"
-    "  --external-gc PORT  a real GameController runs the game (its packets on UDP PORT,\n"
-    "                      3838 on a field; 3939 stays free for it); real time\n"
-    "  --no-video          skip the video\n"
-    "  --quiet             no live status line (it is also off when stdout is not a terminal)\n";
 
-const char* kPenaltyHelp =
-    "usage: simsoccer penalty CONFIG [--kicks N] [--out DIR] [--seed N] [--video-kicks K]\n"
-    "                         [--domain D] [--dds-config FILE]\n"
-    "\n"
-    "Penalty kicks (configs/penalty.yaml): per kick a fresh world seeded SEED+k, the ball on\n"
-    "the penalty mark, a striker and a goalkeeper agent (simsoccer-agent --role auto, which\n"
-    "plays the penalty roles in the shoot-out phase), the shoot-out rules of the referee\n"
-    "(30 s per kick, the keeper on its line until the kick). Prints and writes the scoring\n"
-    "rate with a 95 % confidence interval (Wilson) and each kick's outcome (goal / saved /\n"
-    "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n"
-    "  --domain D          DDS domain id (default 0)\n"
-    "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"
-    "                      configs/dds/loopback.xml)\n";
 
 RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;

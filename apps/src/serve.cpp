@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "cli.hpp"
+#include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/match_runner.hpp"
@@ -17,41 +18,6 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
-    "usage: simsoccer serve SCENARIO|MATCH [--domain D] [--dds-config FILE] [--seconds S]\n"
-    "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
-    "                       [--limp-on-release] [--mode serial|pipelined]\n"
-    "                       [--lola T:P,... [--lola-net] [--out DIR]] [--external-gc PORT]\n"
-    "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
-    "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
-    "\n"
-    "Runs the world as a DDS simulator: waits until N robots (default: all) are claimed by\n"
-    "agents, then runs S simulated seconds (default 60) in lockstep (each period waits up to\n"
-    "--timeout s of wall time, default 0.5, for every owned robot's command) or, with\n"
-    "--realtime, paced to the wall clock with the latest commands. Ctrl-C stops it. Prints\n"
-    "each robot's command counters and the final state hash at the end. --seed overrides the\n"
-    "file's seed. --mode pipelined: the world steps with the answers to the previous period's\n"
-    "frames while the agents compute (one period of actuation delay; default serial).\n"
-    "\n"
-    "Given a match config (configs/match_5v5.yaml...), it serves that match: its scenario,\n"
-    "rule book, halves, teams, team-message delay and loss and lockstep timeout, with the\n"
-    "officials of `simsoccer match` (the whole game, a shoot-out if the rule book calls for\n"
-    "one), until the game is over or S s have passed (--half S: the half duration). Agents\n"
-    "started as the match starts them\n"
-    "play the same game: the same seed gives the same final state hash.\n"
-    "\n"
-    "Given a scenario, --rules (e.g. configs/rules/spl.yaml) adds the same officials (team 0\n"
-    "kicks off; --teams gives the GameController team numbers, default 1,2). The game state\n"
-    "goes to agents on the GameState topic, and with --gc-address also as GameController\n"
-    "packets over UDP (port 3838, every 0.5 simulated s; return packets on 3939), so robot\n"
-    "code written for the SPL GameController runs unchanged.\n"
-    "\n"
-    "--lola T:P,... (with a match config): these robots are driven through LoLA sockets under\n"
-    "DIR/lola/ (default DIR: runs/serve) by team binaries (simsoccer lola-run); --lola-net\n"
-    "adds the field network for them (GameController packets, status, team messages; root).\n"
-    "--external-gc PORT (with a match config or --rules): a real GameController runs the game;\n"
-    "its packets arrive on UDP PORT (3838), the simulator follows them in real time and\n"
-    "leaves 3939 to it; the automatic referee's calls are only reported.\n";
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
@@ -89,7 +55,7 @@ int serve(int argc, char** argv, int first) {
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
                      "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
                      "out", "external-gc"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kServeHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;

@@ -31,7 +31,7 @@ struct TrialContext {
   agents::KickParameters kick;
   bool verbose = false;  // a trace on stderr, for tuning
   // The physics step and control period (0: emptyField's 5 ms and 10 ms);
-  // 4 ms and 12 ms are a LoLA match's.
+  // 3 ms and 12 ms are a LoLA match's.
   double dt = 0.0, control_period = 0.0;
 };
 

@@ -65,7 +65,7 @@ struct MatchConfig {
   uint64_t seed = 1;
   int penalty_kicks = 0;  // > 0: a penalty-kick scenario (simsoccer penalty)
   // With LoLA robots the control period is LoLA's 12 ms (and the physics
-  // step 4 ms when the scenario's does not divide it).
+  // step 3 ms when the scenario's does not divide it).
   LolaSettings lola;
   // An external GameController runs the game (its packets on this UDP port,
   // normally 3838); the match then runs in real time.
