@@ -8,12 +8,12 @@
 //
 //   simsoccer-lola-test-client [--socket P] [--mode M] [--cycles N] [--after K]
 //       [--joint NAME=RAD]... [--stiffness S] [--expect-chest] [--print-id]
-//       [--expect-id BODY_ID]
+//       [--expect-id BODY_ID] [--ramp]
 // modes: hold (answer every map, full), partial (full once, then Position
 // alone, split over two writes, LEDs in a second map), probe (read one map,
 // disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
 // (unknown keys in every map), silent (stop answering for K cycles after K),
-// bump (hold, chest LEDs changing each cycle), gc (no LoLA: on a field
+// bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a field
 // network, receive a GameController packet on 3838, send a status packet to
 // --gc-host:3939, broadcast team messages to --broadcast:10000+team until
 // one from a teammate arrives; --team-number, --player).
@@ -74,6 +74,7 @@ struct Options {
   bool expect_chest = false, print_id = false;
   std::string expect_id;  // the body id the robot must report
   int team_number = 0, player = 0;
+  bool ramp = false;  // HeadYaw = 0.001 rad x the cycle: which cycle a command answers
   std::string gc_host, broadcast;
 };
 
@@ -180,6 +181,7 @@ int main(int argc, char** argv) {
     else if (a == "--stiffness") o.stiffness = std::stof(value());
     else if (a == "--expect-chest") o.expect_chest = true;
     else if (a == "--print-id") o.print_id = true;
+    else if (a == "--ramp") o.ramp = true;
     else if (a == "--expect-id") o.expect_id = value();
     else if (a == "--team-number") o.team_number = std::stoi(value());
     else if (a == "--player") o.player = std::stoi(value());
@@ -264,6 +266,10 @@ int main(int argc, char** argv) {
       silent_until = cycle + o.after;
     }
     if (cycle < silent_until) continue;  // reads, does not answer
+    if (o.mode == "late" && fault_now) {  // one answer after the simulator's timeout
+      faulted = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    }
     if (o.mode == "garbage" && fault_now) {
       faulted = true;
       const char junk[] = "\xc1\xc1\xc1 not msgpack";
@@ -284,6 +290,7 @@ int main(int argc, char** argv) {
     msgpack::sbuffer out;
     msgpack::packer<msgpack::sbuffer> p(out);
     std::vector<float> position = hold, stiffness(25, o.stiffness);
+    if (o.ramp) position[0] = 0.001f * static_cast<float>(cycle);
     if (o.mode == "nan" && fault_now) {
       faulted = true;
       position[0] = std::numeric_limits<float>::quiet_NaN();

@@ -422,6 +422,7 @@ TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
 // the whole game at LoLA's 12 ms cycle, the summary counts the client's maps
 // (and its unknown keys), and the log keeps the LED colours it set.
 TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
+  if (!test::bubblewrapWorks()) GTEST_SKIP() << "bubblewrap cannot make a namespace here";
   BackgroundMatch m("match_lola",
                     "--lola 2:1 --half 5 --max-seconds 20 --no-video --quiet --domain 97");
   const auto socket = m.dir / "lola" / "robot_2_1.sock";

@@ -404,16 +404,21 @@ TEST(Simulation, AnExternalGameControllerRunsTheGame) {
   // A packet for another game is not followed; a malformed one is counted.
   referee::ControlData other = d;
   other.teams[0].team_number = 99;
+  other.state = static_cast<uint8_t>(referee::gc::State::Finished);
+  other.teams[1].score = 7;
   gc.send(referee::encode(other));
   const std::array<uint8_t, 7> junk = {'R', 'G', 'm', 'e', 18, 0, 0};
   gc.send(junk);
   for (int i = 0; i < 20; ++i) simulation.period();
   EXPECT_EQ(officials.game().state(), referee::gc::State::Playing);
+  EXPECT_EQ(officials.game().score(0), 1);
   EXPECT_EQ(officials.externalGameController()->rejected(), 1u);
-  // Finished in the second half: over once the GameController has said nothing new for 30 s.
+  // Finished in the second half: over once the GameController has said nothing new for 60 s.
   d.first_half = 0;
   send(referee::gc::State::Finished, 100);
   EXPECT_FALSE(officials.over());
-  for (int i = 0; i < 3000; ++i) simulation.period();
+  for (int i = 0; i < 5000; ++i) simulation.period();
+  EXPECT_FALSE(officials.over());
+  for (int i = 0; i < 1000; ++i) simulation.period();
   EXPECT_TRUE(officials.over());
 }

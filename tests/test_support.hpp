@@ -38,6 +38,13 @@ inline std::string runCommand(const std::string& cmd, int& status) {
   status = pclose(p);
   return out;
 }
+// bubblewrap can make a mount namespace here (lola-run needs it; a
+// container without user namespaces cannot).
+inline bool bubblewrapWorks() {
+  int status = -1;
+  runCommand("bwrap --dev-bind / / --tmpfs /tmp true", status);
+  return status == 0;
+}
 inline std::string readFile(const std::filesystem::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

@@ -48,9 +48,9 @@ const char* kHelp =
     "  simsoccer lola-run --robot 2:1 --run runs/lola -- ./team-binary &\n"
     "  simsoccer lola-run --robot 2:2 --run runs/lola -- ./team-binary\n";
 
-volatile pid_t g_child = -1;
+volatile std::sig_atomic_t g_child = -1;  // a pid fits
 void forward(int signal) {
-  if (g_child > 0) ::kill(g_child, signal);
+  if (g_child > 0) ::kill(static_cast<pid_t>(g_child), signal);
 }
 
 std::string findBwrap() {
@@ -132,12 +132,26 @@ int lolaRun(int argc, char** argv, int first) {
     throw std::runtime_error("cannot run " + args[0]);
   }
   // With a namespace lola-run stays to remove it when the program ends, and
-  // passes the signals that end it on.
+  // passes the signals that end it on. They are blocked until the handler
+  // knows the child, so none can end lola-run before (and leave the namespace).
+  sigset_t ending, before;
+  sigemptyset(&ending);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&ending, s);
+  ::sigprocmask(SIG_BLOCK, &ending, &before);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setsigmask(&attributes, &before);  // the child starts unblocked
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   pid_t pid = -1;
-  if (posix_spawnp(&pid, cargs[0], nullptr, nullptr, cargs.data(), environ) != 0)
+  const int spawned = posix_spawnp(&pid, cargs[0], nullptr, &attributes, cargs.data(), environ);
+  posix_spawnattr_destroy(&attributes);
+  if (spawned != 0) {
+    ::sigprocmask(SIG_SETMASK, &before, nullptr);
     throw std::runtime_error("cannot run " + args[0]);
+  }
   g_child = pid;
   for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, forward);
+  ::sigprocmask(SIG_SETMASK, &before, nullptr);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }

@@ -71,11 +71,11 @@ bool merge(const msgpack::object& map, ActuatorValues& values, uint64_t& unknown
     bool ok = true;
     if (key == "Position") ok = readFloats(v, next.position), joints = true;
     else if (key == "Stiffness") ok = readFloats(v, next.stiffness), joints = true;
-    else if (key == "Chest") ok = readFloats(v, next.chest);
+    else if (key == "Chest") ok = readFloats(v, next.chest), next.leds_set = true;
     else if (key == "LFoot") ok = readFloats(v, next.lfoot);
     else if (key == "RFoot") ok = readFloats(v, next.rfoot);
-    else if (key == "LEye") ok = readFloats(v, next.leye);
-    else if (key == "REye") ok = readFloats(v, next.reye);
+    else if (key == "LEye") ok = readFloats(v, next.leye), next.leds_set = true;
+    else if (key == "REye") ok = readFloats(v, next.reye), next.leds_set = true;
     else if (key == "LEar") ok = readFloats(v, next.lear);
     else if (key == "REar") ok = readFloats(v, next.rear);
     else if (key == "Skull") ok = readFloats(v, next.skull);
@@ -87,6 +87,11 @@ bool merge(const msgpack::object& map, ActuatorValues& values, uint64_t& unknown
   // A NaN stays a NaN: the command gate refuses it.
   for (float& s : next.stiffness)
     if (!std::isnan(s)) s = std::clamp(s, 0.0f, 1.0f);
+  // LEDs are only shown: a NaN or an out-of-range colour is made harmless.
+  for (auto* leds : {next.chest.data(), next.lfoot.data(), next.rfoot.data()})
+    for (int k = 0; k < 3; ++k) leds[k] = std::isfinite(leds[k]) ? std::clamp(leds[k], 0.0f, 1.0f) : 0.0f;
+  for (auto* eye : {next.leye.data(), next.reye.data()})
+    for (int k = 0; k < 24; ++k) eye[k] = std::isfinite(eye[k]) ? std::clamp(eye[k], 0.0f, 1.0f) : 0.0f;
   values = next;
   unknown_keys += unknown;
   return true;
@@ -115,40 +120,48 @@ void ActuatorStream::restoreJoints(const std::array<float, kJoints>& position,
   values_.stiffness = stiffness;
 }
 
+void ActuatorStream::append(std::span<const uint8_t> bytes) {
+  msgpack::unpacker& u = unpacker_->unpacker;
+  u.reserve_buffer(bytes.size());
+  std::memcpy(u.buffer(), bytes.data(), bytes.size());
+  u.buffer_consumed(bytes.size());
+  counts_.bytes += bytes.size();
+  if (u.nonparsed_size() > kMaxIncomplete)
+    throw StreamError("lola: more than " + std::to_string(kMaxIncomplete) +
+                      " bytes of actuator maps wait (a map that long, or a flood)");
+}
+
+std::optional<bool> ActuatorStream::next() {
+  msgpack::unpacker& u = unpacker_->unpacker;
+  try {
+    msgpack::object_handle handle;
+    if (!u.next(handle)) return std::nullopt;
+    const msgpack::object& o = handle.get();
+    if (o.type != msgpack::type::MAP) throw StreamError("lola: an actuator message is not a map");
+    bool joints = false;
+    if (!merge(o, values_, counts_.unknown_keys, joints)) {
+      ++counts_.bad_maps;
+      return false;
+    }
+    ++counts_.maps;
+    counts_.joint_maps += joints;
+    return joints;
+  } catch (const msgpack::size_overflow& e) {
+    throw StreamError(std::string("lola: an actuator map is over the size limits (") + e.what() +
+                      ")");
+  } catch (const msgpack::unpack_error& e) {
+    throw StreamError(std::string("lola: not MessagePack (") + e.what() + ")");
+  }
+}
+
 std::size_t ActuatorStream::feed(std::span<const uint8_t> bytes) {
   std::size_t maps = 0;
-  msgpack::unpacker& u = unpacker_->unpacker;
-  while (!bytes.empty()) {
+  while (!bytes.empty()) {  // a chunk at a time: a hostile header fails before the rest is kept
     const std::size_t n = std::min(bytes.size(), kChunk);
-    u.reserve_buffer(n);
-    std::memcpy(u.buffer(), bytes.data(), n);
-    u.buffer_consumed(n);
+    append(bytes.first(n));
     bytes = bytes.subspan(n);
-    counts_.bytes += n;
-    try {
-      msgpack::object_handle handle;
-      while (u.next(handle)) {
-        const msgpack::object& o = handle.get();
-        if (o.type != msgpack::type::MAP)
-          throw StreamError("lola: an actuator message is not a map");
-        bool joints = false;
-        if (merge(o, values_, counts_.unknown_keys, joints)) {
-          ++counts_.maps;
-          counts_.joint_maps += joints;
-          ++maps;
-        } else {
-          ++counts_.bad_maps;
-        }
-      }
-      if (u.nonparsed_size() > kMaxIncomplete)
-        throw StreamError("lola: an actuator map longer than " + std::to_string(kMaxIncomplete) +
-                          " bytes");
-    } catch (const msgpack::size_overflow& e) {
-      throw StreamError(std::string("lola: an actuator map is over the size limits (") + e.what() +
-                        ")");
-    } catch (const msgpack::unpack_error& e) {
-      throw StreamError(std::string("lola: not MessagePack (") + e.what() + ")");
-    }
+    for (uint64_t before = counts_.maps; next(); before = counts_.maps)
+      maps += counts_.maps - before;  // merged maps (not those refused whole)
   }
   return maps;
 }

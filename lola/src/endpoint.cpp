@@ -6,6 +6,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -24,8 +25,14 @@ struct Endpoint::Client {
   bool has_latest = false;
   bool latest_sent = false;      // this period's map went out (or was dropped)
   BatteryModel battery;
-  uint64_t maps_seen = 0;        // the stream's joint maps when the period's map went out
-  int missed_in_row = 0;
+  // Sensor maps sent whose answer (a map that sets joints) has not come yet:
+  // 1 after a map goes out; 2 when the last cycle's answer is also late (a
+  // late answer is taken for its own cycle, not the next one; older ones
+  // are forgiven).
+  int owed = 0;
+  bool new_joints = false;  // a map that sets joints was taken since the last collect
+  int missed_in_row = 0, answered_in_row = 0;
+  bool unresponsive = false;  // lockstep does not wait for it until it answers again
   std::array<float, kJoints> accepted_position{}, accepted_stiffness{};
   RobotLolaStats stats;
   Client(const RobotSocket& c) : config(c), battery(c.battery_charge) {}
@@ -47,7 +54,10 @@ int listenOn(const std::filesystem::path& path) {
   std::memcpy(address.sun_path, p.c_str(), p.size() + 1);
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
-  std::filesystem::remove(path, ec);  // a socket left by an earlier run
+  if (std::filesystem::is_socket(path, ec))
+    std::filesystem::remove(path, ec);  // a socket left by an earlier run
+  else if (std::filesystem::exists(path, ec))
+    throw std::invalid_argument("lola: '" + p + "' exists and is not a socket");
   const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) throw std::runtime_error("lola: socket: " + errnoText());
   if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
@@ -61,7 +71,7 @@ int listenOn(const std::filesystem::path& path) {
 }  // namespace
 
 Endpoint::Endpoint(const world::World& world, EndpointConfig config)
-    : world_(world), config_(std::move(config)), cycle_seconds_(world.scenario().physics.control_period) {
+    : config_(std::move(config)), cycle_seconds_(world.scenario().physics.control_period) {
   if (std::abs(cycle_seconds_ - kCycleSeconds) > 1e-9)
     throw std::invalid_argument(
         "lola: LoLA robots need a 12 ms control period (physics.control_period: 0.012 in the "
@@ -92,7 +102,11 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     }
   } catch (...) {
     for (Client& c : clients_)
-      if (c.listen_fd >= 0) ::close(c.listen_fd);
+      if (c.listen_fd >= 0) {
+        ::close(c.listen_fd);
+        std::error_code ec;
+        std::filesystem::remove(c.config.socket, ec);
+      }
     throw;
   }
 }
@@ -136,7 +150,9 @@ void Endpoint::startSession(Client& c, int fd) {
   c.fd = fd;
   ++c.stats.sessions;
   c.unsent.clear();
-  c.missed_in_row = 0;
+  c.owed = 0;
+  c.missed_in_row = c.answered_in_row = 0;
+  c.unresponsive = false;
   ActuatorValues initial = c.stream.values();
   initial.position = c.accepted_position;
   initial.stiffness = c.accepted_stiffness;
@@ -146,7 +162,6 @@ void Endpoint::startSession(Client& c, int fd) {
   c.stats.bad_maps += before.bad_maps;
   c.stats.unknown_keys += before.unknown_keys;
   c.stats.bytes_received += before.bytes;
-  c.maps_seen = 0;
   if (c.has_latest) send(c);  // LoLA speaks first
 }
 
@@ -154,7 +169,7 @@ void Endpoint::endSession(Client& c) {
   if (c.fd < 0) return;
   ::close(c.fd);
   c.fd = -1;
-  c.unsent.clear();
+  c.unsent.clear();  // what the client sent before it went is still taken (parse)
 }
 
 void Endpoint::acceptAll() {
@@ -182,25 +197,27 @@ void Endpoint::flush(Client& c) {
 void Endpoint::send(Client& c) {
   flush(c);
   if (c.fd < 0) return;
+  c.latest_sent = true;
   if (!c.unsent.empty()) {  // the client is not reading: this map is dropped whole
-    c.latest_sent = true;
     ++c.stats.packets_dropped;
     return;
   }
-  c.latest_sent = true;
   c.unsent.assign(c.latest.begin(), c.latest.end());
   flush(c);
   ++c.stats.packets_sent;
-  c.maps_seen = c.stream.counts().joint_maps;
+  c.owed = std::min(c.owed, 1) + 1;
 }
 
 bool Endpoint::receive(Client& c) {
+  // At most 64 KiB per call: a client that writes faster than it is read
+  // cannot keep the period here (the stream ends it past its limit).
   uint8_t buffer[4096];
-  for (;;) {
+  for (std::size_t taken = 0; taken < 64 * 1024;) {
     const ssize_t n = ::recv(c.fd, buffer, sizeof buffer, MSG_DONTWAIT);
     if (n > 0) {
+      taken += static_cast<std::size_t>(n);
       try {
-        c.stream.feed(std::span<const uint8_t>(buffer, static_cast<std::size_t>(n)));
+        c.stream.append(std::span<const uint8_t>(buffer, static_cast<std::size_t>(n)));
       } catch (const StreamError&) {
         ++c.stats.stream_errors;
         endSession(c);
@@ -211,6 +228,26 @@ bool Endpoint::receive(Client& c) {
     if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return true;
     endSession(c);  // closed (0) or failed
     return false;
+  }
+  return true;
+}
+
+void Endpoint::parse(Client& c, bool until_answered) {
+  // In lockstep the maps after a cycle's answer wait for the next period:
+  // what a period applies then depends on the stream's order alone, not on
+  // when the bytes came.
+  try {
+    while (!(until_answered && c.owed == 0)) {
+      const std::optional<bool> joints = c.stream.next();
+      if (!joints) break;
+      if (*joints) {
+        c.new_joints = true;
+        if (c.owed > 0) --c.owed;
+      }
+    }
+  } catch (const StreamError&) {
+    ++c.stats.stream_errors;
+    endSession(c);
   }
 }
 
@@ -233,7 +270,10 @@ bool Endpoint::pollOnce(Clock::time_point deadline, bool wait) {
     if (fds[2 * i].revents & POLLIN) acceptAll();
     if (c.fd >= 0 && fds[2 * i + 1].fd == c.fd) {
       if (fds[2 * i + 1].revents & POLLOUT) flush(c);
-      if (c.fd >= 0 && (fds[2 * i + 1].revents & (POLLIN | POLLHUP | POLLERR))) receive(c);
+      if (c.fd >= 0 && (fds[2 * i + 1].revents & (POLLIN | POLLHUP | POLLERR))) {
+        receive(c);
+        parse(c, config_.lockstep);
+      }
     }
   }
   return true;
@@ -258,19 +298,20 @@ void Endpoint::observe(const sim::Observation& o) {
   }
   observed_ = true;
   acceptAll();  // a new client gets this map at once
-  for (Client& c : clients_)
+  for (Client& c : clients_) {
+    // A late answer to the last cycle that has come meanwhile is taken for
+    // that cycle before this cycle's map goes out.
+    if (c.fd >= 0) {
+      receive(c);
+      parse(c, config_.lockstep);
+    }
     if (c.fd >= 0 && !c.latest_sent) send(c);
+  }
 }
 
 void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
-  // An answer sets joints: maps of LEDs or sonars alone (rUNSWift sends its
-  // sonar map after its joint map) merge in but do not answer a cycle, so a
-  // late one cannot stand in for the next cycle's joints.
-  const auto answered = [](const Client& c) {
-    return c.stream.counts().joint_maps > c.maps_seen;
-  };
   const auto awaited = [&](const Client& c) {
-    return c.fd >= 0 && c.missed_in_row < config_.unresponsive_after && !answered(c);
+    return c.fd >= 0 && c.owed > 0 && !c.unresponsive;
   };
   if (config_.lockstep) {
     const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -280,25 +321,33 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
       for (const Client& c : clients_) waiting = waiting || awaited(c);
       if (!waiting || !pollOnce(deadline, true)) break;
     }
+  } else {
+    for (Client& c : clients_) {  // whatever has arrived
+      if (c.fd >= 0) receive(c);
+      parse(c, false);
+    }
   }
-  pollOnce(Clock::now(), false);  // whatever else has arrived
   for (Client& c : clients_) {
     sim::CommandSlot& slot = slots[c.config.robot];
-    if (c.fd < 0 && !answered(c)) {
-      ++c.stats.no_client;
-      continue;  // holds its last command
-    }
-    if (!answered(c)) {
-      if (config_.lockstep) {
+    const bool answered = c.new_joints && (!config_.lockstep || c.owed == 0);
+    c.new_joints = false;
+    if (!answered) {
+      if (c.fd < 0) {
+        ++c.stats.no_client;  // holds its last command
+      } else if (config_.lockstep) {
         ++c.stats.missed;
-        ++c.missed_in_row;
+        c.answered_in_row = 0;
+        // Three misses in a row: not waited for until it answers three
+        // periods in a row (a client that answers now and then cannot slow
+        // the game by the timeout every few periods).
+        if (++c.missed_in_row >= config_.unresponsive_after) c.unresponsive = true;
         slot.answer = sim::Answer::Missed;
       }
       continue;
     }
     ++c.stats.answered;
     c.missed_in_row = 0;
-    c.maps_seen = c.stream.counts().joint_maps;
+    if (++c.answered_in_row >= config_.unresponsive_after) c.unresponsive = false;
     const ActuatorValues& v = c.stream.values();
     auto command = gate.check(c.config.robot, std::span<const float>(v.position),
                               std::span<const float>(v.stiffness));

@@ -4,7 +4,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <fcntl.h>
+#include <filesystem>
 #include <stdexcept>
 
 extern char** environ;
@@ -25,7 +28,7 @@ std::string FieldNetwork::namespaceName(int team_number, int player) const {
 
 std::string runTool(const std::vector<std::string>& args) {
   int pipe_fds[2];
-  if (::pipe(pipe_fds) != 0) throw std::runtime_error("pipe failed");
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
@@ -44,7 +47,9 @@ std::string runTool(const std::vector<std::string>& args) {
     out.append(buffer, static_cast<size_t>(n));
   ::close(pipe_fds[0]);
   int status = -1;
-  if (spawned == 0) ::waitpid(pid, &status, 0);
+  if (spawned == 0)
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
   if (spawned != 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     std::string line;
     for (const std::string& a : args) line += (line.empty() ? "" : " ") + a;
@@ -65,7 +70,11 @@ void quietly(const std::vector<std::string>& args) {
 }  // namespace
 
 FieldBridge::FieldBridge(const FieldNetwork& net) : net_(net) {
-  quietly({"ip", "link", "del", net_.bridge});
+  // Another run's bridge (or a killed run's) is not taken over.
+  if (std::filesystem::exists("/sys/class/net/" + net_.bridge))
+    throw std::runtime_error("field network: '" + net_.bridge +
+                             "' exists: another run uses it (a killed run's: ip link del " +
+                             net_.bridge + ")");
   runTool({"ip", "link", "add", net_.bridge, "type", "bridge"});
   try {
     runTool({"ip", "addr", "add", net_.hostAddress() + "/16", "broadcast", net_.broadcast(), "dev",

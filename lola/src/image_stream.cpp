@@ -3,10 +3,12 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 
@@ -37,8 +39,10 @@ struct ImageStreams::Server {
   };
   std::vector<Client> clients;
   ImageStreamStats stats;
-  // Frames a client may have unsent before new ones are dropped (whole).
+  // Frames a client may have unsent before new ones are dropped (whole), and
+  // clients per camera (each may hold that much memory).
   static constexpr std::size_t kQueue = 3;
+  static constexpr std::size_t kMaxClients = 4;
 
   Server(const std::string& bind, uint16_t wanted) {
     listen_fd = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -65,6 +69,10 @@ struct ImageStreams::Server {
   }
   void accept() {
     for (int fd; (fd = ::accept4(listen_fd, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC)) >= 0;) {
+      if (clients.size() >= kMaxClients) {
+        ::close(fd);
+        continue;
+      }
       const int yes = 1;
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
       clients.push_back({fd, {}});
@@ -82,6 +90,27 @@ struct ImageStreams::Server {
       return n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR);
     }
     return true;
+  }
+  // Writes what is unsent, waiting for each client until `deadline` (a
+  // client still behind then keeps its tail for later); drops clients gone.
+  void flushAll(std::chrono::steady_clock::time_point deadline) {
+    for (std::size_t i = 0; i < clients.size();) {
+      Client& c = clients[i];
+      bool alive = flush(c);
+      while (alive && !c.unsent.empty()) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
+        pollfd p{c.fd, POLLOUT, 0};
+        if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+        alive = flush(c);
+      }
+      if (!alive) {
+        ::close(c.fd);
+        clients.erase(clients.begin() + static_cast<long>(i));
+        continue;
+      }
+      ++i;
+    }
   }
   void send(const world::CameraImage& image) {
     accept();
@@ -141,10 +170,17 @@ void ImageStreams::deliver(const world::CameraImage& image) {
 }
 
 void ImageStreams::observe(const sim::Observation&) {
-  // The images of this tick are out before the world steps past it.
-  sim_.flushCameras();
+  // Lockstep: the images of this tick are rendered and written before the
+  // world steps past it (a client too slow for that keeps the rest for
+  // later, and loses frames once three are queued). Real time: images go
+  // out as they are rendered.
+  const bool lockstep = sim_.config().lockstep;
+  if (lockstep) sim_.flushCameras();  // delivers on this thread's watch (deliver() locks)
   std::lock_guard lock(mutex_);
   for (auto& s : servers_) s->accept();
+  if (!lockstep) return;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+  for (auto& s : servers_) s->flushAll(deadline);
 }
 
 uint16_t ImageStreams::port(std::size_t i, world::CameraId camera) const {

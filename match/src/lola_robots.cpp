@@ -36,6 +36,24 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
     return std::to_string(c.lola.robots[i].team_number) + ":" +
            std::to_string(c.lola.robots[i].player);
   };
+  // Everything that can fail is made before anything joins `sim`.
+  if (c.lola.network) {
+    const lola::FieldNetwork net;
+    for (const LolaPlayer& p : c.lola.robots) net.robotAddress(p.team_number, p.player);  // throws
+    bridge_ = std::make_unique<lola::FieldBridge>(net);
+    // With an external GameController it broadcasts to the robots itself
+    // (choose this bridge as its network interface) and counts their
+    // messages; the simulator only makes the network.
+    if (!c.external_gc_port) {
+      referee::GameControllerLinkConfig gc;
+      gc.address = net.broadcast();
+      gc.return_bind = net.hostAddress();
+      gc.team_message_bind = net.broadcast();
+      link_ = std::make_unique<referee::GameControllerLink>(gc);
+      link_->update(session.game());  // binds every port now, and sends the first packet
+      team_messages_ = std::make_unique<FieldTeamMessages>(*link_, session);
+    }
+  }
   lola::EndpointConfig ec;
   ec.lockstep = lockstep;
   ec.answer_timeout = c.command_timeout;
@@ -47,10 +65,6 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
     ec.robots.push_back(rs);
   }
   endpoint_ = std::make_unique<lola::Endpoint>(session.world(), ec);
-  sim.addSource(*endpoint_);
-  for (size_t i = 0; i < ec.robots.size(); ++i)
-    say("LoLA robot " + name(i) + " at " + ec.robots[i].socket.string());
-
   if (session.world().scenario().cameras.enabled) {
     std::vector<lola::ImagePorts> ports;
     for (size_t k = 0; k < ec.robots.size(); ++k) {
@@ -59,22 +73,19 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
       say("LoLA robot " + name(k) + " images on TCP ports " + std::to_string(top) + " (top) and " +
           std::to_string(top + 1) + " (bottom)");
     }
-    images_ = std::make_unique<lola::ImageStreams>(sim, ports);
+    images_ = std::make_unique<lola::ImageStreams>(sim, ports);  // joins sim last of all
   }
-
-  if (c.lola.network) {
-    const lola::FieldNetwork net;
-    bridge_ = std::make_unique<lola::FieldBridge>(net);
-    referee::GameControllerLinkConfig gc;
-    gc.address = net.broadcast();
-    gc.return_bind = net.hostAddress();
-    gc.team_message_bind = net.broadcast();
-    link_ = std::make_unique<referee::GameControllerLink>(gc);
-    team_messages_ = std::make_unique<FieldTeamMessages>(*link_, session);
-    sim.addSource(*team_messages_);
-    say("field network " + net.bridge + ": GameController packets to " + net.broadcast() +
-        ":3838, status to " + net.hostAddress() + ":3939; robots at " + net.prefix +
-        ".TEAM.PLAYER (simsoccer lola-run --net)");
+  sim.addSource(*endpoint_);
+  if (team_messages_) sim.addSource(*team_messages_);
+  for (size_t i = 0; i < ec.robots.size(); ++i)
+    say("LoLA robot " + name(i) + " at " + ec.robots[i].socket.string());
+  if (bridge_) {
+    const lola::FieldNetwork& net = bridge_->network();
+    say("field network " + net.bridge + ": robots at " + net.prefix +
+        ".TEAM.PLAYER (simsoccer lola-run --net), the host at " + net.hostAddress() +
+        (link_ ? "; GameController packets to " + net.broadcast() + ":3838, status to " +
+                     net.hostAddress() + ":3939"
+               : "; the external GameController broadcasts on " + net.bridge));
   }
 }
 
@@ -88,8 +99,8 @@ std::optional<std::array<uint8_t, 9>> LolaRobots::leds(world::RobotId r) const {
   const auto& robots = session_.lolaRobots();
   for (size_t i = 0; i < robots.size(); ++i) {
     if (robots[i] != r) continue;
-    if (endpoint_->stats(i).maps == 0) return std::nullopt;
     const lola::ActuatorValues& v = endpoint_->actuators(i);
+    if (!v.leds_set) return std::nullopt;
     const auto byte = [](double x) {
       return static_cast<uint8_t>(std::lround(std::clamp(x, 0.0, 1.0) * 255.0));
     };

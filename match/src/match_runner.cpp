@@ -117,9 +117,11 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   std::vector<std::unique_ptr<ChildProcess>> lola_clients;
   for (size_t i = 0; lola_robots && i < c.lola.robots.size() && !c.lola.client.empty(); ++i) {
     std::vector<std::string> args;
+    const std::string socket = lolaSocketPath(o.out, c.lola.robots[i]).string();
     for (std::string a : c.lola.client) {
-      for (size_t at = a.find("{socket}"); at != std::string::npos; at = a.find("{socket}"))
-        a.replace(at, 8, lolaSocketPath(o.out, c.lola.robots[i]).string());
+      for (size_t at = a.find("{socket}"); at != std::string::npos;
+           at = a.find("{socket}", at + socket.size()))
+        a.replace(at, 8, socket);
       args.push_back(a);
     }
     lola_clients.push_back(std::make_unique<ChildProcess>(args));

@@ -693,10 +693,12 @@ void Game::follow(const ControlData& d) {
       p.remaining = r.secs_till_unpenalised;
     }
   }
-  // The game is over when the GameController finishes the second half (a
-  // shoot-out it starts later opens it again).
-  game_over_ = state_ == gc::State::Finished && phase_ == gc::GamePhase::Normal &&
-               half_ == Half::Second;
+  // The game is over when the GameController finishes the second half, or a
+  // shoot-out or overtime (a shoot-out it starts later opens it again; the
+  // officials wait a while before they call the game over).
+  game_over_ = state_ == gc::State::Finished &&
+               (half_ == Half::Second || phase_ != gc::GamePhase::Normal);
+  stopped_ = d.stopped != 0;
   if (game_over_) {
     if (score_[0] != score_[1]) winner_ = score_[0] > score_[1] ? 0 : 1;
   }
@@ -718,8 +720,9 @@ ControlData Game::packet(uint8_t packet_number) const {
   // A play-off ("long") game stops the clock in Ready and Set.
   d.competition_phase = rules_.clock_in_ready_and_set ? 0 : 1;
   d.competition_type = rules_.competition_type;
-  // The simulator's referee places the ball at once: play is never stopped.
-  d.stopped = 0;
+  // The simulator's referee places the ball at once: play is stopped only
+  // when an external (HSL) GameController that is followed says so.
+  d.stopped = stopped_ ? 1 : 0;
   d.players_per_team = static_cast<uint8_t>(rules_.players_per_team);
   d.game_phase = static_cast<uint8_t>(phase_);
   d.state = static_cast<uint8_t>(state_);

@@ -679,6 +679,10 @@ void Referee::update() {
   std::vector<RefereeEvent> calls(game_.events().begin() + static_cast<long>(seen),
                                   game_.events().end());
   game_ = std::move(truth);
+  // The referee's memory of the state follows the truth, not its copy (else
+  // a whistle the GameController has not made would enter Set again every
+  // period: ball and robots re-placed).
+  if (last_state_ != game_.state()) last_state_ = game_.state();
   // A call the referee keeps making (the GameController has not followed it)
   // is reported when it is first made, not every period.
   std::vector<std::string> made;

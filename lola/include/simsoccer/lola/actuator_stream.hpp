@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -28,6 +29,7 @@ struct ActuatorValues {
   std::array<float, 10> lear{}, rear{};                // ring segments
   std::array<float, 12> skull{};
   std::array<bool, 2> sonar{true, true};  // emitters on
+  bool leds_set = false;                  // a Chest or eye colour was received
 };
 
 struct StreamCounts {
@@ -53,8 +55,14 @@ class ActuatorStream {
   ActuatorStream(ActuatorStream&&) noexcept;
   ActuatorStream& operator=(ActuatorStream&&) noexcept;
 
-  // Bytes as they arrive; returns the number of complete maps among them
-  // (merged into values() in order). Throws StreamError.
+  // Bytes as they arrive, kept until parsed. Throws StreamError when more
+  // than 64 KiB wait (a real actuator map is under 1 KiB).
+  void append(std::span<const uint8_t> bytes);
+  // Parses the next complete map and merges it into values(): none when no
+  // complete map waits; else whether it set joints (Position or Stiffness;
+  // a map refused whole sets none). Throws StreamError.
+  std::optional<bool> next();
+  // append() and next() until no complete map waits; the number of maps.
   std::size_t feed(std::span<const uint8_t> bytes);
   const ActuatorValues& values() const { return values_; }
   // Puts the joint values back (a merged command the gate refused).

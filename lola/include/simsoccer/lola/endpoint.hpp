@@ -37,7 +37,7 @@ struct EndpointConfig {
   bool lockstep = true;
   double answer_timeout = 0.5;  // s of wall time a lockstep period waits for an answer
   // Lockstep stops waiting for a client that missed this many periods in a
-  // row (it is hung or stopped), until it answers again.
+  // row (it is hung or stopped), until it answers this many in a row again.
   int unresponsive_after = 3;
   // Sensor maps a client may leave unread before new ones are dropped
   // (whole, so the stream stays framed), as LoLA ignores a client that does not read.
@@ -88,11 +88,12 @@ class Endpoint : public sim::CommandSource {
   void endSession(Client& c);
   void send(Client& c);
   void flush(Client& c);
-  // Reads what the client sent; false when the session ended.
+  // Reads what the client sent (up to 64 KiB); false when the session ended.
   bool receive(Client& c);
+  // Takes the maps read so far, in lockstep up to this cycle's answer.
+  void parse(Client& c, bool until_answered);
   bool pollOnce(Clock::time_point deadline, bool wait);
 
-  const world::World& world_;
   EndpointConfig config_;
   std::vector<Client> clients_;
   double cycle_seconds_;

@@ -227,6 +227,7 @@ class Game {
   std::array<int, 2> incremental_{};  // incremental penalties so far, per team
   std::array<int, 2> timeouts_left_{1, 1};
   std::array<uint64_t, 2> messages_sent_{};
+  bool stopped_ = false;  // an external HSL GameController stopped play
   double half_clock_ = 0.0, secondary_ = 0.0, time_ = 0.0;
   // Shoot-out.
   int first_shooter_ = 0, shootout_kicks_ = 3, striker_ = 0, keeper_ = 0;

@@ -33,8 +33,9 @@ struct OfficialsConfig {
   // and the referee's own calls are reported only (referee::Referee::follow).
   std::optional<uint16_t> external_gc_port;
   // With an external GameController the game is over this many seconds
-  // after the GameController finished it (it may still start a shoot-out).
-  double external_end_wait = 30.0;
+  // after the GameController finished it and said nothing new (it may still
+  // start a shoot-out).
+  double external_end_wait = 60.0;
 };
 
 class GameOfficials : public Officials {
