@@ -81,6 +81,19 @@ struct Rig {
   }
 };
 
+// Robots 0 and 1 as team 5's players 1 and 2, sockets in `dir`.
+lola::EndpointConfig teamFiveConfig(const std::filesystem::path& dir) {
+  lola::EndpointConfig c;
+  for (world::RobotId r = 0; r < 2; ++r) {
+    lola::RobotSocket rs;
+    rs.robot = r;
+    rs.socket = dir / ("robot_" + std::to_string(r) + ".sock");
+    rs.identity = lola::defaultIdentity(5, static_cast<int>(r) + 1);
+    c.robots.push_back(rs);
+  }
+  return c;
+}
+
 }  // namespace
 
 TEST(LolaEndpoint, AJointFollowsItsCommandAndEveryMapPassesTheStrictClient) {
@@ -221,21 +234,17 @@ TEST(LolaRun, TwoBinariesAtOnceEachSeeTheirOwnRobotAtTmpRobocup) {
   test::TempDir dir("lola_run");
   world::World world(lolaScenario());
   sim::Simulation sim(world);
-  lola::EndpointConfig c;
-  for (world::RobotId r = 0; r < 2; ++r) {
-    lola::RobotSocket rs;
-    rs.robot = r;
-    rs.socket = dir.path() / ("robot_" + std::to_string(r) + ".sock");
-    rs.identity = lola::defaultIdentity(5, static_cast<int>(r) + 1);
-    c.robots.push_back(rs);
-  }
+  const lola::EndpointConfig c = teamFiveConfig(dir.path());
   lola::Endpoint endpoint(world, c);
   sim.addSource(endpoint);
+  // The binary under /tmp, as a team's build may be: the namespace must not hide it.
+  const auto client = dir.path() / "team-binary";
+  std::filesystem::copy_file(SIMSOCCER_LOLA_CLIENT, client);
   std::vector<std::unique_ptr<match::ChildProcess>> clients;
   for (world::RobotId r = 0; r < 2; ++r)
     clients.push_back(std::make_unique<match::ChildProcess>(std::vector<std::string>{
-        SIMSOCCER_BIN, "lola-run", "--socket", c.robots[r].socket.string(), "--",
-        SIMSOCCER_LOLA_CLIENT, "--expect-id", c.robots[r].identity.body_id, "--cycles", "50"}));
+        SIMSOCCER_BIN, "lola-run", "--socket", c.robots[r].socket.string(), "--", client.string(),
+        "--expect-id", c.robots[r].identity.body_id, "--cycles", "50"}));
   ASSERT_TRUE(endpoint.waitForClients(20.0)) << "the clients did not connect through lola-run";
   for (int i = 0; i < 500 && (clients[0]->running() || clients[1]->running()); ++i) sim.period();
   for (auto& client : clients) {
@@ -344,14 +353,7 @@ TEST(LolaRun, TeamBinariesOnTheFieldNetworkGetTheGameAndTalk) {
   net.link_prefix = "st";
   lola::FieldBridge bridge(net);
   world::World world(lolaScenario());
-  lola::EndpointConfig c;
-  for (world::RobotId r = 0; r < 2; ++r) {
-    lola::RobotSocket rs;
-    rs.robot = r;
-    rs.socket = dir.path() / ("robot_" + std::to_string(r) + ".sock");
-    rs.identity = lola::defaultIdentity(5, static_cast<int>(r) + 1);
-    c.robots.push_back(rs);
-  }
+  const lola::EndpointConfig c = teamFiveConfig(dir.path());
   lola::Endpoint endpoint(world, c);  // the sockets lola-run binds
   const referee::RuleBook rules =
       referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");

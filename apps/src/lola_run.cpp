@@ -1,9 +1,9 @@
 // simsoccer lola-run: starts a team's robot binary attached to one simulated
 // Nao. Team code hard-codes LoLA's socket at /tmp/robocup, and a match needs
 // up to 14 such binaries on one machine, so each gets a private mount
-// namespace (bubblewrap, from Debian) in which that robot's socket is
-// /tmp/robocup and /tmp is its own. The rest of the file system, the
-// network and the user are the machine's.
+// namespace (bubblewrap, from Debian) in which that robot's socket is bound
+// at /tmp/robocup. The rest of the file system (the program may live under
+// /tmp), the network (unless --net) and the user are the machine's.
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -33,8 +33,8 @@ const char* kHelp =
     "                          [--net [--bridge NAME] [--prefix A.B]] -- PROGRAM [ARGS...]\n"
     "\n"
     "Runs PROGRAM with a simulated robot's LoLA socket at /tmp/robocup, as on a Nao, in a\n"
-    "private mount namespace (bubblewrap): its /tmp is its own, so several team binaries run\n"
-    "side by side, each seeing its own robot. --robot T:P names the robot (GameController team\n"
+    "private mount namespace (bubblewrap), so several team binaries run side by side, each\n"
+    "seeing its own robot there (the rest of the file system is the machine's). --robot T:P names the robot (GameController team\n"
     "number:player) of the match writing to DIR (default runs/serve; the socket is\n"
     "DIR/lola/robot_T_P.sock), --socket gives the socket itself. Waits up to S s (default\n"
     "60) for the simulator to open the socket. The program's exit status is lola-run's.\n"
@@ -115,9 +115,10 @@ int lolaRun(int argc, char** argv, int first) {
                 netns->name().c_str());
     args = {"ip", "netns", "exec", netns->name()};
   }
+  // The machine as it is (the program and its files may be anywhere, /tmp
+  // too), but for the robot's socket at /tmp/robocup.
   const std::vector<std::string> sandbox = {bwrap,
-                                   "--dev-bind", "/", "/",             // the machine as it is
-                                   "--tmpfs", "/tmp",                  // but a /tmp of its own
+                                   "--dev-bind", "/", "/",
                                    "--bind", socket.string(), "/tmp/robocup",
                                    "--chdir", std::filesystem::current_path().string(),
                                    "--unshare-pid", "--die-with-parent", "--"};

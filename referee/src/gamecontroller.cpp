@@ -11,45 +11,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "little_endian.hpp"
+#include "packet_io.hpp"
 
 namespace simsoccer::referee {
-namespace {
-
-void writeTeam(Out& o, const TeamInfo& t) {
-  o.u8(t.team_number);
-  o.u8(t.field_player_colour);
-  o.u8(t.goalkeeper_colour);
-  o.u8(t.goalkeeper);
-  o.u8(t.score);
-  o.u8(t.penalty_shot);
-  o.u16(t.single_shots);
-  o.u16(t.message_budget);
-  for (const RobotInfo& r : t.players) {
-    o.u8(r.penalty);
-    o.u8(r.secs_till_unpenalised);
-  }
-}
-
-TeamInfo readTeam(In& in) {
-  TeamInfo t;
-  t.team_number = in.u8();
-  t.field_player_colour = in.u8();
-  t.goalkeeper_colour = in.u8();
-  t.goalkeeper = in.u8();
-  t.score = in.u8();
-  t.penalty_shot = in.u8();
-  t.single_shots = in.u16();
-  t.message_budget = in.u16();
-  for (RobotInfo& r : t.players) {
-    r.penalty = in.u8();
-    r.secs_till_unpenalised = in.u8();
-  }
-  return t;
-}
-
-}  // namespace
-
 std::array<uint8_t, kControlSize> encode(const ControlData& d) {
   std::array<uint8_t, kControlSize> b{};
   Out o(b);
@@ -66,7 +30,7 @@ std::array<uint8_t, kControlSize> encode(const ControlData& d) {
   o.u8(d.kicking_team);
   o.i16(d.secs_remaining);
   o.i16(d.secondary_time);
-  for (const TeamInfo& t : d.teams) writeTeam(o, t);
+  for (const TeamInfo& t : d.teams) writeTeam(o, t, false);
   return b;
 }
 
@@ -95,7 +59,7 @@ ControlData decodeControl(std::span<const uint8_t> bytes) {
   d.kicking_team = in.u8();
   d.secs_remaining = in.i16();
   d.secondary_time = in.i16();
-  for (TeamInfo& t : d.teams) t = readTeam(in);
+  for (TeamInfo& t : d.teams) t = readTeam(in, false);
   if (d.game_phase > 3)
     throw PacketError("control packet: gamePhase " + std::to_string(d.game_phase));
   if (d.state > 5) throw PacketError("control packet: state " + std::to_string(d.state));

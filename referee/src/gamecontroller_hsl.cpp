@@ -5,7 +5,7 @@
 // competitionType's byte by `stopped`; RobotInfo grows warnings and cautions.
 #include <cstring>
 
-#include "little_endian.hpp"
+#include "packet_io.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 
 namespace simsoccer::referee {
@@ -119,22 +119,7 @@ std::array<uint8_t, hsl::kControlSize> encodeHsl(const ControlData& d) {
   o.u8(d.kicking_team);
   o.i16(d.secs_remaining);
   o.i16(d.secondary_time);
-  for (const TeamInfo& t : d.teams) {
-    o.u8(t.team_number);
-    o.u8(t.field_player_colour);
-    o.u8(t.goalkeeper_colour);
-    o.u8(t.goalkeeper);
-    o.u8(t.score);
-    o.u8(t.penalty_shot);
-    o.u16(t.single_shots);
-    o.u16(t.message_budget);
-    for (const RobotInfo& r : t.players) {
-      o.u8(hsl::penaltyFromSpl(r.penalty));
-      o.u8(r.secs_till_unpenalised);
-      o.u8(r.warnings);
-      o.u8(r.cautions);
-    }
-  }
+  for (const TeamInfo& t : d.teams) writeTeam(o, t, true);
   return b;
 }
 
@@ -162,24 +147,7 @@ ControlData decodeHsl(std::span<const uint8_t> bytes) {
   d.kicking_team = in.u8();
   d.secs_remaining = in.i16();
   d.secondary_time = in.i16();
-  for (TeamInfo& t : d.teams) {
-    t.team_number = in.u8();
-    t.field_player_colour = in.u8();
-    t.goalkeeper_colour = in.u8();
-    t.goalkeeper = in.u8();
-    t.score = in.u8();
-    t.penalty_shot = in.u8();
-    t.single_shots = in.u16();
-    t.message_budget = in.u16();
-    for (RobotInfo& r : t.players) {
-      const uint8_t penalty = in.u8();
-      if (penalty > 11) throw PacketError("control packet v19: penalty " + std::to_string(penalty));
-      r.penalty = hsl::penaltyToSpl(penalty);
-      r.secs_till_unpenalised = in.u8();
-      r.warnings = in.u8();
-      r.cautions = in.u8();
-    }
-  }
+  for (TeamInfo& t : d.teams) t = readTeam(in, true);
   if (d.competition_type > 2)
     throw PacketError("control packet v19: competitionType " + std::to_string(d.competition_type));
   if (d.game_phase > 3) throw PacketError("control packet: gamePhase " + std::to_string(d.game_phase));
