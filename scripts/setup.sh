@@ -15,6 +15,7 @@ PACKAGES=(
   bubblewrap                    # lola-run: a private /tmp/robocup per team binary
   iproute2                      # lola-run --net: the field network (bridge, namespaces)
   libgtest-dev libgmock-dev     # tests
+  clang libclang-rt-14-dev      # fuzzing: libFuzzer, AddressSanitizer, UBSan (scripts/fuzz.sh)
   libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # off-screen EGL rendering (Mesa llvmpipe on CPU)
 )
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
@@ -794,12 +795,31 @@ TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
     ++n;
   }
   EXPECT_EQ(n, written.size());
-  // Cut the file in the last block: the complete blocks still read.
-  std::filesystem::resize_file(file, std::filesystem::file_size(file) - 100);
+  EXPECT_FALSE(in.truncatedAt().has_value());
+  // Cut the file in the last block: the complete blocks still read, and the
+  // reader says where the log was cut.
+  const auto full = std::filesystem::file_size(file);
+  std::filesystem::resize_file(file, full - 100);
   world::MatchLogReader cut(file);
   n = 0;
   while (cut.next(f)) ++n;
   EXPECT_EQ(n, 200u);
+  ASSERT_TRUE(cut.truncatedAt().has_value());
+  EXPECT_LT(*cut.truncatedAt(), full - 100);
+  // Length fields that claim gigabytes: an error naming the file, no allocation of them.
+  {
+    std::fstream patch(file, std::ios::in | std::ios::out | std::ios::binary);
+    patch.seekp(12);  // the header's length
+    const uint32_t huge = 0xfffffff0u;
+    patch.write(reinterpret_cast<const char*>(&huge), 4);
+  }
+  try {
+    world::MatchLogReader bad(file);
+    FAIL() << "a header length of 4 GiB was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("claims"), std::string::npos) << e.what();
+  }
   // Not a log: a clear error.
   std::ofstream(file) << "hello";
   EXPECT_THROW(world::MatchLogReader{file}, std::runtime_error);

@@ -21,7 +21,9 @@ const char* kReplayHelp =
     "--from); --physics re-runs the\n"
     "game through the physics and the referee with the recorded commands and checks every\n"
     "period's state hash against the log (exit status 1 on the first difference); --threads:\n"
-    "with N solver threads instead of the scenario's (the hashes must not change).\n";
+    "with N solver threads instead of the scenario's (the hashes must not change). A log cut\n"
+    "inside a block (its writer was killed) is read up to the cut, with a warning and exit\n"
+    "status 4.\n";
 
 }  // namespace
 
@@ -58,6 +60,14 @@ int replay(int argc, char** argv, int first) {
               events, h.count("seed") ? h.at("seed").c_str() : "?",
               h.count("config") ? h.at("config").c_str() : "?");
   int status = 0;
+  // A log cut inside a block (its writer was killed) says so, and replay's
+  // exit status says the game is not all there.
+  if (const auto cut = reader.truncatedAt()) {
+    std::printf("warning: the log is cut inside the block at byte %llu: the frames after %.2f s "
+                "are lost\n",
+                static_cast<unsigned long long>(*cut), last_time);
+    status = 4;
+  }
   if (opt.flag("physics")) {
     if (!h.count("config")) throw std::runtime_error(file.string() + ": no config in the header");
     match::MatchConfig config = match::loadMatchConfig(h.at("config"));
@@ -75,7 +85,7 @@ int replay(int argc, char** argv, int first) {
     int checked = 0;
     // Period after period as long as the log has one and every hash agrees.
     sim::RunLoop(simulation, sim::Pacing::Lockstep)
-        .run([&] { return status != 0 || !recorded.next(); }, -1,
+        .run([&] { return (status != 0 && status != 4) || !recorded.next(); }, -1,
              [&] {
                if (session.world().stateHash() != recorded.frame().state_hash) {
                  std::printf("state hash differs at %.2f s (frame %d)\n", recorded.frame().time,
@@ -88,7 +98,7 @@ int replay(int argc, char** argv, int first) {
     if (recorded.refused() > 0)
       std::printf("warning: %llu recorded commands refused (not finite or out of range)\n",
                   static_cast<unsigned long long>(recorded.refused()));
-    if (status == 0)
+    if (status == 0 || status == 4)
       std::printf("physics replay: %d of %d periods, every state hash equal\n", checked, frames);
   }
   if (opt.has("video")) {

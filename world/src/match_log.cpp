@@ -140,6 +140,9 @@ MatchLogReader::MatchLogReader(const std::filesystem::path& file)
     : file_(file), in_(file, std::ios::binary) {
   auto fail = [&](const std::string& why) { throw std::runtime_error(file.string() + ": " + why); };
   if (!in_) fail("cannot open the match log");
+  std::error_code ec;
+  file_size_ = std::filesystem::file_size(file, ec);
+  if (ec) fail("cannot read its size (" + ec.message() + ")");
   char magic[8];
   uint32_t version = 0, length = 0;
   if (!in_.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) fail("not a simsoccer match log");
@@ -149,6 +152,10 @@ MatchLogReader::MatchLogReader(const std::filesystem::path& file)
   if (version != kMatchLogVersion)
     fail("format version " + std::to_string(version) + ", this build reads " +
          std::to_string(kMatchLogVersion));
+  // Lengths come from the file: none may claim more than the file holds.
+  if (length > file_size_ - 16)
+    fail("the header claims " + std::to_string(length) + " bytes, the file has " +
+         std::to_string(file_size_ - 16) + " after its first 16");
   std::string text(length, '\0');
   if (!in_.read(text.data(), length)) fail("truncated header");
   std::istringstream lines(text);
@@ -168,28 +175,53 @@ MatchLogReader::MatchLogReader(const std::filesystem::path& file)
 }
 
 bool MatchLogReader::readBlock() {
+  const auto at = static_cast<uint64_t>(in_.tellg());
   uint32_t raw = 0, packed = 0;
-  if (!in_.read(reinterpret_cast<char*>(&raw), 4) || !in_.read(reinterpret_cast<char*>(&packed), 4))
+  if (!in_.read(reinterpret_cast<char*>(&raw), 4)) {
+    if (in_.gcount() != 0) truncated_at_ = at;  // a few bytes of a block header: cut
+    return false;                              // the end
+  }
+  const auto cut = [&] {
+    truncated_at_ = at;  // the writer was stopped inside this block: what follows is lost
     return false;
+  };
+  if (!in_.read(reinterpret_cast<char*>(&packed), 4)) return cut();
+  // A block's lengths come from the file: the packed bytes must be in it, and
+  // zlib inflates at most about 1032 to 1 (a corrupt length fails here, not
+  // in an allocation of gigabytes).
+  if (packed > file_size_ - at - 8) return cut();
+  if (raw > 1032ull * packed + 1024)
+    throw std::runtime_error(file_.string() + ": the block at byte " + std::to_string(at) +
+                             " claims " + std::to_string(raw) + " bytes from " +
+                             std::to_string(packed) + " packed: corrupt");
   std::vector<uint8_t> z(packed);
-  if (!in_.read(reinterpret_cast<char*>(z.data()), packed)) return false;  // truncated: the end
+  if (!in_.read(reinterpret_cast<char*>(z.data()), packed)) return cut();
   block_.assign(raw, 0);
   uLongf out = raw;
   if (uncompress(block_.data(), &out, z.data(), packed) != Z_OK || out != raw)
-    throw std::runtime_error(file_.string() + ": a corrupt block");
+    throw std::runtime_error(file_.string() + ": the block at byte " + std::to_string(at) +
+                             " is corrupt");
   pos_ = 0;
   return true;
 }
 
 bool MatchLogReader::next(LogFrame& f) {
   if (pos_ >= block_.size() && !readBlock()) return false;
+  try {
+    return readFrame(f);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(file_.string() + ": a corrupt frame (" + e.what() + ")");
+  }
+}
+
+bool MatchLogReader::readFrame(LogFrame& f) {
   In in{block_, pos_};
   f = LogFrame{};
   f.tick = in.raw<uint64_t>();
   f.time = in.raw<double>();
   f.state_hash = in.raw<uint64_t>();
   const auto g = in.raw<uint16_t>();
-  if (pos_ + g > block_.size()) throw std::runtime_error(file_.string() + ": bad frame");
+  if (pos_ + g > block_.size()) throw std::runtime_error("game packet runs past its block");
   f.game.assign(block_.begin() + static_cast<long>(pos_),
                 block_.begin() + static_cast<long>(pos_ + g));
   pos_ += g;

@@ -100,11 +100,18 @@ class MatchLogReader {
   // Throws std::runtime_error naming the file and what is wrong.
   explicit MatchLogReader(const std::filesystem::path& file);
   const MatchLogHeader& header() const { return header_; }
-  // The next frame; false at the end (a truncated last block ends the log).
+  // The next frame; false at the end. Throws std::runtime_error naming the
+  // file for a corrupt block or frame.
   bool next(LogFrame& frame);
+  // Once next() returned false: the byte where the log was cut inside a
+  // block (the writer was stopped; the frames after it are lost), if it was.
+  std::optional<uint64_t> truncatedAt() const { return truncated_at_; }
 
  private:
   bool readBlock();
+  bool readFrame(LogFrame& frame);
+  uint64_t file_size_ = 0;
+  std::optional<uint64_t> truncated_at_;
   std::filesystem::path file_;
   std::ifstream in_;
   MatchLogHeader header_;

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/) with clang under ASan and UBSan in build-fuzz/
+# and runs each for SECONDS (default 20; hours when asked: scripts/fuzz.sh 3600).
+# Findings (crash-*, leak-*, timeout-*, oom-* files) are written to build-fuzz/fuzz/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_EACH="${1:-20}"
+bash scripts/setup.sh
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DSIMSOCCER_FUZZ=ON \
+  -DSIMSOCCER_FUZZ_SECONDS="$SECONDS_EACH" > /dev/null
+cmake --build build-fuzz --target fuzzers
+cd build-fuzz/fuzz
+ctest -L fuzz --output-on-failure -j "$(nproc)"
