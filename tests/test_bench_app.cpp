@@ -198,3 +198,29 @@ TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {
   EXPECT_NE(err.find("get_up_back.yaml"), std::string::npos) << err;
   EXPECT_NE(err.find("LKneePitch"), std::string::npos) << err;
 }
+
+// Every command-line number is range-checked before anything runs (found by
+// probing: --agents -1 waited forever for 2^64 - 1 agents, --gc-port 70000
+// bound 4464, --seed -1 and 1e30 ran seeds 2^64 - 1 and 0).
+TEST(ServeApp, CommandLineNumbersAreRangeChecked) {
+  const std::string scenario =
+      (test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml").string();
+  const std::string rules = (test::sourceDir() / "configs" / "rules" / "spl.yaml").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--agents -1", "--agents must be a whole number from 0 to 10"},
+      {"--rules " + rules + " --gc-address 127.0.0.1 --gc-port 70000",
+       "--gc-port must be a whole number from 1 to 65535"},
+      {"--seed -1", "--seed: expected a whole number"},
+      {"--seed 1e30", "--seed: expected a whole number"},
+      {"--seconds -3", "--seconds must be > 0"},
+      {"--timeout -1", "--timeout must be > 0"},
+      {"--domain 300", "--domain must be a whole number from 0 to 232"},
+  };
+  for (const auto& [options, message] : cases) {
+    int status = -1;
+    const std::string out =
+        test::runCommand(std::string(SIMSOCCER_BIN) + " serve " + scenario + " " + options, status);
+    EXPECT_EQ(WEXITSTATUS(status), 2) << options << ": " << out;
+    EXPECT_NE(out.find(message), std::string::npos) << options << ": " << out;
+  }
+}

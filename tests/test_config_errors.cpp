@@ -212,3 +212,35 @@ TEST_F(ConfigErrors, UnknownServoIntegration) {
   replace(robot_, "leg_pitch: {servo: implicit,", "leg_pitch: {servo: semi,");
   expectError("robot.yaml", "motors.leg_pitch.servo", "must be implicit or explicit, not 'semi'");
 }
+
+// Found by probing as a hostile user would: keys that are not strings, keys
+// twice (YAML forbids it; yaml-cpp kept the first), a denormal "positive"
+// size and absurd sizes all stop the load with file, key and reason.
+TEST_F(ConfigErrors, AKeyThatIsNotAString) {
+  scenario_ += "[1, 2]: 1\n";
+  expectError("scenario.yaml", "", "a key that is not a string");
+}
+
+TEST_F(ConfigErrors, AKeyTwice) {
+  scenario_ += "seed: 5\nseed: 6\n";
+  expectError("scenario.yaml", "seed", "appears twice");
+}
+
+TEST_F(ConfigErrors, DenormalAndAbsurdSizes) {
+  const auto fieldError = [&](const std::string& from, const std::string& to) {
+    std::string field = test::readFile(test::splField());
+    replace(field, from, to);
+    std::ofstream(dir_ / "field.yaml") << field;
+    try {
+      fields::loadFieldModel(dir_ / "field.yaml");
+    } catch (const engine::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("field.yaml"), std::string::npos) << e.what();
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << to << " was accepted";
+    return std::string();
+  };
+  EXPECT_NE(fieldError("radius: 0.05", "radius: 1e-320").find("normal positive"), std::string::npos);
+  EXPECT_NE(fieldError("border: 0.7", "border: 1.2e11").find("border"), std::string::npos);
+  EXPECT_NE(fieldError("width: 6.0", "width: 600.0").find("no soccer field"), std::string::npos);
+}

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     const int team = static_cast<int>(opt.number("team", 0));
     const int player = static_cast<int>(opt.number("player", 1));
     net::DomainConfig dds;
-    dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
+    dds.domain = opt.domain("domain", 0);
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
     dds.lease = opt.number("lease", dds.lease);
     if (!(dds.lease >= net::DomainConfig::kMinLease && dds.lease <= net::DomainConfig::kMaxLease))
@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
       setup.team_number = static_cast<int>(opt.number("team-number", team + 1));
       setup.player = player;
       setup.role = *role;
-      setup.seed = static_cast<uint64_t>(opt.number("seed", 1));
+      setup.seed = opt.seed("seed", 1);
       setup.get_up = !opt.flag("no-get-up");
       soccer = std::make_unique<agents::SoccerAgent>(
           model,

@@ -51,7 +51,7 @@ int benchCameras(int argc, char** argv, int first) {
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   const BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
-  const double seconds = opt.number("seconds", 10.0);
+  const double seconds = opt.positive("seconds", 10.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   world::CameraSettings cameras = cfg.base.cameras;
   cameras.enabled = true;

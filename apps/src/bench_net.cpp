@@ -45,10 +45,10 @@ int benchNet(int argc, char** argv, int first) {
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
-  const double sim_seconds = opt.number("seconds", 10.0);
+  const double sim_seconds = opt.positive("seconds", 10.0);
   if (!(sim_seconds > 0)) throw UsageError("--seconds must be > 0");
   net::DomainConfig dds;
-  dds.domain = static_cast<uint32_t>(opt.number("domain", 42));
+  dds.domain = opt.domain("domain", 42);
   dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   const std::string csv = opt.get("csv", "");
   const auto agent = agentProgram();

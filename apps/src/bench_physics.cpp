@@ -45,7 +45,7 @@ int benchPhysics(int argc, char** argv, int first) {
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);
   const std::vector<int> counts = opt.intList("robots", cfg.robots);
-  cfg.seconds = opt.number("seconds", cfg.seconds);
+  cfg.seconds = opt.positive("seconds", cfg.seconds);
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
   cfg.base.physics.threads =
       opt.wholeNumber("threads", cfg.base.physics.threads, 1, world::PhysicsConfig::kMaxThreads);

@@ -160,7 +160,7 @@ int benchScaling(int argc, char** argv, int first) {
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
   for (int n : counts)
     if (n < 1 || n > 22) throw UsageError("--robots: 1..22 robots per row");
-  const double seconds = opt.number("seconds", 20.0);
+  const double seconds = opt.positive("seconds", 20.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   const bool cameras = opt.flag("cameras");
   const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
@@ -178,7 +178,7 @@ int benchScaling(int argc, char** argv, int first) {
       start = comma + 1;
     }
   }
-  const auto domain = static_cast<uint32_t>(opt.number("domain", 43));
+  const auto domain = opt.domain("domain", 43);
   const std::filesystem::path png = opt.get("png", "scaling.png");
   std::printf(
       "simsoccer bench scaling: full pipeline (physics, sensors, perception, DDS lockstep with N "

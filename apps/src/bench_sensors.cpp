@@ -73,7 +73,7 @@ int benchSensors(int argc, char** argv, int first) {
   const std::vector<int> ray_counts = opt.intList("rays", {9, 32});
   for (int k : ray_counts)
     if (k > 256) throw UsageError("--rays: at most 256 rays per sonar");
-  const double seconds = opt.number("seconds", 2.0);
+  const double seconds = opt.positive("seconds", 2.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   const std::string csv = opt.get("csv", "");
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);

@@ -1,6 +1,7 @@
 // Option parsing and tables for the command-line programs.
 #include "cli.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -69,6 +70,33 @@ int Options::wholeNumber(const std::string& name, int fallback, int lo, int hi) 
     throw UsageError("--" + name + " must be a whole number from " + std::to_string(lo) + " to " +
                      std::to_string(hi));
   return static_cast<int>(v);
+}
+
+double Options::positive(const std::string& name, double fallback) const {
+  const double v = number(name, fallback);
+  if (has(name) && !(v > 0)) throw UsageError("--" + name + " must be > 0");
+  return v;
+}
+
+double Options::nonNegative(const std::string& name, double fallback) const {
+  const double v = number(name, fallback);
+  if (has(name) && v < 0) throw UsageError("--" + name + " must be >= 0");
+  return v;
+}
+
+uint64_t Options::seed(const std::string& name, uint64_t fallback) const {
+  if (!has(name)) return fallback;
+  const std::string v = values_.at(name);
+  uint64_t seed = 0;
+  const auto [end, error] = std::from_chars(v.data(), v.data() + v.size(), seed);
+  if (v.empty() || error != std::errc() || end != v.data() + v.size())
+    throw UsageError("--" + name + ": expected a whole number from 0 to 18446744073709551615, got '" +
+                     v + "'");
+  return seed;
+}
+
+uint32_t Options::domain(const std::string& name, uint32_t fallback) const {
+  return static_cast<uint32_t>(wholeNumber(name, static_cast<int>(fallback), 0, 232));
 }
 
 std::vector<int> Options::intList(const std::string& name, const std::vector<int>& fallback) const {

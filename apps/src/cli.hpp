@@ -1,6 +1,7 @@
 // Small helpers shared by the subcommands: option parsing and tables.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -26,6 +27,13 @@ class Options {
   // A whole number from `lo` to `hi` (a usage error naming the option if
   // not), or `fallback` when the option is not given.
   int wholeNumber(const std::string& name, int fallback, int lo, int hi) const;
+  // A number > 0 (>= 0), finite, or a usage error naming the option.
+  double positive(const std::string& name, double fallback) const;
+  double nonNegative(const std::string& name, double fallback) const;
+  // A seed: a whole number from 0 to 2^64 - 1, written in digits.
+  uint64_t seed(const std::string& name, uint64_t fallback) const;
+  // A DDS domain id: 0..232 (the RTPS port mapping's range).
+  uint32_t domain(const std::string& name, uint32_t fallback) const;
   std::vector<int> intList(const std::string& name, const std::vector<int>& fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
   // --help given: prints `text` and returns true.

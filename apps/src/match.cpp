@@ -37,8 +37,8 @@ std::filesystem::path defaultOut() {
 RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
   o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : defaultOut();
-  o.seed = static_cast<uint64_t>(opt.number("seed", static_cast<double>(c.seed)));
-  o.domain = static_cast<uint32_t>(opt.number("domain", 0));
+  o.seed = opt.seed("seed", c.seed);
+  o.domain = opt.domain("domain", 0);
   o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   if (!std::filesystem::is_regular_file(o.dds_config))
     throw UsageError(opt.has("dds-config")
@@ -104,7 +104,7 @@ int match(int argc, char** argv, int first) {
   o.realtime = opt.flag("realtime") || config.external_gc_port.has_value();
   o.external = opt.flag("external-agents");
   o.video = config.video.enabled && !opt.flag("no-video");
-  o.max_seconds = opt.number("max-seconds", 0);
+  o.max_seconds = opt.nonNegative("max-seconds", 0);
   try {
     o.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
   } catch (const std::invalid_argument& e) {

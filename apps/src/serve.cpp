@@ -59,7 +59,7 @@ int serve(int argc, char** argv, int first) {
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;
-  cfg.dds.domain = static_cast<uint32_t>(opt.number("domain", 0));
+  cfg.dds.domain = opt.domain("domain", 0);
   cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   std::optional<uint16_t> external_gc;
   if (opt.has("external-gc")) {
@@ -86,7 +86,7 @@ int serve(int argc, char** argv, int first) {
     addLolaRobots(opt, mc);
     mc.external_gc_port = external_gc;
     session = std::make_unique<match::MatchSession>(
-        mc, static_cast<uint64_t>(opt.number("seed", static_cast<double>(mc.seed))));
+        mc, opt.seed("seed", mc.seed));
     officials = &session->officials();
     cfg.command_timeout = mc.command_timeout;
     cfg.team_message_delay = mc.message_delay;
@@ -95,7 +95,7 @@ int serve(int argc, char** argv, int first) {
     if (opt.has("half") || opt.has("lola"))
       throw UsageError("--half and --lola go with a match config");
     world::Scenario scenario = world::loadScenario(file);
-    if (opt.has("seed")) scenario.seed = static_cast<uint64_t>(opt.number("seed", 0));
+    if (opt.has("seed")) scenario.seed = opt.seed("seed", 0);
     own_world = std::make_unique<world::World>(scenario);
     if (opt.has("rules")) {
       const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
@@ -112,7 +112,7 @@ int serve(int argc, char** argv, int first) {
       officials = own_officials.get();
     }
   }
-  if (opt.has("timeout")) cfg.command_timeout = opt.number("timeout", 0.5);
+  if (opt.has("timeout")) cfg.command_timeout = opt.positive("timeout", 0.5);
   if (external_gc && !officials)
     throw UsageError("--external-gc needs --rules or a match config (the game it runs)");
   if (opt.has("gc-address") && !officials)
@@ -145,16 +145,16 @@ int serve(int argc, char** argv, int first) {
     if (opt.has("gc-address")) {
       referee::GameControllerLinkConfig gcfg;
       gcfg.address = opt.get("gc-address", "");
-      gcfg.control_port = static_cast<uint16_t>(opt.number("gc-port", 3838));
-      gcfg.return_port = static_cast<uint16_t>(opt.number("gc-return-port", 3939));
+      gcfg.control_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
+      gcfg.return_port = static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
       gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
       gc_link->update(officials->game());
     }
   }
 
-  const double sim_seconds = opt.number("seconds", 60.0);
-  const auto wanted = static_cast<size_t>(
-      opt.number("agents", static_cast<double>(w.robotCount() - cfg.not_served.size())));
+  const double sim_seconds = opt.positive("seconds", 60.0);
+  const int servable = static_cast<int>(w.robotCount() - cfg.not_served.size());
+  const auto wanted = static_cast<size_t>(opt.wholeNumber("agents", servable, 0, servable));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::printf("simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",

@@ -94,6 +94,10 @@ FieldModel loadFieldModel(const std::filesystem::path& file) {
   f.length = root["length"].positive();
   f.width = root["width"].positive();
   f.border = root["border"].nonNegative();
+  // Physically sensible: the largest soccer pitch is 120 x 90 m.
+  if (f.length > 200.0) root.failKey("length", "more than 200 m is no soccer field");
+  if (f.width > 200.0) root.failKey("width", "more than 200 m is no soccer field");
+  if (f.border > 100.0) root.failKey("border", "more than 100 m is no field's border");
   f.line_width = root["line_width"].positive();
   f.centre_circle_radius = 0.5 * root["centre_circle_diameter"].positive();
   if (auto pm = root.optional("penalty_mark")) {
@@ -128,6 +132,8 @@ FieldModel loadFieldModel(const std::filesystem::path& file) {
   b.allowOnly({"radius", "mass", "material", "linear_damping", "angular_damping"});
   f.ball.radius = b["radius"].positive();
   f.ball.mass = b["mass"].positive();
+  if (f.ball.radius > 0.5) b.failKey("radius", "more than 0.5 m is no ball");
+  if (f.ball.mass > 10.0) b.failKey("mass", "more than 10 kg is no ball");
   if (auto m = b.optional("material")) f.ball.material = engine::readMaterial(*m, {});
   f.ball.linear_damping = b.has("linear_damping") ? b["linear_damping"].nonNegative() : 0.0;
   f.ball.angular_damping = b.has("angular_damping") ? b["angular_damping"].nonNegative() : 0.0;

@@ -111,7 +111,7 @@ int benchMotion(int argc, char** argv, int first) {
   c.dt = opt.number("dt", 0.0);
   c.control_period = opt.number("control-period", 0.0);
   if (c.dt < 0 || c.control_period < 0) throw UsageError("--dt and --control-period must be > 0");
-  const auto seed = static_cast<uint64_t>(opt.number("seed", 1));
+  const auto seed = opt.seed("seed", 1);
   if (opt.has("get-up")) {  // one get-up, for tuning
     const std::string side = opt.get("get-up", "");
     if (side != "front" && side != "back") throw UsageError("--get-up must be front or back");

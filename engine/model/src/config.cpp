@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 namespace simsoccer::engine {
 
@@ -12,6 +13,31 @@ ConfigError::ConfigError(std::string file, std::string key, std::string reason)
       key_(std::move(key)),
       reason_(std::move(reason)) {}
 
+namespace {
+// Keys must be strings, and no mapping may have a key twice (YAML forbids it;
+// yaml-cpp keeps the first silently).
+void checkKeys(const YAML::Node& node, const std::string& file, const std::string& path) {
+  const auto where = [](const YAML::Node& n) {
+    return " (line " + std::to_string(n.Mark().line + 1) + ")";
+  };
+  if (node.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar())
+        throw ConfigError(file, path, "a key that is not a string" + where(kv.first));
+      const std::string key = kv.first.Scalar();
+      if (!seen.insert(key).second)
+        throw ConfigError(file, path.empty() ? key : path + "." + key,
+                          "the key appears twice" + where(kv.first));
+      checkKeys(kv.second, file, path.empty() ? key : path + "." + key);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i)
+      checkKeys(node[i], file, path + "[" + std::to_string(i) + "]");
+  }
+}
+}  // namespace
+
 ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   const std::string name = file.string();
   if (!std::filesystem::exists(file)) throw ConfigError(name, "", "file not found");
@@ -19,6 +45,7 @@ ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   try {
     YAML::Node root = YAML::LoadFile(name);
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
+    checkKeys(root, name, "");
     return ConfigNode(root, name, "");
   } catch (const YAML::BadFile&) {
     throw ConfigError(name, "", "cannot be read");
@@ -105,6 +132,8 @@ double ConfigNode::number() const {
 double ConfigNode::positive() const {
   const double v = number();
   if (!(v > 0.0)) fail("must be > 0, got " + node_.Scalar());
+  // A denormal is > 0 but no physical size or time: 1e-320 m is a typo.
+  if (!std::isnormal(v)) fail("must be a normal positive number, got " + node_.Scalar());
   return v;
 }
 
