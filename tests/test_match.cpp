@@ -37,6 +37,7 @@ std::string withoutWallTimes(const std::string& json) {
   std::stringstream in(json), out;
   for (std::string line; std::getline(in, line);)
     if (line.find("wall_seconds") == std::string::npos &&
+        line.find("wait_seconds") == std::string::npos &&
         line.find("real_time_factor") == std::string::npos)
       out << line << "\n";
   return out.str();
@@ -226,6 +227,54 @@ TEST(MatchApp, AKilledAgentIsRestartedAndTheMatchCompletes) {
   EXPECT_NE(jsonValue(summary, "agent_restarts"), "[]") << summary;
   EXPECT_NE(summary.find("\"team\": 1, \"player\": 2, \"exit_status\""), std::string::npos);
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
+}
+
+// Agents killed ten times and one stopped for 10 s: the match finishes,
+// every restart is in the summary, and no period waits longer than the
+// lockstep timeout (a killed agent's robot is released in the next period).
+TEST(MatchApp, KilledAndStoppedAgentsNeverStallTheMatch) {
+  BackgroundMatch m("match_soak", "--half 20 --no-video --domain 147");
+  ASSERT_TRUE(m.waitForLog(100000)) << "the game did not start";
+  const auto pidOf = [](int team, int player) {
+    int status = 0;
+    const std::string out = test::runCommand(
+        "pgrep -f '^[^ ]*simsoccer-agent --team " + std::to_string(team) + " --player " +
+            std::to_string(player) + " --domain 147 '",
+        status);
+    return status == 0 ? std::atoi(out.c_str()) : 0;
+  };
+  // Ten kills, round robin over the four agents (at most 3 each: the restart limit).
+  for (int k = 0; k < 10; ++k) {
+    const int team = k % 2, player = 1 + (k / 2) % 2;
+    for (int tries = 0; tries < 50; ++tries) {  // its restart may not be up yet
+      if (const int pid = pidOf(team, player); pid > 0) {
+        ::kill(pid, SIGKILL);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  }
+  // One agent stopped for 10 s of wall time, then continued (one killed only
+  // twice: after 10 s without a frame it may take the simulator for gone and
+  // exit, which is a third restart).
+  if (const int pid = pidOf(1, 2); pid > 0) {
+    ::kill(pid, SIGSTOP);
+    std::this_thread::sleep_for(std::chrono::seconds(10));
+    ::kill(pid, SIGCONT);
+  }
+  m.join();
+  ASSERT_EQ(m.status, 0) << m.out;
+  const std::string summary = test::readFile(m.dir / "summary.json");
+  EXPECT_EQ(jsonValue(summary, "aborted"), "null") << summary;
+  size_t restarts = 0;
+  for (size_t at = summary.find("\"restart\": "); at != std::string::npos;
+       at = summary.find("\"restart\": ", at + 1))
+    ++restarts;
+  EXPECT_GE(restarts, 10u) << summary;
+  EXPECT_LE(restarts, 11u) << summary;
+  EXPECT_NE(summary.find("end of the second half"), std::string::npos);
+  EXPECT_LE(std::stod(jsonValue(summary, "longest_wait_seconds")), 0.5 + 0.1) << summary;
 }
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {

@@ -52,6 +52,7 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   };
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
+  std::signal(SIGHUP, onInterrupt);  // a closed terminal ends the match cleanly too
   return o;
 }
 

@@ -209,7 +209,9 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       [&] {
         ++i;
         if (lola_robots) lola_robots->afterPeriod();
-        if (!o.external && i % 10 == 0) superviseAgents();
+        // Every period: a crashed agent's robot is released at once, so
+        // lockstep waits for it in one period at most.
+        if (!o.external) superviseAgents();
         if (o.progress && secondsSince(t0) - last_progress > 0.25) {
           last_progress = secondsSince(t0);
           o.progress(session, last_progress);
@@ -217,6 +219,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
       });
   result.interrupted = stopRequested();
   result.wall = secondsSince(t0);
+  result.longest_wait = simulation.profile().longest_collect_s;
   result.final_hash = w.stateHash();
   for (world::RobotId r = 0; r < w.robotCount(); ++r)
     result.missed_commands.push_back(server.stats(r).missed);

@@ -138,6 +138,7 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
   out << "  \"aborted\": " << (r.aborted ? jsonString(r.abort_reason) : "null") << ",\n";
   out << "  \"simulated_seconds\": " << fixedNumber(w.time(), 2) << ",\n";
   out << "  \"wall_seconds\": " << fixedNumber(r.wall, 2) << ",\n";
+  out << "  \"longest_wait_seconds\": " << fixedNumber(r.longest_wait, 3) << ",\n";
   out << "  \"real_time_factor\": " << fixedNumber(w.time() / std::max(r.wall, 1e-9), 3) << ",\n";
   char hash[32];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.final_hash));

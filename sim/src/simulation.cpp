@@ -1,5 +1,6 @@
 #include "simsoccer/sim/simulation.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace simsoccer::sim {
@@ -177,6 +178,8 @@ void Simulation::period() {
   const auto t8 = Clock::now();
   profile_.observe_s += seconds(t0, t1);
   profile_.collect_s += seconds(t1, t2) + seconds(t4, t5);
+  profile_.longest_collect_s =
+      std::max(profile_.longest_collect_s, seconds(t1, t2) + seconds(t4, t5));
   profile_.apply_s += seconds(t2, t3);
   profile_.step_s += seconds(t3, t4);
   profile_.officials_s += seconds(t5, t6);

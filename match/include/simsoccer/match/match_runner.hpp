@@ -52,6 +52,7 @@ struct RunResult {
   uint64_t log_bytes = 0;
   int video_frames = 0;  // playMatch: frames of match.mp4 (0: none written)
   std::vector<LolaResult> lola;  // per LoLA robot, in the config's order
+  double longest_wait = 0.0;     // s of wall time the longest period waited for its answers
 };
 
 // The match log's header for a session (config, scenario, seed, robots).

@@ -62,6 +62,7 @@ struct Profile {
   double officials_s = 0.0;  // the sources' after-step bookkeeping, referee and operator
   double record_s = 0.0;     // recorders (log, statistics)
   double camera_s = 0.0;     // capturing for the render thread (and waiting for it)
+  double longest_collect_s = 0.0;  // the longest one period waited for its answers
   uint64_t periods = 0;
   double total() const {
     return observe_s + collect_s + apply_s + step_s + officials_s + record_s + camera_s;
