@@ -219,7 +219,9 @@ TEST(ServeApp, CommandLineNumbersAreRangeChecked) {
   for (const auto& [options, message] : cases) {
     int status = -1;
     const std::string out =
-        test::runCommand(std::string(SIMSOCCER_BIN) + " serve " + scenario + " " + options, status);
+        test::runCommand(std::string(SIMSOCCER_BIN) + " serve " + scenario + " --domain 149 " +
+                             options,
+                         status);
     EXPECT_EQ(WEXITSTATUS(status), 2) << options << ": " << out;
     EXPECT_NE(out.find(message), std::string::npos) << options << ": " << out;
   }

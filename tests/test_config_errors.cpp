@@ -244,3 +244,25 @@ TEST_F(ConfigErrors, DenormalAndAbsurdSizes) {
   EXPECT_NE(fieldError("border: 0.7", "border: 1.2e11").find("border"), std::string::npos);
   EXPECT_NE(fieldError("width: 6.0", "width: 600.0").find("no soccer field"), std::string::npos);
 }
+
+// Aliases that make a loop or an exponential tree stop the load with an error
+// (they crashed or hung the key check before it was bounded; fuzz seeds keep them).
+TEST_F(ConfigErrors, AliasLoopsAndBlowUps) {
+  scenario_ += "loop: &x [*x]\n";
+  const engine::ConfigError e = load();
+  EXPECT_NE(std::string(e.what()).find("alias loop"), std::string::npos) << e.what();
+  EXPECT_EQ(e.key().rfind("loop", 0), 0u) << e.what();
+  std::string bomb = "a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+  for (char c = 'b'; c <= 'h'; ++c) {
+    bomb += std::string(1, c) + ": &" + c + " [";
+    for (int i = 0; i < 10; ++i) bomb += std::string(i ? ", *" : "*") + static_cast<char>(c - 1);
+    bomb += "]\n";
+  }
+  std::ofstream(dir_ / "bomb.yaml") << "scenario: x\n" << bomb;
+  try {
+    world::loadScenario(dir_ / "bomb.yaml");
+    ADD_FAILURE() << "an alias bomb was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("alias loop"), std::string::npos) << e.what();
+  }
+}

@@ -246,19 +246,22 @@ TEST(MatchApp, KilledAndStoppedAgentsNeverStallTheMatch) {
   // Ten kills, round robin over the four agents (at most 3 each: the restart limit).
   for (int k = 0; k < 10; ++k) {
     const int team = k % 2, player = 1 + (k / 2) % 2;
-    for (int tries = 0; tries < 50; ++tries) {  // its restart may not be up yet
-      if (const int pid = pidOf(team, player); pid > 0) {
-        ::kill(pid, SIGKILL);
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    bool killed = false;
+    for (int tries = 0; tries < 50 && !killed; ++tries) {  // its restart may not be up yet
+      if (const int pid = pidOf(team, player); pid > 0)
+        killed = ::kill(pid, SIGKILL) == 0;
+      else
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
+    EXPECT_TRUE(killed) << "kill " << k << ": no agent " << team << ":" << player;
     std::this_thread::sleep_for(std::chrono::milliseconds(700));
   }
   // One agent stopped for 10 s of wall time, then continued (one killed only
   // twice: after 10 s without a frame it may take the simulator for gone and
   // exit, which is a third restart).
-  if (const int pid = pidOf(1, 2); pid > 0) {
+  const int stopped = pidOf(1, 2);
+  EXPECT_GT(stopped, 0) << "no agent 1:2 to stop";
+  if (const int pid = stopped; pid > 0) {
     ::kill(pid, SIGSTOP);
     std::this_thread::sleep_for(std::chrono::seconds(10));
     ::kill(pid, SIGCONT);
@@ -274,7 +277,8 @@ TEST(MatchApp, KilledAndStoppedAgentsNeverStallTheMatch) {
   EXPECT_GE(restarts, 10u) << summary;
   EXPECT_LE(restarts, 11u) << summary;
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
-  EXPECT_LE(std::stod(jsonValue(summary, "longest_wait_seconds")), 0.5 + 0.1) << summary;
+  // The timeout, and a margin for a loaded machine's scheduling.
+  EXPECT_LE(std::stod(jsonValue(summary, "longest_wait_seconds")), 0.5 + 0.25) << summary;
 }
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
@@ -426,7 +430,7 @@ TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
 TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
   const std::string config = (test::sourceDir() / "configs/match_2v2.yaml").string();
   const uint64_t seed = 5;
-  const ShortMatch m = shortMatch("serve_vs_match", 137, "--seed 5 --max-seconds 4 --no-video");
+  const ShortMatch m = shortMatch("serve_vs_match", 140, "--seed 5 --max-seconds 4 --no-video");
   ASSERT_EQ(m.status, 0) << m.out;
   const std::string summary = test::readFile(m.dir / "summary.json");
   const std::string match_hash = jsonValue(summary, "final_state_hash");
@@ -438,7 +442,7 @@ TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
     const match::MatchSession session(mc, seed);
     match::RunOptions o;
     o.seed = seed;
-    o.domain = 138;
+    o.domain = 141;
     o.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
     std::vector<std::unique_ptr<match::ChildProcess>> agents;
     for (world::RobotId r = 0; r < session.world().robotCount(); ++r) {
@@ -449,7 +453,7 @@ TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
     }
     int status = -1;
     const std::string out = test::runCommand(
-        kBin + " serve " + config + " --half 15 --seed 5 --seconds 4 --domain 138 2>&1", status);
+        kBin + " serve " + config + " --half 15 --seed 5 --seconds 4 --domain 141 2>&1", status);
     ASSERT_EQ(status, 0) << out;
     std::smatch hash;
     ASSERT_TRUE(std::regex_search(out, hash, std::regex("final state hash ([0-9a-f]{16})"))) << out;

@@ -42,7 +42,7 @@ inline std::string runCommand(const std::string& cmd, int& status) {
 // container without user namespaces cannot).
 inline bool bubblewrapWorks() {
   int status = -1;
-  runCommand("bwrap --dev-bind / / --unshare-pid true", status);
+  runCommand("bwrap --dev-bind / / --tmpfs /tmp --unshare-pid true", status);
   return status == 0;
 }
 inline std::string readFile(const std::filesystem::path& p) {

@@ -90,8 +90,8 @@ int main(int argc, char** argv) {
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
       throw apps::UsageError("--team and --player are required");
-    const int team = static_cast<int>(opt.number("team", 0));
-    const int player = static_cast<int>(opt.number("player", 1));
+    const int team = opt.wholeNumber("team", 0, 0, 1);
+    const int player = opt.wholeNumber("player", 1, 1, 20);
     net::DomainConfig dds;
     dds.domain = opt.domain("domain", 0);
     dds.config_file = apps::findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
@@ -107,8 +107,8 @@ int main(int argc, char** argv) {
       throw apps::UsageError("--if-owned must be wait or refuse, not '" + if_owned + "'");
     if (mode != "nod" && mode != "walk" && mode != "garbage" && mode != "stall")
       throw apps::UsageError("--mode must be nod, walk, garbage or stall");
-    const long stall_after = static_cast<long>(opt.number("stall-after", 50));
-    const long max_ticks = static_cast<long>(opt.number("ticks", -1));
+    const long stall_after = opt.wholeNumber("stall-after", 50, 0, 1000000000);
+    const long max_ticks = opt.wholeNumber("ticks", -1, -1, 2000000000);
 
     const robots::RobotModel model = robots::loadRobotModel(robot_file);
 
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
             "penalty-goalkeeper");
       agents::SoccerAgentSetup setup;
       setup.team = team;
-      setup.team_number = static_cast<int>(opt.number("team-number", team + 1));
+      setup.team_number = opt.wholeNumber("team-number", team + 1, 0, 254);
       setup.player = player;
       setup.role = *role;
       setup.seed = opt.seed("seed", 1);

@@ -1,9 +1,10 @@
 // simsoccer lola-run: starts a team's robot binary attached to one simulated
 // Nao. Team code hard-codes LoLA's socket at /tmp/robocup, and a match needs
 // up to 14 such binaries on one machine, so each gets a private mount
-// namespace (bubblewrap, from Debian) in which that robot's socket is bound
-// at /tmp/robocup. The rest of the file system (the program may live under
-// /tmp), the network (unless --net) and the user are the machine's.
+// namespace (bubblewrap, from Debian) with a /tmp of its own in which that
+// robot's socket is /tmp/robocup (the program's folders under the machine's
+// /tmp are bound back). The rest of the file system, the network (unless
+// --net) and the user are the machine's.
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -33,8 +34,9 @@ const char* kHelp =
     "                          [--net [--bridge NAME] [--prefix A.B]] -- PROGRAM [ARGS...]\n"
     "\n"
     "Runs PROGRAM with a simulated robot's LoLA socket at /tmp/robocup, as on a Nao, in a\n"
-    "private mount namespace (bubblewrap), so several team binaries run side by side, each\n"
-    "seeing its own robot there (the rest of the file system is the machine's). --robot T:P names the robot (GameController team\n"
+    "private mount namespace (bubblewrap) with a /tmp of its own, so several team binaries\n"
+    "run side by side, each seeing its own robot there (the working directory and the folders\n"
+    "of the program and its file arguments under /tmp stay visible). --robot T:P names the robot (GameController team\n"
     "number:player) of the match writing to DIR (default runs/serve; the socket is\n"
     "DIR/lola/robot_T_P.sock), --socket gives the socket itself. Waits up to S s (default\n"
     "60) for the simulator to open the socket. The program's exit status is lola-run's.\n"
@@ -115,13 +117,27 @@ int lolaRun(int argc, char** argv, int first) {
                 netns->name().c_str());
     args = {"ip", "netns", "exec", netns->name()};
   }
-  // The machine as it is (the program and its files may be anywhere, /tmp
-  // too), but for the robot's socket at /tmp/robocup.
-  const std::vector<std::string> sandbox = {bwrap,
-                                   "--dev-bind", "/", "/",
-                                   "--bind", socket.string(), "/tmp/robocup",
+  // The machine as it is, but a /tmp of its own (team code keeps lock, pid
+  // and log files there) with the robot's socket at /tmp/robocup. What the
+  // program needs from the machine's /tmp is bound back: the working
+  // directory, and the folder of the program and of every argument that
+  // names a file or folder there.
+  std::vector<std::string> sandbox = {bwrap, "--dev-bind", "/", "/", "--tmpfs", "/tmp"};
+  std::vector<std::filesystem::path> keep = {std::filesystem::current_path()};
+  for (int i = split + 1; i < argc; ++i) {
+    std::error_code ec;
+    const auto p = std::filesystem::absolute(argv[i], ec);
+    if (!ec && std::filesystem::exists(p, ec))
+      keep.push_back(std::filesystem::is_directory(p, ec) ? p : p.parent_path());
+  }
+  for (const auto& k : keep) {
+    const std::string s = k.lexically_normal().string();
+    if (s.rfind("/tmp/", 0) == 0 && s != "/tmp/robocup")
+      sandbox.insert(sandbox.end(), {"--bind", s, s});
+  }
+  sandbox.insert(sandbox.end(), {"--bind", socket.string(), "/tmp/robocup",
                                    "--chdir", std::filesystem::current_path().string(),
-                                   "--unshare-pid", "--die-with-parent", "--"};
+                                   "--unshare-pid", "--die-with-parent", "--"});
   args.insert(args.end(), sandbox.begin(), sandbox.end());
   for (int i = split + 1; i < argc; ++i) args.push_back(argv[i]);
   std::vector<char*> cargs;

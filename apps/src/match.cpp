@@ -52,7 +52,10 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   };
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
-  std::signal(SIGHUP, onInterrupt);  // a closed terminal ends the match cleanly too
+  // A closed terminal ends the match cleanly too, unless it runs under nohup.
+  struct sigaction hangup {};
+  if (::sigaction(SIGHUP, nullptr, &hangup) == 0 && hangup.sa_handler != SIG_IGN)
+    std::signal(SIGHUP, onInterrupt);
   return o;
 }
 
@@ -155,9 +158,9 @@ int penalty(int argc, char** argv, int first) {
   MatchConfig config = match::loadMatchConfig(opt.positional()[0]);
   if (config.penalty_kicks == 0)
     throw UsageError(config.file + " is not a penalty config (`penalty: NAME`)");
-  const int kicks = static_cast<int>(opt.number("kicks", config.penalty_kicks));
+  const int kicks = opt.wholeNumber("kicks", config.penalty_kicks, 1, 100000);
   if (kicks < 1) throw UsageError("--kicks must be >= 1");
-  const int video_kicks = static_cast<int>(opt.number("video-kicks", 3));
+  const int video_kicks = opt.wholeNumber("video-kicks", 3, 0, 100000);
   const RunOptions o = runOptions(opt, config);
   const match::PenaltyResult r =
       match::playPenalties(config, o, kicks, video_kicks,

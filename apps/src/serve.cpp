@@ -153,6 +153,7 @@ int serve(int argc, char** argv, int first) {
   }
 
   const double sim_seconds = opt.positive("seconds", 60.0);
+  if (sim_seconds > 1e7) throw UsageError("--seconds: at most 10000000 (115 days)");
   const int servable = static_cast<int>(w.robotCount() - cfg.not_served.size());
   const auto wanted = static_cast<size_t>(opt.wholeNumber("agents", servable, 0, servable));
   std::signal(SIGINT, onSignal);

@@ -140,9 +140,11 @@ MatchLogReader::MatchLogReader(const std::filesystem::path& file)
     : file_(file), in_(file, std::ios::binary) {
   auto fail = [&](const std::string& why) { throw std::runtime_error(file.string() + ": " + why); };
   if (!in_) fail("cannot open the match log");
+  // Lengths are checked against the file's size; a pipe has none (unbounded).
   std::error_code ec;
-  file_size_ = std::filesystem::file_size(file, ec);
-  if (ec) fail("cannot read its size (" + ec.message() + ")");
+  file_size_ = std::filesystem::is_regular_file(file, ec) ? std::filesystem::file_size(file, ec)
+                                                          : UINT64_MAX;
+  if (ec) file_size_ = UINT64_MAX;
   char magic[8];
   uint32_t version = 0, length = 0;
   if (!in_.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) fail("not a simsoccer match log");
@@ -153,7 +155,7 @@ MatchLogReader::MatchLogReader(const std::filesystem::path& file)
     fail("format version " + std::to_string(version) + ", this build reads " +
          std::to_string(kMatchLogVersion));
   // Lengths come from the file: none may claim more than the file holds.
-  if (length > file_size_ - 16)
+  if (file_size_ != UINT64_MAX && 16ull + length > file_size_)
     fail("the header claims " + std::to_string(length) + " bytes, the file has " +
          std::to_string(file_size_ - 16) + " after its first 16");
   std::string text(length, '\0');
@@ -189,7 +191,12 @@ bool MatchLogReader::readBlock() {
   // A block's lengths come from the file: the packed bytes must be in it, and
   // zlib inflates at most about 1032 to 1 (a corrupt length fails here, not
   // in an allocation of gigabytes).
-  if (packed > file_size_ - at - 8) return cut();
+  if (file_size_ != UINT64_MAX && at + 8 + packed > file_size_) {
+    std::error_code ec;  // a log still being written has grown since it was opened
+    const auto now = std::filesystem::file_size(file_, ec);
+    if (ec || at + 8 + packed > now) return cut();
+    file_size_ = now;
+  }
   if (raw > 1032ull * packed + 1024)
     throw std::runtime_error(file_.string() + ": the block at byte " + std::to_string(at) +
                              " claims " + std::to_string(raw) + " bytes from " +

@@ -15,8 +15,13 @@ ConfigError::ConfigError(std::string file, std::string key, std::string reason)
 
 namespace {
 // Keys must be strings, and no mapping may have a key twice (YAML forbids it;
-// yaml-cpp keeps the first silently).
-void checkKeys(const YAML::Node& node, const std::string& file, const std::string& path) {
+// yaml-cpp keeps the first silently). Aliases can make the document a loop
+// or blow it up exponentially: depth and node count are bounded.
+void checkKeys(const YAML::Node& node, const std::string& file, const std::string& path,
+               int depth, long& budget) {
+  if (depth > 64 || --budget < 0)
+    throw ConfigError(file, path,
+                      "nested deeper than 64 or more than 100000 nodes (an alias loop?)");
   const auto where = [](const YAML::Node& n) {
     return " (line " + std::to_string(n.Mark().line + 1) + ")";
   };
@@ -29,11 +34,11 @@ void checkKeys(const YAML::Node& node, const std::string& file, const std::strin
       if (!seen.insert(key).second)
         throw ConfigError(file, path.empty() ? key : path + "." + key,
                           "the key appears twice" + where(kv.first));
-      checkKeys(kv.second, file, path.empty() ? key : path + "." + key);
+      checkKeys(kv.second, file, path.empty() ? key : path + "." + key, depth + 1, budget);
     }
   } else if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i)
-      checkKeys(node[i], file, path + "[" + std::to_string(i) + "]");
+      checkKeys(node[i], file, path + "[" + std::to_string(i) + "]", depth + 1, budget);
   }
 }
 }  // namespace
@@ -45,7 +50,8 @@ ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   try {
     YAML::Node root = YAML::LoadFile(name);
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
-    checkKeys(root, name, "");
+    long budget = 100000;
+    checkKeys(root, name, "", 0, budget);
     return ConfigNode(root, name, "");
   } catch (const YAML::BadFile&) {
     throw ConfigError(name, "", "cannot be read");
