@@ -6,6 +6,7 @@
 #include <msgpack.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -14,6 +15,8 @@
 #include "lola_reader.hpp"
 #include "simsoccer/lola/actuator_stream.hpp"
 #include "simsoccer/lola/sensor_packet.hpp"
+#include "simsoccer/engine/config.hpp"
+#include "simsoccer/match/match_session.hpp"
 #include "simsoccer/world/render_scene.hpp"
 #include "test_support.hpp"
 
@@ -227,4 +230,34 @@ TEST(LolaWire, LedColoursAreDrawnOnTheRobot) {
       EXPECT_LT((item.transform.block<3, 1>(0, 3).cast<double>() - w.torsoPose(1).translation()).norm(),
                 0.25);
     }
+}
+
+// A match config names LoLA robots and, per robot, the RobotConfig strings it
+// reports; a string of the wrong length is refused at load, naming the key.
+TEST(LolaWire, AMatchConfigGivesEachLolaRobotItsIdentity) {
+  test::TempDir dir("lola_identity");
+  std::string text = test::readFile(test::sourceDir() / "configs" / "match_2v2.yaml");
+  const auto absolute = [&](const std::string& rel) {
+    const auto at = text.find(rel);
+    ASSERT_NE(at, std::string::npos) << rel;
+    text.replace(at, rel.size(), (test::sourceDir() / "configs" / rel).string());
+  };
+  absolute("scenarios/match_2v2.yaml");
+  absolute("rules/spl.yaml");
+  absolute("agents/soccer.yaml");
+  const std::string good = text + "lola:\n  robots: [\"2:1\"]\n  identities:\n    \"2:1\": "
+                                  "{body_id: P0000073A03S83I00011, head_id: P0000074A03S84F00006}\n";
+  std::ofstream(dir.path() / "good.yaml") << good;
+  const match::MatchConfig c = match::loadMatchConfig(dir.path() / "good.yaml");
+  ASSERT_EQ(c.lola.identities.count("2:1"), 1u);
+  EXPECT_EQ(c.lola.identities.at("2:1")[0], "P0000073A03S83I00011");
+  EXPECT_EQ(c.lola.identities.at("2:1")[1], "6.0.0");
+  std::ofstream(dir.path() / "bad.yaml")
+      << text << "lola:\n  robots: [\"2:1\"]\n  identities:\n    \"2:1\": {body_id: SHORT}\n";
+  try {
+    match::loadMatchConfig(dir.path() / "bad.yaml");
+    FAIL() << "a 5-character body id was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "lola.identities.2:1.body_id") << e.what();
+  }
 }

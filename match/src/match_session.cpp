@@ -114,7 +114,28 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
   }
   if (auto l = root.optional("lola")) {
-    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network"});
+    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities"});
+    if (auto ids = l->optional("identities")) {
+      for (const auto& [robot, id] : ids->entries()) {
+        try {
+          if (parseLolaPlayers(robot).size() != 1) throw std::invalid_argument("one robot");
+        } catch (const std::invalid_argument& e) {
+          id.fail(std::string("not a robot T:P: ") + e.what());
+        }
+        id.allowOnly({"body_id", "body_version", "head_id", "head_version"});
+        const std::array<const char*, 4> keys = {"body_id", "body_version", "head_id",
+                                                 "head_version"};
+        std::array<std::string, 4> strings = {"", "6.0.0", "P0000000000000000000", "6.0.0"};
+        for (size_t k = 0; k < 4; ++k)
+          if (id.has(keys[k])) strings[k] = id[keys[k]].string();
+        // Team code checks these lengths (20, 5, 20, 5): refused here, not on the wire.
+        const std::array<size_t, 4> lengths = {20, 5, 20, 5};
+        for (size_t k = 0; k < 4; ++k)
+          if (!strings[k].empty() && strings[k].size() != lengths[k])
+            id.failKey(keys[k], "must be " + std::to_string(lengths[k]) + " characters");
+        c.lola.identities[robot] = strings;
+      }
+    }
     c.lola.network = l->boolean("network", false);
     if (l->has("image_port")) {
       const int port = (*l)["image_port"].integer();

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -48,6 +49,9 @@ struct LolaSettings {
   // The field's network for the binaries (needs root): GameController
   // packets, status and team messages over UDP as on a field.
   bool network = false;
+  // RobotConfig strings per robot ("T:P"), where not the defaults
+  // (lola::defaultIdentity): body id, body version, head id, head version.
+  std::map<std::string, std::array<std::string, 4>> identities;
 };
 
 struct MatchConfig {
