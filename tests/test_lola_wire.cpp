@@ -250,8 +250,8 @@ TEST(LolaWire, AMatchConfigGivesEachLolaRobotItsIdentity) {
   std::ofstream(dir.path() / "good.yaml") << good;
   const match::MatchConfig c = match::loadMatchConfig(dir.path() / "good.yaml");
   ASSERT_EQ(c.lola.identities.count("2:1"), 1u);
-  EXPECT_EQ(c.lola.identities.at("2:1")[0], "P0000073A03S83I00011");
-  EXPECT_EQ(c.lola.identities.at("2:1")[1], "6.0.0");
+  EXPECT_EQ(c.lola.identities.at("2:1").body_id, "P0000073A03S83I00011");
+  EXPECT_EQ(c.lola.identities.at("2:1").body_version, "6.0.0");
   std::ofstream(dir.path() / "bad.yaml")
       << text << "lola:\n  robots: [\"2:1\"]\n  identities:\n    \"2:1\": {body_id: SHORT}\n";
   try {

@@ -61,14 +61,11 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
     lola::RobotSocket rs;
     rs.robot = session.lolaRobots()[i];
     rs.socket = std::filesystem::absolute(lolaSocketPath(out, c.lola.robots[i]));
-    rs.identity = lola::defaultIdentity(c.lola.robots[i].team_number, c.lola.robots[i].player);
     const auto own = c.lola.identities.find(name(i));
-    if (own != c.lola.identities.end()) {
-      if (!own->second[0].empty()) rs.identity.body_id = own->second[0];
-      rs.identity.body_version = own->second[1];
-      rs.identity.head_id = own->second[2];
-      rs.identity.head_version = own->second[3];
-    }
+    rs.identity = own != c.lola.identities.end()
+                      ? own->second
+                      : lola::defaultIdentity(c.lola.robots[i].team_number,
+                                              c.lola.robots[i].player);
     ec.robots.push_back(rs);
   }
   endpoint_ = std::make_unique<lola::Endpoint>(session.world(), ec);

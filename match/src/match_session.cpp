@@ -116,24 +116,27 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   if (auto l = root.optional("lola")) {
     l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities"});
     if (auto ids = l->optional("identities")) {
-      for (const auto& [robot, id] : ids->entries()) {
+      for (const auto& [robot, node] : ids->entries()) {
+        std::vector<LolaPlayer> players;
         try {
-          if (parseLolaPlayers(robot).size() != 1) throw std::invalid_argument("one robot");
+          players = parseLolaPlayers(robot);
         } catch (const std::invalid_argument& e) {
-          id.fail(std::string("not a robot T:P: ") + e.what());
+          node.fail(std::string("not a robot T:P: ") + e.what());
         }
-        id.allowOnly({"body_id", "body_version", "head_id", "head_version"});
-        const std::array<const char*, 4> keys = {"body_id", "body_version", "head_id",
-                                                 "head_version"};
-        std::array<std::string, 4> strings = {"", "6.0.0", "P0000000000000000000", "6.0.0"};
-        for (size_t k = 0; k < 4; ++k)
-          if (id.has(keys[k])) strings[k] = id[keys[k]].string();
-        // Team code checks these lengths (20, 5, 20, 5): refused here, not on the wire.
-        const std::array<size_t, 4> lengths = {20, 5, 20, 5};
-        for (size_t k = 0; k < 4; ++k)
-          if (!strings[k].empty() && strings[k].size() != lengths[k])
-            id.failKey(keys[k], "must be " + std::to_string(lengths[k]) + " characters");
-        c.lola.identities[robot] = strings;
+        if (players.size() != 1) node.fail("one robot T:P");
+        node.allowOnly({"body_id", "body_version", "head_id", "head_version"});
+        lola::RobotIdentity id = lola::defaultIdentity(players[0].team_number, players[0].player);
+        for (auto [key, field] : {std::pair{"body_id", &id.body_id}, {"body_version", &id.body_version},
+                                  {"head_id", &id.head_id}, {"head_version", &id.head_version}}) {
+          if (node.has(key)) *field = node[key].string();
+          try {  // team code checks these strings: refused here, not on the wire
+            lola::checkIdentity(id);
+          } catch (const std::invalid_argument& e) {
+            if (node.has(key) && std::string(e.what()).find(key) != std::string::npos)
+              node.failKey(key, e.what());
+          }
+        }
+        c.lola.identities[robot] = id;
       }
     }
     c.lola.network = l->boolean("network", false);

@@ -43,10 +43,7 @@ void GameControllerLink::countTeamMessages(const Game& game) {
     }
   std::array<uint8_t, 1024> buffer{};
   for (TeamPort& p : team_ports_)
-    for (size_t n; (n = p.receiver->receive(buffer, 0.0)) > 0;) {
-      ++p.messages;
-      p.oversized += n > 128;  // illegal on the field (the GameController reads 129 to tell)
-    }
+    while (p.receiver->receive(buffer, 0.0) > 0) ++p.messages;
 }
 
 uint64_t GameControllerLink::teamMessages(uint8_t team_number) const {
@@ -55,11 +52,6 @@ uint64_t GameControllerLink::teamMessages(uint8_t team_number) const {
   return 0;
 }
 
-uint64_t GameControllerLink::oversizedTeamMessages(uint8_t team_number) const {
-  for (const TeamPort& p : team_ports_)
-    if (p.team_number == team_number) return p.oversized;
-  return 0;
-}
 
 void GameControllerLink::receiveReturns(const Game& game) {
   std::array<uint8_t, 512> buffer{};  // larger than any packet: an oversized one shows its size

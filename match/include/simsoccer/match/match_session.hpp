@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "simsoccer/lola/sensor_packet.hpp"
 #include "simsoccer/referee/referee.hpp"
 #include "simsoccer/sim/officials.hpp"
 #include "simsoccer/sim/simulation.hpp"
@@ -49,9 +50,8 @@ struct LolaSettings {
   // The field's network for the binaries (needs root): GameController
   // packets, status and team messages over UDP as on a field.
   bool network = false;
-  // RobotConfig strings per robot ("T:P"), where not the defaults
-  // (lola::defaultIdentity): body id, body version, head id, head version.
-  std::map<std::string, std::array<std::string, 4>> identities;
+  // RobotConfig strings per robot ("T:P") where not lola::defaultIdentity's.
+  std::map<std::string, lola::RobotIdentity> identities;
 };
 
 struct MatchConfig {

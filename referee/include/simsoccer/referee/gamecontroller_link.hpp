@@ -48,10 +48,8 @@ class GameControllerLink {
   const std::string& lastReturnError() const { return last_error_; }
   // The latest valid return packet from (team number, player number).
   std::optional<ReturnData> lastReturn(uint8_t team_number, uint8_t player) const;
-  // Team messages counted on team `team_number`'s port so far (and those
-  // over the 128-byte limit among them).
+  // Team messages counted on team `team_number`'s port so far.
   uint64_t teamMessages(uint8_t team_number) const;
-  uint64_t oversizedTeamMessages(uint8_t team_number) const;
 
  private:
   void receiveReturns(const Game& game);
@@ -59,7 +57,7 @@ class GameControllerLink {
   struct TeamPort {
     uint8_t team_number = 0;
     std::unique_ptr<UdpReceiver> receiver;
-    uint64_t messages = 0, oversized = 0;
+    uint64_t messages = 0;
   };
   std::vector<TeamPort> team_ports_;
 

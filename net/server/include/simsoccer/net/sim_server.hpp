@@ -88,8 +88,7 @@ class SimServer : public sim::CommandSource {
   // crashed. False if nobody owned it.
   bool releaseRobot(world::RobotId r);
   // Team messages of `team` (index) relayed so far (each sent message once).
-  uint64_t teamMessagesRelayed(int team) const { return team_messages_[team == 0 ? 0 : 1]; }
-  uint64_t teamMessagesSent(int team) const override { return teamMessagesRelayed(team); }
+  uint64_t teamMessagesSent(int team) const override { return team_messages_[team == 0 ? 0 : 1]; }
   // The GameState published at every change and every 0.5 s (2 Hz); none is
   // published until one is set (a simulator without a referee).
   void setGameState(const simsoccer_msg_GameState& state);
