@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "gc_reader.hpp"
 #include "test_support.hpp"
@@ -49,7 +50,9 @@ net::ServerConfig serverConfig(uint32_t domain,
 // A simsoccer-agent process, killed (SIGKILL) when this goes.
 class AgentProcess {
  public:
-  AgentProcess(uint32_t domain, int team, int player, std::vector<std::string> extra = {}) {
+  // `environment`: NAME=VALUE entries added to this process's environment.
+  AgentProcess(uint32_t domain, int team, int player, std::vector<std::string> extra = {},
+               std::vector<std::string> environment = {}) {
     std::vector<std::string> args = {SIMSOCCER_AGENT_BIN,
                                      "--team",
                                      std::to_string(team),
@@ -63,7 +66,11 @@ class AgentProcess {
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    std::vector<char*> envp;
+    for (char** e = environ; *e; ++e) envp.push_back(*e);
+    for (auto& e : environment) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
   }
   ~AgentProcess() { kill(); }
   void kill() {
@@ -206,6 +213,105 @@ TEST(Net, SecondClaimantIsRefusedAndCannotMoveTheRobot) {
               w.jointPosition(0, 0));
   EXPECT_GT(server.stats(0).refused, refused_before + 50);
   EXPECT_NEAR(w.jointPosition(0, 0), 0.0, 0.05);
+}
+
+// A match that starts its agents reserves their robots (net/robot_keys.hpp):
+// without the robot's key nobody claims or moves it, not with the other
+// robot's key, not while its agent is down; the agent ignores a rogue's game
+// states and frames.
+TEST(Net, AReservedRobotAnswersOnlyItsKey) {
+  const uint32_t domain = 150;
+  world::World w(teams(2));
+  net::ServerConfig cfg = serverConfig(domain, 0.05);
+  const net::MatchSecret secret = net::newMatchSecret();
+  cfg.reserve = secret;
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
+  simsoccer_msg_GameState playing{};
+  playing.state = 3;  // PLAYING
+  server.setGameState(playing);
+  const auto keyVariable = [&](int team, int player) {
+    return std::string(net::kRobotKeyVariable) + "=" + net::toHex(net::robotKey(secret, team, player));
+  };
+  auto owner = std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{},
+                                              std::vector<std::string>{keyVariable(0, 1)});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  // Strangers: no key, the other robot's key, a made-up key.
+  agents::AgentClient no_key(dds(domain), 0, 1);
+  agents::AgentClient other_key(dds(domain), 0, 1, net::robotKey(secret, 1, 1));
+  agents::AgentClient made_up(dds(domain), 0, 1, net::robotKey(net::newMatchSecret(), 0, 1));
+  const auto refuse = agents::AgentClient::IfOwned::Refuse;
+  for (agents::AgentClient* c : {&no_key, &other_key, &made_up})
+    EXPECT_FALSE(claimWhilePolling(server, *c, 3.0, refuse));
+  EXPECT_GE(server.stats(0).unauthorised, 3u);
+  // Its agent dies, and the launcher frees the robot (as a match does): still
+  // nobody without the key takes it, and 10,000 of their commands move nothing.
+  owner.reset();
+  ASSERT_TRUE(server.releaseRobot(0));
+  for (agents::AgentClient* c : {&no_key, &other_key, &made_up})
+    EXPECT_FALSE(claimWhilePolling(server, *c, 1.0, agents::AgentClient::IfOwned::WaitForRelease));
+  EXPECT_FALSE(server.stats(0).owned);
+  std::vector<float> pos(25, 0.0f), stiff(25, 1.0f);
+  pos[0] = 1.5f;  // HeadYaw
+  const uint64_t accepted_before = server.stats(0).accepted;
+  const uint64_t refused_before = server.stats(0).refused;
+  for (int i = 0; i < 10000; ++i) {
+    agents::AgentClient* c = i % 3 == 0 ? &no_key : i % 3 == 1 ? &other_key : &made_up;
+    c->send(w.controlTick(), pos, stiff);
+    if (i % 100 == 99) simulation.period();
+  }
+  for (int i = 0; i < 20; ++i) simulation.period();
+  const uint64_t refused = server.stats(0).refused - refused_before;
+  std::printf("unauthorised claims %llu; of 10000 strangers' commands %llu accepted, %llu refused\n",
+              (unsigned long long)server.stats(0).unauthorised,
+              (unsigned long long)(server.stats(0).accepted - accepted_before),
+              (unsigned long long)refused);
+  EXPECT_EQ(server.stats(0).accepted, accepted_before);
+  EXPECT_GE(refused, 9000u);  // the rest may still be in flight: none applied
+  EXPECT_NEAR(w.jointPosition(0, 0), 0.0, 0.05);
+  // Its restarted agent, with the key, gets it back at once.
+  AgentProcess again(domain, 0, 1, {}, {keyVariable(0, 1)});
+  ASSERT_TRUE(server.waitForOwners(1, 20.0));
+  const uint64_t before = server.stats(0).accepted;
+  for (int i = 0; i < 50; ++i) simulation.period();
+  EXPECT_GE(server.stats(0).accepted, before + 45);
+  // An agent in this process holding robot (1, 1)'s key: it learns which
+  // participant is the simulator, and a rogue's game state and frames in its
+  // partition do not reach it.
+  agents::AgentClient mine(dds(domain), 1, 1, net::robotKey(secret, 1, 1));
+  ASSERT_TRUE(claimWhilePolling(server, mine, 10.0, refuse));
+  EXPECT_TRUE(mine.knowsSimulator());
+  {
+    simsoccer_msg_GameState g{};
+    EXPECT_TRUE(mine.gameState(g)) << "before rogue";
+    EXPECT_TRUE(mine.waitForGameState(2.0)) << "before rogue";
+  }
+  net::Participant rogue(dds(domain));
+  net::Writer<simsoccer_msg_GameState> rogue_game(rogue, simsoccer_msg_GameState_desc,
+                                                  "simsoccer_GameState", {true, 1, true, ""});
+  net::Writer<simsoccer_msg_SensorFrame> rogue_frames(
+      rogue, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
+      {true, 1, false, net::robotPartitionName(1, 1)});
+  simsoccer_msg_GameState finished{};
+  finished.state = 4;  // FINISHED
+  simsoccer_msg_SensorFrame fake{};
+  fake.team = 1;
+  fake.player = 1;
+  fake.tick = 1u << 30;
+  const auto t0 = Clock::now();
+  while (mine.foreignSamples() < 100 && seconds(t0) < 20.0) {
+    rogue_game.write(finished);
+    rogue_frames.write(fake);
+    simulation.period();  // the simulator's own frames, and its game state at 2 Hz
+    simsoccer_msg_GameState g{};
+    EXPECT_TRUE(mine.gameState(g));
+    EXPECT_EQ(g.state, 3);
+    simsoccer_msg_SensorFrame f{};
+    if (mine.receive(f, 0.05)) {
+      EXPECT_LT(f.tick, 1u << 30);
+    }
+  }
+  EXPECT_GE(mine.foreignSamples(), 100u);
 }
 
 TEST(Net, KilledAgentReleasesItsRobotAndARestartReclaimsIt) {

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -25,12 +26,43 @@ struct AgentClient::Impl {
   net::Entity waitset, frame_condition;
   std::unique_ptr<net::Reader<simsoccer_msg_CameraImage>> images;  // after subscribeImages()
   net::Entity image_waitset, image_condition;
-  bool have_game = false;
-  simsoccer_msg_GameState game_state{};
   // The tick of the last SensorFrame handed to the agent: team messages carry
   // it, so the simulator relays them by when they were sent, not by when they
   // arrived (which varies with the machine's load).
   std::atomic<uint64_t> frame_tick{0};
+  dds_guid_t me{};  // this agent's participant
+  // The simulator once known, and which writers are its (checked once per
+  // writer): the DDS receive thread and the agent's thread both ask.
+  std::mutex trust_mutex;
+  std::optional<dds_guid_t> simulator;
+  struct KnownWriter {
+    dds_entity_t reader;
+    dds_instance_handle_t handle;
+    dds_guid_t participant;
+  };
+  std::vector<KnownWriter> writers;
+  std::atomic<uint64_t> foreign{0};
+  // The latest GameState of each participant that sent one (a few), until
+  // the simulator is known.
+  struct GameFrom {
+    dds_guid_t participant;
+    simsoccer_msg_GameState state;
+  };
+  std::vector<GameFrom> games;
+  size_t newest_game = 0;
+
+  // The participant behind a sample's writer (trust_mutex held).
+  bool writerParticipant(dds_entity_t reader, dds_instance_handle_t handle, dds_guid_t& out) {
+    for (const KnownWriter& w : writers)
+      if (w.reader == reader && w.handle == handle) {
+        out = w.participant;
+        return true;
+      }
+    if (!net::publisherParticipant(reader, handle, out)) return false;
+    if (writers.size() >= 256) writers.clear();  // strangers' writers come and go
+    writers.push_back({reader, handle, out});
+    return true;
+  }
 
   Impl(const net::DomainConfig& dds, int team, int player)
       : participant(dds),
@@ -44,7 +76,10 @@ struct AgentClient::Impl {
                {true, 1, false, net::robotPartitionName(team, player)}),
         status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
                {true, 1, true, net::robotPartitionName(team, player)}),
-        game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 1, true, ""}),
+        // Several deep: another participant writing game states (one
+        // instance: the topic has no key) cannot push the simulator's out
+        // before they are taken.
+        game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 16, true, ""}),
         perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
                    {true, 1, false, net::robotPartitionName(team, player)}),
         team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
@@ -53,11 +88,16 @@ struct AgentClient::Impl {
     frame_condition = net::Entity(
         net::check(dds_create_readcondition(frames.get(), DDS_ANY_STATE), "read condition"));
     net::check(dds_waitset_attach(waitset.get(), frame_condition.get(), 0), "attach");
+    me = participant.guid();
   }
 };
 
-AgentClient::AgentClient(const net::DomainConfig& dds, int team, int player)
-    : team_(team), player_(player), impl_(std::make_unique<Impl>(dds, team, player)) {
+AgentClient::AgentClient(const net::DomainConfig& dds, int team, int player,
+                         std::optional<net::RobotKey> key)
+    : team_(team),
+      player_(player),
+      impl_(std::make_unique<Impl>(dds, team, player)),
+      key_(key) {
   if (team < 0 || team > 1 || player < 1 || player > 255)
     throw std::invalid_argument("team must be 0 or 1 and player 1..255");
 }
@@ -66,10 +106,31 @@ AgentClient::~AgentClient() {
   if (handler_) dds_set_listener(impl_->frames.get(), nullptr);
 }
 
-void AgentClient::onFrameData(dds_entity_t, void* self) {
+bool AgentClient::fromSimulator(dds_entity_t reader, const dds_sample_info_t& info) {
+  std::lock_guard lock(impl_->trust_mutex);
+  if (!impl_->simulator) return true;
+  dds_guid_t writer;
+  if (impl_->writerParticipant(reader, info.publication_handle, writer) &&
+      net::sameGuid(writer, *impl_->simulator))
+    return true;
+  ++impl_->foreign;
+  return false;
+}
+
+bool AgentClient::knowsSimulator() const {
+  std::lock_guard lock(impl_->trust_mutex);
+  return impl_->simulator.has_value();
+}
+
+uint64_t AgentClient::foreignSamples() const {
+  return impl_->foreign;
+}
+
+void AgentClient::onFrameData(dds_entity_t reader, void* self) {
   auto* client = static_cast<AgentClient*>(self);
-  client->impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t&) {
-    if (f.team == client->team_ && f.player == client->player_ && client->handler_) {
+  client->impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t& info) {
+    if (f.team == client->team_ && f.player == client->player_ && client->handler_ &&
+        client->fromSimulator(reader, info)) {
       client->impl_->frame_tick = f.tick;
       client->handler_(f);
     }
@@ -91,14 +152,26 @@ void AgentClient::onFrame(FrameHandler handler) {
 }
 
 void AgentClient::readStatus() {
-  impl_->status.take([&](const simsoccer_msg_RobotStatus& s, const dds_sample_info_t&) {
-    if (s.team == team_ && s.player == player_) status_ = s;
+  const dds_entity_t reader = impl_->status.get();
+  impl_->status.take([&](const simsoccer_msg_RobotStatus& s, const dds_sample_info_t& info) {
+    if (s.team != team_ || s.player != player_ || !fromSimulator(reader, info)) return;
+    std::lock_guard lock(impl_->trust_mutex);
+    if (!impl_->simulator && s.owned && std::memcmp(s.owner_guid, impl_->me.v, 16) == 0) {
+      // Granted: its writer is the simulator (with a key, if it proves it holds it).
+      dds_guid_t writer;
+      if (!impl_->writerParticipant(reader, info.publication_handle, writer)) return;
+      if (key_ && !net::sameProof(net::simulatorProof(*key_, writer, impl_->me), s.proof)) {
+        ++impl_->foreign;
+        return;
+      }
+      impl_->simulator = writer;
+    }
+    status_ = s;
   });
 }
 
 bool AgentClient::ownsRobot() const {
-  const dds_guid_t me = impl_->participant.guid();
-  return status_.owned && std::memcmp(status_.owner_guid, me.v, 16) == 0;
+  return status_.owned && std::memcmp(status_.owner_guid, impl_->me.v, 16) == 0 && knowsSimulator();
 }
 
 bool AgentClient::claim(double timeout_seconds, IfOwned if_owned) {
@@ -117,7 +190,13 @@ bool AgentClient::claim(double timeout_seconds, IfOwned if_owned) {
   // Refusals counted before this claim are somebody else's.
   readStatus();
   const uint32_t refused_before = status_.refused;
-  simsoccer_msg_JoinRequest j{static_cast<uint8_t>(team_), static_cast<uint8_t>(player_)};
+  simsoccer_msg_JoinRequest j{};
+  j.team = static_cast<uint8_t>(team_);
+  j.player = static_cast<uint8_t>(player_);
+  if (key_) {
+    const net::Proof proof = net::claimProof(*key_, impl_->me);
+    std::memcpy(j.proof, proof.data(), sizeof j.proof);
+  }
   impl_->join.write(j);
   auto asked = Clock::now();
   while (Clock::now() < end) {
@@ -142,8 +221,9 @@ bool AgentClient::claim(double timeout_seconds, IfOwned if_owned) {
 bool AgentClient::receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds) {
   bool got = false;
   auto grab = [&] {
-    impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t&) {
-      if (f.team == team_ && f.player == player_ && (!got || f.tick > frame.tick)) {
+    impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t& info) {
+      if (f.team == team_ && f.player == player_ && (!got || f.tick > frame.tick) &&
+          fromSimulator(impl_->frames.get(), info)) {
         frame = f;
         got = true;
       }
@@ -183,12 +263,37 @@ void AgentClient::sendRaw(const simsoccer_msg_JointCommand& command) {
 }
 
 bool AgentClient::gameState(simsoccer_msg_GameState& out) {
-  impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t&) {
-    impl_->game_state = g;
-    impl_->have_game = true;
+  const dds_entity_t reader = impl_->game.get();
+  std::lock_guard lock(impl_->trust_mutex);
+  auto& games = impl_->games;
+  impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t& info) {
+    dds_guid_t from;
+    if (!impl_->writerParticipant(reader, info.publication_handle, from)) return;
+    if (impl_->simulator && !net::sameGuid(from, *impl_->simulator)) {
+      ++impl_->foreign;  // somebody else's game
+      return;
+    }
+    size_t k = 0;
+    while (k < games.size() && !net::sameGuid(games[k].participant, from)) ++k;
+    if (k == games.size()) {
+      if (games.size() >= 8) k = impl_->newest_game == 0 ? 1 : 0, games[k].participant = from;
+      else games.push_back({from, {}});
+    }
+    games[k].state = g;
+    impl_->newest_game = k;
   });
-  if (impl_->have_game) out = impl_->game_state;
-  return impl_->have_game;
+  // Once the simulator is known, only its game; before, the newest of any.
+  if (impl_->simulator) {
+    for (const auto& gf : games)
+      if (net::sameGuid(gf.participant, *impl_->simulator)) {
+        out = gf.state;
+        return true;
+      }
+    return false;
+  }
+  if (games.empty()) return false;
+  out = games[impl_->newest_game].state;
+  return true;
 }
 
 bool AgentClient::waitForGameState(double timeout_seconds) {
@@ -216,8 +321,10 @@ void AgentClient::sendTeamMessage(std::span<const uint8_t> data) {
 
 std::vector<TeamMessageIn> AgentClient::receiveTeamMessages() {
   std::vector<TeamMessageIn> out;
-  impl_->team_deliver.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t&) {
-    if (m.team != team_ || m.to_player != player_) return;
+  impl_->team_deliver.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t& info) {
+    if (m.team != team_ || m.to_player != player_ ||
+        !fromSimulator(impl_->team_deliver.get(), info))
+      return;
     out.push_back({m.from_player, m.tick,
                    std::vector<uint8_t>(m.data._buffer, m.data._buffer + m.data._length)});
   });
@@ -243,8 +350,9 @@ std::vector<CameraImageIn> AgentClient::receiveImages(double timeout_seconds) {
   if (!impl_->images) throw std::logic_error("receiveImages() before subscribeImages()");
   std::vector<CameraImageIn> out;
   auto grab = [&] {
-    impl_->images->take([&](const simsoccer_msg_CameraImage& m, const dds_sample_info_t&) {
-      if (m.team != team_ || m.player != player_) return;
+    impl_->images->take([&](const simsoccer_msg_CameraImage& m, const dds_sample_info_t& info) {
+      if (m.team != team_ || m.player != player_ || !fromSimulator(impl_->images->get(), info))
+        return;
       CameraImageIn in;
       in.camera = m.camera;
       in.tick = m.tick;
@@ -297,8 +405,10 @@ PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m) {
 
 bool AgentClient::perception(PerceptionIn& out) {
   bool got = false;
-  impl_->perception.take([&](const simsoccer_msg_Perception& m, const dds_sample_info_t&) {
-    if (m.team != team_ || m.player != player_ || (got && m.tick < out.tick)) return;
+  impl_->perception.take([&](const simsoccer_msg_Perception& m, const dds_sample_info_t& info) {
+    if (m.team != team_ || m.player != player_ || (got && m.tick < out.tick) ||
+        !fromSimulator(impl_->perception.get(), info))
+      return;
     out = perceptionFromMessage(m);
     got = true;
   });

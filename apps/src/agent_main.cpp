@@ -141,7 +141,15 @@ int main(int argc, char** argv) {
                              opt.number("turn", 0.0));
     double last_time = 0.0;
 
-    agents::AgentClient client(dds, team, player);
+    // A match that reserves its robots hands each agent its robot's key in
+    // the environment (not on the command line, which every user can read).
+    std::optional<net::RobotKey> key;
+    if (const char* hex = std::getenv(net::kRobotKeyVariable); hex && *hex) {
+      std::string why;
+      key = net::keyFromHex(hex, &why);
+      if (!key) throw apps::UsageError(std::string(net::kRobotKeyVariable) + ": " + why);
+    }
+    agents::AgentClient client(dds, team, player, key);
     simsoccer_msg_GameState game{};
     // The referee's state before claiming: the simulator starts once every
     // robot is claimed, so the first frame is answered with it however late

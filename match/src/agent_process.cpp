@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -12,11 +13,23 @@ extern char** environ;
 
 namespace simsoccer::match {
 
-ChildProcess::ChildProcess(std::vector<std::string> args) {
+ChildProcess::ChildProcess(std::vector<std::string> args, std::vector<std::string> environment) {
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  // This process's environment, less the names `environment` sets.
+  std::vector<char*> envp;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view entry(*e);
+    const bool replaced = std::any_of(environment.begin(), environment.end(), [&](const auto& n) {
+      const size_t eq = n.find('=');
+      return entry.substr(0, entry.find('=')) == std::string_view(n).substr(0, eq);
+    });
+    if (!replaced) envp.push_back(*e);
+  }
+  for (auto& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
 }
 
 ChildProcess::~ChildProcess() {

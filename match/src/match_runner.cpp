@@ -12,6 +12,7 @@
 
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/outputs.hpp"
+#include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/sim/run_loop.hpp"
@@ -108,6 +109,9 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.team_message_delay = c.message_delay;
   sc.team_message_loss = c.message_loss;
   sc.not_served = session.lolaRobots();
+  // The agents this match starts get their robots' keys: nobody else can
+  // claim their robots, also while one restarts (net/robot_keys.hpp).
+  if (!o.external) sc.reserve = net::newMatchSecret();
   // LoLA robots: one socket each under the run's folder, a command source
   // beside DDS, their cameras and field network; their clients are started
   // here if the config names one.
@@ -131,8 +135,13 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   net::SimServer server(simulation, sc);
   // The agents find the game state when they start.
   server.publishGameState(session.controlData(), session.game().leftTeam());
-  auto agentCommand = [&](int team, int number) {  // the same for a restart
-    return match::agentCommand(session, o, team, number);
+  auto startAgent = [&](int team, int number) {  // the same for a restart
+    std::vector<std::string> environment;
+    if (sc.reserve)
+      environment.push_back(std::string(net::kRobotKeyVariable) + "=" +
+                            net::toHex(net::robotKey(*sc.reserve, team, number)));
+    return std::make_unique<ChildProcess>(match::agentCommand(session, o, team, number),
+                                          std::move(environment));
   };
   std::vector<AgentSlot> agents;
   const auto isLola = [&](world::RobotId r) {
@@ -145,7 +154,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     a.team = w.robot(r).team;
     a.number = w.robot(r).number;
     if (!o.external) {
-      a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
+      a.process = startAgent(a.team, a.number);
       if (!a.process->started())
         throw std::runtime_error("cannot start " + agentProgram().string());
     }
@@ -196,7 +205,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
                     fixedNumber(w.time(), 2).c_str(), a.team, a.number, a.process->exitStatus(),
                     a.restarts);
       result.agent_events.push_back(buf);
-      a.process = std::make_unique<ChildProcess>(agentCommand(a.team, a.number));
+      a.process = startAgent(a.team, a.number);
     }
   };
   sim::RunLoop loop(simulation, o.realtime ? sim::Pacing::RealTime : sim::Pacing::Lockstep);

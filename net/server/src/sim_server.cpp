@@ -250,6 +250,7 @@ SimServer::SimServer(sim::Simulation& sim, const ServerConfig& config)
     RobotSlot slot;
     slot.team = info.team;
     slot.player = info.number;
+    if (config.reserve) slot.key = robotKey(*config.reserve, info.team, info.number);
     robots_.push_back(slot);
     impl_->robot_writers.push_back(std::make_unique<Impl::RobotWriters>(
         impl_->participant, robotPartitionName(info.team, info.number),
@@ -349,6 +350,10 @@ void SimServer::publishStatus(world::RobotId r) {
   m.rejected = static_cast<uint32_t>(c.rejected + s.wrong_tick);
   m.refused = static_cast<uint32_t>(s.stats.refused);
   m.missed = static_cast<uint32_t>(c.missed);
+  if (s.key && s.stats.owned) {
+    const Proof proof = simulatorProof(*s.key, impl_->participant.guid(), s.owner);
+    std::memcpy(m.proof, proof.data(), sizeof m.proof);
+  }
   impl_->robot_writers[r]->status.write(m);
 }
 
@@ -384,7 +389,10 @@ void SimServer::handleJoins() {
     RobotSlot& s = robots_[static_cast<size_t>(ri)];
     dds_guid_t guid;
     if (!publisherParticipant(impl_->joins.get(), info.publication_handle, guid)) return;
-    if (!s.stats.owned) {
+    if (s.key && !sameProof(claimProof(*s.key, guid), j.proof)) {
+      ++s.stats.refused;  // reserved, and this claimant cannot prove it holds the key
+      ++s.stats.unauthorised;
+    } else if (!s.stats.owned) {
       s.stats.owned = true;
       s.owner = guid;
       s.owner_join = info.publication_handle;

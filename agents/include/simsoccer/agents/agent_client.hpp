@@ -8,10 +8,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
+#include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/protocol/wire.hpp"
 #include "simsoccer_msgs.h"
 
@@ -55,9 +57,15 @@ struct PerceptionIn {
 // The Perception message as the agent side keeps it.
 PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m);
 
+// Which participant is the simulator: the one whose RobotStatus granted this
+// agent its robot (with a robot key: whose status also proved it holds that
+// key). From then on game states, frames, perception, team messages, images
+// and status samples from any other participant are ignored and counted.
 class AgentClient {
  public:
-  AgentClient(const net::DomainConfig& dds, int team, int player);
+  // `key`: the robot's key when the match reserves robots (robot_keys.hpp).
+  AgentClient(const net::DomainConfig& dds, int team, int player,
+              std::optional<net::RobotKey> key = std::nullopt);
   ~AgentClient();
 
   int team() const { return team_; }
@@ -77,6 +85,10 @@ class AgentClient {
   // The latest RobotStatus seen for this robot (owner, counters).
   const simsoccer_msg_RobotStatus& status() const { return status_; }
   bool ownsRobot() const;
+  // Whether the simulator is known (this agent was granted its robot).
+  bool knowsSimulator() const;
+  // Samples ignored because another participant than the simulator wrote them.
+  uint64_t foreignSamples() const;
 
   // Waits for this robot's next SensorFrame; false on timeout.
   bool receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds);
@@ -119,7 +131,11 @@ class AgentClient {
   simsoccer_msg_RobotStatus status_{};
   uint32_t serial_ = 0;
   FrameHandler handler_;
+  std::optional<net::RobotKey> key_;
   void readStatus();
+  // Whether the writer of a sample `reader` took is the simulator (true for
+  // any writer until the simulator is known).
+  bool fromSimulator(dds_entity_t reader, const dds_sample_info_t& info);
   static void onFrameData(dds_entity_t reader, void* self);
 };
 

@@ -18,7 +18,9 @@ namespace simsoccer::match {
 // A child process, killed (SIGTERM, then SIGKILL) when this goes.
 class ChildProcess {
  public:
-  explicit ChildProcess(std::vector<std::string> args);
+  // `environment`: NAME=VALUE entries set for the child on top of this
+  // process's environment.
+  explicit ChildProcess(std::vector<std::string> args, std::vector<std::string> environment = {});
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "simsoccer/net/dds.hpp"
+#include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/camera_system.hpp"
@@ -50,14 +51,20 @@ struct ServerConfig {
   bool world_truth = false;
   // Robots another transport drives (LoLA): claims and commands for them are ignored.
   std::vector<world::RobotId> not_served;
+  // Reserved robots: a claim must prove it holds its robot's key
+  // (robotKey(secret, team, player)), also after the owner went away; the
+  // owner's status proves the simulator holds it too (robot_keys.hpp).
+  // Empty: the first claimant owns a free robot.
+  std::optional<MatchSecret> reserve;
 };
 
 // accepted, missed: the simulation's count (sim::CommandStats); rejected:
 // the gate's refusals and answers to the wrong tick; refused: samples from a
-// participant that does not own the robot.
+// participant that does not own the robot; unauthorised: of those, claims
+// of a reserved robot without its key's proof.
 struct RobotNetStats {
   bool owned = false;
-  uint64_t accepted = 0, rejected = 0, refused = 0, missed = 0;
+  uint64_t accepted = 0, rejected = 0, refused = 0, missed = 0, unauthorised = 0;
 };
 
 class SimServer : public sim::CommandSource {
@@ -105,6 +112,7 @@ class SimServer : public sim::CommandSource {
     int team = 0, player = 0;
     RobotNetStats stats;
     dds_guid_t owner{};
+    std::optional<RobotKey> key;           // reserved: only a claim proving this key
     dds_instance_handle_t owner_join = 0;  // the owner's JoinRequest writer (liveness)
     bool has_command = false;              // a checked command waits to be taken
     uint64_t last_tick = 0;                // tick of the last accepted command
