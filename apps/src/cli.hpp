@@ -75,5 +75,6 @@ int match(int argc, char** argv, int first);
 int penalty(int argc, char** argv, int first);
 int replay(int argc, char** argv, int first);
 int check(int argc, char** argv, int first);
+int soak(int argc, char** argv, int first);
 
 }  // namespace simsoccer::apps
