@@ -67,11 +67,11 @@ struct AgentClient::Impl {
   Impl(const net::DomainConfig& dds, int team, int player)
       : participant(dds),
         join(participant, simsoccer_msg_JoinRequest_desc, "simsoccer_JoinRequest",
-             {true, 4, true, ""}),
+             {true, 4, true, net::robotPartitionName(team, player)}),
         command(participant, simsoccer_msg_JointCommand_desc, "simsoccer_JointCommand",
-                {true, 16, false, ""}),
+                {true, 16, false, net::robotPartitionName(team, player)}),
         team_send(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageSend",
-                  {true, 16, false, ""}),
+                  {true, 16, false, net::robotPartitionName(team, player)}),
         frames(participant, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
                {true, 1, false, net::robotPartitionName(team, player)}),
         status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
@@ -120,6 +120,12 @@ bool AgentClient::fromSimulator(dds_entity_t reader, const dds_sample_info_t& in
 bool AgentClient::knowsSimulator() const {
   std::lock_guard lock(impl_->trust_mutex);
   return impl_->simulator.has_value();
+}
+
+int AgentClient::commandReadersMatched() const {
+  dds_publication_matched_status_t st{};
+  if (dds_get_publication_matched_status(impl_->command.get(), &st) != DDS_RETCODE_OK) return 0;
+  return static_cast<int>(st.current_count);
 }
 
 uint64_t AgentClient::foreignSamples() const {

@@ -76,5 +76,6 @@ int penalty(int argc, char** argv, int first);
 int replay(int argc, char** argv, int first);
 int check(int argc, char** argv, int first);
 int soak(int argc, char** argv, int first);
+int credentials(int argc, char** argv, int first);
 
 }  // namespace simsoccer::apps

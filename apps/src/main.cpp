@@ -28,6 +28,7 @@ const char* kUsage =
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "  lola-run        start a team's robot binary with a simulated Nao's LoLA socket\n"
     "  soak [CONFIG]   matches back to back with agents killed: memory, descriptors, threads\n"
+    "  credentials DIR DDS Security certificates and permissions for a secure match\n"
     "\n"
     "Run 'simsoccer <command> --help' for the options of a command.\n";
 
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
     if (cmd == "replay") return replay(argc, argv, 2);
     if (cmd == "lola-run") return lolaRun(argc, argv, 2);
     if (cmd == "soak") return soak(argc, argv, 2);
+    if (cmd == "credentials") return credentials(argc, argv, 2);
     if (cmd == "bench") {
       const std::string sub = argc > 2 ? argv[2] : "";
       if (sub == "physics") return benchPhysics(argc, argv, 3);

@@ -83,7 +83,7 @@ int match(int argc, char** argv, int first) {
   const Options opt(
       argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net"},
       {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
-       "lola", "external-gc"});
+       "lola", "external-gc", "secure"});
   char help[4096];
   std::snprintf(help, sizeof help, kMatchHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -107,6 +107,13 @@ int match(int argc, char** argv, int first) {
   RunOptions o = runOptions(opt, config);
   o.realtime = opt.flag("realtime") || config.external_gc_port.has_value();
   o.external = opt.flag("external-agents");
+  if (opt.has("secure")) {
+    o.secure = opt.get("secure", "");
+    for (const char* id : {"simulator.xml", "team_0.xml", "team_1.xml"})
+      if (!std::filesystem::is_regular_file(o.secure / id))
+        throw UsageError("--secure " + o.secure.string() + ": no " + id +
+                         " (make the folder with `simsoccer credentials DIR`)");
+  }
   o.video = config.video.enabled && !opt.flag("no-video");
   o.max_seconds = opt.nonNegative("max-seconds", 0);
   try {

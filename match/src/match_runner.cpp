@@ -80,7 +80,8 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
   ao.team = team;
   ao.player = number;
   ao.domain = static_cast<int>(o.domain);
-  ao.dds_config = o.dds_config;
+  ao.dds_config = o.secure.empty() ? o.dds_config
+                                   : o.secure / ("team_" + std::to_string(team) + ".xml");
   ao.role = c.role;
   ao.field = session.world().scenario().field_file;
   ao.config = c.agent_config;
@@ -103,7 +104,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   simulation.addRecorder(recorder);
   net::ServerConfig sc;
   sc.dds.domain = o.domain;
-  sc.dds.config_file = o.dds_config;
+  sc.dds.config_file = o.secure.empty() ? o.dds_config : o.secure / "simulator.xml";
   sc.lockstep = !o.realtime;
   sc.command_timeout = c.command_timeout;
   sc.team_message_delay = c.message_delay;

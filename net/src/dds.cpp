@@ -91,6 +91,23 @@ bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication
   return true;
 }
 
+bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication,
+                          dds_guid_t& participant, std::string& partition) {
+  dds_builtintopic_endpoint_t* ep = dds_get_matched_publication_data(reader, publication);
+  if (!ep) return false;
+  participant = ep->participant_key;
+  partition.clear();
+  uint32_t n = 0;
+  char** names = nullptr;
+  if (ep->qos && dds_qget_partition(ep->qos, &n, &names)) {
+    if (n > 0) partition = names[0];
+    for (uint32_t i = 0; i < n; ++i) dds_free(names[i]);
+    dds_free(names);
+  }
+  dds_builtintopic_free_endpoint(ep);
+  return true;
+}
+
 bool publicationMatched(dds_entity_t reader, dds_instance_handle_t publication) {
   dds_instance_handle_t handles[256];
   const dds_return_t n = dds_get_matched_publications(reader, handles, 256);

@@ -188,9 +188,14 @@ struct SimServer::Impl {
   Reader<simsoccer_msg_TeamMessage> team_send;
   Entity waitset;
   Entity join_condition;
-  // Publication handle -> participant GUID of writers seen on the command
-  // and team-message readers (cached: looked up once per writer).
-  std::vector<std::pair<dds_instance_handle_t, dds_guid_t>> publishers;
+  // Writers seen on the command and team-message readers: their participant
+  // and partition (cached: looked up once per writer).
+  struct Publisher {
+    dds_instance_handle_t handle;
+    dds_guid_t participant;
+    std::string partition;
+  };
+  std::vector<Publisher> publishers;
   // Team messages waiting for their delivery tick (one per message sent).
   struct Pending {
     uint64_t due;
@@ -210,11 +215,11 @@ struct SimServer::Impl {
         clock(participant, simsoccer_msg_SimClock_desc, "simsoccer_SimClock", latest()),
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", latestDurable()),
         commands(participant, simsoccer_msg_JointCommand_desc, "simsoccer_JointCommand",
-                 {true, 16, false, ""}),
+                 {true, 16, false, kAllRobotPartitions}),
         joins(participant, simsoccer_msg_JoinRequest_desc, "simsoccer_JoinRequest",
-              {true, 4, true, ""}),
+              {true, 4, true, kAllRobotPartitions}),
         team_send(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageSend",
-                  {true, 16, false, ""}),
+                  {true, 16, false, kAllRobotPartitions}),
         loss_rng(seed) {
     waitset = Entity(check(dds_create_waitset(participant.get()), "create waitset"));
     join_condition =
@@ -222,15 +227,23 @@ struct SimServer::Impl {
     check(dds_waitset_attach(waitset.get(), join_condition.get(), 1), "attach");
   }
 
-  bool participantOf(dds_entity_t reader, dds_instance_handle_t h, dds_guid_t& guid) {
-    for (const auto& [handle, g] : publishers)
-      if (handle == h) {
-        guid = g;
-        return true;
-      }
-    if (!publisherParticipant(reader, h, guid)) return false;
-    publishers.emplace_back(h, guid);
-    return true;
+  // The participant of a sample's writer, if that writer writes in the
+  // partition of the robot the sample is for (DDS Security's permissions
+  // grant a team's agents only their robots' partitions).
+  bool participantOf(dds_entity_t reader, dds_instance_handle_t h, int team, int player,
+                     dds_guid_t& guid) {
+    const Publisher* known = nullptr;
+    for (const Publisher& p : publishers)
+      if (p.handle == h) known = &p;
+    if (!known) {
+      Publisher p{h, {}, {}};
+      if (!publisherParticipant(reader, h, p.participant, p.partition)) return false;
+      if (publishers.size() >= 4096) publishers.clear();  // strangers' writers come and go
+      publishers.push_back(std::move(p));
+      known = &publishers.back();
+    }
+    guid = known->participant;
+    return known->partition == robotPartitionName(team, player);
   }
 };
 
@@ -388,8 +401,12 @@ void SimServer::handleJoins() {
     if (ri < 0) return;
     RobotSlot& s = robots_[static_cast<size_t>(ri)];
     dds_guid_t guid;
-    if (!publisherParticipant(impl_->joins.get(), info.publication_handle, guid)) return;
-    if (s.key && !sameProof(claimProof(*s.key, guid), j.proof)) {
+    std::string partition;
+    if (!publisherParticipant(impl_->joins.get(), info.publication_handle, guid, partition)) return;
+    if (partition != robotPartitionName(j.team, j.player)) {
+      ++s.stats.refused;  // a claim written outside the robot's partition
+      ++s.stats.unauthorised;
+    } else if (s.key && !sameProof(claimProof(*s.key, guid), j.proof)) {
       ++s.stats.refused;  // reserved, and this claimant cannot prove it holds the key
       ++s.stats.unauthorised;
     } else if (!s.stats.owned) {
@@ -423,7 +440,8 @@ void SimServer::handleCommands() {
     RobotSlot& s = robots_[static_cast<size_t>(ri)];
     dds_guid_t guid;
     if (!s.stats.owned ||
-        !impl_->participantOf(impl_->commands.get(), info.publication_handle, guid) ||
+        !impl_->participantOf(impl_->commands.get(), info.publication_handle, c.team, c.player,
+                              guid) ||
         !sameGuid(guid, s.owner)) {
       ++s.stats.refused;
       return;
@@ -465,7 +483,8 @@ void SimServer::relayTeamMessages(uint64_t tick) {
     RobotSlot& sender = robots_[static_cast<size_t>(ri)];
     dds_guid_t guid;
     if (!sender.stats.owned ||
-        !impl_->participantOf(impl_->team_send.get(), info.publication_handle, guid) ||
+        !impl_->participantOf(impl_->team_send.get(), info.publication_handle, m.team,
+                              m.from_player, guid) ||
         !sameGuid(guid, sender.owner) || m.data._length > 128) {
       ++sender.stats.refused;
       return;

@@ -87,6 +87,8 @@ class AgentClient {
   bool ownsRobot() const;
   // Whether the simulator is known (this agent was granted its robot).
   bool knowsSimulator() const;
+  // Readers (the simulator's) this agent's command writer is matched with.
+  int commandReadersMatched() const;
   // Samples ignored because another participant than the simulator wrote them.
   uint64_t foreignSamples() const;
 

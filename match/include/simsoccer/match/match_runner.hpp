@@ -26,6 +26,10 @@ struct RunOptions {
   bool video = true;
   uint32_t domain = 0;
   std::filesystem::path dds_config;  // the simulator's and the agents' Cyclone configuration
+  // DDS Security (simsoccer credentials): the simulator runs with
+  // secure/simulator.xml and team T's agents with secure/team_T.xml
+  // (replacing dds_config). Empty: no DDS Security.
+  std::filesystem::path secure;
   double max_seconds = 0.0;          // > 0: stop after this much simulated time
   sim::Mode mode = sim::kDefaultMode;  // of the control period
   // Asked after every period: true stops the run (Ctrl-C), keeping what was recorded.

@@ -158,14 +158,22 @@ class Reader {
 // (as this reader sees it); false if the writer is no longer known.
 bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication,
                           dds_guid_t& participant);
+// The same, and the writer's partition (its first; empty: the default one).
+bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication,
+                          dds_guid_t& participant, std::string& partition);
 // Whether a writer is still matched with (alive for) this reader.
 bool publicationMatched(dds_entity_t reader, dds_instance_handle_t publication);
 
 // The DDS partition of one robot's own topics: its SensorFrames, status,
-// team messages to it, perception and camera images.
+// team messages to it, perception and camera images; and its agent's
+// claims, commands and team messages (so that DDS Security's permissions can
+// say which robots a team's agents may write for).
 inline std::string robotPartitionName(int team, int player) {
   return "robot_" + std::to_string(team) + "_" + std::to_string(player);
 }
+
+// What the simulator's readers of the agents' topics subscribe to.
+inline constexpr const char* kAllRobotPartitions = "robot_*";
 
 inline bool sameGuid(const dds_guid_t& a, const dds_guid_t& b) {
   for (int i = 0; i < 16; ++i)

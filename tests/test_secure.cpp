@@ -1,0 +1,175 @@
+// DDS Security (simsoccer credentials, docs/security.md): the simulator in
+// this process with its credentials; its agent, strangers and the other team
+// as processes with theirs (a process holds one DDS configuration per domain).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <future>
+#include <string>
+#include <vector>
+
+#include "simsoccer/net/credentials.hpp"
+#include "simsoccer/net/sim_server.hpp"
+#include "test_support.hpp"
+
+extern char** environ;
+
+using namespace simsoccer;
+
+namespace {
+
+// A simsoccer-agent (nod mode) for robot (team, player) with a Cyclone configuration.
+class AgentProcess {
+ public:
+  AgentProcess(uint32_t domain, int team, int player, const std::filesystem::path& dds_config) {
+    std::vector<std::string> args = {SIMSOCCER_AGENT_BIN, "--team",   std::to_string(team),
+                                     "--player",          std::to_string(player),
+                                     "--domain",          std::to_string(domain),
+                                     "--dds-config",      dds_config.string()};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~AgentProcess() { kill(); }
+  void kill() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+      pid_ = -1;
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+// Credentials of one match authority in a folder of the test's own.
+struct Credentials {
+  explicit Credentials(const std::string& name) : dir(name) {
+    net::CredentialsOptions o;
+    o.dir = dir.path();
+    o.network = test::sourceDir() / "configs" / "dds" / "loopback.xml";
+    net::writeMatchCredentials(o);
+  }
+  std::filesystem::path operator/(const std::string& file) const { return dir / file; }
+  test::TempDir dir;
+};
+
+// An intruder (tests/dds_intruder.cpp) run while the simulation steps: its report.
+std::future<std::string> intrude(const std::filesystem::path& dds_config, uint32_t domain,
+                                 int team, int player, int commands, double claim_seconds) {
+  const std::string cmd = std::string(SIMSOCCER_INTRUDER_BIN) + " " + dds_config.string() + " " +
+                          std::to_string(domain) + " " + std::to_string(team) + " " +
+                          std::to_string(player) + " " + std::to_string(commands) + " " +
+                          std::to_string(claim_seconds);
+  return std::async(std::launch::async, [cmd] {
+    int status = 0;
+    return test::runCommand(cmd, status);
+  });
+}
+
+bool ready(const std::future<std::string>& f) {
+  return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+
+}  // namespace
+
+TEST(Secure, CredentialsAreSignedByTheMatchAuthority) {
+  const Credentials c("secure_files");
+  int status = 0;
+  for (const std::string id : {"simulator", "team_0", "team_1"}) {
+    std::string out = test::runCommand(
+        "openssl verify -CAfile " + (c / "ca.pem").string() + " " + (c / (id + ".pem")).string(),
+        status);
+    EXPECT_EQ(status, 0) << out;
+    out = test::runCommand("openssl smime -verify -text -CAfile " + (c / "ca.pem").string() +
+                               " -in " + (c / (id + "_permissions.p7s")).string(),
+                           status);
+    EXPECT_EQ(status, 0) << out;
+    EXPECT_NE(out.find("<subject_name>CN=" + id + ",O=simsoccer</subject_name>"), std::string::npos)
+        << out;
+    EXPECT_EQ(std::filesystem::status(c / (id + "_key.pem")).permissions() &
+                  std::filesystem::perms::others_read,
+              std::filesystem::perms::none);
+  }
+  const std::string team0 = test::readFile(c / "team_0_permissions.xml");
+  EXPECT_NE(team0.find("<partition>robot_0_*</partition>"), std::string::npos);
+  EXPECT_EQ(team0.find("robot_1_"), std::string::npos);
+}
+
+// Without this authority's credentials a participant is not even matched;
+// with the other team's, its own DDS refuses it the robot's topics. 10,002
+// commands tried, none arrives; nobody claims the robot, also once its
+// agent is gone.
+TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
+  const Credentials match("secure_match"), forged("secure_forged");
+  const uint32_t domain = 151;
+  world::World w(test::scenario(2));
+  net::ServerConfig cfg;
+  cfg.dds.domain = domain;
+  cfg.dds.config_file = match / "simulator.xml";
+  cfg.command_timeout = 0.05;
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, cfg);
+  auto owner = std::make_unique<AgentProcess>(domain, 0, 1, match / "team_0.xml");
+  ASSERT_TRUE(server.waitForOwners(1, 30.0)) << "the team's own agent did not get its robot";
+  const std::filesystem::path plain = test::sourceDir() / "configs" / "dds" / "loopback.xml";
+  std::vector<std::future<std::string>> strangers;
+  strangers.push_back(intrude(plain, domain, 0, 1, 3334, 3.0));
+  strangers.push_back(intrude(forged / "team_0.xml", domain, 0, 1, 3334, 3.0));
+  strangers.push_back(intrude(forged / "simulator.xml", domain, 0, 1, 3334, 3.0));
+  auto other_team = intrude(match / "team_1.xml", domain, 0, 1, 3334, 3.0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto allReady = [&] {
+    for (const auto& f : strangers)
+      if (!ready(f)) return false;
+    return ready(other_team);
+  };
+  while (!allReady() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    simulation.period();
+  ASSERT_TRUE(allReady());
+  for (auto& f : strangers) {
+    const std::string report = f.get();
+    EXPECT_NE(report.find("granted 0 matched 0 sent 3334"), std::string::npos) << report;
+  }
+  const std::string refused = other_team.get();
+  EXPECT_NE(refused.find("refused:"), std::string::npos) << refused;
+  EXPECT_EQ(server.stats(0).refused, 0u);  // nothing of theirs even arrived
+  EXPECT_GT(server.stats(0).accepted, 50u);
+  EXPECT_NEAR(w.jointPosition(0, 0), 0.0, 0.05);  // HeadYaw: theirs was 1.5
+  // The owner goes; a stranger still cannot have the robot.
+  owner.reset();
+  server.releaseRobot(0);
+  auto late = intrude(plain, domain, 0, 1, 10, 2.0);
+  while (!ready(late)) simulation.period();
+  const std::string report = late.get();
+  EXPECT_NE(report.find("granted 0 matched 0"), std::string::npos) << report;
+  EXPECT_FALSE(server.stats(0).owned);
+}
+
+// The same match over DDS Security and without it: the same game.
+TEST(Secure, AMatchIsTheSameGameOverDdsSecurity) {
+  const Credentials c("secure_hash");
+  const test::TempDir out("secure_hash_out");
+  const auto play = [&](const std::string& name, const std::string& options) {
+    int status = 0;
+    const std::string log = test::runCommand(
+        std::string(SIMSOCCER_BIN) + " match " +
+            (test::sourceDir() / "configs" / "match_2v2.yaml").string() +
+            " --max-seconds 10 --no-video --quiet --out " + (out / name).string() + " " + options,
+        status);
+    EXPECT_EQ(status, 0) << log;
+    const std::string summary = test::readFile(out / name / "summary.json");
+    const size_t at = summary.find("\"final_state_hash\": \"");
+    return at == std::string::npos ? std::string("none") : summary.substr(at + 21, 16);
+  };
+  const std::string plain = play("plain", "--domain 152");
+  const std::string secure = play("secure", "--domain 153 --secure " + c.dir.path().string());
+  std::printf("final state hash: plain %s, secure %s\n", plain.c_str(), secure.c_str());
+  EXPECT_NE(plain, "none");
+  EXPECT_EQ(plain, secure);
+}
