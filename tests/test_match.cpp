@@ -303,6 +303,24 @@ TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
   EXPECT_TRUE(left.empty()) << left;
 }
 
+TEST(MatchApp, AKilledSimulatorTakesItsAgentsWithIt) {
+  BackgroundMatch m("match_kill9", "--no-video --domain 154");
+  EXPECT_TRUE(m.waitForLog(100000)) << "the game did not start";
+  int s = 0;
+  test::runCommand("pkill -KILL -f '^" + kBin + " match .*--domain 154 '", s);
+  m.join();
+  // SIGKILL: the match could not stop its agents; each asked the kernel to
+  // be told when its parent dies, and exits at once (not after 5 s without frames).
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string left = "?";
+  while (!left.empty() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) {
+    int ps = 0;
+    left = test::runCommand("pgrep -f '^[^ ]*simsoccer-agent .*--domain 154 '", ps);
+    if (!left.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(left.empty()) << "agents left 2 s after the simulator was killed: " << left;
+}
+
 TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
   const test::TempDir dir("match_bad");
   std::ofstream(dir / "bad.yaml") << "match: bad\nscenario: nowhere.yaml\nrules: rules/spl.yaml\n";

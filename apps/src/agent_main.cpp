@@ -3,7 +3,11 @@
 // kick, fall detector) driven by the robot's perception, the GameState and
 // team messages; without, simple modes (stand and nod, walk at a velocity)
 // and test modes that send malformed commands or stop answering.
+#include <sys/prctl.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <csignal>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -141,6 +145,12 @@ int main(int argc, char** argv) {
                              opt.number("turn", 0.0));
     double last_time = 0.0;
 
+    // Started by a match (which names itself): go when it goes, also when it
+    // was killed with SIGKILL and could not stop its agents.
+    if (const char* parent = std::getenv(simsoccer::protocol::kParentPidVariable); parent && *parent) {
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (::getppid() != static_cast<pid_t>(std::atol(parent))) return 4;  // already gone
+    }
     // A match that reserves its robots hands each agent its robot's key in
     // the environment (not on the command line, which every user can read).
     std::optional<net::RobotKey> key;

@@ -1,5 +1,7 @@
 #include "simsoccer/match/match_runner.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +15,7 @@
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/outputs.hpp"
 #include "simsoccer/net/robot_keys.hpp"
+#include "simsoccer/protocol/wire.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/sim/run_loop.hpp"
@@ -137,7 +140,10 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   // The agents find the game state when they start.
   server.publishGameState(session.controlData(), session.game().leftTeam());
   auto startAgent = [&](int team, int number) {  // the same for a restart
-    std::vector<std::string> environment;
+    // The agent exits when this process does, even killed (simsoccer-agent
+    // asks the kernel for SIGTERM when its parent dies).
+    std::vector<std::string> environment{std::string(protocol::kParentPidVariable) + "=" +
+                                         std::to_string(::getpid())};
     if (sc.reserve)
       environment.push_back(std::string(net::kRobotKeyVariable) + "=" +
                             net::toHex(net::robotKey(*sc.reserve, team, number)));

@@ -45,6 +45,10 @@ constexpr std::size_t extent(const T (&)[N]) {
 }
 }  // namespace detail
 
+// A match tells the agents it starts its process id in this environment
+// variable: an agent exits when that process does, even if it was killed.
+inline constexpr const char* kParentPidVariable = "SIMSOCCER_PARENT_PID";
+
 // The IDL and these constants agree (a changed IDL fails to compile here).
 static_assert(detail::extent(simsoccer_msg_SensorFrame{}.position) == kActuators);
 static_assert(detail::extent(simsoccer_msg_SensorFrame{}.fsr) == kFsrs);
