@@ -306,17 +306,23 @@ TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
 TEST(MatchApp, AKilledSimulatorTakesItsAgentsWithIt) {
   BackgroundMatch m("match_kill9", "--no-video --domain 154");
   EXPECT_TRUE(m.waitForLog(100000)) << "the game did not start";
+  const auto agents = [] {
+    int ps = 0;
+    return test::runCommand("pgrep -f '^[^ ]*simsoccer-agent .*--domain 154 '", ps);
+  };
+  ASSERT_FALSE(agents().empty()) << "no agents to be left behind";
   int s = 0;
   test::runCommand("pkill -KILL -f '^" + kBin + " match .*--domain 154 '", s);
+  ASSERT_EQ(s, 0) << "no simulator to kill";
   m.join();
+  EXPECT_EQ(WEXITSTATUS(m.status), 128 + SIGKILL) << m.out;  // through the shell
   // SIGKILL: the match could not stop its agents; each asked the kernel to
   // be told when its parent dies, and exits at once (not after 5 s without frames).
   const auto t0 = std::chrono::steady_clock::now();
-  std::string left = "?";
+  std::string left = agents();
   while (!left.empty() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) {
-    int ps = 0;
-    left = test::runCommand("pgrep -f '^[^ ]*simsoccer-agent .*--domain 154 '", ps);
-    if (!left.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    left = agents();
   }
   EXPECT_TRUE(left.empty()) << "agents left 2 s after the simulator was killed: " << left;
 }

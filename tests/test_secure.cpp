@@ -145,7 +145,10 @@ TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
   owner.reset();
   server.releaseRobot(0);
   auto late = intrude(plain, domain, 0, 1, 10, 2.0);
-  while (!ready(late)) simulation.period();
+  const auto t1 = std::chrono::steady_clock::now();
+  while (!ready(late) && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(30))
+    simulation.period();
+  ASSERT_TRUE(ready(late));
   const std::string report = late.get();
   EXPECT_NE(report.find("granted 0 matched 0"), std::string::npos) << report;
   EXPECT_FALSE(server.stats(0).owned);

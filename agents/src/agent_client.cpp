@@ -47,9 +47,11 @@ struct AgentClient::Impl {
   struct GameFrom {
     dds_guid_t participant;
     simsoccer_msg_GameState state;
+    uint64_t received;  // order of arrival
   };
   std::vector<GameFrom> games;
   size_t newest_game = 0;
+  uint64_t games_received = 0;
 
   // The participant behind a sample's writer (trust_mutex held).
   bool writerParticipant(dds_entity_t reader, dds_instance_handle_t handle, dds_guid_t& out) {
@@ -76,9 +78,9 @@ struct AgentClient::Impl {
                {true, 1, false, net::robotPartitionName(team, player)}),
         status(participant, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
                {true, 1, true, net::robotPartitionName(team, player)}),
-        // Several deep: another participant writing game states (one
-        // instance: the topic has no key) cannot push the simulator's out
-        // before they are taken.
+        // Several deep: another participant writing game states now and
+        // then (one instance: the topic has no key) does not push the
+        // simulator's out before they are taken (a flood still can).
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 16, true, ""}),
         perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
                    {true, 1, false, net::robotPartitionName(team, player)}),
@@ -282,10 +284,17 @@ bool AgentClient::gameState(simsoccer_msg_GameState& out) {
     size_t k = 0;
     while (k < games.size() && !net::sameGuid(games[k].participant, from)) ++k;
     if (k == games.size()) {
-      if (games.size() >= 8) k = impl_->newest_game == 0 ? 1 : 0, games[k].participant = from;
-      else games.push_back({from, {}});
+      if (games.size() < 8) {
+        games.push_back({from, {}, 0});
+      } else {  // the one heard from longest ago makes room
+        k = 0;
+        for (size_t i = 1; i < games.size(); ++i)
+          if (games[i].received < games[k].received) k = i;
+        games[k].participant = from;
+      }
     }
     games[k].state = g;
+    games[k].received = ++impl_->games_received;
     impl_->newest_game = k;
   });
   // Once the simulator is known, only its game; before, the newest of any.

@@ -158,6 +158,7 @@ int main(int argc, char** argv) {
       std::string why;
       key = net::keyFromHex(hex, &why);
       if (!key) throw apps::UsageError(std::string(net::kRobotKeyVariable) + ": " + why);
+      ::unsetenv(net::kRobotKeyVariable);  // not inherited by anything this starts
     }
     agents::AgentClient client(dds, team, player, key);
     simsoccer_msg_GameState game{};

@@ -12,6 +12,7 @@
 #include "lola_option.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/match/outputs.hpp"
+#include "simsoccer/net/credentials.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -109,6 +110,10 @@ int match(int argc, char** argv, int first) {
   o.external = opt.flag("external-agents");
   if (opt.has("secure")) {
     o.secure = opt.get("secure", "");
+    if (o.domain > net::CredentialsOptions{}.domain_max)
+      throw UsageError("--secure: the credentials cover DDS domains 0 to " +
+                       std::to_string(net::CredentialsOptions{}.domain_max) + ", not " +
+                       std::to_string(o.domain));
     for (const char* id : {"simulator.xml", "team_0.xml", "team_1.xml"})
       if (!std::filesystem::is_regular_file(o.secure / id))
         throw UsageError("--secure " + o.secure.string() + ": no " + id +

@@ -111,7 +111,7 @@ bool sampleProcess(int pid, ProcessSample& out) {
     while (const dirent* e = ::readdir(fd))
       if (e->d_name[0] != '.') ++out.fds;
     ::closedir(fd);
-    --out.fds;  // the one opendir holds
+    if (pid == 0) --out.fds;  // the one opendir held
   }
   return rss;
 }
@@ -141,11 +141,13 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
     g.sim_peak_rss = g.sim_start.rss_mib;
     {
       MatchSession session(config, g.seed);
-      // The faults' simulated times, spread over both halves (not the first
-      // 5 s: the agents are still claiming), victims drawn when due.
+      // The faults' simulated times, spread over both halves and the break
+      // between them (not the first 5 s: the agents are still claiming; the
+      // stoppages make a game longer still), victims drawn when due.
       std::mt19937_64 rng(g.seed * 7919 + 17);
-      const double half = session.game().rules().half_duration;
-      std::uniform_real_distribution<double> when(5.0, std::max(6.0, 2.0 * half));
+      const auto& rules = session.game().rules();
+      std::uniform_real_distribution<double> when(
+          5.0, std::max(6.0, 2.0 * rules.half_duration + rules.half_time_break));
       std::vector<double> kills(static_cast<size_t>(o.kills_per_game)),
           stops(static_cast<size_t>(o.stops_per_game));
       for (double& t : kills) t = when(rng);
@@ -156,7 +158,7 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
       std::map<int, int> killed;  // robot (team * 256 + player) -> kills this game
       std::vector<std::pair<int, Clock::time_point>> frozen;  // pid, when to continue
       bool first_sample = true;
-      const auto sample = [&](bool last) {
+      const auto sample = [&] {
         ProcessSample s;
         if (sampleProcess(0, s)) g.sim_peak_rss = std::max(g.sim_peak_rss, s.rss_mib);
         double sum = 0.0;
@@ -171,11 +173,11 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
         if (n == 0) return;
         if (first_sample) g.agent_rss_start = sum / n;
         first_sample = false;
-        if (!last) g.agent_rss_end = sum / n;
+        g.agent_rss_end = sum / n;
       };
       run.progress = [&](const MatchSession& s, double wall) {
         if (o.run.progress) o.run.progress(s, wall);
-        sample(false);
+        sample();
         const double t = s.world().time();
         const auto now = Clock::now();
         for (auto it = frozen.begin(); it != frozen.end();)
@@ -224,7 +226,7 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
         r.aborted = true;
         r.abort_reason = e.what();
       }
-      for (const auto& f : frozen) ::kill(f.first, SIGCONT);
+      // (A frozen agent is stopped with the rest: SIGKILL needs no SIGCONT.)
       g.finished = !r.aborted && !r.interrupted && session.over();
       g.abort_reason = r.abort_reason;
       g.restarts = static_cast<int>(r.agent_events.size());

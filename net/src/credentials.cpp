@@ -8,7 +8,9 @@
 #include <openssl/rand.h>
 #include <openssl/x509.h>
 #include <openssl/x509v3.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <ctime>
 #include <fstream>
@@ -27,6 +29,7 @@ using Key = std::unique_ptr<EVP_PKEY, Deleter<EVP_PKEY, EVP_PKEY_free>>;
 using Cert = std::unique_ptr<X509, Deleter<X509, X509_free>>;
 using Bio = std::unique_ptr<BIO, Deleter<BIO, BIO_free_all>>;
 using Pkcs7 = std::unique_ptr<PKCS7, Deleter<PKCS7, PKCS7_free>>;
+using Extension = std::unique_ptr<X509_EXTENSION, Deleter<X509_EXTENSION, X509_EXTENSION_free>>;
 
 [[noreturn]] void fail(const std::string& what) {
   char buf[256] = "";
@@ -44,9 +47,9 @@ void addExtension(X509* cert, X509* issuer, int nid, const char* value) {
   X509V3_CTX ctx;
   X509V3_set_ctx_nodb(&ctx);
   X509V3_set_ctx(&ctx, issuer, cert, nullptr, nullptr, 0);
-  X509_EXTENSION* ext = X509V3_EXT_conf_nid(nullptr, &ctx, nid, value);
-  if (!ext || !X509_add_ext(cert, ext, -1)) fail(std::string("cannot add the extension ") + value);
-  X509_EXTENSION_free(ext);
+  const Extension ext(X509V3_EXT_conf_nid(nullptr, &ctx, nid, value));
+  if (!ext || !X509_add_ext(cert, ext.get(), -1))
+    fail(std::string("cannot add the extension ") + value);
 }
 
 // A certificate for `key` named O=simsoccer, CN=`cn`, signed by the issuer
@@ -56,17 +59,18 @@ Cert newCert(EVP_PKEY* key, const std::string& cn, X509* issuer, EVP_PKEY* issue
   if (!c) fail("cannot make a certificate");
   X509_set_version(c.get(), 2);
   uint64_t serial = 0;
-  RAND_bytes(reinterpret_cast<unsigned char*>(&serial), sizeof serial);
-  ASN1_INTEGER_set_uint64(X509_get_serialNumber(c.get()), serial >> 1);
-  X509_gmtime_adj(X509_getm_notBefore(c.get()), -3600);  // clocks of other machines
-  X509_gmtime_adj(X509_getm_notAfter(c.get()), static_cast<long>(days) * 86400);
-  X509_set_pubkey(c.get(), key);
   X509_NAME* name = X509_get_subject_name(c.get());
-  X509_NAME_add_entry_by_txt(name, "O", MBSTRING_ASC,
-                             reinterpret_cast<const unsigned char*>("simsoccer"), -1, -1, 0);
-  X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_ASC,
-                             reinterpret_cast<const unsigned char*>(cn.c_str()), -1, -1, 0);
-  X509_set_issuer_name(c.get(), issuer ? X509_get_subject_name(issuer) : name);
+  if (RAND_bytes(reinterpret_cast<unsigned char*>(&serial), sizeof serial) != 1 ||
+      !ASN1_INTEGER_set_uint64(X509_get_serialNumber(c.get()), serial >> 1) ||
+      !X509_gmtime_adj(X509_getm_notBefore(c.get()), -3600) ||  // clocks of other machines
+      !X509_gmtime_adj(X509_getm_notAfter(c.get()), static_cast<long>(days) * 86400) ||
+      !X509_set_pubkey(c.get(), key) ||
+      !X509_NAME_add_entry_by_txt(name, "O", MBSTRING_ASC,
+                                  reinterpret_cast<const unsigned char*>("simsoccer"), -1, -1, 0) ||
+      !X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_ASC,
+                                  reinterpret_cast<const unsigned char*>(cn.c_str()), -1, -1, 0) ||
+      !X509_set_issuer_name(c.get(), issuer ? X509_get_subject_name(issuer) : name))
+    fail("cannot fill in the certificate of " + cn);
   X509* signer = issuer ? issuer : c.get();
   if (issuer) {
     addExtension(c.get(), signer, NID_basic_constraints, "critical,CA:FALSE");
@@ -80,28 +84,42 @@ Cert newCert(EVP_PKEY* key, const std::string& cn, X509* issuer, EVP_PKEY* issue
   return c;
 }
 
+// A new file (a key: mode 0600 from its creation, never through a link).
 Bio openFile(const std::filesystem::path& file, bool secret) {
-  Bio b(BIO_new_file(file.c_str(), "w"));
-  if (!b) fail(file.string() + ": cannot write");
-  if (secret) ::chmod(file.c_str(), 0600);
+  std::filesystem::remove(file);  // a left-over file keeps its mode; a new one gets ours
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
+                        secret ? 0600 : 0644);
+  if (fd < 0) throw std::runtime_error(file.string() + ": cannot create");
+  Bio b(BIO_new_fd(fd, BIO_CLOSE));
+  if (!b) {
+    ::close(fd);
+    fail(file.string() + ": cannot write");
+  }
   return b;
+}
+
+void finish(BIO* b, const std::filesystem::path& file) {
+  if (BIO_flush(b) != 1) fail(file.string() + ": cannot write (disk full?)");
 }
 
 void writeCert(const std::filesystem::path& file, X509* c) {
   Bio b = openFile(file, false);
   if (!PEM_write_bio_X509(b.get(), c)) fail(file.string() + ": cannot write the certificate");
+  finish(b.get(), file);
 }
 
 void writeKey(const std::filesystem::path& file, EVP_PKEY* k) {
   Bio b = openFile(file, true);
   if (!PEM_write_bio_PrivateKey(b.get(), k, nullptr, nullptr, 0, nullptr, nullptr))
     fail(file.string() + ": cannot write the key");
+  finish(b.get(), file);
 }
 
 void writeText(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream f(file);
-  f << text;
-  if (!f) throw std::runtime_error(file.string() + ": cannot write");
+  Bio b = openFile(file, false);
+  if (BIO_write(b.get(), text.data(), static_cast<int>(text.size())) != static_cast<int>(text.size()))
+    fail(file.string() + ": cannot write");
+  finish(b.get(), file);
 }
 
 // `xml` as S/MIME signed by the authority (what `openssl smime -sign -text`
@@ -115,6 +133,7 @@ void writeSigned(const std::filesystem::path& file, const std::string& xml, X509
   Bio out = openFile(file, false);
   if (!SMIME_write_PKCS7(out.get(), p7.get(), in.get(), flags))
     fail(file.string() + ": cannot write the signed document");
+  finish(out.get(), file);
 }
 
 std::string isoTime(std::time_t t) {
@@ -134,8 +153,8 @@ std::string topicList(const std::vector<std::string>& topics) {
   return s + "</topics>";
 }
 
-// Every RTPS message's metadata is signed (a forged participant GUID or an
-// injected sample fails the check); team messages are encrypted (a team's
+// Every sample's metadata is signed with its writer's key (a participant
+// without that key cannot inject one); team messages are encrypted (a team's
 // plans are its own); no unauthenticated participant is matched at all.
 std::string governance(const CredentialsOptions& o) {
   const auto rule = [](const std::string& topics, const char* data) {

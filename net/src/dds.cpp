@@ -84,11 +84,8 @@ dds_qos_t* makeQos(const QosSpec& spec) {
 
 bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication,
                           dds_guid_t& participant) {
-  dds_builtintopic_endpoint_t* ep = dds_get_matched_publication_data(reader, publication);
-  if (!ep) return false;
-  participant = ep->participant_key;
-  dds_builtintopic_free_endpoint(ep);
-  return true;
+  std::string partition;
+  return publisherParticipant(reader, publication, participant, partition);
 }
 
 bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication,

@@ -9,6 +9,7 @@
 // frames, status and game state. docs/security.md.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
