@@ -2,9 +2,6 @@
 // this process with its credentials; its agent, strangers and the other team
 // as processes with theirs (a process holds one DDS configuration per domain).
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <chrono>
 #include <future>
@@ -13,39 +10,13 @@
 
 #include "simsoccer/net/credentials.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "agent_process.hpp"
 #include "test_support.hpp"
-
-extern char** environ;
 
 using namespace simsoccer;
 
 namespace {
 
-// A simsoccer-agent (nod mode) for robot (team, player) with a Cyclone configuration.
-class AgentProcess {
- public:
-  AgentProcess(uint32_t domain, int team, int player, const std::filesystem::path& dds_config) {
-    std::vector<std::string> args = {SIMSOCCER_AGENT_BIN, "--team",   std::to_string(team),
-                                     "--player",          std::to_string(player),
-                                     "--domain",          std::to_string(domain),
-                                     "--dds-config",      dds_config.string()};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
-  }
-  ~AgentProcess() { kill(); }
-  void kill() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-      pid_ = -1;
-    }
-  }
-
- private:
-  pid_t pid_ = -1;
-};
 
 // Credentials of one match authority in a folder of the test's own.
 struct Credentials {
@@ -115,7 +86,8 @@ TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
   cfg.command_timeout = 0.05;
   sim::Simulation simulation(w);
   net::SimServer server(simulation, cfg);
-  auto owner = std::make_unique<AgentProcess>(domain, 0, 1, match / "team_0.xml");
+  auto owner = std::make_unique<test::AgentProcess>(domain, 0, 1, std::vector<std::string>{},
+                                                    std::vector<std::string>{}, match / "team_0.xml");
   ASSERT_TRUE(server.waitForOwners(1, 30.0)) << "the team's own agent did not get its robot";
   const std::filesystem::path plain = test::sourceDir() / "configs" / "dds" / "loopback.xml";
   std::vector<std::future<std::string>> strangers;
