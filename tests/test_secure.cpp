@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <fstream>
 #include <future>
 #include <string>
 #include <vector>
@@ -73,9 +74,10 @@ TEST(Secure, CredentialsAreSignedByTheMatchAuthority) {
 }
 
 // Without this authority's credentials a participant is not even matched;
-// with the other team's, its own DDS refuses it the robot's topics. 10,002
-// commands tried, none arrives; nobody claims the robot, also once its
-// agent is gone.
+// with the other team's, its own DDS refuses it the robot's topics, and with
+// the other team's identity and permissions it signed itself the simulator
+// does not match it. 13,336 commands tried, none arrives; nobody claims the
+// robot, also once its agent is gone.
 TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
   const Credentials match("secure_match"), forged("secure_forged");
   const uint32_t domain = 151;
@@ -94,6 +96,34 @@ TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
   strangers.push_back(intrude(plain, domain, 0, 1, 3334, 3.0));
   strangers.push_back(intrude(forged / "team_0.xml", domain, 0, 1, 3334, 3.0));
   strangers.push_back(intrude(forged / "simulator.xml", domain, 0, 1, 3334, 3.0));
+  // Team 1's own identity with permissions it signed itself (an authority of
+  // its own, granting every robot's partition): its own DDS lets it write in
+  // team 0's partition; the simulator checks the permissions against the
+  // match authority and does not match it.
+  {
+    std::string grab = test::readFile(match / "team_1_permissions.xml");
+    for (size_t at = grab.find("robot_1_*"); at != std::string::npos; at = grab.find("robot_1_*"))
+      grab.replace(at, 9, "robot_*");
+    std::ofstream(forged / "grab.xml") << grab;
+    int status = 0;
+    const std::string out = test::runCommand(
+        "openssl smime -sign -text -in " + (forged / "grab.xml").string() + " -out " +
+            (forged / "grab.p7s").string() + " -signer " + (forged / "ca.pem").string() +
+            " -inkey " + (forged / "ca_key.pem").string(),
+        status);
+    ASSERT_EQ(status, 0) << out;
+    std::string config = test::readFile(match / "team_1.xml");
+    const auto swap = [&](const std::filesystem::path& from, const std::filesystem::path& to) {
+      const size_t at = config.find("file:" + from.string());
+      ASSERT_NE(at, std::string::npos) << from;
+      config.replace(at, 5 + from.string().size(), "file:" + to.string());
+    };
+    swap(match / "ca.pem</PermissionsCA>", forged / "ca.pem</PermissionsCA>");
+    swap(match / "team_1_permissions.p7s", forged / "grab.p7s");
+    swap(match / "governance.p7s", forged / "governance.p7s");  // the same rules, its signature
+    std::ofstream(forged / "team_1_grabs.xml") << config;
+  }
+  strangers.push_back(intrude(forged / "team_1_grabs.xml", domain, 0, 1, 3334, 3.0));
   auto other_team = intrude(match / "team_1.xml", domain, 0, 1, 3334, 3.0);
   const auto t0 = std::chrono::steady_clock::now();
   const auto allReady = [&] {
