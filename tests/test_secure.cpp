@@ -68,6 +68,11 @@ TEST(Secure, CredentialsAreSignedByTheMatchAuthority) {
                   std::filesystem::perms::others_read,
               std::filesystem::perms::none);
   }
+  const std::string governance = test::readFile(c / "governance.xml");
+  EXPECT_NE(governance.find("<allow_unauthenticated_participants>false<"), std::string::npos);
+  EXPECT_NE(governance.find("<topic_expression>simsoccer_GameState</topic_expression>"),
+            std::string::npos);
+  EXPECT_NE(governance.find("SIGN_WITH_ORIGIN_AUTHENTICATION"), std::string::npos);
   const std::string team0 = test::readFile(c / "team_0_permissions.xml");
   EXPECT_NE(team0.find("<partition>robot_0_*</partition>"), std::string::npos);
   EXPECT_EQ(team0.find("robot_1_"), std::string::npos);

@@ -154,19 +154,23 @@ std::string topicList(const std::vector<std::string>& topics) {
 }
 
 // Every sample's metadata is signed with its writer's key (a participant
-// without that key cannot inject one); team messages are encrypted (a team's
-// plans are its own); no unauthenticated participant is matched at all.
+// without that key cannot inject one); the game state and clock, which both
+// teams read (and so both hold the writer's key), also with a code per
+// receiver that only the writer can make (origin authentication); team
+// messages are encrypted (a team's plans are its own); no unauthenticated
+// participant is matched at all.
 std::string governance(const CredentialsOptions& o) {
-  const auto rule = [](const std::string& topics, const char* data) {
+  const auto rule = [](const std::string& topics, const char* data,
+                       const char* metadata = "SIGN") {
     return std::string("      <topic_rule>\n        <topic_expression>") + topics +
            "</topic_expression>\n"
            "        <enable_discovery_protection>false</enable_discovery_protection>\n"
            "        <enable_liveliness_protection>false</enable_liveliness_protection>\n"
            "        <enable_read_access_control>true</enable_read_access_control>\n"
            "        <enable_write_access_control>true</enable_write_access_control>\n"
-           "        <metadata_protection_kind>SIGN</metadata_protection_kind>\n"
-           "        <data_protection_kind>" +
-           data + "</data_protection_kind>\n      </topic_rule>\n";
+           "        <metadata_protection_kind>" +
+           metadata + "</metadata_protection_kind>\n        <data_protection_kind>" + data +
+           "</data_protection_kind>\n      </topic_rule>\n";
   };
   return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
          "<dds xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
@@ -180,7 +184,9 @@ std::string governance(const CredentialsOptions& o) {
          "      <liveliness_protection_kind>NONE</liveliness_protection_kind>\n"
          "      <rtps_protection_kind>NONE</rtps_protection_kind>\n"
          "      <topic_access_rules>\n" +
-         rule("simsoccer_TeamMessage*", "ENCRYPT") + rule("*", "NONE") +
+         rule("simsoccer_TeamMessage*", "ENCRYPT") +
+         rule("simsoccer_GameState", "NONE", "SIGN_WITH_ORIGIN_AUTHENTICATION") +
+         rule("simsoccer_SimClock", "NONE", "SIGN_WITH_ORIGIN_AUTHENTICATION") + rule("*", "NONE") +
          "      </topic_access_rules>\n    </domain_rule>\n  </domain_access_rules>\n</dds>\n";
 }
 
