@@ -114,9 +114,9 @@ int match(int argc, char** argv, int first) {
       throw UsageError("--secure: the credentials cover DDS domains 0 to " +
                        std::to_string(net::CredentialsOptions{}.domain_max) + ", not " +
                        std::to_string(o.domain));
-    for (const char* id : {"simulator.xml", "team_0.xml", "team_1.xml"})
-      if (!std::filesystem::is_regular_file(o.secure / id))
-        throw UsageError("--secure " + o.secure.string() + ": no " + id +
+    for (const std::string& id : net::credentialIdentities())
+      if (!std::filesystem::is_regular_file(net::credentialConfig(o.secure, id)))
+        throw UsageError("--secure " + o.secure.string() + ": no " + id + ".xml" +
                          " (make the folder with `simsoccer credentials DIR`)");
   }
   o.video = config.video.enabled && !opt.flag("no-video");

@@ -14,6 +14,7 @@
 
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/outputs.hpp"
+#include "simsoccer/net/credentials.hpp"
 #include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/protocol/wire.hpp"
 #include "simsoccer/net/sim_server.hpp"
@@ -84,7 +85,7 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
   ao.player = number;
   ao.domain = static_cast<int>(o.domain);
   ao.dds_config = o.secure.empty() ? o.dds_config
-                                   : o.secure / ("team_" + std::to_string(team) + ".xml");
+                                   : net::credentialConfig(o.secure, net::teamIdentity(team));
   ao.role = c.role;
   ao.field = session.world().scenario().field_file;
   ao.config = c.agent_config;
@@ -107,7 +108,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   simulation.addRecorder(recorder);
   net::ServerConfig sc;
   sc.dds.domain = o.domain;
-  sc.dds.config_file = o.secure.empty() ? o.dds_config : o.secure / "simulator.xml";
+  sc.dds.config_file = o.secure.empty() ? o.dds_config : net::credentialConfig(o.secure, "simulator");
   sc.lockstep = !o.realtime;
   sc.command_timeout = c.command_timeout;
   sc.team_message_delay = c.message_delay;

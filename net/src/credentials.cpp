@@ -282,7 +282,7 @@ void writeMatchCredentials(const CredentialsOptions& o) {
     const std::string perm = permissions(o, id);
     writeText(dir / (id + "_permissions.xml"), perm);
     writeSigned(dir / (id + "_permissions.p7s"), perm, ca.get(), ca_key.get());
-    writeText(dir / (id + ".xml"), cycloneConfig(o, dir, id, plugins));
+    writeText(credentialConfig(dir, id), cycloneConfig(o, dir, id, plugins));
   }
 }
 

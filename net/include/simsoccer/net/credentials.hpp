@@ -27,9 +27,19 @@ struct CredentialsOptions {
   std::filesystem::path plugin_dir;
 };
 
+// Team T's identity ("team_T"); the simulator's is "simulator".
+inline std::string teamIdentity(int team) {
+  return "team_" + std::to_string(team);
+}
+// The Cyclone configuration writeMatchCredentials writes for identity `id`.
+inline std::filesystem::path credentialConfig(const std::filesystem::path& dir,
+                                              const std::string& id) {
+  return dir / (id + ".xml");
+}
+
 // The identities written, in order.
 inline const std::vector<std::string>& credentialIdentities() {
-  static const std::vector<std::string> ids{"simulator", "team_0", "team_1"};
+  static const std::vector<std::string> ids{"simulator", teamIdentity(0), teamIdentity(1)};
   return ids;
 }
 
