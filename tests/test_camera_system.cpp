@@ -163,8 +163,8 @@ TEST(CameraSystem, SameStateAndSeedSameBytesNoiseIncluded) {
 
 TEST(CameraSystem, EffectsMoveBlurAndNoiseAsConfigured) {
   // A white vertical bar 4 px wide on grey, seen by a 640x480 camera.
-  const engine::RenderView view = engine::pinholeView(
-      engine::Pose::Identity(), 640, 480, world::kNaoHorizontalFov, world::kNaoVerticalFov);
+  const engine::RenderView view = engine::pinholeView(engine::Pose::Identity(), 640, 480,
+                                                      56.3 * M_PI / 180.0, 43.7 * M_PI / 180.0);
   cv::Mat clean(480, 640, CV_8UC4, cv::Scalar(100, 100, 100, 255));
   clean.colRange(318, 322).setTo(cv::Scalar(250, 250, 250, 255));
   auto barCentre = [](const cv::Mat& img, int row) {

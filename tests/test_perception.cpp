@@ -33,8 +33,10 @@ world::Scenario scene(int robots = 1) {
 bool byHand(const world::World& w, const char* camera, const Vec3& p) {
   const engine::RenderView v = world::robotCameraView(w, 0, camera, 640, 480);
   const Vec3 c = v.pose.inverse() * p;
-  return c.x() > 0 && std::abs(std::atan2(c.y(), c.x())) < 0.5 * world::kNaoHorizontalFov &&
-         std::abs(std::atan2(c.z(), c.x())) < 0.5 * world::kNaoVerticalFov;
+  // The V6's documented field of view (docs/reference.md): 56.3 x 43.7 deg.
+  constexpr double kHorizontal = 56.3 * M_PI / 180.0, kVertical = 43.7 * M_PI / 180.0;
+  return c.x() > 0 && std::abs(std::atan2(c.y(), c.x())) < 0.5 * kHorizontal &&
+         std::abs(std::atan2(c.z(), c.x())) < 0.5 * kVertical;
 }
 
 }  // namespace

@@ -77,6 +77,7 @@ const SensorFrame* RobotModel::sensor(const std::string& sensor_name) const {
   return nullptr;
 }
 
+
 double RobotModel::soleDepth(const std::vector<double>& q) const {
   const auto frames = body->linkFramesAt(q);
   double lowest = std::numeric_limits<double>::infinity();
@@ -380,15 +381,33 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   // Sensor frames.
   if (auto sensors = root.optional("sensors")) {
     for (const ConfigNode& n : sensors->items()) {
-      n.allowOnly({"name", "type", "link", "position", "rpy"});
+      n.allowOnly({"name", "type", "link", "position", "rpy", "fov"});
       SensorFrame s;
       s.name = n["name"].string();
       s.type = n["type"].string();
+      static const char* kTypes[] = {"accelerometer", "gyroscope", "camera", "sonar",
+                                     "fsr",           "bumper",    "touch"};
+      if (std::find(std::begin(kTypes), std::end(kTypes), s.type) == std::end(kTypes))
+        n["type"].fail("unknown sensor type '" + s.type +
+                       "' (accelerometer, gyroscope, camera, sonar, fsr, bumper, touch)");
+      // A camera's field of view: [horizontal, vertical] in rad, each in (0, pi).
+      if (s.type == "camera") {
+        const ConfigNode fov = n["fov"];
+        const std::vector<double> v = fov.numbers();
+        if (v.size() != 2) fov.fail("expected [horizontal, vertical] in rad");
+        for (double a : v)
+          if (!(a > 0.0 && a < std::numbers::pi)) fov.fail("each angle must be in (0, pi) rad");
+        s.horizontal_fov = v[0];
+        s.vertical_fov = v[1];
+      } else if (n.has("fov")) {
+        n["fov"].fail("only a camera has a field of view");
+      }
       Vec3 off;
       s.link = body->linkIndex(resolve(n["link"].string(), off));
       if (s.link < 0) n["link"].fail("unknown link '" + n["link"].string() + "'");
       s.pose = engine::readPose(n);
       s.pose.pretranslate(off);
+      if (s.type == "camera") robot.camera_sensors.push_back(robot.sensors.size());
       robot.sensors.push_back(s);
     }
   }

@@ -121,8 +121,10 @@ void Simulation::apply() {
     const CommandSlot& s = due_[r];
     if (s.answer == Answer::Missed) ++missed_[r];
     if (s.answer != Answer::Given) continue;
-    world_.setCommand(r, std::span<const double>(s.command.position),
-                      std::span<const double>(s.command.stiffness));
+    // The command holds kActuators slots; the robot uses its own count of them.
+    const size_t n = world_.robot(r).model->actuators.size();
+    world_.setCommand(r, std::span<const double>(s.command.position).first(n),
+                      std::span<const double>(s.command.stiffness).first(n));
     applied_[r] = s.command;
     commanded_[r] = true;
     ++accepted_[r];

@@ -17,8 +17,6 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-const char* kCameraFrames[2] = {"CameraTop", "CameraBottom"};
-
 // Angular velocity (world frame) of a robot link: the root's plus every joint
 // on the way up, each about its axis as the parent link holds it now.
 Vec3 linkAngularVelocity(const World& world, RobotId r, int link) {
@@ -71,14 +69,18 @@ CameraSystem::CameraSystem(const World& world, const CameraSettings& settings, B
                                 "no robot team " + std::to_string(c.team) + " number " +
                                     std::to_string(c.number) + " in the scenario");
   }
-  for (RobotId r = 0; r < world.robotCount(); ++r)
-    for (const char* frame : kCameraFrames) {
-      const robots::SensorFrame* s = world.robot(r).model->sensor(frame);
-      if (!s || s->type != "camera")
-        throw engine::ConfigError(
-            world.scenario().source_file, "cameras",
-            "robot model " + world.robot(r).model->name + " has no " + frame + " camera");
-    }
+  // A robot's first camera takes the `top` settings, its second the `bottom`
+  // ones (a Nao: CameraTop, CameraBottom); a robot with one camera (a
+  // Booster K1's head camera) has no second view.
+  for (RobotId r = 0; r < world.robotCount(); ++r) {
+    const robots::RobotModel& model = *world.robot(r).model;
+    if (model.cameraCount() == 0)
+      throw engine::ConfigError(world.scenario().source_file, "cameras",
+                                "robot model " + model.name + " has no camera");
+    std::array<const robots::SensorFrame*, 2> slots{};
+    for (size_t c = 0; c < model.cameraCount() && c < 2; ++c) slots[c] = &model.camera(c);
+    cameras_.push_back(slots);
+  }
   thread_ = std::thread([this] { run(); });
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return started_; });
@@ -131,15 +133,15 @@ void CameraSystem::capture(const World& world) {
   for (RobotId r = 0; r < world.robotCount(); ++r) {
     const RobotInfo& info = world.robot(r);
     for (size_t c = 0; c < 2; ++c) {
-      if (!robot_due[c]) continue;
-      const robots::SensorFrame* s = info.model->sensor(kCameraFrames[c]);
+      const robots::SensorFrame* s = cameras_[r][c];
+      if (!robot_due[c] || !s) continue;
       const engine::Pose pose = world.linkPose(r, s->link) * s->pose * calibration_[2 * r + c];
       ViewJob v{static_cast<CameraId>(c),
                 r,
                 info.team,
                 info.number,
-                engine::pinholeView(pose, specs[c]->width, specs[c]->height, kNaoHorizontalFov,
-                                    kNaoVerticalFov),
+                engine::pinholeView(pose, specs[c]->width, specs[c]->height, s->horizontal_fov,
+                                    s->vertical_fov),
                 Vec3::Zero()};
       const auto& e = settings_.effects;
       if (e.motion_blur_exposure > 0 || e.rolling_shutter_readout > 0)

@@ -8,9 +8,9 @@ namespace simsoccer::world {
 namespace {
 
 // Image sizes the frustums are taken from (the V6's practice: top 640x480,
-// bottom 320x240); only the aspect matters.
+// bottom 320x240, for a robot's first and second camera); only the aspect
+// matters.
 constexpr int kSize[2][2] = {{640, 480}, {320, 240}};
-const char* kCameras[2] = {"CameraTop", "CameraBottom"};
 
 // The robot frame: under the torso, heading along its yaw.
 engine::Pose robotFrame(const World& world, RobotId r) {
@@ -82,7 +82,7 @@ void PerceptionSystem::observe(const World& world, const Viewpoint& from, const 
                                double range, PerceivedObject& object, RobotId skip) {
   object.in_view = false;
   int camera = -1;
-  for (int c = 0; c < 2 && camera < 0; ++c)
+  for (int c = 0; c < static_cast<int>(from.camera_count) && camera < 0; ++c)
     if (inFrustum(from.cameras[static_cast<size_t>(c)], point)) camera = c;
   if (camera < 0) return;
   const Vec3 rel = from.frame.inverse() * point;
@@ -117,8 +117,10 @@ void PerceptionSystem::update(const World& world) {
     p.time = world.time();
     // The robot's frame and camera views, once for all the objects it looks at.
     Viewpoint from{r, robotFrame(world, r), {}};
-    for (size_t c = 0; c < 2; ++c)
-      from.cameras[c] = robotCameraView(world, r, kCameras[c], kSize[c][0], kSize[c][1]);
+    const robots::RobotModel& model = *world.robot(r).model;
+    from.camera_count = std::min(model.cameraCount(), from.cameras.size());
+    for (size_t c = 0; c < from.camera_count; ++c)
+      from.cameras[c] = robotCameraView(world, r, model.camera(c), kSize[c][0], kSize[c][1]);
     const engine::Pose& frame = from.frame;
     // Where the robot thinks it is.
     const double yaw = std::atan2(frame.linear()(1, 0), frame.linear()(0, 0));

@@ -104,9 +104,9 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
       const engine::Pose lp = world.linkPose(r, static_cast<int>(l));
       for (const auto& s : links[l].shapes) addShape(items, s, lp, l == 0 ? jersey : c.robot);
     }
-    // LEDs: the chest button (nao.md 5.4: 49.9, 1.6, 55.2 mm in the torso
-    // frame) and the eyes on the face, beside the top camera, a little
-    // proud of the shells so the spectator sees them.
+    // LEDs (a Nao's, set through LoLA): the chest button (nao.md 5.4: 49.9,
+    // 1.6, 55.2 mm in the torso frame) and the eyes on the face, beside the
+    // top camera, a little proud of the shells so the spectator sees them.
     if (r < c.leds.size() && c.leds[r]) {
       const engine::Pose torso = world.linkPose(r, 0);
       engine::Pose at = torso;
@@ -135,14 +135,18 @@ void buildRenderScene(const World& world, std::vector<DrawItem>& items, const Sc
 }
 
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,
-                                   int width, int height, double horizontal_fov,
-                                   double vertical_fov) {
+                                   int width, int height) {
   const auto& info = world.robot(r);
   const robots::SensorFrame* s = info.model->sensor(camera);
   if (!s || s->type != "camera")
     throw std::invalid_argument("robot model " + info.model->name + " has no camera " + camera);
-  return engine::pinholeView(world.linkPose(r, s->link) * s->pose, width, height, horizontal_fov,
-                             vertical_fov);
+  return robotCameraView(world, r, *s, width, height);
+}
+
+engine::RenderView robotCameraView(const World& world, RobotId r,
+                                   const robots::SensorFrame& camera, int width, int height) {
+  return engine::pinholeView(world.linkPose(r, camera.link) * camera.pose, width, height,
+                             camera.horizontal_fov, camera.vertical_fov);
 }
 
 engine::Pose lookAtPose(const Vec3& position, const Vec3& target) {

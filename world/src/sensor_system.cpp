@@ -78,18 +78,32 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   for (const RobotRef& ref : robots) {
     const robots::RobotModel& model = *ref.model;
-    if (model.actuators.size() != kActuators)
+    // The frame's arrays hold up to kActuators entries (a Nao's 25 LoLA
+    // slots); a robot with fewer leaves the rest 0.
+    if (model.actuators.size() > kActuators)
       throw engine::ConfigError(model.source_file, "actuators",
-                                "the sensor frame needs exactly " + std::to_string(kActuators) +
-                                    " actuators (LoLA order)");
+                                "the sensor frame holds at most " + std::to_string(kActuators) +
+                                    " actuators, the model has " +
+                                    std::to_string(model.actuators.size()));
     Robot r;
     r.body = ref.body;
     r.group = ref.collision_group;
     r.model = ref.model;
+    // Sensors are what the model has: foot pressure sensors, toe bumpers and
+    // sonars are a Nao's; a robot without them (a Booster K1) reports none.
     const char* feet[2] = {"L", "R"};
-    for (int f = 0; f < 2; ++f) {
+    const char* corners[4] = {"FL", "FR", "RL", "RR"};
+    int fsrs_found = 0;
+    for (const char* side : feet)
+      for (const char* corner : corners)
+        fsrs_found += model.sensor(std::string(side) + "Fsr" + corner) != nullptr;
+    if (fsrs_found != 0 && fsrs_found != 8)
+      throw engine::ConfigError(model.source_file, "sensors",
+                                "foot pressure sensors come in eights (LFsrFL ... RFsrRR), found " +
+                                    std::to_string(fsrs_found));
+    r.has_feet = fsrs_found == 8;
+    for (int f = 0; f < 2 && r.has_feet; ++f) {
       Foot& foot = r.feet[static_cast<size_t>(f)];
-      const char* corners[4] = {"FL", "FR", "RL", "RR"};
       for (int c = 0; c < 4; ++c) {
         const auto& s = needSensor(model, std::string(feet[f]) + "Fsr" + corners[c]);
         foot.link = s.link;
@@ -100,19 +114,26 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
       foot.rect.y_left = 0.5 * (foot.fsr[0].y() + foot.fsr[2].y());
       foot.rect.y_right = 0.5 * (foot.fsr[1].y() + foot.fsr[3].y());
       foot.sole_z = foot.fsr[0].z();
-      foot.bumper[0] =
-          needSensor(model, std::string(feet[f]) + "FootBumperLeft").pose.translation();
-      foot.bumper[1] =
-          needSensor(model, std::string(feet[f]) + "FootBumperRight").pose.translation();
+      const robots::SensorFrame* left = model.sensor(std::string(feet[f]) + "FootBumperLeft");
+      const robots::SensorFrame* right = model.sensor(std::string(feet[f]) + "FootBumperRight");
+      foot.has_bumpers = left && right;
+      if (foot.has_bumpers) {
+        foot.bumper[0] = left->pose.translation();
+        foot.bumper[1] = right->pose.translation();
+      }
     }
     r.accel_point = needSensor(model, "Accelerometer").pose.translation();
     if (needSensor(model, "Accelerometer").link != 0)
       throw engine::ConfigError(model.source_file, "sensors",
                                 "the accelerometer must be on the root link");
-    for (int s = 0; s < 2; ++s) {
-      const auto& sonar = needSensor(model, s == 0 ? "SonarLeft" : "SonarRight");
-      r.sonar_link[static_cast<size_t>(s)] = sonar.link;
-      r.sonar_pose[static_cast<size_t>(s)] = sonar.pose;
+    const robots::SensorFrame* sonars[2] = {model.sensor("SonarLeft"), model.sensor("SonarRight")};
+    if ((sonars[0] == nullptr) != (sonars[1] == nullptr))
+      throw engine::ConfigError(model.source_file, "sensors",
+                                "sonars come in pairs (SonarLeft, SonarRight)");
+    r.has_sonars = sonars[0] != nullptr;
+    for (size_t s = 0; s < 2 && r.has_sonars; ++s) {
+      r.sonar_link[s] = sonars[s]->link;
+      r.sonar_pose[s] = sonars[s]->pose;
     }
     const char* touch_names[kTouchSensors] = {
         "ChestButton",     "HeadTouchFront",   "HeadTouchMiddle",  "HeadTouchRear",
@@ -121,10 +142,13 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
         "RHandTouchLeft",  "RHandTouchRight"};
     for (size_t t = 0; t < kTouchSensors; ++t) {
       const std::string name = touch_names[t];
-      if (name.find("FootBumper") != std::string::npos)
-        r.touch_source[t] = (name[0] == 'L' ? 0 : 2) + (name.find("Right") != std::string::npos);
-      else
+      if (name.find("FootBumper") != std::string::npos) {
+        const bool present = r.has_feet && r.feet[name[0] == 'L' ? 0 : 1].has_bumpers;
+        r.touch_source[t] =
+            present ? (name[0] == 'L' ? 0 : 2) + (name.find("Right") != std::string::npos) : -2;
+      } else {
         r.touch_source[t] = model.sensor(name) ? -1 : -2;
+      }
     }
     // Clusters for the ray broadphase: the root, and one per subtree hanging
     // off it (head, each arm, each leg).
@@ -185,7 +209,7 @@ void SensorSystem::commandHand(size_t robot, size_t hand, double target, double 
 }
 
 void SensorSystem::restartDifferences(const engine::PhysicsWorld& physics, Robot& r) {
-  for (size_t a = 0; a < kActuators; ++a) {
+  for (size_t a = 0; a < r.model->actuators.size(); ++a) {
     const auto& act = r.model->actuators[a];
     if (act.kind == robots::Actuator::Kind::Joint)
       r.last_position[a] = physics.jointPosition(r.body, act.index);
@@ -210,6 +234,7 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     const int ri = articulation_robot_[c.articulation];
     if (ri < 0) continue;
     Robot& r = robots_[static_cast<size_t>(ri)];
+    if (!r.has_feet) continue;
     const int f = c.link == r.feet[0].link ? 0 : c.link == r.feet[1].link ? 1 : -1;
     if (f < 0) continue;
     if (!r.feet_posed) {
@@ -232,7 +257,8 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     }
     // A toe pushed against something: contact at the front, normal mostly horizontal.
     // (pushed backwards: the impulse on the foot points mostly along -x).
-    if (force > 0.0 && -n.x() > 0.5 && p.x() >= foot.bumper[0].x() - 0.005) {
+    if (foot.has_bumpers && force > 0.0 && -n.x() > 0.5 &&
+        p.x() >= foot.bumper[0].x() - 0.005) {
       const double mid = 0.5 * (foot.bumper[0].y() + foot.bumper[1].y());
       r.bumper_hit[static_cast<size_t>(2 * f + (p.y() >= mid ? 0 : 1))] = true;
     }
@@ -242,7 +268,7 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     const Pose torso = physics.linkPose(r.body, 0);
     r.gyro_sum += torso.linear().transpose() * physics.rootAngularVelocity(r.body);
     const auto& model = *r.model;
-    for (size_t a = 0; a < kActuators; ++a) {
+    for (size_t a = 0; a < model.actuators.size(); ++a) {
       const auto& act = model.actuators[a];
       if (act.kind != robots::Actuator::Kind::Joint) continue;
       const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
@@ -273,7 +299,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
 
     // Joints and hands.
     const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
-    for (size_t a = 0; a < kActuators; ++a) {
+    for (size_t a = 0; a < model.actuators.size(); ++a) {
       const auto& act = model.actuators[a];
       if (act.kind == robots::Actuator::Kind::Joint) {
         const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
@@ -365,7 +391,9 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
 const std::vector<engine::Ray>& SensorSystem::buildSonarRays(const engine::PhysicsWorld& physics) {
   rays_.clear();
   for (size_t ri = 0; ri < robots_.size(); ++ri) {
-    const Robot& r = robots_[ri];
+    Robot& r = robots_[ri];
+    r.first_ray = rays_.size();
+    if (!r.has_sonars) continue;
     const float range = static_cast<float>(r.model->sensor_spec.sonar_max_range);
     for (size_t s = 0; s < 2; ++s) {
       const Pose sonar = physics.linkPose(r.body, r.sonar_link[s]) * r.sonar_pose[s];
@@ -434,6 +462,7 @@ void SensorSystem::updateSonar(const engine::PhysicsWorld& physics) {
   traceBatched(physics, hits_);
   const size_t k = rays_per_sonar_;
   for (size_t ri = 0; ri < robots_.size(); ++ri) {
+    if (!robots_[ri].has_sonars) continue;
     const auto& spec = robots_[ri].model->sensor_spec;
     const float min_cos = static_cast<float>(std::cos(spec.sonar_max_incidence));
     SensorFrame& f = frames_[ri];
@@ -443,7 +472,7 @@ void SensorSystem::updateSonar(const engine::PhysicsWorld& physics) {
       // the maximum incidence (smooth surfaces reflect ultrasound away).
       echo_scratch_.clear();
       for (size_t i = 0; i < k; ++i) {
-        const size_t index = (2 * ri + s) * k + i;
+        const size_t index = robots_[ri].first_ray + s * k + i;
         const engine::RayHit& h = hits_[index];
         if (h.object == engine::kNoObject) continue;
         if (-h.normal.dot(rays_[index].direction) < min_cos) continue;

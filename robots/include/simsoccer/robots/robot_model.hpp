@@ -38,7 +38,8 @@ struct SensorFrame {
   std::string name;
   std::string type;  // accelerometer, gyroscope, camera, sonar, fsr, bumper, touch
   int link = -1;
-  Pose pose = Pose::Identity();  // in the link's joint frame
+  Pose pose = Pose::Identity();  // in the link's joint frame (a camera looks along x)
+  double horizontal_fov = 0.0, vertical_fov = 0.0;  // rad, cameras only
 };
 
 // Sensor hardware characteristics (not placement: that is SensorFrame).
@@ -69,6 +70,10 @@ struct RobotModel {
   const std::vector<double>& pose(const std::string& pose_name) const;
   int actuatorIndex(const std::string& actuator_name) const;  // -1 if absent
   const SensorFrame* sensor(const std::string& sensor_name) const;
+  // The robot's cameras in the description's order (a Nao: top, bottom).
+  std::size_t cameraCount() const { return camera_sensors.size(); }
+  const SensorFrame& camera(std::size_t k) const { return sensors.at(camera_sensors.at(k)); }
+  std::vector<std::size_t> camera_sensors;  // indices into sensors
   // Depth of the lowest point of any collision shape (the soles, standing)
   // below the torso origin at the given joint angles, torso upright.
   double soleDepth(const std::vector<double>& joint_positions) const;

@@ -13,6 +13,7 @@
 //   Drop  - the new capture is dropped and counted (real time).
 #pragma once
 
+#include <array>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -130,6 +131,8 @@ class CameraSystem {
   double control_period_;
   std::vector<engine::Pose>
       calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
+  // Per robot: its first and second camera of the model (null: none).
+  std::vector<std::array<const robots::SensorFrame*, 2>> cameras_;
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;

@@ -57,7 +57,8 @@ class PerceptionSystem {
   struct Viewpoint {
     RobotId robot;
     engine::Pose frame;  // robot frame in the field
-    std::array<engine::RenderView, 2> cameras;
+    std::array<engine::RenderView, 2> cameras;  // the robot's first two cameras
+    size_t camera_count = 0;
   };
   void observe(const World& world, const Viewpoint& from, const Vec3& point, double range,
                PerceivedObject& object, RobotId skip);

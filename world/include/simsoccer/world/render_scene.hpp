@@ -38,14 +38,12 @@ void buildRenderScene(const World& world, std::vector<engine::DrawItem>& items,
 // z up; the horizon level).
 engine::Pose lookAtPose(const Vec3& position, const Vec3& target);
 
-// The Nao V6's cameras (nao.md section 5.1): 56.3 x 43.7 degrees.
-constexpr double kNaoHorizontalFov = 56.3 * M_PI / 180.0;
-constexpr double kNaoVerticalFov = 43.7 * M_PI / 180.0;
-
-// A robot's camera ("CameraTop" or "CameraBottom" from its model) as a view
-// at its current head pose.
+// A robot's camera (a camera sensor of its model: "CameraTop" on a Nao) as
+// a view at its current head pose, with the model's field of view; throws
+// std::invalid_argument if the model has no such camera.
 engine::RenderView robotCameraView(const World& world, RobotId r, const std::string& camera,
-                                   int width, int height, double horizontal_fov = kNaoHorizontalFov,
-                                   double vertical_fov = kNaoVerticalFov);
+                                   int width, int height);
+engine::RenderView robotCameraView(const World& world, RobotId r,
+                                   const robots::SensorFrame& camera, int width, int height);
 
 }  // namespace simsoccer::world

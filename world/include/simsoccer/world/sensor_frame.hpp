@@ -3,7 +3,9 @@
 // without heap allocation, stamped with simulation time.
 //
 // Arrays indexed by actuator follow the robot model's actuator order (LoLA
-// order on a Nao: 0 HeadYaw ... 24 RHand). Frames: IMU values in the torso
+// order on a Nao: 0 HeadYaw ... 24 RHand; the SDK's order on a Booster K1).
+// Sensors a robot lacks (a K1 has no foot pressure sensors, bumpers or
+// sonars) stay 0. Frames: IMU values in the torso
 // frame (x forward, y left, z up); centres of pressure in each foot's sole
 // frame (ankle projected to the sole), metres.
 #pragma once
@@ -15,7 +17,9 @@
 
 namespace simsoccer::world {
 
-// The protocol's layout (a frame goes to the agents as it is).
+// The protocol's layout (a frame goes to the agents as it is). kActuators is
+// the capacity of the per-actuator arrays (a Nao's 25 LoLA slots); a robot
+// with fewer actuators (a Booster K1 has 22) fills the first ones.
 constexpr std::size_t kActuators = protocol::kActuators;
 constexpr std::size_t kFsrs = protocol::kFsrs;  // L FL, FR, RL, RR, R FL, FR, RL, RR
 constexpr std::size_t kTouchSensors = protocol::kTouchSensors;

@@ -73,6 +73,7 @@ class SensorSystem {
     engine::FsrRectangle rect;
     double sole_z = 0;
     std::array<engine::Vec3, 2> bumper;  // left, right
+    bool has_bumpers = false;
   };
   struct Robot {
     engine::ArticulationId body;
@@ -82,6 +83,9 @@ class SensorSystem {
     std::vector<engine::Vec3> ray_dirs;           // sonar cone directions, sonar frame (x = axis)
     std::array<engine::Pose, 2> foot_from_world;  // this step's, computed on first use
     bool feet_posed = false;
+    bool has_feet = false;    // foot pressure sensors (a Nao's eight FSRs)
+    bool has_sonars = false;  // a left and a right sonar
+    size_t first_ray = 0;     // this robot's first sonar ray in rays_
     std::array<Foot, 2> feet;
     engine::Vec3 accel_point = engine::Vec3::Zero();  // torso frame
     std::array<int, 2> sonar_link{};
