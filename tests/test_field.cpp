@@ -1,6 +1,8 @@
 // Field descriptions: dimensions, derived markings and goal geometry.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "simsoccer/fields/field_model.hpp"
 #include "test_support.hpp"
 
@@ -44,4 +46,29 @@ TEST(Field, SimLeagueField) {
   EXPECT_DOUBLE_EQ(f.width, 20.0);
   EXPECT_FALSE(f.goal_area.has_value());
   EXPECT_DOUBLE_EQ(f.goal.inner_width, 2.1);
+}
+
+// The HSL 2026 fields (HSL-Rules field generator data, between line centres):
+// the penalty marks land on whole metres, 5 m (M) and 3 m (S) from the centre.
+TEST(Field, HslMiddleDivisionFields) {
+  const auto m = fields::loadFieldModel(test::sourceDir() / "fields" / "hsl_m.yaml");
+  EXPECT_DOUBLE_EQ(m.length + m.line_width, 14.0);  // outside to outside
+  EXPECT_DOUBLE_EQ(m.width + m.line_width, 9.0);
+  ASSERT_TRUE(m.penalty_area && m.goal_area);
+  EXPECT_DOUBLE_EQ(m.penalty_area->width, 5.95);
+  EXPECT_NEAR(m.marks[0].x(), -5.0, 1e-12);
+  EXPECT_DOUBLE_EQ(m.goal.inner_width, 2.4);
+  EXPECT_NEAR(m.ball.radius * 2 * M_PI, 0.59, 0.001);  // FIFA size 3: 0.58-0.60 m around
+  EXPECT_GE(m.ball.mass, 0.30);
+  EXPECT_LE(m.ball.mass, 0.32);
+  const auto post = m.goalShapes(+1);
+  EXPECT_NEAR(post[1].pose.translation().y() - post[0].pose.translation().y() - 2 * post[0].radius,
+              2.4, 1e-12);
+
+  const auto s = fields::loadFieldModel(test::sourceDir() / "fields" / "hsl_s.yaml");
+  EXPECT_DOUBLE_EQ(s.length + s.line_width, 9.0);
+  EXPECT_DOUBLE_EQ(s.width + s.line_width, 6.0);
+  EXPECT_NEAR(s.marks[0].x(), -3.0, 1e-12);
+  EXPECT_DOUBLE_EQ(s.goal.inner_width, 1.8);
+  EXPECT_DOUBLE_EQ(s.ball.radius, m.ball.radius);
 }

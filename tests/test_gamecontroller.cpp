@@ -271,9 +271,17 @@ TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
 // The link sends the rule book's version, with the message budget going down
 // as the team sends messages.
 TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
-  for (const char* book : {"spl.yaml", "hsl_small_foundation.yaml"}) {
+  for (const char* book : {"spl.yaml", "hsl_small_foundation.yaml", "hsl_middle_foundation.yaml",
+                           "hsl_middle_advanced.yaml"}) {
     const RuleBook rules = loadRuleBook(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs" /
                                         "rules" / book);
+    const std::string name = book;
+    // HSL divisions on the wire (RoboCupGameControlData.h v19): SMALL 0, MIDDLE 1;
+    // the Middle division plays 3 v 3 (Foundation) and 5 v 5 (Advanced).
+    const int division = name.starts_with("hsl_middle") ? 1 : 0;
+    if (name.starts_with("hsl_middle")) {
+      EXPECT_EQ(rules.players_per_team, name.find("advanced") != std::string::npos ? 5 : 3);
+    }
     Game game(rules, {TeamSetup{7, 0, 2, 1}, TeamSetup{9, 1, 3, 1}}, 0);
     UdpReceiver robot(0, "127.0.0.1");
     GameControllerLinkConfig c;
@@ -291,6 +299,9 @@ TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
       ASSERT_GT(n, 0u) << book;
       const auto p = simsoccer::test::readGcPacket(std::span<const uint8_t>(buf.data(), n));
       EXPECT_EQ(p.version, rules.gc_version) << book;
+      if (rules.gc_version == 19) {
+        EXPECT_EQ(p.competition_type, division) << book;
+      }
       EXPECT_EQ(p.teams[0].number, 7);
       budgets.push_back(p.teams[0].message_budget);
       EXPECT_EQ(p.teams[1].message_budget, rules.message_budget);

@@ -99,10 +99,14 @@ TEST(RobotModel, ZeroPoseSoleToTorsoHeight) {
   }
 }
 
-TEST(RobotModel, JointLimitsAndAxesAsInTheData) {
-  const auto nao = robots::loadRobotModel(test::naoH25());
-  // Read the file independently of the loader.
-  const YAML::Node doc = YAML::LoadFile(test::naoH25().string());
+namespace {
+
+// Every joint of a robot file, read independently of the loader, against the
+// model it built and against Bullet's placement of the links.
+void checkJointsAgainstTheFile(const std::filesystem::path& file) {
+  SCOPED_TRACE(file.string());
+  const auto nao = robots::loadRobotModel(file);
+  const YAML::Node doc = YAML::LoadFile(file.string());
   ASSERT_EQ(doc["joints"].size(), nao.body->joints.size());
   const std::vector<double> zero(nao.body->joints.size(), 0.0);
   for (const YAML::Node& j : doc["joints"]) {
@@ -129,6 +133,13 @@ TEST(RobotModel, JointLimitsAndAxesAsInTheData) {
     const Vec3 origin = parent.inverse() * child.translation();
     EXPECT_LT((origin - joint.origin).norm(), 1e-5) << name;
   }
+}
+
+}  // namespace
+
+TEST(RobotModel, JointLimitsAndAxesAsInTheData) {
+  checkJointsAgainstTheFile(test::naoH25());
+  const auto nao = robots::loadRobotModel(test::naoH25());
   // Spot checks against the reference table (nao.md 2.2).
   const auto& hyp = nao.body->joints[static_cast<size_t>(nao.body->jointIndex("LHipYawPitch"))];
   EXPECT_LT((hyp.axis - Vec3(0, std::sqrt(0.5), -std::sqrt(0.5))).norm(), 1e-6);
@@ -257,4 +268,118 @@ TEST(RobotModel, ALinksOwnMaterialReachesTheContacts) {
   std::printf("body material 0.2: slid %.3f m; own material 0.8: %.4f m\n", slid, held);
   EXPECT_GT(slid, 0.5);  // (0.4 - 0.2) g / 2 over 1 s: about 1 m
   EXPECT_LT(std::abs(held), 0.01);
+}
+
+// The Booster K1 (robots/booster_k1.yaml) against the numbers of its sources,
+// typed here from docs/models.md's K1 table (booster_assets@486da0f, the
+// Booster SDK's JointIndexK1), not read from the YAML.
+TEST(BoosterK1, MassJointsAndTheSdksJointOrder) {
+  const auto k1 = robots::loadRobotModel(test::boosterK1());
+  EXPECT_NEAR(k1.body->totalMass(), 19.67, 0.01 * 19.67);  // booster_assets: 19.67 kg
+  EXPECT_EQ(k1.body->links.size(), 23u);                  // trunk + 22 hinge links
+  EXPECT_EQ(k1.body->joints.size(), 22u);
+  EXPECT_TRUE(k1.hands.empty());
+  // JointIndexK1: the order of LowState's and LowCmd's 22 motor entries.
+  const char* sdk[22] = {
+      "HeadYaw",           "HeadPitch",         "LeftShoulderPitch", "LeftShoulderRoll",
+      "LeftElbowPitch",    "LeftElbowYaw",      "RightShoulderPitch", "RightShoulderRoll",
+      "RightElbowPitch",   "RightElbowYaw",     "LeftHipPitch",      "LeftHipRoll",
+      "LeftHipYaw",        "LeftKneePitch",     "LeftAnklePitch",    "LeftAnkleRoll",
+      "RightHipPitch",     "RightHipRoll",      "RightHipYaw",       "RightKneePitch",
+      "RightAnklePitch",   "RightAnkleRoll"};
+  ASSERT_EQ(k1.actuators.size(), 22u);
+  for (size_t a = 0; a < 22; ++a) {
+    EXPECT_EQ(k1.actuators[a].name, sdk[a]) << "entry " << a;
+    EXPECT_EQ(k1.actuators[a].kind, robots::Actuator::Kind::Joint) << sdk[a];
+  }
+  // An IMU in the trunk, one head camera; no foot pressure sensors, sonars or touch.
+  for (const auto& sensor : k1.sensors)
+    EXPECT_TRUE(sensor.type == "accelerometer" || sensor.type == "gyroscope" ||
+                sensor.type == "camera")
+        << sensor.name << " " << sensor.type;
+  ASSERT_EQ(k1.cameraCount(), 1u);
+  EXPECT_EQ(k1.body->links[static_cast<size_t>(k1.camera(0).link)].name, "Head");
+  EXPECT_EQ(k1.sensor("Accelerometer")->link, 0);
+}
+
+TEST(BoosterK1, LimitsAxesAndOffsetsOfTheSources) {
+  checkJointsAgainstTheFile(test::boosterK1());
+  const auto k1 = robots::loadRobotModel(test::boosterK1());
+  struct Row {
+    const char* name;
+    double lower, upper;
+    Vec3 origin, axis;
+    double effort, speed;
+  };
+  const Row rows[] = {
+      {"HeadYaw", -1.0, 1.0, {0.0056, 0, 0.2149}, {0, 0, 1}, 6, 18},
+      {"HeadPitch", -0.349, 0.855, {0, 0, 0.033}, {0, 1, 0}, 6, 18},
+      {"LeftShoulderPitch", -3.316, 1.22, {0, 0.077, 0.1845}, {0, 1, 0}, 14, 18},
+      {"LeftShoulderRoll", -1.74, 1.57, {0.0025, 0.068, -0.0135}, {1, 0, 0}, 14, 18},
+      {"LeftElbowYaw", -2.44, 0.0, {0, 0.1215, 0}, {0, 0, 1}, 14, 18},
+      {"RightShoulderRoll", -1.57, 1.74, {0.0025, -0.068, -0.0135}, {1, 0, 0}, 14, 18},
+      {"RightElbowYaw", 0.0, 2.44, {0, -0.1215, 0}, {0, 0, 1}, 14, 18},
+      {"LeftHipPitch", -3.0, 2.21, {0, 0.096, -0.077}, {0, 1, 0}, 30, 7.1},
+      {"LeftHipRoll", -0.4, 1.57, {0, 0, -0.026}, {1, 0, 0}, 35, 12.9},
+      {"LeftHipYaw", -1.0, 1.0, {0.012, 0, -0.0485}, {0, 0, 1}, 20, 18.1},
+      {"LeftKneePitch", 0.0, 2.23, {-0.014, 0, -0.117}, {0, 1, 0}, 40, 12.5},
+      {"LeftAnklePitch", -0.87, 0.345, {0.0002, 0.0002, -0.24519}, {0, 1, 0}, 20, 18.1},
+      {"LeftAnkleRoll", -0.345, 0.345, {0, 0, 0}, {1, 0, 0}, 20, 18.1},
+      {"RightHipRoll", -1.57, 0.4, {0, 0, -0.026}, {1, 0, 0}, 35, 12.9},
+  };
+  for (const Row& r : rows) {
+    const int j = k1.body->jointIndex(r.name);
+    ASSERT_GE(j, 0) << r.name;
+    const auto& joint = k1.body->joints[static_cast<size_t>(j)];
+    EXPECT_NEAR(joint.lower, r.lower, 1e-6) << r.name;
+    EXPECT_NEAR(joint.upper, r.upper, 1e-6) << r.name;
+    EXPECT_LT((joint.origin - r.origin).norm(), 1e-4) << r.name;
+    EXPECT_LT((joint.axis - r.axis).norm(), 1e-9) << r.name;
+    const auto& motor = k1.body->motors[static_cast<size_t>(joint.motor)];
+    EXPECT_DOUBLE_EQ(motor.stall_torque, r.effort) << r.name;
+    EXPECT_DOUBLE_EQ(motor.no_load_speed, r.speed) << r.name;
+  }
+  // Masses of the table: trunk, head, shank, foot.
+  auto mass = [&](const char* link) {
+    return k1.body->links[static_cast<size_t>(k1.body->linkIndex(link))].mass;
+  };
+  EXPECT_DOUBLE_EQ(mass("Trunk"), 6.5);
+  EXPECT_DOUBLE_EQ(mass("Head"), 0.7);
+  EXPECT_DOUBLE_EQ(mass("LeftShank"), 1.5);
+  EXPECT_DOUBLE_EQ(mass("RightFoot"), 0.494);
+}
+
+// booster_assets at zero pose: the trunk origin 0.552 m above the soles,
+// the top of the head 0.954 m (docs/models.md), through the loader and Bullet.
+TEST(BoosterK1, ZeroPoseHeights) {
+  const auto k1 = robots::loadRobotModel(test::boosterK1());
+  const std::vector<double> zero(k1.body->joints.size(), 0.0);
+  const double sole = k1.soleDepth(zero);
+  EXPECT_NEAR(sole, 0.552, 0.003);
+  FloatingRobot robot(k1, zero);
+  double top = -1.0;
+  for (size_t l = 0; l < k1.body->links.size(); ++l) {
+    const engine::Pose pose = robot.physics.linkPose(robot.id, static_cast<int>(l));
+    for (const auto& shape : k1.body->links[l].shapes)
+      if (shape.type == engine::ShapeType::Sphere)
+        top = std::max(top, (pose * shape.pose).translation().z() + shape.radius);
+  }
+  const double trunk = robot.physics.linkPose(robot.id, 0).translation().z();
+  EXPECT_NEAR(top - trunk + sole, 0.954, 0.01);
+  // The ankles: straight under the hips, 0.077 + 0.026 + 0.0485 + 0.117 + 0.24519 below the trunk.
+  const Vec3 ankle = robot.physics.linkPose(robot.id, 0).inverse() *
+                     robot.physics.linkPose(robot.id, k1.body->linkIndex("LeftFoot")).translation();
+  EXPECT_NEAR(ankle.z(), -(0.077 + 0.026 + 0.0485 + 0.117 + 0.24519), 1e-4);
+  EXPECT_NEAR(ankle.y(), 0.096 + 0.0002, 1e-4);
+}
+
+TEST(BoosterK1, StandPoseHasFlatFeetUnderTheHips) {
+  const auto k1 = robots::loadRobotModel(test::boosterK1());
+  const auto frames = k1.body->linkFramesAt(k1.pose("stand"));
+  for (const char* side : {"Left", "Right"}) {
+    const auto& foot = frames[static_cast<size_t>(k1.body->linkIndex(std::string(side) + "Foot"))];
+    const auto& hip = frames[static_cast<size_t>(k1.body->linkIndex(std::string(side) + "Hip"))];
+    EXPECT_NEAR(foot.linear()(2, 2), 1.0, 1e-9) << side;
+    EXPECT_NEAR(foot.translation().x(), hip.translation().x(), 0.03) << side;
+  }
 }

@@ -139,6 +139,9 @@ inline std::filesystem::path naoH25() {
 inline std::filesystem::path naoH21() {
   return sourceDir() / "robots" / "nao_h21.yaml";
 }
+inline std::filesystem::path boosterK1() {
+  return sourceDir() / "robots" / "booster_k1.yaml";
+}
 inline std::filesystem::path splField() {
   return sourceDir() / "fields" / "spl.yaml";
 }
