@@ -28,6 +28,10 @@ engine::Motor testMotor(double kp, bool implicit) {
 double stepAlone(engine::JointServoBatch& batch, double q, double qd, double inertia, double dt) {
   batch.prepare(std::vector<double>{q}, std::vector<double>{qd}, dt);
   if (!batch.implicit(0)) return batch.motorTorque(0);
+  if (!batch.row(0).active) {  // no row this step (limp, or a pure torque): as the physics does
+    batch.setRowImpulse(0, 0.0);
+    return batch.motorTorque(0);
+  }
   const double tau = batch.solveAlone(0, q, qd, inertia);
   batch.setRowImpulse(0, (tau - batch.row(0).feedforward) * dt);
   return tau;
@@ -123,6 +127,56 @@ TEST(JointServoBatch, ImplicitServoIsStableWhereTheExplicitOneDiverges) {
     else
       EXPECT_GT(late, 1.0);
   }
+}
+
+// A command with its own gains (a Booster joint command): tau = kp (q* - q)
+// + kd (dq* - dq) + tau_ff, the same law explicit and implicit (for a heavy
+// joint, where backward Euler's prediction changes nothing), inside the
+// motor's envelope at full drive; the motor's own gains come back with the
+// next position command.
+TEST(JointServoBatch, CommandWithItsOwnGains) {
+  for (const bool implicit : {false, true}) {
+    SCOPED_TRACE(implicit ? "implicit" : "explicit");
+    engine::Motor motor = testMotor(100.0, implicit);
+    motor.stall_torque = 50.0;
+    motor.no_load_speed = 1e6;  // no speed limit to speak of
+    engine::JointServoBatch batch;
+    batch.add(motor, 0.0, -1.0, 1.0, 1e12);
+    const double dt = 0.005;
+    auto torque = [&](double q, double qd) {
+      batch.resetHistory(0);
+      return stepAlone(batch, q, qd, 1e12, dt);
+    };
+    // kp 20, kd 2, velocity 0.5, torque 1.5 at q 0.1, qd -0.3.
+    batch.setCommand(0, 0.4, 0.5, 1.5, 20.0, 2.0);
+    const double law = 20.0 * (0.4 - 0.1) + 2.0 * (0.5 - (-0.3)) + 1.5;  // 9.1 N m
+    // Implicit: backward Euler damps with max(kd, dt kp) = kd here, as explicit.
+    EXPECT_NEAR(torque(0.1, -0.3), law, 1e-6);
+    // Pure torque (kp = kd = 0): the torque as given, implicit or not.
+    batch.setCommand(0, 0.0, 0.0, -3.25, 0.0, 0.0);
+    EXPECT_NEAR(torque(0.7, 1.0), -3.25, 1e-9);
+    // Beyond the motor: clamped to its stall torque.
+    batch.setCommand(0, 1.0, 0.0, 0.0, 1000.0, 0.0);
+    EXPECT_NEAR(torque(-1.0, 0.0), 50.0, 1e-9);
+    // A position command restores the motor's kp 100, kd 0 (and no velocity or torque).
+    batch.setTarget(0, 0.5, 1.0);
+    EXPECT_NEAR(torque(0.49, 0.0), 1.0, 1e-9);
+  }
+}
+
+// The state hash covers the commanded gains once they are used, and is the
+// old one before.
+TEST(JointServoBatch, CommandedGainsEnterTheStateOnceUsed) {
+  engine::JointServoBatch batch;
+  batch.add(testMotor(100.0, true), 0.0, -1.0, 1.0, 1.0);
+  std::vector<double> before, after;
+  batch.appendState(before);
+  EXPECT_EQ(before.size(), 6u);  // target, stiffness, prev qdot, load, torque, history
+  batch.setCommand(0, 0.2, 0.0, 0.0, 30.0, 1.0);
+  batch.appendState(after);
+  EXPECT_EQ(after.size(), 10u);
+  EXPECT_EQ(after[6], 30.0);
+  EXPECT_EQ(after[7], 1.0);
 }
 
 namespace {
@@ -300,4 +354,65 @@ TEST(Servo, LinkPosesAreCurrentAfterEachStep) {
           << link << " at step " << i;
     }
   }
+}
+
+// A Booster K1 in real Bullet driven by servo commands with their own gains:
+// it stands with kp 80 / kd 2 and falls with a tenth of them; the head yaw
+// reaches a target with the command's kp 10 / kd 1; a pure torque command
+// (no gravity about the yaw axis) turns the head the way the torque says.
+TEST(Servo, BoosterK1FollowsCommandsWithTheirOwnGains) {
+  world::Scenario s = test::scenario(1);
+  s.robot_model_file = test::boosterK1();
+  world::World w(s);
+  const auto& model = *w.robot(0).model;
+  const size_t n = model.actuators.size();
+  const auto stand = model.pose("stand");
+  std::vector<double> q(n), v(n, 0.0), tau(n, 0.0), kp(n, 80.0), kd(n, 2.0);
+  for (size_t a = 0; a < n; ++a) q[a] = stand[static_cast<size_t>(model.actuators[a].index)];
+  auto command = [&] { w.setServoCommand(0, {q, v, tau, kp, kd}); };
+  auto run = [&](double seconds) {
+    for (int i = 0; i < static_cast<int>(std::lround(seconds / s.physics.dt)); ++i) {
+      command();
+      w.step();
+    }
+  };
+  run(2.0);
+  EXPECT_TRUE(w.isStanding(0));
+  const int knee = model.body->jointIndex("LeftKneePitch");
+  const double held = w.physics().jointPosition(w.robot(0).body, knee);
+  EXPECT_NEAR(held, 0.9, 0.1);  // a loaded knee sags: error = load / kp
+  // The gains are the command's: with a tenth of them (kp 8, kd 0.2, far
+  // below what holds 20 kg) the robot cannot stand.
+  const std::vector<double> stiff_kp = kp, stiff_kd = kd;
+  for (size_t a = 0; a < n; ++a) {
+    kp[a] = 8.0;
+    kd[a] = 0.2;
+  }
+  run(2.0);
+  EXPECT_FALSE(w.isStanding(0));
+  w.placeRobot(0, -3.0, 0.0, 0.0);  // back on its feet
+  kp = stiff_kp;
+  kd = stiff_kd;
+  run(2.0);
+  ASSERT_TRUE(w.isStanding(0));
+  // A head yaw target of 0.5 with the command's kp 10, kd 1.
+  const size_t yaw = static_cast<size_t>(model.actuatorIndex("HeadYaw"));
+  q[yaw] = 0.5;
+  kp[yaw] = 10.0;
+  kd[yaw] = 1.0;
+  run(1.0);
+  const int head = model.body->jointIndex("HeadYaw");
+  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.5, 0.01);
+  // Pure torque on the head yaw: 0.2 N m from rest turns it one way.
+  kp[yaw] = 0.0;
+  kd[yaw] = 0.0;
+  tau[yaw] = -0.2;
+  run(0.2);
+  const double turned = w.physics().jointPosition(w.robot(0).body, head);
+  EXPECT_LT(turned, 0.5 - 0.02);
+  std::printf("K1 knee at kp 80 %.3f rad (target 0.9); head yaw 0.5 -> %.3f rad under -0.2 N m\n",
+              held, turned);
+  // Refused: a negative gain.
+  kd[yaw] = -1.0;
+  EXPECT_THROW(command(), std::invalid_argument);
 }

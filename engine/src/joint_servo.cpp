@@ -19,6 +19,10 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
   stiffness_.push_back(0.0);
   kp_.push_back(motor.kp);
   kd_.push_back(motor.kd);
+  motor_kp_.push_back(motor.kp);
+  motor_kd_.push_back(motor.kd);
+  target_velocity_.push_back(0.0);
+  torque_.push_back(0.0);
   damping_.push_back(damping);
   stall_.push_back(motor.stall_torque);
   inv_no_load_.push_back(1.0 / motor.no_load_speed);
@@ -40,12 +44,34 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
 void JointServoBatch::setTarget(size_t i, double target_rad, double stiffness) {
   target_[i] = std::clamp(target_rad, lower_[i], upper_[i]);
   stiffness_[i] = std::clamp(stiffness, 0.0, 1.0);
+  kp_[i] = motor_kp_[i];
+  kd_[i] = motor_kd_[i];
+  target_velocity_[i] = 0.0;
+  torque_[i] = 0.0;
+}
+
+void JointServoBatch::setCommand(size_t i, double target_rad, double velocity, double torque,
+                                 double kp, double kd) {
+  target_[i] = std::clamp(target_rad, lower_[i], upper_[i]);
+  stiffness_[i] = 1.0;
+  kp_[i] = std::max(kp, 0.0);
+  kd_[i] = std::max(kd, 0.0);
+  target_velocity_[i] = velocity;
+  torque_[i] = torque;
+  any_commanded_gains_ = true;
 }
 
 void JointServoBatch::appendState(std::vector<double>& out) const {
   for (const auto* v : {&target_, &stiffness_, &prev_qdot_, &load_, &motor_tau_})
     out.insert(out.end(), v->begin(), v->end());
   for (unsigned char h : has_history_) out.push_back(h);
+  if (any_commanded_gains_)
+    for (const auto* v : {&kp_, &kd_, &target_velocity_, &torque_})
+      out.insert(out.end(), v->begin(), v->end());
+}
+
+bool JointServoBatch::rowActive(size_t i) const {
+  return implicit_[i] && stiffness_[i] > 0.0 && kp_[i] + kd_[i] > 0.0;
 }
 
 void JointServoBatch::resetHistory(size_t i) {
@@ -79,10 +105,14 @@ void JointServoBatch::prepare(std::span<const double> q, std::span<const double>
     lo_[i] = lo;
     hi_[i] = hi;
     passive_tau_[i] = -damping_[i] * w;
-    if (implicit_[i]) {
+    if (implicit_[i] && kp_[i] + kd_[i] > 0.0) {
       feedforward_[i] = drive > 0.0 ? std::clamp(motor_tau_[i], lo, hi) : 0.0;
     } else {
-      const double pd = kp_[i] * (target_[i] - q[i]) - kd_[i] * w;
+      // (target_velocity_ and torque_ are 0 unless a command set them: the
+      // position servo's torque is computed as it always was.)
+      double pd = kp_[i] * (target_[i] - q[i]) - kd_[i] * w;
+      if (target_velocity_[i] != 0.0 || torque_[i] != 0.0)
+        pd += kd_[i] * target_velocity_[i] + torque_[i];
       feedforward_[i] = motor_tau_[i] = drive > 0.0 ? std::clamp(pd, lo, hi) : 0.0;
     }
     prev_qdot_[i] = w;
@@ -92,7 +122,7 @@ void JointServoBatch::prepare(std::span<const double> q, std::span<const double>
 
 JointServoBatch::Row JointServoBatch::row(size_t i) const {
   Row r;
-  if (!implicit_[i] || !(stiffness_[i] > 0.0) || !(dt_ > 0.0)) return r;
+  if (!rowActive(i) || !(dt_ > 0.0)) return r;
   // Backward Euler of tau = kp (target - q') - kd' qdot' with q' = q + dt qdot'
   // and the impulse p = dt tau: qdot' = beta / dt (target - q) - gamma p, where
   // c = kd' + dt kp. For a heavy joint (qdot' ~ qdot) that is
@@ -104,6 +134,12 @@ JointServoBatch::Row JointServoBatch::row(size_t i) const {
   r.target = target_[i];
   r.beta = dt_ * kp_[i] / c;
   r.gamma = 1.0 / (dt_ * c);
+  // A command's velocity and torque: the target moves at the velocity over
+  // the step, so tau = kp (target + dt velocity - q') + kd' (velocity - qdot')
+  // + torque = ... + c velocity + torque - c qdot': qdot' gains velocity +
+  // torque / c (for a heavy joint the explicit law, kd (velocity - qdot)).
+  if (target_velocity_[i] != 0.0 || torque_[i] != 0.0)
+    r.bias = target_velocity_[i] + torque_[i] / c;
   r.feedforward = feedforward_[i];
   r.lower = lo_[i];
   r.upper = hi_[i];
@@ -119,7 +155,7 @@ double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inert
   if (!r.active) return 0.0;
   // qdot' = qdot + P / I  and  qdot' = beta / dt (target - q) - gamma P, with P
   // the whole impulse (feedforward included).
-  const double p = (r.beta / dt_ * (r.target - q) - qdot) / (1.0 / inertia + r.gamma);
+  const double p = (r.beta / dt_ * (r.target - q) + r.bias - qdot) / (1.0 / inertia + r.gamma);
   return std::clamp(p / dt_, r.lower, r.upper);
 }
 

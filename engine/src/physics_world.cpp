@@ -227,8 +227,9 @@ class ServoConstraint : public btMultiBodyJointMotor {
     // Soft row: qdot' = beta / dt (target - q) - gamma (dt feedforward + p).
     const btScalar h = info.m_timeStep;
     const btScalar gamma = static_cast<btScalar>(r.gamma);
-    const btScalar goal = static_cast<btScalar>(r.beta / h * (r.target - mb->getJointPos(m_linkA)) -
-                                                r.gamma * h * r.feedforward);
+    btScalar goal = static_cast<btScalar>(r.beta / h * (r.target - mb->getJointPos(m_linkA)) -
+                                          r.gamma * h * r.feedforward);
+    if (r.bias != 0.0) goal += static_cast<btScalar>(r.bias);  // a command's velocity, torque
     const btScalar soft = btScalar(1) / (inv_mass + gamma);
     row.m_jacDiagABInv = soft;
     row.m_rhs = (goal - velocity) * soft;
@@ -630,17 +631,30 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   return id;
 }
 
-void PhysicsWorld::setJointTarget(ArticulationId a, int joint, double target_rad,
-                                  double stiffness) {
-  Impl& m = *impl_;
-  const Articulation& art = m.articulations.at(a);
+namespace {
+// The servo of a commandable joint (-1: passive); throws for a mimic joint.
+int commandedServo(const Articulation& art, int joint) {
   const Joint& j = art.model->joints.at(static_cast<size_t>(joint));
   if (j.mimic_of >= 0)
     throw std::invalid_argument("joint '" + j.name + "' follows '" +
                                 art.model->joints[static_cast<size_t>(j.mimic_of)].name +
                                 "' (one motor): command that joint");
-  const int s = art.servo[static_cast<size_t>(joint)];
+  return art.servo[static_cast<size_t>(joint)];
+}
+}  // namespace
+
+void PhysicsWorld::setJointTarget(ArticulationId a, int joint, double target_rad,
+                                  double stiffness) {
+  Impl& m = *impl_;
+  const int s = commandedServo(m.articulations.at(a), joint);
   if (s >= 0) m.servos.setTarget(static_cast<size_t>(s), target_rad, stiffness);
+}
+
+void PhysicsWorld::setJointCommand(ArticulationId a, int joint, double target_rad,
+                                   double velocity, double torque, double kp, double kd) {
+  Impl& m = *impl_;
+  const int s = commandedServo(m.articulations.at(a), joint);
+  if (s >= 0) m.servos.setCommand(static_cast<size_t>(s), target_rad, velocity, torque, kp, kd);
 }
 
 void PhysicsWorld::resetArticulation(ArticulationId a, const Pose& root_pose,

@@ -20,6 +20,12 @@ const char* faultName(CommandFault f) {
       return "a target is beyond its joint's limits";
     case CommandFault::ActuatorRange:
       return "a non-joint actuator value is beyond +-10";
+    case CommandFault::GainRange:
+      return "a servo gain is negative or beyond kp 10000 N m/rad, kd 1000 N m s/rad";
+    case CommandFault::VelocityRange:
+      return "a target velocity is beyond +-100 rad/s";
+    case CommandFault::TorqueRange:
+      return "a feedforward torque is beyond +-1000 N m";
   }
   return "?";
 }
@@ -28,6 +34,9 @@ namespace {
 // Non-joint actuators (LEDs, ...) take values in a small range; beyond it a
 // command is garbage.
 constexpr double kActuatorBound = 10.0;
+// Beyond these a servo command is garbage (a real motor's envelope clamps
+// what it can do long before).
+constexpr double kMaxKp = 1e4, kMaxKd = 1e3, kMaxVelocity = 100.0, kMaxTorque = 1e3;
 }  // namespace
 
 CommandGate::CommandGate(const world::World& world, double position_margin)
@@ -47,6 +56,7 @@ CommandGate::CommandGate(const world::World& world, double position_margin)
       }
     }
     limits_.push_back(l);
+    actuator_count_.push_back(model.actuators.size());
     rejected_[r] = 0;
     last_fault_[r] = CommandFault::None;
   }
@@ -97,6 +107,51 @@ std::optional<RobotCommand> CommandGate::check(world::RobotId r, std::span<const
                                                std::span<const float> stiffness,
                                                CommandFault* fault) {
   return checkAny(r, position, stiffness, fault);
+}
+
+}  // namespace simsoccer::sim
+
+namespace simsoccer::sim {
+
+std::optional<RobotCommand> CommandGate::refuse(world::RobotId r, CommandFault why,
+                                                CommandFault* fault) {
+  if (fault) *fault = why;
+  ++rejected_[r];
+  last_fault_[r] = why;
+  return std::nullopt;
+}
+
+std::optional<RobotCommand> CommandGate::checkServo(world::RobotId r, const ServoSpans& c,
+                                                    CommandFault* fault) {
+  const Limits& l = limits_.at(r);
+  const size_t n = actuator_count_.at(r);
+  for (const auto* part : {&c.position, &c.velocity, &c.torque, &c.kp, &c.kd})
+    if (part->size() != n) return refuse(r, CommandFault::WrongSize, fault);
+  RobotCommand out;
+  out.with_gains = true;
+  for (size_t a = 0; a < n; ++a) {
+    const double p = c.position[a], v = c.velocity[a], t = c.torque[a], kp = c.kp[a],
+                 kd = c.kd[a];
+    if (!std::isfinite(p) || !std::isfinite(v) || !std::isfinite(t) || !std::isfinite(kp) ||
+        !std::isfinite(kd))
+      return refuse(r, CommandFault::NotFinite, fault);
+    if (kp < 0.0 || kd < 0.0 || kp > kMaxKp || kd > kMaxKd)
+      return refuse(r, CommandFault::GainRange, fault);
+    if (std::abs(v) > kMaxVelocity) return refuse(r, CommandFault::VelocityRange, fault);
+    if (std::abs(t) > kMaxTorque) return refuse(r, CommandFault::TorqueRange, fault);
+    const double q = world::quantizeCommand(p);
+    if (q < l.lower[a] || q > l.upper[a])
+      return refuse(r, l.joint[a] ? CommandFault::PositionRange : CommandFault::ActuatorRange,
+                    fault);
+    out.position[a] = q;
+    out.stiffness[a] = 1.0;
+    out.velocity[a] = v;
+    out.torque[a] = t;
+    out.kp[a] = kp;
+    out.kd[a] = kd;
+  }
+  if (fault) *fault = CommandFault::None;
+  return out;
 }
 
 }  // namespace simsoccer::sim

@@ -123,8 +123,16 @@ void Simulation::apply() {
     if (s.answer != Answer::Given) continue;
     // The command holds kActuators slots; the robot uses its own count of them.
     const size_t n = world_.robot(r).model->actuators.size();
-    world_.setCommand(r, std::span<const double>(s.command.position).first(n),
-                      std::span<const double>(s.command.stiffness).first(n));
+    const RobotCommand& c = s.command;
+    if (c.with_gains)
+      world_.setServoCommand(r, {std::span<const double>(c.position).first(n),
+                                 std::span<const double>(c.velocity).first(n),
+                                 std::span<const double>(c.torque).first(n),
+                                 std::span<const double>(c.kp).first(n),
+                                 std::span<const double>(c.kd).first(n)});
+    else
+      world_.setCommand(r, std::span<const double>(c.position).first(n),
+                        std::span<const double>(c.stiffness).first(n));
     applied_[r] = s.command;
     commanded_[r] = true;
     ++accepted_[r];

@@ -180,6 +180,29 @@ void World::applyCommand(RobotId r, std::span<const T> positions, std::span<cons
   }
 }
 
+void World::setServoCommand(RobotId r, const ServoCommand& c) {
+  const RobotInfo& info = robots_.at(r);
+  const auto& actuators = info.model->actuators;
+  const std::span<const double>* parts[5] = {&c.position, &c.velocity, &c.torque, &c.kp, &c.kd};
+  for (const auto* part : parts)
+    if (part->size() != actuators.size())
+      throw std::invalid_argument("servo command for robot " + std::to_string(r) + " needs " +
+                                  std::to_string(actuators.size()) + " entries per field");
+  for (size_t i = 0; i < actuators.size(); ++i) {
+    for (const auto* part : parts)
+      if (!std::isfinite((*part)[i]))
+        throw std::invalid_argument("servo command for robot " + std::to_string(r) +
+                                    ": non-finite value for " + actuators[i].name);
+    if (c.kp[i] < 0.0 || c.kd[i] < 0.0)
+      throw std::invalid_argument("servo command for robot " + std::to_string(r) +
+                                  ": negative gain for " + actuators[i].name);
+  }
+  for (size_t i = 0; i < actuators.size(); ++i)
+    if (actuators[i].kind == robots::Actuator::Kind::Joint)
+      physics_->setJointCommand(info.body, actuators[i].index, c.position[i], c.velocity[i],
+                                c.torque[i], c.kp[i], c.kd[i]);
+}
+
 void World::setJointTarget(RobotId r, int joint, double target_rad, double stiffness) {
   physics_->setJointTarget(robots_.at(r).body, joint, target_rad, stiffness);
 }

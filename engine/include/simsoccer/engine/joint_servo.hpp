@@ -3,6 +3,8 @@
 //
 // Model (per joint and physics step of h seconds):
 //   tau_pd = kp (target - q) - kd qdot              (the position servo)
+//   (a command with its own gains: kp (target - q) + kd (velocity - qdot) + torque,
+//   at stiffness 1: setCommand)
 //   DC motor envelope with the stiffness s in [0, 1] scaling the drive D = s stall:
 //     D (-1 - w/w0) <= tau_motor <= D (1 - w/w0)
 //   tau = clamp(tau_pd, envelope) - damping qdot    (the passive damping explicit: it is small)
@@ -43,8 +45,15 @@ class JointServoBatch {
   size_t add(const Motor& motor, double damping, double lower, double upper, double min_inertia);
   size_t size() const { return target_.size(); }
 
-  // Target angles are clamped to the joint limits; stiffness to [0, 1].
+  // Target angles are clamped to the joint limits; stiffness to [0, 1]. The
+  // servo runs with its motor's gains (kp, kd at stiffness 1, scaled drive).
   void setTarget(size_t i, double target_rad, double stiffness);
+  // A command with its own gains, as a Booster robot's joint command carries
+  // them: tau = kp (target - q) + kd (velocity - qdot) + torque, within the
+  // motor's envelope at full drive (stiffness 1). kp, kd >= 0 (clamped).
+  // It holds until the next setTarget or setCommand.
+  void setCommand(size_t i, double target_rad, double velocity, double torque, double kp,
+                  double kd);
   double target(size_t i) const { return target_[i]; }
   double stiffness(size_t i) const { return stiffness_[i]; }
   // Motor part of the last step's torque (without passive damping), N m.
@@ -52,7 +61,8 @@ class JointServoBatch {
   // The whole torque of the last step: motor plus passive damping, N m.
   double torque(size_t i) const { return motor_tau_[i] + passive_tau_[i]; }
   // Appends every servo's target, stiffness and the state it carries between
-  // steps (for state hashes).
+  // steps (for state hashes); the commanded gains too, once a setCommand has
+  // set any (a world that never used them hashes as before they existed).
   void appendState(std::vector<double>& out) const;
   // Forget the load history of one servo (after a teleport).
   void resetHistory(size_t i);
@@ -81,6 +91,7 @@ class JointServoBatch {
     bool active = false;
     double target = 0.0;              // rad
     double beta = 0.0;                // share of the position error removed in one step
+    double bias = 0.0;                // rad/s: a commanded velocity and torque's share
     double gamma = 0.0;               // compliance, rad/s per N m s
     double feedforward = 0.0;         // N m
     double lower = 0.0, upper = 0.0;  // motor torque bounds, N m
@@ -98,9 +109,16 @@ class JointServoBatch {
   double solveAlone(size_t i, double q, double qdot, double inertia) const;
 
  private:
+  // The row of servo i this step: an implicit servo with some gain (a pure
+  // torque command, kp = kd = 0, is applied as a joint torque).
+  bool rowActive(size_t i) const;
+
   std::vector<double> target_, stiffness_, kp_, kd_, damping_, stall_, inv_no_load_, lower_, upper_,
       min_inertia_, prev_qdot_, load_, motor_tau_, passive_tau_, feedforward_, lo_, hi_;
+  // The motor's own gains, and what a command with gains adds.
+  std::vector<double> motor_kp_, motor_kd_, target_velocity_, torque_;
   std::vector<unsigned char> has_history_, implicit_;
+  bool any_commanded_gains_ = false;
   double dt_ = 0.0;
 };
 

@@ -97,6 +97,10 @@ class PhysicsWorld {
   // Servo target and stiffness of one joint. A mimic joint has no motor of
   // its own (a gear constraint ties it to its master): commanding it throws.
   void setJointTarget(ArticulationId a, int joint, double target_rad, double stiffness);
+  // A command with its own servo gains (JointServoBatch::setCommand):
+  // tau = kp (target - q) + kd (velocity - qdot) + torque, at full drive.
+  void setJointCommand(ArticulationId a, int joint, double target_rad, double velocity,
+                       double torque, double kp, double kd);
   // Teleports an articulation (zero velocities); for placement and tests.
   void resetArticulation(ArticulationId a, const Pose& root_pose,
                          std::span<const double> joint_positions);

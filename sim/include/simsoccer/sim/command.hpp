@@ -23,6 +23,12 @@ namespace simsoccer::sim {
 // resolution the physics gets and the match log keeps.
 struct RobotCommand {
   std::array<double, world::kActuators> position{}, stiffness{};
+  // A command with its own servo gains (a Booster robot's joint command, its
+  // CUSTOM mode): per actuator tau = kp (position - q) + kd (velocity - qdot)
+  // + torque, at full drive (stiffness 1). Otherwise the robot's own servo
+  // gains scaled by the stiffness.
+  bool with_gains = false;
+  std::array<double, world::kActuators> velocity{}, torque{}, kp{}, kd{};
   bool operator==(const RobotCommand&) const = default;
 };
 
@@ -34,6 +40,9 @@ enum class CommandFault : uint8_t {
   StiffnessRange,     // outside 0..1
   PositionRange,      // beyond the joint's limits by more than the margin
   ActuatorRange,      // a non-joint actuator (LEDs...) beyond +-10
+  GainRange,          // a servo gain negative or absurd (kp > 10^4, kd > 10^3)
+  VelocityRange,      // a target velocity beyond +-100 rad/s
+  TorqueRange,        // a feedforward torque beyond +-1000 N m
 };
 const char* faultName(CommandFault f);
 
@@ -52,6 +61,13 @@ class CommandGate {
   std::optional<RobotCommand> check(world::RobotId r, std::span<const float> position,
                                     std::span<const float> stiffness,
                                     CommandFault* fault = nullptr);
+  // A command with its own gains (RobotCommand::with_gains), one entry per
+  // actuator of the robot (its model's count, not the frame's 25 slots).
+  struct ServoSpans {
+    std::span<const float> position, velocity, torque, kp, kd;
+  };
+  std::optional<RobotCommand> checkServo(world::RobotId r, const ServoSpans& command,
+                                         CommandFault* fault = nullptr);
   uint64_t rejected(world::RobotId r) const { return rejected_.at(r).load(); }
   CommandFault lastFault(world::RobotId r) const { return last_fault_.at(r).load(); }
 
@@ -63,7 +79,9 @@ class CommandGate {
     std::array<double, world::kActuators> lower{}, upper{};
     std::array<bool, world::kActuators> joint{};  // a joint (else a hand, an LED...)
   };
+  std::optional<RobotCommand> refuse(world::RobotId r, CommandFault why, CommandFault* fault);
   std::vector<Limits> limits_;  // per robot, margin included
+  std::vector<size_t> actuator_count_;  // per robot, its model's
   std::vector<std::atomic<uint64_t>> rejected_;
   std::vector<std::atomic<CommandFault>> last_fault_;
 };

@@ -77,6 +77,14 @@ class World {
   void setCommand(RobotId r, std::span<const double> positions, std::span<const double> stiffness);
   // The same in single precision, as agents and the wire carry it.
   void setCommand(RobotId r, std::span<const float> positions, std::span<const float> stiffness);
+  // Per actuator, with its own servo gains (a Booster robot's joint command):
+  // tau = kp (position - q) + kd (velocity - qdot) + torque at full drive.
+  // Every span has one entry per actuator; non-finite values or negative
+  // gains are rejected (throws). Non-joint actuators are ignored.
+  struct ServoCommand {
+    std::span<const double> position, velocity, torque, kp, kd;
+  };
+  void setServoCommand(RobotId r, const ServoCommand& command);
   // One body joint by index (a mimic joint cannot be commanded: its master is).
   void setJointTarget(RobotId r, int joint, double target_rad, double stiffness);
   // A named pose of the robot model at one stiffness for every joint.
