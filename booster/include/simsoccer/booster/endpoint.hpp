@@ -1,0 +1,91 @@
+// The Booster Robotics SDK's robot side over DDS, for simulated Booster robots
+// (the K1): what a team's unmodified SDK client (the C++ SDK's ChannelFactory,
+// B1LocoClient, its Rust and ROS 2 equivalents) talks to on the real robot.
+// A command source of the period pipeline.
+//
+// Each robot gets its own DDS domain (base + its index in the config: the
+// SDK's topics carry no robot id, and team code uses domain 0 unless told
+// otherwise) with the SDK's topics and registered type names:
+//   rt/low_state          LowState_ out, once per control period (a 2 ms
+//                         period gives the robot's 500 Hz)
+//   rt/joint_ctrl         LowCmd_ in: obeyed in CUSTOM mode, SERIAL command
+//                         type, per joint q, dq, tau, kp, kd
+//   rt/LocoApiTopicReq    RpcReqMsg_ in (LocoService: modes, head)
+//   rt/LocoApiTopicResp   RpcRespMsg_ out (reliable, transient-local: the
+//                         C++ SDK's volatile and the Rust SDK's
+//                         transient-local readers both match)
+//   rt/fall_down          FallDownState_ out, on change and once a second
+// What a client does wrong (a LowCmd with 21 entries, NaNs, PARALLEL
+// commands, garbage JSON) is refused and counted; the robot holds its last
+// command. docs/booster.md has the details and the sources.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "simsoccer/booster/loco_service.hpp"
+#include "simsoccer/sim/command.hpp"
+
+namespace simsoccer::booster {
+
+struct BoosterRobot {
+  world::RobotId robot = 0;
+  uint32_t domain = 0;  // the DDS domain its SDK client joins
+  RobotMode initial_mode = RobotMode::Prepare;
+};
+
+struct EndpointConfig {
+  std::vector<BoosterRobot> robots;
+  std::filesystem::path dds_config;  // Cyclone XML (empty: Cyclone's default)
+  // Lockstep: a robot in CUSTOM mode whose client has sent a LowCmd is
+  // waited for (up to answer_timeout s of wall time) to answer each
+  // LowState; real time: whatever has arrived is taken.
+  bool lockstep = false;
+  double answer_timeout = 0.5;
+  int unresponsive_after = 3;  // misses in a row before a client is no longer waited for
+  double fall_down_interval = 1.0;  // s of simulation between unchanged fall_down samples
+};
+
+struct RobotBoosterStats {
+  RobotMode mode = RobotMode::Prepare;
+  uint64_t states_sent = 0;       // LowState_ samples
+  uint64_t commands = 0;          // LowCmd_ samples received
+  uint64_t applied = 0;           // periods a LowCmd drove the robot (CUSTOM)
+  uint64_t ignored = 0;           // LowCmds outside CUSTOM mode
+  uint64_t refused = 0;           // LowCmds refused (size, NaN, range, PARALLEL)
+  uint64_t missed = 0;            // lockstep periods without a LowCmd in time
+  uint64_t requests = 0, requests_refused = 0, requests_malformed = 0;
+};
+
+class Endpoint : public sim::CommandSource {
+ public:
+  // Joins every robot's domain. Throws std::invalid_argument for a robot
+  // index out of range or served twice, two robots on one domain, or a robot
+  // model without a stand pose; net::DdsError if DDS fails.
+  Endpoint(const world::World& world, EndpointConfig config);
+  ~Endpoint() override;
+  Endpoint(const Endpoint&) = delete;
+  Endpoint& operator=(const Endpoint&) = delete;
+
+  void observe(const sim::Observation& o) override;
+  void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override;
+
+  const EndpointConfig& config() const { return config_; }
+  // Per robot of the config, in its order.
+  RobotBoosterStats stats(std::size_t i) const;
+  // Whether robot i's client has a LowCmd reader matched (the client is there).
+  bool clientConnected(std::size_t i) const;
+
+ private:
+  struct Robot;
+  void answerRequests(Robot& r);
+  const world::World& world_;
+  EndpointConfig config_;
+  std::vector<std::unique_ptr<Robot>> robots_;
+};
+
+}  // namespace simsoccer::booster

@@ -1,0 +1,340 @@
+#include "simsoccer/booster/endpoint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "booster_sdk.h"
+#include "simsoccer/net/dds.hpp"
+
+namespace simsoccer::booster {
+
+using Clock = std::chrono::steady_clock;
+using LowState = booster_interface_msg_dds__LowState_;
+using LowCmd = booster_interface_msg_dds__LowCmd_;
+using MotorState = booster_interface_msg_dds__MotorState_;
+using FallDown = booster_interface_msg_dds__FallDownState_;
+using RpcReq = booster_msgs_msg_dds__RpcReqMsg_;
+using RpcResp = booster_msgs_msg_dds__RpcRespMsg_;
+
+namespace {
+net::QosSpec qos(bool reliable, int depth, bool transient_local = false) {
+  net::QosSpec q;
+  q.reliable = reliable;
+  q.depth = depth;
+  q.transient_local = transient_local;
+  return q;
+}
+}  // namespace
+
+struct Endpoint::Robot {
+  BoosterRobot config;
+  size_t actuators = 0;
+  net::Participant participant;
+  net::Writer<LowState> state;
+  net::Reader<LowCmd> commands;
+  net::Reader<RpcReq> requests;
+  net::Writer<RpcResp> answers;
+  net::Writer<FallDown> fall;
+  LocoService loco;
+  RobotBoosterStats stats;
+
+  // The latest LowCmd taken and not yet applied (SERIAL, one entry per actuator).
+  bool new_command = false;
+  bool ever_commanded = false;  // lockstep waits only for a client that commands
+  std::vector<float> q, dq, tau, kp, kd;
+  // Lockstep: a client that missed `unresponsive_after` periods in a row is
+  // no longer waited for until it answers again.
+  int missed_in_row = 0;
+  bool unresponsive = false;
+
+  // What the robot was last given outside CUSTOM mode (sent again only on change).
+  std::optional<RobotMode> held_mode;
+  std::optional<HeadTarget> held_head;
+
+  // LowState buffers (the sample points at them) and the last joint speeds.
+  std::vector<MotorState> motors;
+  std::vector<float> last_dq;
+  bool has_last = false;
+  int fall_state = -1;
+  double fall_sent_at = -1e9;
+
+  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds)
+      : config(c),
+        actuators(n),
+        participant(dds),
+        state(participant, booster_interface_msg_dds__LowState__desc, "rt/low_state",
+              qos(true, 5)),
+        // Best effort matches both reliable and best-effort writers; 16 deep so
+        // that every command of a period is seen (the last good one drives).
+        commands(participant, booster_interface_msg_dds__LowCmd__desc, "rt/joint_ctrl",
+                 qos(false, 16)),
+        requests(participant, booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq",
+                 qos(true, 10)),
+        answers(participant, booster_msgs_msg_dds__RpcRespMsg__desc, "rt/LocoApiTopicResp",
+                qos(true, 10, true)),
+        fall(participant, booster_interface_msg_dds__FallDownState__desc, "rt/fall_down",
+             qos(true, 1)),
+        loco(c.initial_mode),
+        q(n),
+        dq(n),
+        tau(n),
+        kp(n),
+        kd(n),
+        motors(n),
+        last_dq(n) {}
+};
+
+Endpoint::Endpoint(const world::World& world, EndpointConfig config)
+    : world_(world), config_(std::move(config)) {
+  if (!(config_.answer_timeout > 0.0 && config_.answer_timeout <= 60.0))
+    throw std::invalid_argument("Booster endpoint: answer timeout must be in (0, 60] s");
+  std::set<world::RobotId> robots;
+  std::set<uint32_t> domains;
+  for (const BoosterRobot& b : config_.robots) {
+    if (b.robot >= world.robotCount())
+      throw std::invalid_argument("Booster endpoint: no robot " + std::to_string(b.robot));
+    if (!robots.insert(b.robot).second)
+      throw std::invalid_argument("Booster endpoint: robot " + std::to_string(b.robot) +
+                                  " is served twice");
+    if (!domains.insert(b.domain).second)
+      throw std::invalid_argument("Booster endpoint: two robots on DDS domain " +
+                                  std::to_string(b.domain) +
+                                  " (the SDK's topics carry no robot id: one robot per domain)");
+    if (b.domain > 230)
+      throw std::invalid_argument("Booster endpoint: DDS domain " + std::to_string(b.domain) +
+                                  " is beyond 230 (the RTPS port mapping)");
+    const robots::RobotModel& model = *world.robot(b.robot).model;
+    model.pose("stand");  // throws if the model has none
+    net::DomainConfig dds;
+    dds.domain = b.domain;
+    dds.config_file = config_.dds_config;
+    auto r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+    r->stats.mode = r->loco.mode();
+    robots_.push_back(std::move(r));
+  }
+}
+
+Endpoint::~Endpoint() = default;
+
+RobotBoosterStats Endpoint::stats(std::size_t i) const {
+  const Robot& r = *robots_.at(i);
+  RobotBoosterStats s = r.stats;
+  s.mode = r.loco.mode();
+  s.requests = r.loco.requests();
+  s.requests_refused = r.loco.refused();
+  s.requests_malformed = r.loco.malformed();
+  return s;
+}
+
+bool Endpoint::clientConnected(std::size_t i) const {
+  dds_publication_matched_status_t st{};
+  if (dds_get_publication_matched_status(robots_.at(i)->state.get(), &st) != DDS_RETCODE_OK)
+    return false;
+  return st.current_count > 0;
+}
+
+void Endpoint::observe(const sim::Observation& o) {
+  const world::World& w = *o.world;
+  const double period = w.scenario().physics.control_period;
+  for (auto& rp : robots_) {
+    Robot& r = *rp;
+    const world::SensorFrame& f = w.sensorFrame(r.config.robot);
+    const auto& info = w.robot(r.config.robot);
+    const auto& actuators = info.model->actuators;
+    for (size_t a = 0; a < r.actuators; ++a) {
+      MotorState& m = r.motors[a];
+      m = MotorState{};
+      m.q = f.position[a];
+      m.dq = f.velocity[a];
+      m.ddq = r.has_last ? static_cast<float>((f.velocity[a] - r.last_dq[a]) / period) : 0.0f;
+      r.last_dq[a] = f.velocity[a];
+      if (actuators[a].kind == robots::Actuator::Kind::Joint)
+        m.tau_est = static_cast<float>(w.physics().jointMotorTorque(info.body, actuators[a].index));
+      m.temperature = static_cast<uint8_t>(std::clamp(std::lround(f.temperature[a]), 0L, 255L));
+    }
+    r.has_last = true;
+    LowState s{};
+    for (int k = 0; k < 3; ++k) {
+      s.imu_state.rpy[k] = f.angles[static_cast<size_t>(k)];
+      s.imu_state.gyro[k] = f.gyroscope[static_cast<size_t>(k)];
+      s.imu_state.acc[k] = f.accelerometer[static_cast<size_t>(k)];
+    }
+    // Joint space; the motor space is the same until the ankle linkage is
+    // modelled (the cranks are reported as the serial ankle joints).
+    for (auto* seq : {&s.motor_state_serial, &s.motor_state_parallel}) {
+      seq->_buffer = r.motors.data();
+      seq->_length = seq->_maximum = static_cast<uint32_t>(r.actuators);
+      seq->_release = false;
+    }
+    r.state.write(s);
+    ++r.stats.states_sent;
+
+    const int fallen = w.isStanding(r.config.robot) ? booster_interface_msg_dds__IS_READY
+                                                    : booster_interface_msg_dds__HAS_FALLEN;
+    if (fallen != r.fall_state || o.time - r.fall_sent_at >= config_.fall_down_interval) {
+      FallDown fd{};
+      fd.fall_down_state = static_cast<booster_interface_msg_dds__FallDownStateType>(fallen);
+      fd.is_recovery_available = false;  // no get-up service (LocoService refuses GetUp)
+      r.fall.write(fd);
+      r.fall_state = fallen;
+      r.fall_sent_at = o.time;
+    }
+  }
+}
+
+void Endpoint::answerRequests(Robot& r) {
+  r.requests.take([&](const RpcReq& req, const dds_sample_info_t&) {
+    const RpcAnswer a = r.loco.handle(req.header ? req.header : "", req.body ? req.body : "");
+    if (!a.respond) return;
+    const std::string header = nlohmann::json{{"status", a.status}}.dump();
+    RpcResp resp{};
+    resp.uuid = req.uuid ? req.uuid : const_cast<char*>("");
+    resp.header = const_cast<char*>(header.c_str());
+    resp.body = const_cast<char*>(a.body.c_str());
+    r.answers.write(resp);
+  });
+}
+
+namespace {
+
+// Takes every LowCmd that arrived; keeps the last well-formed one.
+void takeCommands(const Endpoint&, auto& r) {
+  r.commands.take([&](const LowCmd& c, const dds_sample_info_t&) {
+    ++r.stats.commands;
+    r.ever_commanded = true;
+    if (c.cmd_type != booster_interface_msg_dds__SERIAL || c.motor_cmd._length != r.actuators) {
+      // PARALLEL needs the ankle linkage, which the model does not have.
+      ++r.stats.refused;
+      return;
+    }
+    for (size_t a = 0; a < r.actuators; ++a) {
+      const auto& m = c.motor_cmd._buffer[a];
+      r.q[a] = m.q;
+      r.dq[a] = m.dq;
+      r.tau[a] = m.tau;
+      r.kp[a] = m.kp;
+      r.kd[a] = m.kd;
+    }
+    r.new_command = true;
+  });
+}
+
+}  // namespace
+
+void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
+  for (auto& rp : robots_) {
+    answerRequests(*rp);
+    takeCommands(*this, *rp);
+  }
+  const auto awaited = [&](const Robot& r) {
+    return config_.lockstep && r.loco.mode() == RobotMode::Custom && r.ever_commanded &&
+           !r.unresponsive && !r.new_command;
+  };
+  if (config_.lockstep) {
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                             std::chrono::duration<double>(config_.answer_timeout));
+    net::Entity waitset(dds_create_waitset(DDS_CYCLONEDDS_HANDLE));
+    std::vector<net::Entity> conditions;
+    for (auto& rp : robots_) {
+      if (!awaited(*rp)) continue;
+      const dds_entity_t c = dds_create_readcondition(rp->commands.get(), DDS_ANY_STATE);
+      if (c > 0) {
+        dds_waitset_attach(waitset.get(), c, 0);
+        conditions.emplace_back(c);
+      }
+    }
+    while (!conditions.empty()) {
+      bool waiting = false;
+      for (auto& rp : robots_) waiting = waiting || awaited(*rp);
+      if (!waiting) break;
+      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now());
+      if (left.count() <= 0) break;
+      dds_waitset_wait(waitset.get(), nullptr, 0, static_cast<dds_duration_t>(left.count()));
+      for (auto& rp : robots_) takeCommands(*this, *rp);
+    }
+  }
+
+  for (auto& rp : robots_) {
+    Robot& r = *rp;
+    sim::CommandSlot& slot = slots[r.config.robot];
+    const robots::RobotModel& model = *world_.robot(r.config.robot).model;
+    r.stats.mode = r.loco.mode();
+    if (r.loco.mode() != RobotMode::Custom) {
+      if (r.new_command) ++r.stats.ignored;
+      r.new_command = false;
+      r.missed_in_row = 0;
+      if (r.held_mode == r.loco.mode() && r.held_head.has_value() == r.loco.headTarget().has_value() &&
+          (!r.held_head || (r.held_head->pitch == r.loco.headTarget()->pitch &&
+                            r.held_head->yaw == r.loco.headTarget()->yaw)))
+        continue;  // the robot holds what it was given
+      std::optional<sim::RobotCommand> command;
+      const size_t n = r.actuators;
+      if (r.loco.mode() == RobotMode::Prepare) {
+        // Standing: the stand pose on the robot's own servos, the head where
+        // RotateHead turned it (clamped to the joints' limits by the servo).
+        std::vector<float> position(world::kActuators, 0.0f), stiffness(world::kActuators, 0.0f);
+        const std::vector<double>& stand = model.pose("stand");
+        for (size_t a = 0; a < n; ++a) {
+          const auto& act = model.actuators[a];
+          if (act.kind != robots::Actuator::Kind::Joint) continue;
+          const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+          double target = stand[static_cast<size_t>(act.index)];
+          if (const auto& head = r.loco.headTarget()) {
+            if (act.name == "HeadYaw") target = head->yaw;
+            if (act.name == "HeadPitch") target = head->pitch;
+          }
+          position[a] = static_cast<float>(std::clamp(target, joint.lower, joint.upper));
+          stiffness[a] = 1.0f;
+        }
+        command = gate.check(r.config.robot, std::span<const float>(position),
+                             std::span<const float>(stiffness));
+      } else {
+        // Damping: every joint limp but damped by its motor's kd.
+        std::vector<float> zero(n, 0.0f), position(n, 0.0f), kd(n, 0.0f);
+        const world::SensorFrame& f = world_.sensorFrame(r.config.robot);
+        for (size_t a = 0; a < n; ++a) {
+          position[a] = f.position[a];
+          const auto& act = model.actuators[a];
+          if (act.kind == robots::Actuator::Kind::Joint) {
+            const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+            kd[a] = static_cast<float>(model.body->motors[static_cast<size_t>(joint.motor)].kd);
+          }
+        }
+        command = gate.checkServo(r.config.robot, {position, zero, zero, zero, kd});
+      }
+      if (command) {
+        slot.answer = sim::Answer::Given;
+        slot.command = *command;
+      }
+      r.held_mode = r.loco.mode();
+      r.held_head = r.loco.headTarget();
+      continue;
+    }
+    r.held_mode.reset();  // leaving CUSTOM gives the mode's command again
+    if (!r.new_command) {
+      if (config_.lockstep && r.ever_commanded && !r.unresponsive) {
+        ++r.stats.missed;
+        slot.answer = sim::Answer::Missed;
+        if (++r.missed_in_row >= config_.unresponsive_after) r.unresponsive = true;
+      }
+      continue;  // holds its last command, as the robot does
+    }
+    r.new_command = false;
+    r.missed_in_row = 0;
+    r.unresponsive = false;
+    const auto command = gate.checkServo(r.config.robot, {r.q, r.dq, r.tau, r.kp, r.kd});
+    if (!command) {
+      ++r.stats.refused;
+      continue;
+    }
+    ++r.stats.applied;
+    slot.answer = sim::Answer::Given;
+    slot.command = *command;
+  }
+}
+
+}  // namespace simsoccer::booster

@@ -1,0 +1,138 @@
+#include "simsoccer/booster/loco_service.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+namespace simsoccer::booster {
+
+using nlohmann::json;
+
+const char* modeName(RobotMode m) {
+  switch (m) {
+    case RobotMode::Damping:
+      return "damping";
+    case RobotMode::Prepare:
+      return "prepare";
+    case RobotMode::Walking:
+      return "walking";
+    case RobotMode::Custom:
+      return "custom";
+    case RobotMode::Soccer:
+      return "soccer";
+  }
+  return "?";
+}
+
+namespace {
+
+// A JSON object from a request's bytes; nullopt if it is not one.
+std::optional<json> parseObject(std::string_view text) {
+  json j = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object()) return std::nullopt;
+  return j;
+}
+
+// A finite number field of an object.
+std::optional<double> number(const json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_number()) return std::nullopt;
+  const double v = it->get<double>();
+  if (!std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+RpcAnswer error(int64_t status, const std::string& why) {
+  RpcAnswer a;
+  a.status = status;
+  a.body = json{{"error", why}}.dump();
+  return a;
+}
+
+}  // namespace
+
+RpcAnswer LocoService::handle(std::string_view header_text, std::string_view body_text) {
+  ++requests_;
+  const std::optional<json> header = parseObject(header_text);
+  const std::optional<double> api = header ? number(*header, "api_id") : std::nullopt;
+  if (!api || *api != std::floor(*api) || std::abs(*api) > 1e9) {
+    ++malformed_;
+    return error(kStatusBadRequest, "the header is not {\"api_id\": N, ...}");
+  }
+  bool respond = true;
+  if (const auto it = header->find("expect_response"); it != header->end() && it->is_boolean())
+    respond = it->get<bool>();
+  // An empty body is an empty object (GetMode sends none).
+  const std::optional<json> body =
+      body_text.empty() ? std::optional<json>(json::object()) : parseObject(body_text);
+
+  RpcAnswer a;
+  const auto bad = [&](const std::string& why) {
+    ++malformed_;
+    a = error(kStatusBadRequest, why);
+  };
+  const auto unavailable = [&](const std::string& what) {
+    ++refused_;
+    a = error(kStatusServerRefused,
+              what + " needs Booster's walking controller, which simsoccer does not have yet");
+  };
+  if (!body) {
+    bad("the body is not a JSON object");
+  } else {
+    switch (static_cast<LocoApi>(static_cast<int>(*api))) {
+      case LocoApi::ChangeMode: {
+        const std::optional<double> m = number(*body, "mode");
+        if (!m || *m != std::floor(*m) || *m < 0 || *m > 4) {
+          bad("ChangeMode: \"mode\" must be 0..4 (damping, prepare, walking, custom, soccer)");
+        } else {
+          const auto mode = static_cast<RobotMode>(static_cast<int>(*m));
+          if (mode == RobotMode::Walking || mode == RobotMode::Soccer) {
+            unavailable(std::string("the ") + modeName(mode) + " mode");
+          } else {
+            mode_ = mode;
+            if (mode_ != RobotMode::Prepare) head_.reset();
+          }
+        }
+        break;
+      }
+      case LocoApi::GetMode:
+        a.body = json{{"mode", static_cast<int>(mode_)}}.dump();
+        break;
+      case LocoApi::RotateHead: {
+        const std::optional<double> pitch = number(*body, "pitch"), yaw = number(*body, "yaw");
+        if (!pitch || !yaw)
+          bad("RotateHead: \"pitch\" and \"yaw\" must be numbers (rad)");
+        else if (mode_ != RobotMode::Prepare)
+          a = error(kStatusServerRefused, "RotateHead: simsoccer turns the head in prepare mode");
+        else
+          head_ = HeadTarget{*pitch, *yaw};
+        break;
+      }
+      case LocoApi::Move:
+        unavailable("Move");
+        break;
+      case LocoApi::LieDown:
+      case LocoApi::GetUp:
+      case LocoApi::GetUpWithMode:
+        unavailable("Getting up and lying down");
+        break;
+      case LocoApi::Shoot:
+      case LocoApi::VisualKick:
+        unavailable("Kicking");
+        break;
+      case LocoApi::SwitchGait:
+        unavailable("SwitchGait");
+        break;
+      case LocoApi::GetStatus:
+      case LocoApi::RotateHeadWithTime:
+        ++refused_;
+        a = error(kStatusServerRefused, "not available in simsoccer");
+        break;
+      default:
+        bad("unknown api_id " + std::to_string(static_cast<long long>(*api)));
+    }
+  }
+  a.respond = respond;
+  return a;
+}
+
+}  // namespace simsoccer::booster

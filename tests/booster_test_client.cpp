@@ -1,0 +1,211 @@
+// A Booster SDK client written for the tests, as a separate process: the
+// robot side's contract from a client's view, with the SDK's topic names,
+// registered type names and QoS (the C++ SDK's BEST_EFFORT state reader, a
+// RELIABLE command writer as Booster's deploy code has, RELIABLE RPC with a
+// volatile answer reader). Drives one simulated robot on its own domain:
+//   GetMode (prepare), ChangeMode(custom), refused and malformed requests,
+//   then answers every LowState with a SERIAL LowCmd that holds the posture
+//   it found and turns the head yaw to 0.4 rad, with three bad commands in
+//   between (21 entries, PARALLEL, a NaN), then GetMode (custom).
+// Prints one JSON line of what it saw; exit status 0 if every answer was as
+// the SDK expects.
+#include <dds/dds.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "booster_sdk.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+dds_entity_t g_participant = 0;
+
+[[noreturn]] void fail(const std::string& why) {
+  std::fprintf(stderr, "booster test client: %s\n", why.c_str());
+  std::exit(2);
+}
+
+dds_entity_t endpoint(bool reader, const dds_topic_descriptor_t* desc, const char* name,
+                      bool reliable, int depth) {
+  const dds_entity_t topic = dds_create_topic(g_participant, desc, name, nullptr, nullptr);
+  if (topic < 0) fail(std::string("topic ") + name);
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+                       DDS_SECS(1));
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+  const dds_entity_t e = reader ? dds_create_reader(g_participant, topic, q, nullptr)
+                                : dds_create_writer(g_participant, topic, q, nullptr);
+  dds_delete_qos(q);
+  if (e < 0) fail(std::string("endpoint ") + name);
+  return e;
+}
+
+struct Rpc {
+  dds_entity_t request, response;
+  int serial = 0;
+  // Sends one request and waits up to 5 s for the answer with its uuid.
+  json call(const std::string& header, const std::string& body) {
+    const std::string uuid = "test-" + std::to_string(++serial);
+    booster_msgs_msg_dds__RpcReqMsg_ req{};
+    req.uuid = const_cast<char*>(uuid.c_str());
+    req.header = const_cast<char*>(header.c_str());
+    req.body = const_cast<char*>(body.c_str());
+    if (dds_write(request, &req) < 0) fail("write request");
+    const auto end = Clock::now() + std::chrono::seconds(5);
+    while (Clock::now() < end) {
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      while (dds_take(response, samples, info, 1, 1) > 0) {
+        const auto* r = static_cast<const booster_msgs_msg_dds__RpcRespMsg_*>(samples[0]);
+        json answer;
+        bool mine = false;
+        if (info[0].valid_data && r->uuid && uuid == r->uuid) {
+          mine = true;
+          answer = {{"status", json::parse(r->header).at("status")},
+                    {"body", r->body ? r->body : ""}};
+        }
+        dds_return_loan(response, samples, 1);
+        if (mine) return answer;
+        samples[0] = nullptr;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    fail("no answer to " + header);
+  }
+  json api(int id, const json& body) {
+    return call(json{{"api_id", id}, {"expect_response", true}}.dump(), body.dump());
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  uint32_t domain = 0;
+  std::string config;
+  int periods = 300;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--domain") domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
+    else if (a == "--dds-config") config = argv[i + 1];
+    else if (a == "--periods") periods = std::stoi(argv[i + 1]);
+  }
+  if (!config.empty()) {
+    std::ifstream f(config);
+    std::stringstream xml;
+    xml << f.rdbuf();
+    if (dds_create_domain(domain, xml.str().c_str()) < 0) fail("create domain");
+  }
+  g_participant = dds_create_participant(domain, nullptr, nullptr);
+  if (g_participant < 0) fail("create participant");
+  const dds_entity_t state = endpoint(true, &booster_interface_msg_dds__LowState__desc,
+                                      "rt/low_state", false, 64);
+  const dds_entity_t command = endpoint(false, &booster_interface_msg_dds__LowCmd__desc,
+                                        "rt/joint_ctrl", true, 1);
+  Rpc rpc{endpoint(false, &booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", true, 10),
+          endpoint(true, &booster_msgs_msg_dds__RpcRespMsg__desc, "rt/LocoApiTopicResp", true,
+                   10)};
+
+  json out;
+  // The latest LowState (waits up to 10 s for a new one).
+  std::vector<booster_interface_msg_dds__MotorState_> motors;
+  float acc_z = 0;
+  size_t parallel = 0;
+  auto nextState = [&](double seconds) {
+    const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(seconds));
+    while (Clock::now() < end) {
+      bool got = false;
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      while (dds_take(state, samples, info, 1, 1) > 0) {
+        const auto* s = static_cast<const booster_interface_msg_dds__LowState_*>(samples[0]);
+        if (info[0].valid_data) {
+          motors.assign(s->motor_state_serial._buffer,
+                        s->motor_state_serial._buffer + s->motor_state_serial._length);
+          parallel = s->motor_state_parallel._length;
+          acc_z = s->imu_state.acc[2];
+          got = true;
+        }
+        dds_return_loan(state, samples, 1);
+        samples[0] = nullptr;
+      }
+      if (got) return true;
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    return false;
+  };
+  if (!nextState(10.0)) fail("no LowState within 10 s");
+  out["motors"] = motors.size();
+  out["parallel"] = parallel;
+  bool ok = true;
+  auto expect = [&](const char* what, const json& answer, int status) {
+    out[what] = answer;
+    if (answer.at("status") != status) ok = false;
+  };
+  const json mode = rpc.api(2017, json::object());
+  expect("get_mode_first", mode, 0);
+  if (json::parse(mode.at("body").get<std::string>()).at("mode") != 1) ok = false;
+  expect("walking", rpc.api(2000, {{"mode", 2}}), 501);
+  expect("mode_out_of_range", rpc.api(2000, {{"mode", 9}}), 400);
+  expect("garbage_header", rpc.call("{not json", "{}"), 400);
+  expect("move", rpc.api(2001, {{"vx", 0.3}, {"vy", 0}, {"vyaw", 0}}), 501);
+  expect("custom", rpc.api(2000, {{"mode", 3}}), 0);
+
+  // CUSTOM: hold the posture found, turn the head; answer every LowState.
+  if (!nextState(5.0)) fail("no LowState in custom mode");
+  const size_t n = motors.size();
+  std::vector<float> hold(n);
+  for (size_t i = 0; i < n; ++i) hold[i] = motors[i].q;
+  std::vector<booster_interface_msg_dds__MotorCmd_> cmd(n);
+  auto send = [&](size_t count, booster_interface_msg_dds__CmdType type, float nan_at_head) {
+    booster_interface_msg_dds__LowCmd_ c{};
+    c.cmd_type = type;
+    c.motor_cmd._buffer = cmd.data();
+    c.motor_cmd._length = c.motor_cmd._maximum = static_cast<uint32_t>(count);
+    c.motor_cmd._release = false;
+    const float keep = cmd[0].q;
+    if (nan_at_head != 0) cmd[0].q = std::numeric_limits<float>::quiet_NaN();
+    if (dds_write(command, &c) < 0) fail("write LowCmd");
+    cmd[0].q = keep;
+  };
+  int answered = 0;
+  for (int k = 0; k < periods; ++k) {
+    for (size_t i = 0; i < n; ++i) {
+      const bool leg = i >= 10;  // JointIndexK1: 10.. are the legs
+      cmd[i] = booster_interface_msg_dds__MotorCmd_{};
+      cmd[i].q = hold[i];
+      cmd[i].kp = leg ? 80.0f : 10.0f;
+      cmd[i].kd = leg ? 2.0f : 1.0f;
+      cmd[i].weight = 1.0f;
+    }
+    cmd[0].q = static_cast<float>(0.4 * std::min(1.0, k / 100.0));  // head yaw
+    if (k == 50) send(n - 1, booster_interface_msg_dds__SERIAL, 0);    // one entry short
+    if (k == 60) send(n, booster_interface_msg_dds__PARALLEL, 0);      // motor space
+    send(n, booster_interface_msg_dds__SERIAL, k == 70 ? 1.0f : 0.0f);  // a NaN at 70
+    ++answered;
+    if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+  }
+  out["answered"] = answered;
+  out["acc_z"] = acc_z;  // standing still: the specific force, g up
+  out["head_yaw"] = motors.at(0).q;
+  const json custom = rpc.api(2017, json::object());
+  expect("get_mode_custom", custom, 0);
+  if (json::parse(custom.at("body").get<std::string>()).at("mode") != 3) ok = false;
+  out["ok"] = ok;
+  std::printf("%s\n", out.dump().c_str());
+  std::fflush(stdout);
+  dds_delete(g_participant);
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,156 @@
+// The Booster SDK endpoint with a client written for the tests in a separate
+// process (tests/booster_test_client.cpp), on real DDS over loopback: a
+// simulated K1 on its own domain, its modes by RPC, CUSTOM-mode joint
+// commands with their own gains in lockstep, bad commands refused.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "simsoccer/booster/endpoint.hpp"
+#include "simsoccer/sim/simulation.hpp"
+#include "test_support.hpp"
+
+extern char** environ;
+
+using namespace simsoccer;
+using nlohmann::json;
+
+namespace {
+
+// The test client as a process, its standard output in a file.
+struct ClientProcess {
+  pid_t pid = -1;
+  std::filesystem::path out;
+  ClientProcess(uint32_t domain, int periods) {
+    out = std::filesystem::temp_directory_path() /
+          ("simsoccer_booster_client_" + std::to_string(getpid()) + ".json");
+    std::vector<std::string> args = {SIMSOCCER_BOOSTER_CLIENT, "--domain", std::to_string(domain),
+                                     "--dds-config",
+                                     (test::sourceDir() / "configs/dds/loopback.xml").string(),
+                                     "--periods", std::to_string(periods)};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  ~ClientProcess() {
+    if (pid > 0) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+    }
+    std::filesystem::remove(out);
+  }
+  // Exit status once it ended (-1 while it runs).
+  int ended() {
+    int status = 0;
+    if (pid > 0 && waitpid(pid, &status, WNOHANG) == pid) {
+      pid = -1;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+    }
+    return -1;
+  }
+  json result() const {
+    std::ifstream f(out);
+    std::string line;
+    std::getline(f, line);
+    return line.empty() ? json() : json::parse(line);
+  }
+};
+
+world::Scenario k1Scenario() {
+  world::Scenario s = test::scenario(1);
+  s.robot_model_file = test::boosterK1();
+  return s;
+}
+
+}  // namespace
+
+TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
+  world::World w(k1Scenario());
+  sim::SimulationConfig sc;
+  sc.lockstep = true;
+  sim::Simulation simulation(w, sc);
+  booster::EndpointConfig ec;
+  ec.robots = {{0, 170, booster::RobotMode::Prepare}};
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  ec.lockstep = true;
+  ec.answer_timeout = 0.5;
+  booster::Endpoint endpoint(w, ec);
+  simulation.addSource(endpoint);
+
+  const int periods = 300;
+  ClientProcess client(170, periods);
+  ASSERT_GT(client.pid, 0);
+  int status = -1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while ((status = client.ended()) < 0 && std::chrono::steady_clock::now() < end) {
+    simulation.period();
+    // Until the client commands (CUSTOM), nothing waits: pace at about 2x real time.
+    if (endpoint.stats(0).applied == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  for (int i = 0; i < 20 && status < 0; ++i) {  // its last GetMode
+    simulation.period();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    status = client.ended();
+  }
+  const json r = client.result();
+  std::printf("client: %s\n", r.dump().c_str());
+  ASSERT_EQ(status, 0) << r.dump();
+  EXPECT_EQ(r.at("motors"), 22);    // JointIndexK1
+  EXPECT_EQ(r.at("parallel"), 22);  // motor space: the same joints until the linkage is modelled
+  EXPECT_NEAR(r.at("acc_z").get<double>(), 9.81, 0.5);
+  EXPECT_NEAR(r.at("head_yaw").get<double>(), 0.4, 0.03);
+
+  const auto s = endpoint.stats(0);
+  std::printf("states %llu, commands %llu, applied %llu, refused %llu, missed %llu\n",
+              (unsigned long long)s.states_sent, (unsigned long long)s.commands,
+              (unsigned long long)s.applied, (unsigned long long)s.refused,
+              (unsigned long long)s.missed);
+  EXPECT_EQ(s.mode, booster::RobotMode::Custom);
+  EXPECT_EQ(s.commands, static_cast<uint64_t>(periods + 2));  // one per period, two bad extra
+  EXPECT_EQ(s.refused, 3u);  // 21 entries, PARALLEL, the NaN (the gate)
+  // Every good command drives the robot, but two that arrive in one period
+  // drive it once (the later): 299 good ones, nearly one per period.
+  EXPECT_LE(s.applied, static_cast<uint64_t>(periods - 1));
+  EXPECT_GE(s.applied, static_cast<uint64_t>(periods - 4));
+  // After its last command the client asks GetMode and exits: the periods
+  // until the test sees it gone wait in vain (at most two).
+  EXPECT_LE(s.missed, 2u);
+  EXPECT_EQ(s.requests, 7u);
+  EXPECT_EQ(s.requests_refused, 2u);    // walking, Move
+  EXPECT_EQ(s.requests_malformed, 2u);  // mode 9, the garbage header
+  // The world did what the commands said: head turned, robot standing.
+  const int head = w.robot(0).model->body->jointIndex("HeadYaw");
+  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.4, 0.03);
+  EXPECT_TRUE(w.isStanding(0));
+}
+
+// Two robots cannot share a domain (the SDK's topics carry no robot id), and
+// a robot is served once.
+TEST(BoosterEndpoint, OneRobotPerDomain) {
+  world::Scenario s = k1Scenario();
+  s.robots.push_back(s.robots[0]);
+  s.robots[1].number = 2;
+  s.robots[1].y = 1.0;
+  world::World w(s);
+  booster::EndpointConfig ec;
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {1, 171, booster::RobotMode::Prepare}};
+  EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
+  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {0, 172, booster::RobotMode::Prepare}};
+  EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
+  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {1, 172, booster::RobotMode::Prepare}};
+  EXPECT_NO_THROW(booster::Endpoint(w, ec));
+}

@@ -1,0 +1,73 @@
+// The Booster SDK locomotion service's answers (the mode machine and the RPC
+// conventions), without DDS.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "simsoccer/booster/loco_service.hpp"
+
+using namespace simsoccer::booster;
+using nlohmann::json;
+
+namespace {
+RpcAnswer call(LocoService& s, int api, const json& body, bool expect = true) {
+  return s.handle(json{{"api_id", api}, {"expect_response", expect}}.dump(), body.dump());
+}
+}  // namespace
+
+TEST(BoosterLoco, ModesAsTheSdkNamesThem) {
+  LocoService s;  // a simulated robot starts standing (prepare)
+  EXPECT_EQ(s.mode(), RobotMode::Prepare);
+  RpcAnswer a = call(s, 2017, json::object());
+  EXPECT_EQ(a.status, kStatusSuccess);
+  EXPECT_EQ(json::parse(a.body).at("mode"), 1);
+  EXPECT_EQ(call(s, 2000, {{"mode", 3}}).status, kStatusSuccess);
+  EXPECT_EQ(s.mode(), RobotMode::Custom);
+  EXPECT_EQ(json::parse(call(s, 2017, json::object()).body).at("mode"), 3);
+  EXPECT_EQ(call(s, 2000, {{"mode", 0}}).status, kStatusSuccess);
+  EXPECT_EQ(s.mode(), RobotMode::Damping);
+  // Walking and soccer need Booster's walk: refused, the mode stays.
+  for (int m : {2, 4}) {
+    a = call(s, 2000, {{"mode", m}});
+    EXPECT_EQ(a.status, kStatusServerRefused) << m;
+    EXPECT_NE(a.body.find("walking controller"), std::string::npos) << a.body;
+    EXPECT_EQ(s.mode(), RobotMode::Damping);
+  }
+  EXPECT_EQ(s.refused(), 2u);
+  EXPECT_EQ(s.requests(), 6u);
+}
+
+TEST(BoosterLoco, HeadTurnsInPrepareMode) {
+  LocoService s;
+  EXPECT_EQ(call(s, 2004, {{"pitch", 0.2}, {"yaw", -0.5}}).status, kStatusSuccess);
+  ASSERT_TRUE(s.headTarget());
+  EXPECT_DOUBLE_EQ(s.headTarget()->pitch, 0.2);
+  EXPECT_DOUBLE_EQ(s.headTarget()->yaw, -0.5);
+  call(s, 2000, {{"mode", 3}});
+  EXPECT_FALSE(s.headTarget());  // custom: the client commands the head itself
+  EXPECT_EQ(call(s, 2004, {{"pitch", 0.2}, {"yaw", 0.1}}).status, kStatusServerRefused);
+}
+
+TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
+  LocoService s;
+  for (int api : {2001, 2007, 2008, 2024, 2025, 2038, 2042})
+    EXPECT_EQ(call(s, api, {{"vx", 0.5}}).status, kStatusServerRefused) << api;
+  // Bad requests: 400, and the service goes on.
+  EXPECT_EQ(s.handle("{not json", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": "2000"})", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": 1e300})", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": 2000.5})", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": 9999})", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(call(s, 2000, {{"mode", 7}}).status, kStatusBadRequest);
+  EXPECT_EQ(call(s, 2000, {{"mode", "custom"}}).status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": 2000})", "[1, 2]").status, kStatusBadRequest);
+  EXPECT_EQ(call(s, 2004, {{"pitch", 0.1}}).status, kStatusBadRequest);
+  EXPECT_EQ(s.malformed(), 9u);
+  EXPECT_EQ(s.mode(), RobotMode::Prepare);
+  // A fire-and-forget request gets no answer but is carried out.
+  const RpcAnswer quiet = call(s, 2000, {{"mode", 3}}, false);
+  EXPECT_FALSE(quiet.respond);
+  EXPECT_EQ(s.mode(), RobotMode::Custom);
+  // GetMode may come with an empty body.
+  EXPECT_EQ(s.handle(R"({"api_id": 2017, "expect_response": true})", "").status, kStatusSuccess);
+}
