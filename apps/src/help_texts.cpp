@@ -67,6 +67,7 @@ const char* const kServeHelp =
     "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
     "                       [--limp-on-release] [--mode serial|pipelined]\n"
     "                       [--lola T:P,... [--lola-net] [--out DIR]] [--external-gc PORT]\n"
+    "                       [--booster all|T:P,... [--booster-domain D] [--booster-lockstep]]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
     "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
@@ -96,6 +97,13 @@ const char* const kServeHelp =
     "adds the field network for them (GameController packets, status, team messages; root).\n"
     "--external-gc PORT (with a match config or --rules): a real GameController runs the game;\n"
     "its packets arrive on UDP PORT (3838), the simulator follows them in real time and\n"
-    "leaves 3939 to it; the automatic referee's calls are only reported.\n";
+    "leaves 3939 to it; the automatic referee's calls are only reported.\n"
+    "\n"
+    "--booster all|T:P,... (T: the scenario's team 0 or 1, P: player): these robots (Booster\n"
+    "K1s: configs/scenarios/k1_3v3.yaml) are served to Booster SDK clients, each on its own\n"
+    "DDS domain from --booster-domain D (default 0) up: rt/low_state every control period,\n"
+    "rt/joint_ctrl obeyed in CUSTOM mode, the locomotion RPC's modes (docs/booster.md). The\n"
+    "run is paced to the wall clock; --booster-lockstep instead waits, each period, for the\n"
+    "LowCmd of every robot in CUSTOM mode whose client commands (up to --timeout s).\n";
 
 }  // namespace simsoccer::apps

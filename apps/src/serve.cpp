@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 
+#include "booster_robots.hpp"
 #include "cli.hpp"
 #include "help_texts.hpp"
 #include "lola_option.hpp"
@@ -51,10 +52,11 @@ void printGame(const referee::Game& g) {
 
 int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first,
-                    {"help", "realtime", "limp-on-release", "auto-placement", "lola-net"},
+                    {"help", "realtime", "limp-on-release", "auto-placement", "lola-net",
+                     "booster-lockstep"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
                      "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
-                     "out", "external-gc"});
+                     "out", "external-gc", "booster", "booster-domain"});
   if (opt.help(kServeHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
@@ -118,6 +120,9 @@ int serve(int argc, char** argv, int first) {
   if (opt.has("gc-address") && !officials)
     throw UsageError("--gc-address needs --rules or a match config (the referee makes the packets)");
   world::World& w = session ? session->world() : *own_world;
+  // Booster SDK clients run on the wall clock: real time unless --booster-lockstep.
+  const std::vector<world::RobotId> booster_robots = boosterRobots(opt, w);
+  if (!booster_robots.empty() && !opt.flag("booster-lockstep")) cfg.lockstep = false;
 
   sim::SimulationConfig simc;
   simc.lockstep = cfg.lockstep;
@@ -138,6 +143,9 @@ int serve(int argc, char** argv, int first) {
         [](const std::string& line) { std::printf("%s\n", line.c_str()); });
     cfg.not_served = session->lolaRobots();
   }
+  const auto booster_endpoint =
+      openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file);
+  cfg.not_served.insert(cfg.not_served.end(), booster_robots.begin(), booster_robots.end());
   net::SimServer server(simulation, cfg);
   std::unique_ptr<referee::GameControllerLink> gc_link;
   if (officials) {
@@ -188,6 +196,7 @@ int serve(int argc, char** argv, int first) {
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
   printCounters(w, server);
+  if (booster_endpoint) printBoosterStats(*booster_endpoint, w);
   for (const match::LolaResult& l : lola_robots ? lola_robots->results()
                                                  : std::vector<match::LolaResult>{})
     std::printf("  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
