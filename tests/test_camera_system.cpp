@@ -342,3 +342,35 @@ TEST(CameraSystem, ScenarioCamerasBlockIsReadAndChecked) {
     }
   }
 }
+
+// A robot with one camera (a Booster K1's head camera): its images come from
+// the `top` settings with the model's field of view, and it has no second view.
+TEST(CameraSystem, ARobotWithOneCameraGetsOneView) {
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  world::Scenario s = test::scenario(2);
+  s.robots[1].model_file = test::boosterK1().string();
+  world::World w(s);
+  const robots::RobotModel& k1 = *w.robot(1).model;
+  ASSERT_EQ(k1.cameraCount(), 1u);
+  Collected got;
+  world::CameraSystem cameras(w, smallCameras(), world::BehindPolicy::Wait, got.sink());
+  cameras.capture(w);  // tick 0: both rates due
+  cameras.flush();
+  int nao = 0, booster = 0;
+  for (const auto& image : got.images) {
+    if (image.robot == 0) {
+      ++nao;
+      continue;
+    }
+    ++booster;
+    EXPECT_EQ(image.camera, world::CameraId::Top);
+    const engine::RenderView expected = world::robotCameraView(w, 1, k1.camera(0), 64, 48);
+    EXPECT_TRUE(image.view.pose.isApprox(expected.pose, 1e-12));
+    // The K1 camera's 105.6 deg: fx = 32 / tan(52.8 deg).
+    EXPECT_NEAR(image.view.fx, 32.0 / std::tan(0.5 * k1.camera(0).horizontal_fov), 1e-9);
+    EXPECT_NEAR(k1.camera(0).horizontal_fov, 1.8433, 1e-4);
+  }
+  EXPECT_EQ(nao, 2);
+  EXPECT_EQ(booster, 1);
+}
