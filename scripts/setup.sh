@@ -14,6 +14,7 @@ PACKAGES=(
   libmsgpack-cxx-dev            # LoLA actuator maps (parsed only: sensor maps are hand-encoded)
   libssl-dev                    # robot keys (HMAC-SHA256), DDS Security credentials
   nlohmann-json3-dev            # Booster SDK endpoint: the JSON of its RPC requests and answers
+  libfastrtps-dev               # tests: a Booster SDK client on Fast DDS, the middleware the SDK bundles
   bubblewrap                    # lola-run: a private /tmp/robocup per team binary
   iproute2                      # lola-run --net: the field network (bridge, namespaces)
   libgtest-dev libgmock-dev     # tests

@@ -29,20 +29,21 @@ namespace {
 struct ClientProcess {
   pid_t pid = -1;
   std::filesystem::path out;
-  ClientProcess(uint32_t domain, int periods) {
+  // `environment`: NAME=VALUE entries added to this process's.
+  ClientProcess(std::vector<std::string> args, std::vector<std::string> environment = {}) {
     out = std::filesystem::temp_directory_path() /
           ("simsoccer_booster_client_" + std::to_string(getpid()) + ".json");
-    std::vector<std::string> args = {SIMSOCCER_BOOSTER_CLIENT, "--domain", std::to_string(domain),
-                                     "--dds-config",
-                                     (test::sourceDir() / "configs/dds/loopback.xml").string(),
-                                     "--periods", std::to_string(periods)};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
+    std::vector<char*> envp;
+    for (char** e = environ; *e; ++e) envp.push_back(*e);
+    for (auto& e : environment) envp.push_back(e.data());
+    envp.push_back(nullptr);
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid = -1;
+    if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid = -1;
     posix_spawn_file_actions_destroy(&fa);
   }
   ~ClientProcess() {
@@ -75,6 +76,20 @@ world::Scenario k1Scenario() {
   return s;
 }
 
+// Runs periods until the client process ends (60 s at most); until the
+// client commands (CUSTOM) nothing waits, so the loop paces itself at about
+// twice real time. Returns the client's exit status.
+int runUntilTheClientEnds(sim::Simulation& simulation, const booster::Endpoint& endpoint,
+                          ClientProcess& client) {
+  int status = -1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while ((status = client.ended()) < 0 && std::chrono::steady_clock::now() < end) {
+    simulation.period();
+    if (endpoint.stats(0).applied == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return status;
+}
+
 }  // namespace
 
 TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
@@ -91,20 +106,11 @@ TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
   simulation.addSource(endpoint);
 
   const int periods = 300;
-  ClientProcess client(170, periods);
+  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "170", "--dds-config",
+                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
+                        std::to_string(periods)});
   ASSERT_GT(client.pid, 0);
-  int status = -1;
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while ((status = client.ended()) < 0 && std::chrono::steady_clock::now() < end) {
-    simulation.period();
-    // Until the client commands (CUSTOM), nothing waits: pace at about 2x real time.
-    if (endpoint.stats(0).applied == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  for (int i = 0; i < 20 && status < 0; ++i) {  // its last GetMode
-    simulation.period();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    status = client.ended();
-  }
+  const int status = runUntilTheClientEnds(simulation, endpoint, client);
   const json r = client.result();
   std::printf("client: %s\n", r.dump().c_str());
   ASSERT_EQ(status, 0) << r.dump();
@@ -153,4 +159,41 @@ TEST(BoosterEndpoint, OneRobotPerDomain) {
   EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
   ec.robots = {{0, 171, booster::RobotMode::Prepare}, {1, 172, booster::RobotMode::Prepare}};
   EXPECT_NO_THROW(booster::Endpoint(w, ec));
+}
+
+// The SDK's own middleware: a client on Fast DDS (Debian's 2.9) with the
+// SDK's classic-CDR types and names and the participant profile
+// "booster_dds" from configs/dds/booster_fastdds.xml, as a team process on
+// this machine would use it, against the Cyclone endpoint.
+TEST(BoosterEndpoint, AFastDdsClientWithTheShippedProfileDrivesAK1) {
+  world::World w(k1Scenario());
+  sim::SimulationConfig sc;
+  sc.lockstep = true;
+  sim::Simulation simulation(w, sc);
+  booster::EndpointConfig ec;
+  ec.robots = {{0, 173, booster::RobotMode::Prepare}};
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  ec.lockstep = true;
+  booster::Endpoint endpoint(w, ec);
+  simulation.addSource(endpoint);
+  const int periods = 200;
+  ClientProcess client(
+      {SIMSOCCER_BOOSTER_FASTDDS_CLIENT, "--domain", "173", "--periods", std::to_string(periods)},
+      {"FASTRTPS_DEFAULT_PROFILES_FILE=" +
+       (test::sourceDir() / "configs/dds/booster_fastdds.xml").string()});
+  ASSERT_GT(client.pid, 0);
+  const int status = runUntilTheClientEnds(simulation, endpoint, client);
+  const json r = client.result();
+  std::printf("Fast DDS client: %s\n", r.dump().c_str());
+  ASSERT_EQ(status, 0) << r.dump();
+  EXPECT_EQ(r.at("motors"), 22);
+  EXPECT_NEAR(r.at("head_yaw").get<double>(), 0.4, 0.03);
+  EXPECT_NEAR(r.at("acc_z").get<double>(), 9.81, 1.0);
+  const auto s = endpoint.stats(0);
+  EXPECT_EQ(s.mode, booster::RobotMode::Custom);
+  EXPECT_EQ(s.refused, 0u);
+  EXPECT_GE(s.applied, static_cast<uint64_t>(periods - 3));
+  const int head = w.robot(0).model->body->jointIndex("HeadYaw");
+  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.4, 0.03);
+  EXPECT_TRUE(w.isStanding(0));
 }
