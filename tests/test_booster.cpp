@@ -10,11 +10,15 @@
 
 #include <chrono>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
+#include "booster_sdk.h"
 #include "simsoccer/booster/endpoint.hpp"
+#include "simsoccer/net/dds.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "test_support.hpp"
 
@@ -196,4 +200,68 @@ TEST(BoosterEndpoint, AFastDdsClientWithTheShippedProfileDrivesAK1) {
   const int head = w.robot(0).model->body->jointIndex("HeadYaw");
   EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.4, 0.03);
   EXPECT_TRUE(w.isStanding(0));
+}
+
+// The head camera's images reach ROS 2 subscribers of Booster's image topic:
+// sensor_msgs Image_, YUYV as "yuv422_yuy2", the bytes the camera system
+// rendered, stamped with the simulation time of the capture.
+TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  world::Scenario sc = k1Scenario();
+  sc.cameras.enabled = true;
+  sc.cameras.top = {true, 64, 48, 30.0};
+  world::World w(sc);
+  sim::Simulation simulation(w, sim::SimulationConfig{});
+  booster::EndpointConfig ec;
+  ec.robots = {{0, 176, booster::RobotMode::Prepare}};
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  booster::Endpoint endpoint(w, ec);
+  simulation.addSource(endpoint);
+  endpoint.attachCameras(simulation);
+  std::mutex mutex;
+  std::map<uint64_t, std::vector<uint8_t>> rendered;  // by tick
+  simulation.addImageSink([&](const world::CameraImage& image) {
+    std::lock_guard lock(mutex);
+    if (image.camera == world::CameraId::Top) rendered[image.tick] = image.data;
+  });
+  // A ROS 2 subscriber's reader: best effort, as image subscribers usually are.
+  net::DomainConfig dds;
+  dds.domain = 176;
+  dds.config_file = ec.dds_config;
+  net::Participant participant(dds);
+  net::QosSpec q;
+  q.reliable = false;
+  q.depth = 64;
+  net::Reader<sensor_msgs_msg_dds__Image_> reader(participant, sensor_msgs_msg_dds__Image__desc,
+                                                 "rt/StereoNetNode/rectified_image", q);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery
+  for (int i = 0; i < 40; ++i) {
+    simulation.period();
+    simulation.flushCameras();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  int got = 0, matched = 0;
+  reader.take([&](const sensor_msgs_msg_dds__Image_& m, const dds_sample_info_t&) {
+    ++got;
+    EXPECT_EQ(m.width, 64u);
+    EXPECT_EQ(m.height, 48u);
+    EXPECT_STREQ(m.encoding, "yuv422_yuy2");
+    EXPECT_EQ(m.step, 128u);
+    ASSERT_EQ(m.data._length, 64u * 48u * 2u);
+    // The tick from the stamp (10 ms periods), and the same bytes as rendered.
+    const double t = m.header.stamp.sec + m.header.stamp.nanosec * 1e-9;
+    const auto tick = static_cast<uint64_t>(std::lround(t / 0.01));
+    std::lock_guard lock(mutex);
+    const auto it = rendered.find(tick);
+    if (it != rendered.end() &&
+        std::equal(it->second.begin(), it->second.end(), m.data._buffer))
+      ++matched;
+  });
+  std::printf("%d images received, %d equal to the rendered ones, %llu published\n", got,
+              matched, (unsigned long long)endpoint.stats(0).images);
+  EXPECT_GE(got, 10);  // 30 Hz over 0.4 s: 12 or 13
+  EXPECT_EQ(matched, got);
+  EXPECT_EQ(endpoint.stats(0).images, rendered.size());
 }

@@ -61,6 +61,7 @@ std::unique_ptr<booster::Endpoint> openBoosterRobots(const Options& opt, const w
     ec.robots.push_back({robots[i], base + static_cast<uint32_t>(i), booster::RobotMode::Prepare});
   auto endpoint = std::make_unique<booster::Endpoint>(w, ec);
   simulation.addSource(*endpoint);
+  if (w.scenario().cameras.enabled) endpoint->attachCameras(simulation);
   for (const booster::BoosterRobot& b : ec.robots)
     std::printf("Booster SDK: team %d player %d (%s) on DDS domain %u\n", w.robot(b.robot).team,
                 w.robot(b.robot).number, w.robot(b.robot).model->name.c_str(), b.domain);
@@ -73,13 +74,14 @@ void printBoosterStats(const booster::Endpoint& endpoint, const world::World& w)
     const booster::RobotBoosterStats s = endpoint.stats(i);
     std::printf(
         "  Booster %d:%d (domain %u): mode %s, %llu states, %llu commands (%llu applied, %llu "
-        "ignored, %llu refused, %llu missed), %llu requests (%llu refused, %llu malformed)\n",
+        "ignored, %llu refused, %llu missed), %llu requests (%llu refused, %llu malformed), "
+        "%llu images\n",
         w.robot(b.robot).team, w.robot(b.robot).number, b.domain, booster::modeName(s.mode),
         (unsigned long long)s.states_sent, (unsigned long long)s.commands,
         (unsigned long long)s.applied, (unsigned long long)s.ignored,
         (unsigned long long)s.refused, (unsigned long long)s.missed,
         (unsigned long long)s.requests, (unsigned long long)s.requests_refused,
-        (unsigned long long)s.requests_malformed);
+        (unsigned long long)s.requests_malformed, (unsigned long long)s.images);
   }
 }
 

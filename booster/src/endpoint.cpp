@@ -1,6 +1,7 @@
 #include "simsoccer/booster/endpoint.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -19,6 +20,8 @@ using MotorState = booster_interface_msg_dds__MotorState_;
 using FallDown = booster_interface_msg_dds__FallDownState_;
 using RpcReq = booster_msgs_msg_dds__RpcReqMsg_;
 using RpcResp = booster_msgs_msg_dds__RpcRespMsg_;
+using Image = sensor_msgs_msg_dds__Image_;
+using CompressedImage = sensor_msgs_msg_dds__CompressedImage_;
 
 namespace {
 net::QosSpec qos(bool reliable, int depth, bool transient_local = false) {
@@ -41,6 +44,10 @@ struct Endpoint::Robot {
   net::Writer<FallDown> fall;
   LocoService loco;
   RobotBoosterStats stats;
+  // Camera images (attachCameras), written from the camera conversion thread.
+  std::unique_ptr<net::Writer<Image>> image;
+  std::unique_ptr<net::Writer<CompressedImage>> compressed;
+  std::atomic<uint64_t> images{0};
 
   // The latest LowCmd taken and not yet applied (SERIAL, one entry per actuator).
   bool new_command = false;
@@ -120,9 +127,67 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
 
 Endpoint::~Endpoint() = default;
 
+void Endpoint::attachCameras(sim::Simulation& simulation) {
+  const world::CameraSettings& cameras = world_.scenario().cameras;
+  if (!cameras.enabled)
+    throw std::invalid_argument("Booster endpoint: the scenario's cameras are off");
+  for (auto& rp : robots_) {
+    Robot& r = *rp;
+    if (cameras.encoding == "jpeg")
+      r.compressed = std::make_unique<net::Writer<CompressedImage>>(
+          r.participant, sensor_msgs_msg_dds__CompressedImage__desc,
+          config_.image_topic + "/compressed", qos(false, 1));
+    else
+      r.image = std::make_unique<net::Writer<Image>>(
+          r.participant, sensor_msgs_msg_dds__Image__desc, config_.image_topic, qos(false, 1));
+  }
+  simulation.addImageSink([this](const world::CameraImage& image) { publishImage(image); });
+}
+
+void Endpoint::publishImage(const world::CameraImage& image) {
+  if (image.camera != world::CameraId::Top) return;  // the robot's first camera
+  for (auto& rp : robots_) {
+    Robot& r = *rp;
+    if (r.config.robot != image.robot) continue;
+    // The simulation time, as the robot's clock would stamp it.
+    const double whole = std::floor(image.sim_time);
+    const std::string frame = "camera";
+    std_msgs_msg_dds__Header_ header{};
+    header.stamp.sec = static_cast<int32_t>(whole);
+    header.stamp.nanosec = static_cast<uint32_t>(std::lround((image.sim_time - whole) * 1e9) %
+                                                 1000000000L);
+    header.frame_id = const_cast<char*>(frame.c_str());
+    if (r.image && image.encoding == world::ImageEncoding::Yuyv) {
+      const std::string encoding = "yuv422_yuy2";
+      Image m{};
+      m.header = header;
+      m.width = static_cast<uint32_t>(image.view.width);
+      m.height = static_cast<uint32_t>(image.view.height);
+      m.encoding = const_cast<char*>(encoding.c_str());
+      m.step = m.width * 2;
+      m.data._buffer = const_cast<uint8_t*>(image.data.data());
+      m.data._length = m.data._maximum = static_cast<uint32_t>(image.data.size());
+      m.data._release = false;
+      r.image->write(m);
+      ++r.images;
+    } else if (r.compressed && image.encoding == world::ImageEncoding::Jpeg) {
+      const std::string format = "jpeg";
+      CompressedImage m{};
+      m.header = header;
+      m.format = const_cast<char*>(format.c_str());
+      m.data._buffer = const_cast<uint8_t*>(image.data.data());
+      m.data._length = m.data._maximum = static_cast<uint32_t>(image.data.size());
+      m.data._release = false;
+      r.compressed->write(m);
+      ++r.images;
+    }
+  }
+}
+
 RobotBoosterStats Endpoint::stats(std::size_t i) const {
   const Robot& r = *robots_.at(i);
   RobotBoosterStats s = r.stats;
+  s.images = r.images.load();
   s.mode = r.loco.mode();
   s.requests = r.loco.requests();
   s.requests_refused = r.loco.refused();

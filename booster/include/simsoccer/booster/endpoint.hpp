@@ -15,6 +15,10 @@
 //                         C++ SDK's volatile and the Rust SDK's
 //                         transient-local readers both match)
 //   rt/fall_down          FallDownState_ out, on change and once a second
+//   rt/StereoNetNode/rectified_image   the head camera's images as ROS 2's
+//                         sensor_msgs Image_ (YUYV: "yuv422_yuy2") or, with
+//                         JPEG cameras, CompressedImage_ on .../compressed,
+//                         stamped with the simulation time (attachCameras)
 // What a client does wrong (a LowCmd with 21 entries, NaNs, PARALLEL
 // commands, garbage JSON) is refused and counted; the robot holds its last
 // command. docs/booster.md has the details and the sources.
@@ -25,10 +29,12 @@
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "simsoccer/booster/loco_service.hpp"
 #include "simsoccer/sim/command.hpp"
+#include "simsoccer/sim/simulation.hpp"
 
 namespace simsoccer::booster {
 
@@ -48,6 +54,9 @@ struct EndpointConfig {
   double answer_timeout = 0.5;
   int unresponsive_after = 3;  // misses in a row before a client is no longer waited for
   double fall_down_interval = 1.0;  // s of simulation between unchanged fall_down samples
+  // The ROS 2 topic (DDS name) of the robot's first camera; Booster's vision
+  // stack publishes its rectified head-camera image here.
+  std::string image_topic = "rt/StereoNetNode/rectified_image";
 };
 
 struct RobotBoosterStats {
@@ -59,6 +68,7 @@ struct RobotBoosterStats {
   uint64_t refused = 0;           // LowCmds refused (size, NaN, range, PARALLEL)
   uint64_t missed = 0;            // lockstep periods without a LowCmd in time
   uint64_t requests = 0, requests_refused = 0, requests_malformed = 0;
+  uint64_t images = 0;            // camera images published
 };
 
 class Endpoint : public sim::CommandSource {
@@ -70,6 +80,10 @@ class Endpoint : public sim::CommandSource {
   ~Endpoint() override;
   Endpoint(const Endpoint&) = delete;
   Endpoint& operator=(const Endpoint&) = delete;
+
+  // Publishes the served robots' first-camera images as ROS 2 image messages
+  // (the simulation's cameras must be on; before its first period).
+  void attachCameras(sim::Simulation& simulation);
 
   void observe(const sim::Observation& o) override;
   void collect(uint64_t tick, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) override;
@@ -83,6 +97,7 @@ class Endpoint : public sim::CommandSource {
  private:
   struct Robot;
   void answerRequests(Robot& r);
+  void publishImage(const world::CameraImage& image);
   const world::World& world_;
   EndpointConfig config_;
   std::vector<std::unique_ptr<Robot>> robots_;
