@@ -74,6 +74,13 @@ struct ClientProcess {
   }
 };
 
+booster::BoosterRobot served(world::RobotId robot, uint32_t domain) {
+  booster::BoosterRobot b;
+  b.robot = robot;
+  b.domain = domain;
+  return b;
+}
+
 world::Scenario k1Scenario() {
   world::Scenario s = test::scenario(1);
   s.robot_model_file = test::boosterK1();
@@ -102,7 +109,7 @@ TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
   sc.lockstep = true;
   sim::Simulation simulation(w, sc);
   booster::EndpointConfig ec;
-  ec.robots = {{0, 170, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 170)};
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
   ec.lockstep = true;
   ec.answer_timeout = 0.5;
@@ -157,11 +164,11 @@ TEST(BoosterEndpoint, OneRobotPerDomain) {
   world::World w(s);
   booster::EndpointConfig ec;
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {1, 171, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 171), served(1, 171)};
   EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
-  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {0, 172, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 171), served(0, 172)};
   EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
-  ec.robots = {{0, 171, booster::RobotMode::Prepare}, {1, 172, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 171), served(1, 172)};
   EXPECT_NO_THROW(booster::Endpoint(w, ec));
 }
 
@@ -175,7 +182,7 @@ TEST(BoosterEndpoint, AFastDdsClientWithTheShippedProfileDrivesAK1) {
   sc.lockstep = true;
   sim::Simulation simulation(w, sc);
   booster::EndpointConfig ec;
-  ec.robots = {{0, 173, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 173)};
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
   ec.lockstep = true;
   booster::Endpoint endpoint(w, ec);
@@ -214,7 +221,7 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   world::World w(sc);
   sim::Simulation simulation(w, sim::SimulationConfig{});
   booster::EndpointConfig ec;
-  ec.robots = {{0, 176, booster::RobotMode::Prepare}};
+  ec.robots = {served(0, 176)};
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
   booster::Endpoint endpoint(w, ec);
   simulation.addSource(endpoint);
@@ -264,4 +271,65 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   EXPECT_GE(got, 10);  // 30 Hz over 0.4 s: 12 or 13
   EXPECT_EQ(matched, got);
   EXPECT_EQ(endpoint.stats(0).images, rendered.size());
+}
+
+// Unmodified team code joins domain 0. A robot served in its own network
+// namespace looks like domain 0 there (Cyclone's ExternalDomainId) while this
+// process knows it by another id; a client run in the namespace on domain 0
+// drives it, and domain 0 outside sees nothing of it. Needs root.
+TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
+  const char* ip = ::access("/usr/sbin/ip", X_OK) == 0 ? "/usr/sbin/ip" : "/sbin/ip";
+  if (::geteuid() != 0 || ::access(ip, X_OK) != 0) GTEST_SKIP() << "needs root and iproute2";
+  const std::string ns = "simsoccer-k1t-" + std::to_string(::getpid());
+  struct Namespace {
+    std::string ip, name;
+    Namespace(std::string i, std::string n) : ip(std::move(i)), name(std::move(n)) {
+      EXPECT_EQ(std::system((ip + " netns add " + name).c_str()), 0);
+      EXPECT_EQ(std::system((ip + " -n " + name + " link set lo up").c_str()), 0);
+    }
+    ~Namespace() { std::system((ip + " netns delete " + name + " 2>/dev/null").c_str()); }
+  } scope(ip, ns);
+
+  world::World w(k1Scenario());
+  sim::SimulationConfig sc;
+  sc.lockstep = true;
+  sim::Simulation simulation(w, sc);
+  booster::EndpointConfig ec;
+  booster::BoosterRobot robot = served(0, 177);
+  robot.network_namespace = ns;
+  ec.robots = {robot};
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  ec.lockstep = true;
+  booster::Endpoint endpoint(w, ec);
+  simulation.addSource(endpoint);
+
+  // Outside the namespace, domain 0 has no robot.
+  net::DomainConfig host;
+  host.domain = 0;
+  host.config_file = ec.dds_config;
+  net::Participant outside(host);
+  net::QosSpec q;
+  q.reliable = false;
+  q.depth = 8;
+  net::Reader<booster_interface_msg_dds__LowState_> stranger(
+      outside, booster_interface_msg_dds__LowState__desc, "rt/low_state", q);
+
+  const int periods = 200;  // the client turns the head over its first 100
+  ClientProcess client({ip, "netns", "exec", ns, SIMSOCCER_BOOSTER_CLIENT, "--domain", "0",
+                        "--dds-config", (test::sourceDir() / "configs/dds/loopback.xml").string(),
+                        "--periods", std::to_string(periods)});
+  ASSERT_GT(client.pid, 0);
+  const int status = runUntilTheClientEnds(simulation, endpoint, client);
+  const json r = client.result();
+  ASSERT_EQ(status, 0) << r.dump();
+  EXPECT_NEAR(r.at("head_yaw").get<double>(), 0.4, 0.03);
+  EXPECT_EQ(endpoint.stats(0).mode, booster::RobotMode::Custom);
+  int seen = 0;
+  stranger.take([&](const booster_interface_msg_dds__LowState_&, const dds_sample_info_t&) {
+    ++seen;
+  });
+  EXPECT_EQ(seen, 0);
+  std::printf("client in %s on domain 0: %llu states, %llu applied; outside: %d states\n",
+              ns.c_str(), (unsigned long long)endpoint.stats(0).states_sent,
+              (unsigned long long)endpoint.stats(0).applied, seen);
 }

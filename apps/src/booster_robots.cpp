@@ -1,7 +1,10 @@
 #include "booster_robots.hpp"
 
 #include <cstdio>
+#include <stdexcept>
 #include <string>
+
+#include "simsoccer/lola/field_network.hpp"
 
 namespace simsoccer::apps {
 
@@ -44,11 +47,28 @@ std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World
   return out;
 }
 
-std::unique_ptr<booster::Endpoint> openBoosterRobots(const Options& opt, const world::World& w,
-                                                     sim::Simulation& simulation,
-                                                     const std::vector<world::RobotId>& robots,
-                                                     const std::filesystem::path& dds_config) {
+std::string boosterNamespace(int team, int player) {
+  return "simsoccer-booster-" + std::to_string(team) + "-" + std::to_string(player);
+}
+
+BoosterRobots::~BoosterRobots() {
+  endpoint.reset();  // its sockets first
+  for (const std::string& name : namespaces) {
+    try {
+      lola::runTool({"ip", "netns", "delete", name});
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+    }
+  }
+}
+
+std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world::World& w,
+                                                 sim::Simulation& simulation,
+                                                 const std::vector<world::RobotId>& robots,
+                                                 const std::filesystem::path& dds_config) {
   if (robots.empty()) return nullptr;
+  auto out = std::make_unique<BoosterRobots>();
+  const bool netns = opt.flag("booster-netns");
   const auto base = static_cast<uint32_t>(opt.wholeNumber("booster-domain", 0, 0, 230));
   if (base + robots.size() - 1 > 230)
     throw UsageError("--booster-domain: " + std::to_string(robots.size()) +
@@ -57,18 +77,43 @@ std::unique_ptr<booster::Endpoint> openBoosterRobots(const Options& opt, const w
   ec.dds_config = dds_config;
   ec.lockstep = opt.flag("booster-lockstep");
   if (opt.has("timeout")) ec.answer_timeout = opt.positive("timeout", 0.5);
-  for (size_t i = 0; i < robots.size(); ++i)
-    ec.robots.push_back({robots[i], base + static_cast<uint32_t>(i), booster::RobotMode::Prepare});
-  auto endpoint = std::make_unique<booster::Endpoint>(w, ec);
-  simulation.addSource(*endpoint);
-  if (w.scenario().cameras.enabled) endpoint->attachCameras(simulation);
-  for (const booster::BoosterRobot& b : ec.robots)
-    std::printf("Booster SDK: team %d player %d (%s) on DDS domain %u\n", w.robot(b.robot).team,
-                w.robot(b.robot).number, w.robot(b.robot).model->name.c_str(), b.domain);
-  return endpoint;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    booster::BoosterRobot b;
+    b.robot = robots[i];
+    b.domain = base + static_cast<uint32_t>(i);
+    if (netns) {
+      // Its own namespace with only loopback (a killed run's is replaced).
+      b.network_namespace = boosterNamespace(w.robot(b.robot).team, w.robot(b.robot).number);
+      try {
+        lola::runTool({"ip", "netns", "delete", b.network_namespace});
+      } catch (const std::runtime_error&) {  // none there
+      }
+      lola::runTool({"ip", "netns", "add", b.network_namespace});
+      out->namespaces.push_back(b.network_namespace);
+      lola::runTool({"ip", "-n", b.network_namespace, "link", "set", "lo", "up"});
+    }
+    ec.robots.push_back(b);
+  }
+  out->endpoint = std::make_unique<booster::Endpoint>(w, ec);
+  simulation.addSource(*out->endpoint);
+  if (w.scenario().cameras.enabled) out->endpoint->attachCameras(simulation);
+  for (const booster::BoosterRobot& b : ec.robots) {
+    const auto& info = w.robot(b.robot);
+    if (netns)
+      std::printf(
+          "Booster SDK: team %d player %d (%s) as DDS domain 0 in network namespace %s: "
+          "simsoccer booster-run --robot %d:%d -- PROGRAM\n",
+          info.team, info.number, info.model->name.c_str(), b.network_namespace.c_str(),
+          info.team, info.number);
+    else
+      std::printf("Booster SDK: team %d player %d (%s) on DDS domain %u\n", info.team,
+                  info.number, info.model->name.c_str(), b.domain);
+  }
+  return out;
 }
 
-void printBoosterStats(const booster::Endpoint& endpoint, const world::World& w) {
+void printBoosterStats(const BoosterRobots& robots, const world::World& w) {
+  const booster::Endpoint& endpoint = *robots.endpoint;
   for (size_t i = 0; i < endpoint.config().robots.size(); ++i) {
     const booster::BoosterRobot& b = endpoint.config().robots[i];
     const booster::RobotBoosterStats s = endpoint.stats(i);

@@ -1,9 +1,11 @@
 // `serve --booster all|T:P,...`: robots served to Booster SDK clients (team
 // code for a Booster K1), each on its own DDS domain from --booster-domain
-// (default 0) up, in the order of the scenario's robots.
+// (default 0) up, in the order of the scenario's robots; with
+// --booster-netns each in a network namespace of its own as domain 0.
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "cli.hpp"
@@ -16,13 +18,26 @@ namespace simsoccer::apps {
 // T the scenario's team (0, 1) and P the player number.
 std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World& w);
 
-// Joins each robot's domain and adds the endpoint to the simulation; prints
-// which domain serves which robot.
-std::unique_ptr<booster::Endpoint> openBoosterRobots(const Options& opt, const world::World& w,
-                                                     sim::Simulation& simulation,
-                                                     const std::vector<world::RobotId>& robots,
-                                                     const std::filesystem::path& dds_config);
+// The network namespace `serve --booster-netns` serves robot T:P in (and
+// `booster-run --robot T:P` runs a team binary in).
+std::string boosterNamespace(int team, int player);
 
-void printBoosterStats(const booster::Endpoint& endpoint, const world::World& w);
+// The robots' endpoint, added to the simulation, and with --booster-netns
+// their network namespaces (removed when this goes); prints where each
+// robot is served.
+struct BoosterRobots {
+  std::vector<std::string> namespaces;  // made here, removed in the destructor
+  std::unique_ptr<booster::Endpoint> endpoint;
+  BoosterRobots() = default;
+  BoosterRobots(const BoosterRobots&) = delete;
+  BoosterRobots& operator=(const BoosterRobots&) = delete;
+  ~BoosterRobots();
+};
+std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world::World& w,
+                                                 sim::Simulation& simulation,
+                                                 const std::vector<world::RobotId>& robots,
+                                                 const std::filesystem::path& dds_config);
+
+void printBoosterStats(const BoosterRobots& robots, const world::World& w);
 
 }  // namespace simsoccer::apps

@@ -65,6 +65,7 @@ std::string fmt(double value, int decimals);
 
 int benchPhysics(int argc, char** argv, int first);
 int lolaRun(int argc, char** argv, int first);
+int boosterRun(int argc, char** argv, int first);
 int benchSensors(int argc, char** argv, int first);
 int benchNet(int argc, char** argv, int first);
 int benchCameras(int argc, char** argv, int first);

@@ -67,7 +67,8 @@ const char* const kServeHelp =
     "                       [--seed N] [--half S] [--agents N] [--realtime] [--timeout S]\n"
     "                       [--limp-on-release] [--mode serial|pipelined]\n"
     "                       [--lola T:P,... [--lola-net] [--out DIR]] [--external-gc PORT]\n"
-    "                       [--booster all|T:P,... [--booster-domain D] [--booster-lockstep]]\n"
+    "                       [--booster all|T:P,... [--booster-domain D] [--booster-lockstep]\n"
+    "                        [--booster-netns]]\n"
     "                       [--rules FILE [--teams A,B] [--auto-placement]]\n"
     "                       [--gc-address ADDR [--gc-port P] [--gc-return-port P]]\n"
     "\n"
@@ -104,6 +105,9 @@ const char* const kServeHelp =
     "DDS domain from --booster-domain D (default 0) up: rt/low_state every control period,\n"
     "rt/joint_ctrl obeyed in CUSTOM mode, the locomotion RPC's modes (docs/booster.md). The\n"
     "run is paced to the wall clock; --booster-lockstep instead waits, each period, for the\n"
-    "LowCmd of every robot in CUSTOM mode whose client commands (up to --timeout s).\n";
+    "LowCmd of every robot in CUSTOM mode whose client commands (up to --timeout s).\n"
+    "--booster-netns (root): each robot in a network namespace of its own, as domain 0 there\n"
+    "(unmodified team code joins domain 0); `simsoccer booster-run --robot T:P -- PROGRAM`\n"
+    "runs a team's program in it.\n";
 
 }  // namespace simsoccer::apps

@@ -27,6 +27,7 @@ const char* kUsage =
     "  bench scaling   the full pipeline with agent processes, 1..22 robots, vs USARSim\n"
     "  serve SCENARIO  run a scenario as a DDS simulator for agents started elsewhere\n"
     "  lola-run        start a team's robot binary with a simulated Nao's LoLA socket\n"
+    "  booster-run     start a team's Booster SDK program attached to one simulated K1\n"
     "  soak [CONFIG]   matches back to back with agents killed: memory, descriptors, threads\n"
     "  credentials DIR DDS Security certificates and permissions for a secure match\n"
     "\n"
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
     if (cmd == "penalty") return penalty(argc, argv, 2);
     if (cmd == "replay") return replay(argc, argv, 2);
     if (cmd == "lola-run") return lolaRun(argc, argv, 2);
+    if (cmd == "booster-run") return boosterRun(argc, argv, 2);
     if (cmd == "soak") return soak(argc, argv, 2);
     if (cmd == "credentials") return credentials(argc, argv, 2);
     if (cmd == "bench") {

@@ -53,7 +53,7 @@ void printGame(const referee::Game& g) {
 int serve(int argc, char** argv, int first) {
   const Options opt(argc, argv, first,
                     {"help", "realtime", "limp-on-release", "auto-placement", "lola-net",
-                     "booster-lockstep"},
+                     "booster-lockstep", "booster-netns"},
                     {"domain", "dds-config", "seconds", "agents", "timeout", "rules", "teams",
                      "gc-address", "gc-port", "gc-return-port", "mode", "seed", "half", "lola",
                      "out", "external-gc", "booster", "booster-domain"});
@@ -143,7 +143,7 @@ int serve(int argc, char** argv, int first) {
         [](const std::string& line) { std::printf("%s\n", line.c_str()); });
     cfg.not_served = session->lolaRobots();
   }
-  const auto booster_endpoint =
+  const auto booster =
       openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file);
   cfg.not_served.insert(cfg.not_served.end(), booster_robots.begin(), booster_robots.end());
   net::SimServer server(simulation, cfg);
@@ -196,7 +196,7 @@ int serve(int argc, char** argv, int first) {
         c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
   }
   printCounters(w, server);
-  if (booster_endpoint) printBoosterStats(*booster_endpoint, w);
+  if (booster) printBoosterStats(*booster, w);
   for (const match::LolaResult& l : lola_robots ? lola_robots->results()
                                                  : std::vector<match::LolaResult>{})
     std::printf("  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",

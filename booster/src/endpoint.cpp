@@ -1,8 +1,14 @@
 #include "simsoccer/booster/endpoint.hpp"
 
+#include <fcntl.h>
+#include <sched.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
+#include <thread>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -119,7 +125,33 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     net::DomainConfig dds;
     dds.domain = b.domain;
     dds.config_file = config_.dds_config;
-    auto r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+    std::unique_ptr<Robot> r;
+    if (b.network_namespace.empty()) {
+      r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+    } else {
+      // Cyclone opens the domain's sockets and starts its threads when the
+      // domain is made: made on a thread inside the namespace, they stay
+      // there (a thread's network namespace is its own; this one ends after).
+      dds.external_domain = b.namespace_domain;
+      std::exception_ptr failed;
+      std::thread([&] {
+        try {
+          const std::string path = "/run/netns/" + b.network_namespace;
+          const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+          if (fd < 0)
+            throw std::invalid_argument("Booster endpoint: no network namespace " + path);
+          const int rc = ::setns(fd, CLONE_NEWNET);
+          ::close(fd);
+          if (rc != 0)
+            throw std::runtime_error("Booster endpoint: cannot enter network namespace " +
+                                     b.network_namespace + " (needs CAP_SYS_ADMIN)");
+          r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+        } catch (...) {
+          failed = std::current_exception();
+        }
+      }).join();
+      if (failed) std::rethrow_exception(failed);
+    }
     r->stats.mode = r->loco.mode();
     robots_.push_back(std::move(r));
   }

@@ -36,12 +36,19 @@ Participant::Participant(const DomainConfig& config) {
                                 engine::formatNumber(DomainConfig::kMinLease) + " and " +
                                 engine::formatNumber(DomainConfig::kMaxLease) + " s, not " +
                                 engine::formatNumber(config.lease));
-  if (!config.config_file.empty()) {
-    std::ifstream f(config.config_file);
-    if (!f)
-      throw std::runtime_error(config.config_file.string() + ": cannot read DDS configuration");
+  if (!config.config_file.empty() || config.external_domain) {
     std::stringstream xml;
-    xml << f.rdbuf();
+    if (!config.config_file.empty()) {
+      std::ifstream f(config.config_file);
+      if (!f)
+        throw std::runtime_error(config.config_file.string() + ": cannot read DDS configuration");
+      xml << f.rdbuf();
+    }
+    // Cyclone reads a list of configurations, later ones adding to earlier ones.
+    if (config.external_domain)
+      xml << (xml.tellp() > 0 ? "," : "")
+          << "<CycloneDDS><Domain><Discovery><ExternalDomainId>" << *config.external_domain
+          << "</ExternalDomainId></Discovery></Domain></CycloneDDS>";
     const dds_entity_t d = dds_create_domain(config.domain, xml.str().c_str());
     // A domain this process already created keeps its configuration.
     if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) check(d, "create domain");

@@ -42,6 +42,12 @@ struct BoosterRobot {
   world::RobotId robot = 0;
   uint32_t domain = 0;  // the DDS domain its SDK client joins
   RobotMode initial_mode = RobotMode::Prepare;
+  // A network namespace (a name under /run/netns) to serve the robot in: its
+  // topics go out on that namespace's loopback as domain `namespace_domain`
+  // (0: what unmodified team code joins), while `domain` stays the id this
+  // process knows the robot's domain by (unique). Needs CAP_SYS_ADMIN.
+  std::string network_namespace;
+  uint32_t namespace_domain = 0;
 };
 
 struct EndpointConfig {

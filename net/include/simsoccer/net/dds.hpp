@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,6 +53,11 @@ struct DomainConfig {
   // control period more than 5 s (bench net); at 5 s a killed agent's robot
   // is free after about 5 s.
   double lease = 5.0;
+  // The domain id the participant shows on the network (RTPS ports and
+  // discovery) when it differs from `domain`, Cyclone's ExternalDomainId:
+  // several domains of one process can each look like domain 0, each in its
+  // own network namespace (one Booster robot per namespace).
+  std::optional<uint32_t> external_domain;
   // Its range: Cyclone counts in int64 nanoseconds, and below 0.1 s every
   // participant would announce itself to every port more than ten times a second.
   static constexpr double kMinLease = 0.1, kMaxLease = 86400.0;

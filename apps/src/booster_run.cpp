@@ -1,0 +1,82 @@
+// simsoccer booster-run: starts a team's Booster SDK program attached to one
+// simulated robot that `serve --booster-netns` serves in a network namespace
+// of its own as DDS domain 0 (what unmodified team code joins), with the Fast
+// DDS profile the SDK asks for (configs/dds/booster_fastdds.xml).
+#include <fcntl.h>
+#include <sched.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "booster_robots.hpp"
+#include "cli.hpp"
+
+namespace simsoccer::apps {
+namespace {
+
+const char* kHelp =
+    "usage: simsoccer booster-run --robot T:P [--profile FILE] -- PROGRAM [ARGS...]\n"
+    "\n"
+    "Runs PROGRAM (a team's Booster SDK client, unmodified) in the network namespace where\n"
+    "`simsoccer serve SCENARIO --booster ... --booster-netns` serves robot T:P (the\n"
+    "scenario's team 0 or 1, player number) as DDS domain 0, so that several such programs,\n"
+    "each on domain 0, each drive their own robot. FASTRTPS_DEFAULT_PROFILES_FILE is set to\n"
+    "FILE (default configs/dds/booster_fastdds.xml: the participant profile booster_dds on\n"
+    "loopback) unless it is set already. Needs root (entering a network namespace); the\n"
+    "program runs as this user, with this environment and file system. docs/booster.md.\n";
+
+}  // namespace
+
+int boosterRun(int argc, char** argv, int first) {
+  int split = argc;  // everything after "--" is the program's
+  for (int i = first; i < argc; ++i)
+    if (std::string(argv[i]) == "--") {
+      split = i;
+      break;
+    }
+  const Options opt(split, argv, first, {"help"}, {"robot", "profile"});
+  if (opt.help(kHelp)) return 0;
+  opt.noPositional();
+  if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
+  const std::string robot = opt.get("robot", "");
+  const size_t colon = robot.find(':');
+  int team = -1, player = -1;
+  try {
+    size_t used = 0;
+    if (colon == std::string::npos) throw std::invalid_argument(robot);
+    team = std::stoi(robot.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument(robot);
+    player = std::stoi(robot.substr(colon + 1), &used);
+    if (used != robot.size() - colon - 1) throw std::invalid_argument(robot);
+  } catch (const std::exception&) {
+    throw UsageError("--robot: '" + robot + "' is not T:P (team 0 or 1, player number)");
+  }
+  if (team < 0 || team > 1 || player < 1 || player > 99)
+    throw UsageError("--robot: team 0 or 1, player 1..99");
+  const std::string name = boosterNamespace(team, player);
+  const std::string path = "/run/netns/" + name;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
+    throw UsageError("no network namespace " + name +
+                     ": is `simsoccer serve ... --booster ... --booster-netns` serving robot " +
+                     robot + "?");
+  if (::setns(fd, CLONE_NEWNET) != 0) {
+    const int e = errno;
+    ::close(fd);
+    throw UsageError("cannot enter network namespace " + name + ": " + std::strerror(e) +
+                     " (needs root)");
+  }
+  ::close(fd);
+  const std::string profile =
+      findConfig(opt.get("profile", ""), "configs/dds/booster_fastdds.xml").string();
+  ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", profile.c_str(), /*overwrite=*/0);
+  ::execvp(argv[split + 1], argv + split + 1);
+  const int e = errno;
+  throw UsageError(std::string("cannot run ") + argv[split + 1] + ": " + std::strerror(e));
+}
+
+}  // namespace simsoccer::apps
