@@ -111,8 +111,9 @@ int main(int argc, char** argv) {
   if (g_participant < 0) fail("create participant");
   const dds_entity_t state = endpoint(true, &booster_interface_msg_dds__LowState__desc,
                                       "rt/low_state", false, 64);
+  // Reliable as Booster's deploy code, 4 deep: two commands sent back to back both arrive.
   const dds_entity_t command = endpoint(false, &booster_interface_msg_dds__LowCmd__desc,
-                                        "rt/joint_ctrl", true, 1);
+                                        "rt/joint_ctrl", true, 4);
   Rpc rpc{endpoint(false, &booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", true, 10),
           endpoint(true, &booster_msgs_msg_dds__RpcRespMsg__desc, "rt/LocoApiTopicResp", true,
                    10)};

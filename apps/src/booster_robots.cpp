@@ -65,7 +65,8 @@ BoosterRobots::~BoosterRobots() {
 std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world::World& w,
                                                  sim::Simulation& simulation,
                                                  const std::vector<world::RobotId>& robots,
-                                                 const std::filesystem::path& dds_config) {
+                                                 const std::filesystem::path& dds_config,
+                                                 double answer_timeout) {
   if (robots.empty()) return nullptr;
   auto out = std::make_unique<BoosterRobots>();
   const bool netns = opt.flag("booster-netns");
@@ -76,7 +77,9 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
   booster::EndpointConfig ec;
   ec.dds_config = dds_config;
   ec.lockstep = opt.flag("booster-lockstep");
-  if (opt.has("timeout")) ec.answer_timeout = opt.positive("timeout", 0.5);
+  ec.answer_timeout = answer_timeout;
+  if (!(ec.answer_timeout > 0.0 && ec.answer_timeout <= 60.0))
+    throw UsageError("--timeout: more than 0 and at most 60 s with --booster");
   for (size_t i = 0; i < robots.size(); ++i) {
     booster::BoosterRobot b;
     b.robot = robots[i];

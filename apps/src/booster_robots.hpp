@@ -33,10 +33,19 @@ struct BoosterRobots {
   BoosterRobots& operator=(const BoosterRobots&) = delete;
   ~BoosterRobots();
 };
+// `answer_timeout`: lockstep's wait for a LowCmd (s), unless --timeout.
 std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world::World& w,
                                                  sim::Simulation& simulation,
                                                  const std::vector<world::RobotId>& robots,
-                                                 const std::filesystem::path& dds_config);
+                                                 const std::filesystem::path& dds_config,
+                                                 double answer_timeout);
+
+// Delivers the camera images still queued when it goes, before the image
+// sinks (transports declared before it) go.
+struct FlushCamerasOnExit {
+  sim::Simulation& simulation;
+  ~FlushCamerasOnExit() { simulation.flushCameras(); }
+};
 
 void printBoosterStats(const BoosterRobots& robots, const world::World& w);
 

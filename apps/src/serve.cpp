@@ -143,10 +143,16 @@ int serve(int argc, char** argv, int first) {
         [](const std::string& line) { std::printf("%s\n", line.c_str()); });
     cfg.not_served = session->lolaRobots();
   }
-  const auto booster =
-      openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file);
+  for (world::RobotId r : booster_robots)
+    for (world::RobotId l : cfg.not_served)
+      if (r == l) throw UsageError("--booster and --lola name the same robot");
+  const auto booster = openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file,
+                                         cfg.command_timeout);
   cfg.not_served.insert(cfg.not_served.end(), booster_robots.begin(), booster_robots.end());
   net::SimServer server(simulation, cfg);
+  // Images still on their way reach the transports (their sinks) before those
+  // go, also when the run ends with an exception.
+  const FlushCamerasOnExit flush_cameras{simulation};
   std::unique_ptr<referee::GameControllerLink> gc_link;
   if (officials) {
     server.publishGameState(officials->controlData(), officials->leftTeam());  // before agents

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -55,18 +56,21 @@ struct Endpoint::Robot {
   std::unique_ptr<net::Writer<CompressedImage>> compressed;
   std::atomic<uint64_t> images{0};
 
-  // The latest LowCmd taken and not yet applied (SERIAL, one entry per actuator).
-  bool new_command = false;
+  // The well-formed LowCmds (SERIAL, one entry per actuator) taken and not
+  // yet applied, oldest first; the last that passes the gate drives.
+  struct Command {
+    std::vector<float> q, dq, tau, kp, kd;
+  };
+  static constexpr size_t kMaxPending = 16;  // the reader's depth
+  std::vector<Command> pending_pool;
+  size_t pending = 0;
   bool ever_commanded = false;  // lockstep waits only for a client that commands
-  std::vector<float> q, dq, tau, kp, kd;
   // Lockstep: a client that missed `unresponsive_after` periods in a row is
   // no longer waited for until it answers again.
   int missed_in_row = 0;
   bool unresponsive = false;
-
-  // What the robot was last given outside CUSTOM mode (sent again only on change).
-  std::optional<RobotMode> held_mode;
-  std::optional<HeadTarget> held_head;
+  dds_entity_t command_condition = 0;  // data on rt/joint_ctrl (owned by the reader)
+  const std::vector<double>* stand = nullptr;  // the model's stand pose
 
   // LowState buffers (the sample points at them) and the last joint speeds.
   std::vector<MotorState> motors;
@@ -92,13 +96,14 @@ struct Endpoint::Robot {
         fall(participant, booster_interface_msg_dds__FallDownState__desc, "rt/fall_down",
              qos(true, 1)),
         loco(c.initial_mode),
-        q(n),
-        dq(n),
-        tau(n),
-        kp(n),
-        kd(n),
+        pending_pool(kMaxPending, Command{std::vector<float>(n), std::vector<float>(n),
+                                          std::vector<float>(n), std::vector<float>(n),
+                                          std::vector<float>(n)}),
         motors(n),
-        last_dq(n) {}
+        last_dq(n) {
+    command_condition = dds_create_readcondition(commands.get(), DDS_ANY_STATE);
+    if (command_condition < 0) net::check(command_condition, "create read condition");
+  }
 };
 
 Endpoint::Endpoint(const world::World& world, EndpointConfig config)
@@ -153,11 +158,18 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       if (failed) std::rethrow_exception(failed);
     }
     r->stats.mode = r->loco.mode();
+    r->stand = &model.pose("stand");
     robots_.push_back(std::move(r));
   }
+  // Lockstep waits on every robot's commands at once.
+  waitset_ = net::check(dds_create_waitset(DDS_CYCLONEDDS_HANDLE), "create waitset");
+  for (auto& r : robots_)
+    net::check(dds_waitset_attach(waitset_, r->command_condition, 0), "attach read condition");
 }
 
-Endpoint::~Endpoint() = default;
+Endpoint::~Endpoint() {
+  if (waitset_ > 0) dds_delete(waitset_);
+}
 
 void Endpoint::attachCameras(sim::Simulation& simulation) {
   const world::CameraSettings& cameras = world_.scenario().cameras;
@@ -182,12 +194,11 @@ void Endpoint::publishImage(const world::CameraImage& image) {
     Robot& r = *rp;
     if (r.config.robot != image.robot) continue;
     // The simulation time, as the robot's clock would stamp it.
-    const double whole = std::floor(image.sim_time);
+    const long long ns = std::llround(image.sim_time * 1e9);
     const std::string frame = "camera";
     std_msgs_msg_dds__Header_ header{};
-    header.stamp.sec = static_cast<int32_t>(whole);
-    header.stamp.nanosec = static_cast<uint32_t>(std::lround((image.sim_time - whole) * 1e9) %
-                                                 1000000000L);
+    header.stamp.sec = static_cast<int32_t>(ns / 1000000000LL);
+    header.stamp.nanosec = static_cast<uint32_t>(ns % 1000000000LL);
     header.frame_id = const_cast<char*>(frame.c_str());
     if (r.image && image.encoding == world::ImageEncoding::Yuyv) {
       const std::string encoding = "yuv422_yuy2";
@@ -234,11 +245,50 @@ bool Endpoint::clientConnected(std::size_t i) const {
   return st.current_count > 0;
 }
 
+namespace {
+
+// Takes every LowCmd that arrived: a malformed one is refused and counted,
+// a well-formed one joins the pending (the oldest goes beyond kMaxPending).
+void takeCommands(auto& r) {
+  r.commands.take([&](const LowCmd& c, const dds_sample_info_t&) {
+    ++r.stats.commands;
+    r.ever_commanded = true;
+    if (c.cmd_type != booster_interface_msg_dds__SERIAL || c.motor_cmd._length != r.actuators) {
+      // PARALLEL needs the ankle linkage, which the model does not have.
+      ++r.stats.refused;
+      return;
+    }
+    if (r.pending == r.pending_pool.size()) {
+      std::rotate(r.pending_pool.begin(), r.pending_pool.begin() + 1, r.pending_pool.end());
+      --r.pending;
+    }
+    auto& p = r.pending_pool[r.pending++];
+    for (size_t a = 0; a < r.actuators; ++a) {
+      const auto& m = c.motor_cmd._buffer[a];
+      p.q[a] = m.q;
+      p.dq[a] = m.dq;
+      p.tau[a] = m.tau;
+      p.kp[a] = m.kp;
+      p.kd[a] = m.kd;
+    }
+  });
+}
+
+}  // namespace
+
 void Endpoint::observe(const sim::Observation& o) {
   const world::World& w = *o.world;
   const double period = w.scenario().physics.control_period;
   for (auto& rp : robots_) {
     Robot& r = *rp;
+    // Lockstep: what came after the last period's wait answers a state that
+    // is gone; it must not answer the new one (the robot would run a period
+    // behind for good).
+    if (config_.lockstep) {
+      takeCommands(r);
+      r.stats.late += r.pending;
+      r.pending = 0;
+    }
     const world::SensorFrame& f = w.sensorFrame(r.config.robot);
     const auto& info = w.robot(r.config.robot);
     const auto& actuators = info.model->actuators;
@@ -296,123 +346,46 @@ void Endpoint::answerRequests(Robot& r) {
   });
 }
 
-namespace {
-
-// Takes every LowCmd that arrived; keeps the last well-formed one.
-void takeCommands(const Endpoint&, auto& r) {
-  r.commands.take([&](const LowCmd& c, const dds_sample_info_t&) {
-    ++r.stats.commands;
-    r.ever_commanded = true;
-    if (c.cmd_type != booster_interface_msg_dds__SERIAL || c.motor_cmd._length != r.actuators) {
-      // PARALLEL needs the ankle linkage, which the model does not have.
-      ++r.stats.refused;
-      return;
-    }
-    for (size_t a = 0; a < r.actuators; ++a) {
-      const auto& m = c.motor_cmd._buffer[a];
-      r.q[a] = m.q;
-      r.dq[a] = m.dq;
-      r.tau[a] = m.tau;
-      r.kp[a] = m.kp;
-      r.kd[a] = m.kd;
-    }
-    r.new_command = true;
-  });
-}
-
-}  // namespace
 
 void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
   for (auto& rp : robots_) {
     answerRequests(*rp);
-    takeCommands(*this, *rp);
+    takeCommands(*rp);
   }
   const auto awaited = [&](const Robot& r) {
     return config_.lockstep && r.loco.mode() == RobotMode::Custom && r.ever_commanded &&
-           !r.unresponsive && !r.new_command;
+           !r.unresponsive && r.pending == 0;
   };
   if (config_.lockstep) {
     const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(config_.answer_timeout));
-    net::Entity waitset(dds_create_waitset(DDS_CYCLONEDDS_HANDLE));
-    std::vector<net::Entity> conditions;
-    for (auto& rp : robots_) {
-      if (!awaited(*rp)) continue;
-      const dds_entity_t c = dds_create_readcondition(rp->commands.get(), DDS_ANY_STATE);
-      if (c > 0) {
-        dds_waitset_attach(waitset.get(), c, 0);
-        conditions.emplace_back(c);
-      }
-    }
-    while (!conditions.empty()) {
+    for (;;) {
       bool waiting = false;
       for (auto& rp : robots_) waiting = waiting || awaited(*rp);
-      if (!waiting) break;
       const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now());
-      if (left.count() <= 0) break;
-      dds_waitset_wait(waitset.get(), nullptr, 0, static_cast<dds_duration_t>(left.count()));
-      for (auto& rp : robots_) takeCommands(*this, *rp);
+      if (!waiting || left.count() <= 0) break;
+      dds_waitset_wait(waitset_, nullptr, 0, static_cast<dds_duration_t>(left.count()));
+      for (auto& rp : robots_) takeCommands(*rp);
     }
   }
 
   for (auto& rp : robots_) {
     Robot& r = *rp;
     sim::CommandSlot& slot = slots[r.config.robot];
-    const robots::RobotModel& model = *world_.robot(r.config.robot).model;
     r.stats.mode = r.loco.mode();
     if (r.loco.mode() != RobotMode::Custom) {
-      if (r.new_command) ++r.stats.ignored;
-      r.new_command = false;
+      r.stats.ignored += r.pending;
+      r.pending = 0;
       r.missed_in_row = 0;
-      if (r.held_mode == r.loco.mode() && r.held_head.has_value() == r.loco.headTarget().has_value() &&
-          (!r.held_head || (r.held_head->pitch == r.loco.headTarget()->pitch &&
-                            r.held_head->yaw == r.loco.headTarget()->yaw)))
-        continue;  // the robot holds what it was given
-      std::optional<sim::RobotCommand> command;
-      const size_t n = r.actuators;
-      if (r.loco.mode() == RobotMode::Prepare) {
-        // Standing: the stand pose on the robot's own servos, the head where
-        // RotateHead turned it (clamped to the joints' limits by the servo).
-        std::vector<float> position(world::kActuators, 0.0f), stiffness(world::kActuators, 0.0f);
-        const std::vector<double>& stand = model.pose("stand");
-        for (size_t a = 0; a < n; ++a) {
-          const auto& act = model.actuators[a];
-          if (act.kind != robots::Actuator::Kind::Joint) continue;
-          const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
-          double target = stand[static_cast<size_t>(act.index)];
-          if (const auto& head = r.loco.headTarget()) {
-            if (act.name == "HeadYaw") target = head->yaw;
-            if (act.name == "HeadPitch") target = head->pitch;
-          }
-          position[a] = static_cast<float>(std::clamp(target, joint.lower, joint.upper));
-          stiffness[a] = 1.0f;
-        }
-        command = gate.check(r.config.robot, std::span<const float>(position),
-                             std::span<const float>(stiffness));
-      } else {
-        // Damping: every joint limp but damped by its motor's kd.
-        std::vector<float> zero(n, 0.0f), position(n, 0.0f), kd(n, 0.0f);
-        const world::SensorFrame& f = world_.sensorFrame(r.config.robot);
-        for (size_t a = 0; a < n; ++a) {
-          position[a] = f.position[a];
-          const auto& act = model.actuators[a];
-          if (act.kind == robots::Actuator::Kind::Joint) {
-            const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
-            kd[a] = static_cast<float>(model.body->motors[static_cast<size_t>(joint.motor)].kd);
-          }
-        }
-        command = gate.checkServo(r.config.robot, {position, zero, zero, zero, kd});
-      }
-      if (command) {
+      // The mode's command, every period: whatever moved the servos since (a
+      // referee placing the robot holds its joints) does not last.
+      if (const auto command = modeCommand(r, gate)) {
         slot.answer = sim::Answer::Given;
         slot.command = *command;
       }
-      r.held_mode = r.loco.mode();
-      r.held_head = r.loco.headTarget();
       continue;
     }
-    r.held_mode.reset();  // leaving CUSTOM gives the mode's command again
-    if (!r.new_command) {
+    if (r.pending == 0) {
       if (config_.lockstep && r.ever_commanded && !r.unresponsive) {
         ++r.stats.missed;
         slot.answer = sim::Answer::Missed;
@@ -420,18 +393,62 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
       }
       continue;  // holds its last command, as the robot does
     }
-    r.new_command = false;
     r.missed_in_row = 0;
     r.unresponsive = false;
-    const auto command = gate.checkServo(r.config.robot, {r.q, r.dq, r.tau, r.kp, r.kd});
-    if (!command) {
-      ++r.stats.refused;
-      continue;
+    // The last command of the period that passes the gate drives.
+    std::optional<sim::RobotCommand> good;
+    for (size_t k = 0; k < r.pending; ++k) {
+      const auto& p = r.pending_pool[k];
+      auto command = gate.checkServo(r.config.robot, {p.q, p.dq, p.tau, p.kp, p.kd});
+      if (command)
+        good = std::move(command);
+      else
+        ++r.stats.refused;
     }
+    r.pending = 0;
+    if (!good) continue;
     ++r.stats.applied;
     slot.answer = sim::Answer::Given;
-    slot.command = *command;
+    slot.command = *good;
   }
+}
+
+std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGate& gate) const {
+  const robots::RobotModel& model = *world_.robot(r.config.robot).model;
+  const size_t n = r.actuators;
+  if (r.loco.mode() == RobotMode::Prepare) {
+    // Standing: the stand pose on the robot's own servos, the head where
+    // RotateHead turned it (clamped to the joints' limits).
+    std::array<float, world::kActuators> position{}, stiffness{};
+    for (size_t a = 0; a < n; ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind != robots::Actuator::Kind::Joint) continue;
+      const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+      double target = (*r.stand)[static_cast<size_t>(act.index)];
+      if (const auto& head = r.loco.headTarget()) {
+        if (act.name == "HeadYaw") target = head->yaw;
+        if (act.name == "HeadPitch") target = head->pitch;
+      }
+      position[a] = static_cast<float>(std::clamp(target, joint.lower, joint.upper));
+      stiffness[a] = 1.0f;
+    }
+    return gate.check(r.config.robot, std::span<const float>(position),
+                      std::span<const float>(stiffness));
+  }
+  // Damping: every joint limp but damped by its motor's kd (kp 0: the
+  // position is the joint's own, inside its limits).
+  std::array<float, world::kActuators> zero{}, position{}, kd{};
+  const world::SensorFrame& f = world_.sensorFrame(r.config.robot);
+  for (size_t a = 0; a < n; ++a) {
+    const auto& act = model.actuators[a];
+    if (act.kind != robots::Actuator::Kind::Joint) continue;
+    const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+    position[a] = static_cast<float>(std::clamp<double>(f.position[a], joint.lower, joint.upper));
+    kd[a] = static_cast<float>(model.body->motors[static_cast<size_t>(joint.motor)].kd);
+  }
+  const std::span<const float> z = std::span<const float>(zero).first(n);
+  return gate.checkServo(r.config.robot, {std::span<const float>(position).first(n), z, z, z,
+                                          std::span<const float>(kd).first(n)});
 }
 
 }  // namespace simsoccer::booster

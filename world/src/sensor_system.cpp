@@ -102,6 +102,13 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
                                 "foot pressure sensors come in eights (LFsrFL ... RFsrRR), found " +
                                     std::to_string(fsrs_found));
     r.has_feet = fsrs_found == 8;
+    if (!r.has_feet)
+      for (const char* side : feet)
+        for (const char* which : {"FootBumperLeft", "FootBumperRight"})
+          if (model.sensor(std::string(side) + which))
+            throw engine::ConfigError(model.source_file, "sensors",
+                                      std::string("a toe bumper (") + side + which +
+                                          ") needs the foot's pressure sensors (its sole frame)");
     for (int f = 0; f < 2 && r.has_feet; ++f) {
       Foot& foot = r.feet[static_cast<size_t>(f)];
       for (int c = 0; c < 4; ++c) {
@@ -116,6 +123,10 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
       foot.sole_z = foot.fsr[0].z();
       const robots::SensorFrame* left = model.sensor(std::string(feet[f]) + "FootBumperLeft");
       const robots::SensorFrame* right = model.sensor(std::string(feet[f]) + "FootBumperRight");
+      if ((left == nullptr) != (right == nullptr))
+        throw engine::ConfigError(model.source_file, "sensors",
+                                  std::string("toe bumpers come in pairs (") + feet[f] +
+                                      "FootBumperLeft, " + feet[f] + "FootBumperRight)");
       foot.has_bumpers = left && right;
       if (foot.has_bumpers) {
         foot.bumper[0] = left->pose.translation();

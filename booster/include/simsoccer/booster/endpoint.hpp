@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -70,9 +71,10 @@ struct RobotBoosterStats {
   uint64_t states_sent = 0;       // LowState_ samples
   uint64_t commands = 0;          // LowCmd_ samples received
   uint64_t applied = 0;           // periods a LowCmd drove the robot (CUSTOM)
-  uint64_t ignored = 0;           // LowCmds outside CUSTOM mode
-  uint64_t refused = 0;           // LowCmds refused (size, NaN, range, PARALLEL)
+  uint64_t ignored = 0;           // well-formed LowCmds outside CUSTOM mode
+  uint64_t refused = 0;           // LowCmds refused (size, PARALLEL; NaN, range: the gate)
   uint64_t missed = 0;            // lockstep periods without a LowCmd in time
+  uint64_t late = 0;              // lockstep: LowCmds that came after their period (dropped)
   uint64_t requests = 0, requests_refused = 0, requests_malformed = 0;
   uint64_t images = 0;            // camera images published
 };
@@ -80,8 +82,9 @@ struct RobotBoosterStats {
 class Endpoint : public sim::CommandSource {
  public:
   // Joins every robot's domain. Throws std::invalid_argument for a robot
-  // index out of range or served twice, two robots on one domain, or a robot
-  // model without a stand pose; net::DdsError if DDS fails.
+  // index out of range or served twice, or two robots on one domain,
+  // std::out_of_range for a robot model without a stand pose, net::DdsError
+  // if DDS fails.
   Endpoint(const world::World& world, EndpointConfig config);
   ~Endpoint() override;
   Endpoint(const Endpoint&) = delete;
@@ -97,16 +100,19 @@ class Endpoint : public sim::CommandSource {
   const EndpointConfig& config() const { return config_; }
   // Per robot of the config, in its order.
   RobotBoosterStats stats(std::size_t i) const;
-  // Whether robot i's client has a LowCmd reader matched (the client is there).
+  // Whether robot i's rt/low_state has a reader matched (a client is there).
   bool clientConnected(std::size_t i) const;
 
  private:
   struct Robot;
   void answerRequests(Robot& r);
   void publishImage(const world::CameraImage& image);
+  // The command of robot r's mode outside CUSTOM (prepare: stand, damping).
+  std::optional<sim::RobotCommand> modeCommand(Robot& r, sim::CommandGate& gate) const;
   const world::World& world_;
   EndpointConfig config_;
   std::vector<std::unique_ptr<Robot>> robots_;
+  int32_t waitset_ = 0;  // a DDS waitset on every robot's commands (lockstep)
 };
 
 }  // namespace simsoccer::booster
