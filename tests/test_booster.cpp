@@ -333,3 +333,57 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
               ns.c_str(), (unsigned long long)endpoint.stats(0).states_sent,
               (unsigned long long)endpoint.stats(0).applied, seen);
 }
+
+// The modes act on the robot: DAMPING lets it fall (joints limp, damped);
+// PREPARE stands it again once placed back, and holds the stand pose every
+// period, whatever moved its servos meanwhile.
+TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
+  world::World w(k1Scenario());
+  sim::Simulation simulation(w, sim::SimulationConfig{});
+  booster::EndpointConfig ec;
+  ec.robots = {served(0, 178)};
+  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+  booster::Endpoint endpoint(w, ec);
+  simulation.addSource(endpoint);
+  net::DomainConfig dds;
+  dds.domain = 178;
+  dds.config_file = ec.dds_config;
+  net::Participant client(dds);
+  net::QosSpec reliable;
+  reliable.depth = 10;
+  net::Writer<booster_msgs_msg_dds__RpcReqMsg_> request(
+      client, booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", reliable);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery
+  auto changeMode = [&](int mode) {
+    const std::string header = R"({"api_id": 2000, "expect_response": false})";
+    const std::string body = json{{"mode", mode}}.dump();
+    booster_msgs_msg_dds__RpcReqMsg_ req{};
+    req.uuid = const_cast<char*>("test");
+    req.header = const_cast<char*>(header.c_str());
+    req.body = const_cast<char*>(body.c_str());
+    request.write(req);
+    for (int i = 0; i < 100 && endpoint.stats(0).mode != static_cast<booster::RobotMode>(mode);
+         ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      simulation.period();
+    }
+    ASSERT_EQ(endpoint.stats(0).mode, static_cast<booster::RobotMode>(mode));
+  };
+  auto run = [&](double seconds) {
+    for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i) simulation.period();
+  };
+  run(1.0);
+  EXPECT_TRUE(w.isStanding(0));
+  changeMode(0);  // damping
+  run(3.0);
+  EXPECT_FALSE(w.isStanding(0));
+  changeMode(1);  // prepare: stiff again, but lying; the referee's hands put it back
+  w.placeRobot(0, -3.0, 0.0, 0.0, "stand");
+  // A placement holds the joints itself; the mode's command follows each period.
+  w.setJointTarget(0, w.robot(0).model->body->jointIndex("HeadYaw"), 0.8, 1.0);
+  run(3.0);
+  EXPECT_TRUE(w.isStanding(0));
+  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body,
+                                        w.robot(0).model->body->jointIndex("HeadYaw")),
+              0.0, 0.02);
+}
