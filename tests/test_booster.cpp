@@ -3,9 +3,6 @@
 // simulated K1 on its own domain, its modes by RPC, CUSTOM-mode joint
 // commands with their own gains in lockstep, bad commands refused.
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -19,52 +16,27 @@
 #include "booster_sdk.h"
 #include "simsoccer/booster/endpoint.hpp"
 #include "simsoccer/net/dds.hpp"
+#include "child_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "test_support.hpp"
-
-extern char** environ;
 
 using namespace simsoccer;
 using nlohmann::json;
 
 namespace {
 
-// The test client as a process, its standard output in a file.
+// A test client as a process, its standard output (one JSON line) in a file.
 struct ClientProcess {
-  pid_t pid = -1;
   std::filesystem::path out;
+  test::ChildProcess process;
   // `environment`: NAME=VALUE entries added to this process's.
-  ClientProcess(std::vector<std::string> args, std::vector<std::string> environment = {}) {
-    out = std::filesystem::temp_directory_path() /
-          ("simsoccer_booster_client_" + std::to_string(getpid()) + ".json");
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::vector<char*> envp;
-    for (char** e = environ; *e; ++e) envp.push_back(*e);
-    for (auto& e : environment) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
+  explicit ClientProcess(std::vector<std::string> args, std::vector<std::string> environment = {})
+      : out(std::filesystem::temp_directory_path() /
+            ("simsoccer_booster_client_" + std::to_string(getpid()) + ".json")),
+        process(std::move(args), std::move(environment), out) {}
   ~ClientProcess() {
-    if (pid > 0) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
+    process.kill();
     std::filesystem::remove(out);
-  }
-  // Exit status once it ended (-1 while it runs).
-  int ended() {
-    int status = 0;
-    if (pid > 0 && waitpid(pid, &status, WNOHANG) == pid) {
-      pid = -1;
-      return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-    }
-    return -1;
   }
   json result() const {
     std::ifstream f(out);
@@ -87,6 +59,30 @@ world::Scenario k1Scenario() {
   return s;
 }
 
+// One K1 served to SDK clients: its world, the simulation (lockstep or not)
+// and the endpoint, with the project's loopback DDS configuration.
+struct ServedK1 {
+  world::World w;
+  sim::Simulation simulation;
+  booster::Endpoint endpoint;
+  ServedK1(const booster::BoosterRobot& robot, bool lockstep)
+      : w(k1Scenario()),
+        simulation(w, [&] {
+          sim::SimulationConfig c;
+          c.lockstep = lockstep;
+          return c;
+        }()),
+        endpoint(w, [&] {
+          booster::EndpointConfig c;
+          c.robots = {robot};
+          c.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
+          c.lockstep = lockstep;
+          return c;
+        }()) {
+    simulation.addSource(endpoint);
+  }
+};
+
 // Runs periods until the client process ends (60 s at most); until the
 // client commands (CUSTOM) nothing waits, so the loop paces itself at about
 // twice real time. Returns the client's exit status.
@@ -94,7 +90,7 @@ int runUntilTheClientEnds(sim::Simulation& simulation, const booster::Endpoint& 
                           ClientProcess& client) {
   int status = -1;
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while ((status = client.ended()) < 0 && std::chrono::steady_clock::now() < end) {
+  while ((status = client.process.exitStatus(0)) < 0 && std::chrono::steady_clock::now() < end) {
     simulation.period();
     if (endpoint.stats(0).applied == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
@@ -104,23 +100,14 @@ int runUntilTheClientEnds(sim::Simulation& simulation, const booster::Endpoint& 
 }  // namespace
 
 TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
-  world::World w(k1Scenario());
-  sim::SimulationConfig sc;
-  sc.lockstep = true;
-  sim::Simulation simulation(w, sc);
-  booster::EndpointConfig ec;
-  ec.robots = {served(0, 170)};
-  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  ec.lockstep = true;
-  ec.answer_timeout = 0.5;
-  booster::Endpoint endpoint(w, ec);
-  simulation.addSource(endpoint);
+  ServedK1 k1(served(0, 170), /*lockstep=*/true);
+  auto& [w, simulation, endpoint] = k1;
 
   const int periods = 300;
   ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "170", "--dds-config",
                         (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
                         std::to_string(periods)});
-  ASSERT_GT(client.pid, 0);
+  ASSERT_TRUE(client.process.started());
   const int status = runUntilTheClientEnds(simulation, endpoint, client);
   const json r = client.result();
   std::printf("client: %s\n", r.dump().c_str());
@@ -177,22 +164,14 @@ TEST(BoosterEndpoint, OneRobotPerDomain) {
 // "booster_dds" from configs/dds/booster_fastdds.xml, as a team process on
 // this machine would use it, against the Cyclone endpoint.
 TEST(BoosterEndpoint, AFastDdsClientWithTheShippedProfileDrivesAK1) {
-  world::World w(k1Scenario());
-  sim::SimulationConfig sc;
-  sc.lockstep = true;
-  sim::Simulation simulation(w, sc);
-  booster::EndpointConfig ec;
-  ec.robots = {served(0, 173)};
-  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  ec.lockstep = true;
-  booster::Endpoint endpoint(w, ec);
-  simulation.addSource(endpoint);
+  ServedK1 k1(served(0, 173), /*lockstep=*/true);
+  auto& [w, simulation, endpoint] = k1;
   const int periods = 200;
   ClientProcess client(
       {SIMSOCCER_BOOSTER_FASTDDS_CLIENT, "--domain", "173", "--periods", std::to_string(periods)},
       {"FASTRTPS_DEFAULT_PROFILES_FILE=" +
        (test::sourceDir() / "configs/dds/booster_fastdds.xml").string()});
-  ASSERT_GT(client.pid, 0);
+  ASSERT_TRUE(client.process.started());
   const int status = runUntilTheClientEnds(simulation, endpoint, client);
   const json r = client.result();
   std::printf("Fast DDS client: %s\n", r.dump().c_str());
@@ -290,23 +269,15 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
     ~Namespace() { std::system((ip + " netns delete " + name + " 2>/dev/null").c_str()); }
   } scope(ip, ns);
 
-  world::World w(k1Scenario());
-  sim::SimulationConfig sc;
-  sc.lockstep = true;
-  sim::Simulation simulation(w, sc);
-  booster::EndpointConfig ec;
   booster::BoosterRobot robot = served(0, 177);
   robot.network_namespace = ns;
-  ec.robots = {robot};
-  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  ec.lockstep = true;
-  booster::Endpoint endpoint(w, ec);
-  simulation.addSource(endpoint);
+  ServedK1 k1(robot, /*lockstep=*/true);
+  auto& [w, simulation, endpoint] = k1;
 
   // Outside the namespace, domain 0 has no robot.
   net::DomainConfig host;
   host.domain = 0;
-  host.config_file = ec.dds_config;
+  host.config_file = test::sourceDir() / "configs/dds/loopback.xml";
   net::Participant outside(host);
   net::QosSpec q;
   q.reliable = false;
@@ -318,7 +289,7 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
   ClientProcess client({ip, "netns", "exec", ns, SIMSOCCER_BOOSTER_CLIENT, "--domain", "0",
                         "--dds-config", (test::sourceDir() / "configs/dds/loopback.xml").string(),
                         "--periods", std::to_string(periods)});
-  ASSERT_GT(client.pid, 0);
+  ASSERT_TRUE(client.process.started());
   const int status = runUntilTheClientEnds(simulation, endpoint, client);
   const json r = client.result();
   ASSERT_EQ(status, 0) << r.dump();
@@ -338,16 +309,11 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
 // PREPARE stands it again once placed back, and holds the stand pose every
 // period, whatever moved its servos meanwhile.
 TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
-  world::World w(k1Scenario());
-  sim::Simulation simulation(w, sim::SimulationConfig{});
-  booster::EndpointConfig ec;
-  ec.robots = {served(0, 178)};
-  ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  booster::Endpoint endpoint(w, ec);
-  simulation.addSource(endpoint);
+  ServedK1 k1(served(0, 178), /*lockstep=*/false);
+  auto& [w, simulation, endpoint] = k1;
   net::DomainConfig dds;
   dds.domain = 178;
-  dds.config_file = ec.dds_config;
+  dds.config_file = test::sourceDir() / "configs/dds/loopback.xml";
   net::Participant client(dds);
   net::QosSpec reliable;
   reliable.depth = 10;

@@ -1,5 +1,6 @@
 #include "booster_robots.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -7,6 +8,16 @@
 #include "simsoccer/lola/field_network.hpp"
 
 namespace simsoccer::apps {
+
+std::pair<int, int> parseTeamPlayer(const std::string& item, const std::string& option) {
+  int team = -1, player = -1;
+  char rest = 0;
+  if (std::sscanf(item.c_str(), "%d:%d%c", &team, &player, &rest) != 2 || team < 0 || team > 1 ||
+      player < 1 || player > 99)
+    throw UsageError(option + ": '" + item +
+                     "' is not T:P (the scenario's team 0 or 1, a player number 1..99)");
+  return {team, player};
+}
 
 std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World& w) {
   std::vector<world::RobotId> out;
@@ -16,33 +27,20 @@ std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World
     for (world::RobotId r = 0; r < w.robotCount(); ++r) out.push_back(r);
     return out;
   }
-  size_t start = 0;
-  while (start <= spec.size()) {
-    const size_t comma = spec.find(',', start);
-    const std::string item = spec.substr(start, comma == std::string::npos ? spec.npos : comma - start);
-    const size_t colon = item.find(':');
-    int team = -1, number = -1;
-    try {
-      if (colon == std::string::npos) throw std::invalid_argument(item);
-      size_t used = 0;
-      team = std::stoi(item.substr(0, colon), &used);
-      if (used != colon) throw std::invalid_argument(item);
-      number = std::stoi(item.substr(colon + 1), &used);
-      if (used != item.size() - colon - 1) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--booster: '" + item + "' is not T:P (team 0 or 1, player number) or all");
-    }
+  for (size_t at = 0; at <= spec.size();) {
+    const size_t end = std::min(spec.find(',', at), spec.size());
+    const std::string item = spec.substr(at, end - at);
+    at = end + 1;
+    const auto [team, player] = parseTeamPlayer(item, "--booster");
     bool found = false;
     for (world::RobotId r = 0; r < w.robotCount(); ++r)
-      if (w.robot(r).team == team && w.robot(r).number == number) {
+      if (w.robot(r).team == team && w.robot(r).number == player) {
         for (world::RobotId seen : out)
           if (seen == r) throw UsageError("--booster: " + item + " is named twice");
         out.push_back(r);
         found = true;
       }
     if (!found) throw UsageError("--booster: the scenario has no robot " + item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
   }
   return out;
 }

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -13,6 +14,10 @@
 #include "simsoccer/sim/simulation.hpp"
 
 namespace simsoccer::apps {
+
+// "T:P": the scenario's team (0, 1) and a player number; throws UsageError
+// naming `option`.
+std::pair<int, int> parseTeamPlayer(const std::string& item, const std::string& option);
 
 // The robots --booster names (empty without the option): "all", or T:P with
 // T the scenario's team (0, 1) and P the player number.

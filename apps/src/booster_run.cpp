@@ -43,20 +43,7 @@ int boosterRun(int argc, char** argv, int first) {
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   const std::string robot = opt.get("robot", "");
-  const size_t colon = robot.find(':');
-  int team = -1, player = -1;
-  try {
-    size_t used = 0;
-    if (colon == std::string::npos) throw std::invalid_argument(robot);
-    team = std::stoi(robot.substr(0, colon), &used);
-    if (used != colon) throw std::invalid_argument(robot);
-    player = std::stoi(robot.substr(colon + 1), &used);
-    if (used != robot.size() - colon - 1) throw std::invalid_argument(robot);
-  } catch (const std::exception&) {
-    throw UsageError("--robot: '" + robot + "' is not T:P (team 0 or 1, player number)");
-  }
-  if (team < 0 || team > 1 || player < 1 || player > 99)
-    throw UsageError("--robot: team 0 or 1, player 1..99");
+  const auto [team, player] = parseTeamPlayer(robot, "--robot");
   const std::string name = boosterNamespace(team, player);
   const std::string path = "/run/netns/" + name;
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
