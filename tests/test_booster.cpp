@@ -2,7 +2,12 @@
 // process (tests/booster_test_client.cpp), on real DDS over loopback: a
 // simulated K1 on its own domain, its modes by RPC, CUSTOM-mode joint
 // commands with their own gains in lockstep, bad commands refused.
+#include <arpa/inet.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sched.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +20,8 @@
 
 #include "booster_sdk.h"
 #include "simsoccer/booster/endpoint.hpp"
+#include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/net/dds.hpp"
 #include "child_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
@@ -45,6 +52,14 @@ struct ClientProcess {
     return line.empty() ? json() : json::parse(line);
   }
 };
+
+// A participant's configuration on `domain` with the project's loopback DDS.
+net::DomainConfig loopback(uint32_t domain) {
+  net::DomainConfig c;
+  c.domain = domain;
+  c.config_file = test::sourceDir() / "configs/dds/loopback.xml";
+  return c;
+}
 
 booster::BoosterRobot served(world::RobotId robot, uint32_t domain) {
   booster::BoosterRobot b;
@@ -212,10 +227,7 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
     if (image.camera == world::CameraId::Top) rendered[image.tick] = image.data;
   });
   // A ROS 2 subscriber's reader: best effort, as image subscribers usually are.
-  net::DomainConfig dds;
-  dds.domain = 176;
-  dds.config_file = ec.dds_config;
-  net::Participant participant(dds);
+  net::Participant participant(loopback(176));
   net::QosSpec q;
   q.reliable = false;
   q.depth = 64;
@@ -275,10 +287,7 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
   auto& [w, simulation, endpoint] = k1;
 
   // Outside the namespace, domain 0 has no robot.
-  net::DomainConfig host;
-  host.domain = 0;
-  host.config_file = test::sourceDir() / "configs/dds/loopback.xml";
-  net::Participant outside(host);
+  net::Participant outside(loopback(0));
   net::QosSpec q;
   q.reliable = false;
   q.depth = 8;
@@ -311,10 +320,7 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
 TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
   ServedK1 k1(served(0, 178), /*lockstep=*/false);
   auto& [w, simulation, endpoint] = k1;
-  net::DomainConfig dds;
-  dds.domain = 178;
-  dds.config_file = test::sourceDir() / "configs/dds/loopback.xml";
-  net::Participant client(dds);
+  net::Participant client(loopback(178));
   net::QosSpec reliable;
   reliable.depth = 10;
   net::Writer<booster_msgs_msg_dds__RpcReqMsg_> request(
@@ -352,4 +358,71 @@ TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
   EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body,
                                         w.robot(0).model->body->jointIndex("HeadYaw")),
               0.0, 0.02);
+}
+
+// With the field network (`serve --booster-netns`): the robot's namespace sits
+// on a bridge at PREFIX.T.P; the GameController's broadcast reaches a program
+// in it, while its DDS stays on the namespace's loopback as domain 0. Root.
+TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespace) {
+  if (::geteuid() != 0 || ::access("/usr/sbin/ip", X_OK) != 0)
+    GTEST_SKIP() << "needs root and iproute2";
+  lola::FieldNetwork net;
+  net.bridge = "sbt" + std::to_string(::getpid() % 100000);  // beside other runs' bridges
+  net.prefix = "10.79";
+  net.link_prefix = "sbt";
+  lola::FieldBridge bridge(net);
+  lola::RobotNamespace ns(net, 3, 1);
+  booster::BoosterRobot robot = served(0, 179);
+  robot.network_namespace = ns.name();
+  ServedK1 k1(robot, /*lockstep=*/true);
+
+  // A program in the namespace listening on the GameController's port.
+  std::string received;
+  std::thread listener([&] {
+    const int fd = ::open(("/run/netns/" + ns.name()).c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || ::setns(fd, CLONE_NEWNET) != 0) return;
+    ::close(fd);
+    const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    const int one = 1;
+    ::setsockopt(s, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    sockaddr_in any{};
+    any.sin_family = AF_INET;
+    any.sin_port = htons(3838);
+    ::bind(s, reinterpret_cast<const sockaddr*>(&any), sizeof any);
+    timeval wait{3, 0};
+    ::setsockopt(s, SOL_SOCKET, SO_RCVTIMEO, &wait, sizeof wait);
+    char buffer[512];
+    const ssize_t n = ::recv(s, buffer, sizeof buffer, 0);
+    if (n > 0) received.assign(buffer, static_cast<size_t>(n));
+    ::close(s);
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs/rules/hsl_middle_foundation.yaml");
+  referee::Game game(rules, {referee::TeamSetup{3, 0, 2, 1}, referee::TeamSetup{4, 1, 3, 1}}, 0);
+  referee::GameControllerLinkConfig gc;
+  gc.address = net.broadcast();
+  gc.return_bind = net.hostAddress();
+  gc.return_port = 0;
+  referee::GameControllerLink link(gc);
+  for (int i = 0; i < 10 && received.empty(); ++i) {
+    link.update(game);
+    game.advance(0.5);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  listener.join();
+  ASSERT_GE(received.size(), 8u);
+  EXPECT_EQ(received.substr(0, 4), "RGme");
+  EXPECT_EQ(static_cast<uint8_t>(received[4]), 19);  // the HSL's version
+
+  ClientProcess client({"/usr/sbin/ip", "netns", "exec", ns.name(), SIMSOCCER_BOOSTER_CLIENT,
+                        "--domain", "0", "--dds-config",
+                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
+                        "150"});
+  ASSERT_TRUE(client.process.started());
+  const int status = runUntilTheClientEnds(k1.simulation, k1.endpoint, client);
+  ASSERT_EQ(status, 0) << client.result().dump();
+  EXPECT_NEAR(client.result().at("head_yaw").get<double>(), 0.4, 0.03);
+  std::printf("%s at %s: a %zu-byte RGme v19 packet; the client drove its robot on domain 0\n",
+              ns.name().c_str(), ns.address().c_str(), received.size());
 }

@@ -5,21 +5,12 @@
 #include <stdexcept>
 #include <string>
 
-#include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/match/match_session.hpp"
 
 namespace simsoccer::apps {
 
-std::pair<int, int> parseTeamPlayer(const std::string& item, const std::string& option) {
-  int team = -1, player = -1;
-  char rest = 0;
-  if (std::sscanf(item.c_str(), "%d:%d%c", &team, &player, &rest) != 2 || team < 0 || team > 1 ||
-      player < 1 || player > 99)
-    throw UsageError(option + ": '" + item +
-                     "' is not T:P (the scenario's team 0 or 1, a player number 1..99)");
-  return {team, player};
-}
-
-std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World& w) {
+std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World& w,
+                                          const std::array<int, 2>& team_numbers) {
   std::vector<world::RobotId> out;
   if (!opt.has("booster")) return out;
   const std::string spec = opt.get("booster", "");
@@ -27,47 +18,64 @@ std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World
     for (world::RobotId r = 0; r < w.robotCount(); ++r) out.push_back(r);
     return out;
   }
-  for (size_t at = 0; at <= spec.size();) {
-    const size_t end = std::min(spec.find(',', at), spec.size());
-    const std::string item = spec.substr(at, end - at);
-    at = end + 1;
-    const auto [team, player] = parseTeamPlayer(item, "--booster");
+  std::vector<match::LolaPlayer> players;
+  try {
+    players = match::parseLolaPlayers(spec);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--booster: ") + e.what());
+  }
+  for (const match::LolaPlayer& p : players) {
+    const std::string item = std::to_string(p.team_number) + ":" + std::to_string(p.player);
     bool found = false;
-    for (world::RobotId r = 0; r < w.robotCount(); ++r)
-      if (w.robot(r).team == team && w.robot(r).number == player) {
-        for (world::RobotId seen : out)
-          if (seen == r) throw UsageError("--booster: " + item + " is named twice");
-        out.push_back(r);
-        found = true;
-      }
-    if (!found) throw UsageError("--booster: the scenario has no robot " + item);
+    for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+      const auto& info = w.robot(r);
+      if (info.team < 0 || info.team > 1 ||
+          team_numbers[static_cast<size_t>(info.team)] != p.team_number || info.number != p.player)
+        continue;
+      for (world::RobotId seen : out)
+        if (seen == r) throw UsageError("--booster: " + item + " is named twice");
+      out.push_back(r);
+      found = true;
+    }
+    if (!found)
+      throw UsageError("--booster: no robot " + item + " (team numbers " +
+                       std::to_string(team_numbers[0]) + " and " +
+                       std::to_string(team_numbers[1]) + ")");
   }
   return out;
 }
 
-std::string boosterNamespace(int team, int player) {
-  return "simsoccer-booster-" + std::to_string(team) + "-" + std::to_string(player);
+lola::FieldNetwork boosterFieldNetwork() {
+  lola::FieldNetwork net;
+  net.bridge = "simsoccerk0";  // beside a LoLA match's simsoccer0
+  net.prefix = "10.78";
+  net.link_prefix = "sk";
+  return net;
 }
 
 BoosterRobots::~BoosterRobots() {
-  endpoint.reset();  // its sockets first
-  for (const std::string& name : namespaces) {
-    try {
-      lola::runTool({"ip", "netns", "delete", name});
-    } catch (const std::runtime_error& e) {
-      std::fprintf(stderr, "%s\n", e.what());
-    }
-  }
+  endpoint.reset();  // its sockets first, then the namespaces, then the bridge
+  namespaces.clear();
+  bridge.reset();
 }
 
 std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world::World& w,
                                                  sim::Simulation& simulation,
                                                  const std::vector<world::RobotId>& robots,
                                                  const std::filesystem::path& dds_config,
-                                                 double answer_timeout) {
+                                                 double answer_timeout,
+                                                 const std::array<int, 2>& team_numbers) {
   if (robots.empty()) return nullptr;
   auto out = std::make_unique<BoosterRobots>();
   const bool netns = opt.flag("booster-netns");
+  const lola::FieldNetwork net = boosterFieldNetwork();
+  const auto teamNumber = [&](world::RobotId r) {
+    return team_numbers[static_cast<size_t>(std::clamp(w.robot(r).team, 0, 1))];
+  };
+  if (netns) {
+    for (world::RobotId r : robots) net.robotAddress(teamNumber(r), w.robot(r).number);  // throws
+    out->bridge = std::make_unique<lola::FieldBridge>(net);
+  }
   const auto base = static_cast<uint32_t>(opt.wholeNumber("booster-domain", 0, 0, 230));
   if (base + robots.size() - 1 > 230)
     throw UsageError("--booster-domain: " + std::to_string(robots.size()) +
@@ -83,15 +91,11 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
     b.robot = robots[i];
     b.domain = base + static_cast<uint32_t>(i);
     if (netns) {
-      // Its own namespace with only loopback (a killed run's is replaced).
-      b.network_namespace = boosterNamespace(w.robot(b.robot).team, w.robot(b.robot).number);
-      try {
-        lola::runTool({"ip", "netns", "delete", b.network_namespace});
-      } catch (const std::runtime_error&) {  // none there
-      }
-      lola::runTool({"ip", "netns", "add", b.network_namespace});
-      out->namespaces.push_back(b.network_namespace);
-      lola::runTool({"ip", "-n", b.network_namespace, "link", "set", "lo", "up"});
+      // Its own namespace on the field network (a killed run's is replaced);
+      // DDS stays on the namespace's loopback.
+      out->namespaces.push_back(std::make_unique<lola::RobotNamespace>(
+          net, teamNumber(b.robot), w.robot(b.robot).number));
+      b.network_namespace = out->namespaces.back()->name();
     }
     ec.robots.push_back(b);
   }
@@ -100,29 +104,31 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
   if (w.scenario().cameras.enabled) out->endpoint->attachCameras(simulation);
   for (const booster::BoosterRobot& b : ec.robots) {
     const auto& info = w.robot(b.robot);
+    out->names.push_back(std::to_string(teamNumber(b.robot)) + ":" + std::to_string(info.number));
     if (netns)
       std::printf(
-          "Booster SDK: team %d player %d (%s) as DDS domain 0 in network namespace %s: "
+          "Booster SDK: robot %d:%d (%s) as DDS domain 0 in network namespace %s at %s: "
           "simsoccer booster-run --robot %d:%d -- PROGRAM\n",
-          info.team, info.number, info.model->name.c_str(), b.network_namespace.c_str(),
-          info.team, info.number);
+          teamNumber(b.robot), info.number, info.model->name.c_str(),
+          b.network_namespace.c_str(), net.robotAddress(teamNumber(b.robot), info.number).c_str(),
+          teamNumber(b.robot), info.number);
     else
-      std::printf("Booster SDK: team %d player %d (%s) on DDS domain %u\n", info.team,
+      std::printf("Booster SDK: robot %d:%d (%s) on DDS domain %u\n", teamNumber(b.robot),
                   info.number, info.model->name.c_str(), b.domain);
   }
   return out;
 }
 
-void printBoosterStats(const BoosterRobots& robots, const world::World& w) {
+void printBoosterStats(const BoosterRobots& robots) {
   const booster::Endpoint& endpoint = *robots.endpoint;
   for (size_t i = 0; i < endpoint.config().robots.size(); ++i) {
     const booster::BoosterRobot& b = endpoint.config().robots[i];
     const booster::RobotBoosterStats s = endpoint.stats(i);
     std::printf(
-        "  Booster %d:%d (domain %u): mode %s, %llu states, %llu commands (%llu applied, %llu "
+        "  Booster %s (domain %u): mode %s, %llu states, %llu commands (%llu applied, %llu "
         "ignored, %llu refused, %llu missed), %llu requests (%llu refused, %llu malformed), "
         "%llu images\n",
-        w.robot(b.robot).team, w.robot(b.robot).number, b.domain, booster::modeName(s.mode),
+        robots.names[i].c_str(), b.domain, booster::modeName(s.mode),
         (unsigned long long)s.states_sent, (unsigned long long)s.commands,
         (unsigned long long)s.applied, (unsigned long long)s.ignored,
         (unsigned long long)s.refused, (unsigned long long)s.missed,

@@ -14,6 +14,7 @@
 
 #include "booster_robots.hpp"
 #include "cli.hpp"
+#include "simsoccer/match/match_session.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -22,9 +23,10 @@ const char* kHelp =
     "usage: simsoccer booster-run --robot T:P [--profile FILE] -- PROGRAM [ARGS...]\n"
     "\n"
     "Runs PROGRAM (a team's Booster SDK client, unmodified) in the network namespace where\n"
-    "`simsoccer serve SCENARIO --booster ... --booster-netns` serves robot T:P (the\n"
-    "scenario's team 0 or 1, player number) as DDS domain 0, so that several such programs,\n"
-    "each on domain 0, each drive their own robot. FASTRTPS_DEFAULT_PROFILES_FILE is set to\n"
+    "`simsoccer serve SCENARIO --booster ... --booster-netns` serves robot T:P (GameController\n"
+    "team number:player) as DDS domain 0, so that several such programs, each on domain 0,\n"
+    "each drive their own robot; the namespace is on the field network (10.78.T.P), where the\n"
+    "GameController's packets arrive. FASTRTPS_DEFAULT_PROFILES_FILE is set to\n"
     "FILE (default configs/dds/booster_fastdds.xml: the participant profile booster_dds on\n"
     "loopback) unless it is set already. Needs root (entering a network namespace); the\n"
     "program runs as this user, with this environment and file system. docs/booster.md.\n";
@@ -43,8 +45,15 @@ int boosterRun(int argc, char** argv, int first) {
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   const std::string robot = opt.get("robot", "");
-  const auto [team, player] = parseTeamPlayer(robot, "--robot");
-  const std::string name = boosterNamespace(team, player);
+  std::vector<match::LolaPlayer> players;
+  try {
+    players = match::parseLolaPlayers(robot);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--robot: ") + e.what());
+  }
+  if (players.size() != 1) throw UsageError("--robot: one robot T:P");
+  const std::string name =
+      boosterFieldNetwork().namespaceName(players[0].team_number, players[0].player);
   const std::string path = "/run/netns/" + name;
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)

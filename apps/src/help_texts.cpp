@@ -100,14 +100,15 @@ const char* const kServeHelp =
     "its packets arrive on UDP PORT (3838), the simulator follows them in real time and\n"
     "leaves 3939 to it; the automatic referee's calls are only reported.\n"
     "\n"
-    "--booster all|T:P,... (T: the scenario's team 0 or 1, P: player): these robots (Booster\n"
+    "--booster all|T:P,... (GameController team number:player, --teams): these robots (Booster\n"
     "K1s: configs/scenarios/k1_3v3.yaml) are served to Booster SDK clients, each on its own\n"
     "DDS domain from --booster-domain D (default 0) up: rt/low_state every control period,\n"
     "rt/joint_ctrl obeyed in CUSTOM mode, the locomotion RPC's modes (docs/booster.md). The\n"
     "run is paced to the wall clock; --booster-lockstep instead waits, each period, for the\n"
     "LowCmd of every robot in CUSTOM mode whose client commands (up to --timeout s).\n"
     "--booster-netns (root): each robot in a network namespace of its own, as domain 0 there\n"
-    "(unmodified team code joins domain 0); `simsoccer booster-run --robot T:P -- PROGRAM`\n"
-    "runs a team's program in it.\n";
+    "(unmodified team code joins domain 0), on a field network (10.78.T.P; GameController\n"
+    "packets to 10.78.255.255 with --rules or a match config); `simsoccer booster-run --robot\n"
+    "T:P -- PROGRAM` runs a team's program in it.\n";
 
 }  // namespace simsoccer::apps

@@ -7,6 +7,7 @@
 
 #include "booster_robots.hpp"
 #include "cli.hpp"
+#include "serve_report.hpp"
 #include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "simsoccer/engine/config.hpp"
@@ -27,25 +28,6 @@ void onSignal(int) {
 
 bool isMatchConfig(const std::filesystem::path& file) {
   return engine::ConfigNode::loadFile(file).has("match");
-}
-
-void printCounters(const world::World& w, const net::SimServer& server) {
-  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-    const auto& s = server.stats(r);
-    std::printf(
-        "  team %d player %d: %s, accepted %llu, rejected %llu, refused %llu, missed %llu\n",
-        w.robot(r).team, w.robot(r).number, s.owned ? "owned" : "free",
-        (unsigned long long)s.accepted, (unsigned long long)s.rejected,
-        (unsigned long long)s.refused, (unsigned long long)s.missed);
-  }
-}
-
-void printGame(const referee::Game& g) {
-  std::printf("game: %s, score %d:%d, %zu referee events\n", referee::stateName(g.state()),
-              g.score(0), g.score(1), g.events().size());
-  for (const auto& e : g.events())
-    std::printf("  %8.2f s  %-12s team %2d player %2d  %s\n", e.time, referee::eventName(e.type),
-                e.team, e.player, e.detail.c_str());
 }
 
 }  // namespace
@@ -120,8 +102,17 @@ int serve(int argc, char** argv, int first) {
   if (opt.has("gc-address") && !officials)
     throw UsageError("--gc-address needs --rules or a match config (the referee makes the packets)");
   world::World& w = session ? session->world() : *own_world;
+  // GameController team numbers of the scenario's teams 0 and 1.
+  std::array<int, 2> team_numbers{1, 2};
+  if (session) {
+    team_numbers = session->config().team_numbers;
+  } else if (opt.has("teams")) {
+    const std::vector<int> numbers = opt.intList("teams", {1, 2});
+    if (numbers.size() != 2) throw UsageError("--teams: two team numbers");
+    team_numbers = {numbers[0], numbers[1]};
+  }
   // Booster SDK clients run on the wall clock: real time unless --booster-lockstep.
-  const std::vector<world::RobotId> booster_robots = boosterRobots(opt, w);
+  const std::vector<world::RobotId> booster_robots = boosterRobots(opt, w, team_numbers);
   if (!booster_robots.empty() && !opt.flag("booster-lockstep")) cfg.lockstep = false;
 
   sim::SimulationConfig simc;
@@ -147,7 +138,7 @@ int serve(int argc, char** argv, int first) {
     for (world::RobotId l : cfg.not_served)
       if (r == l) throw UsageError("--booster and --lola name the same robot");
   const auto booster = openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file,
-                                         cfg.command_timeout);
+                                         cfg.command_timeout, team_numbers);
   cfg.not_served.insert(cfg.not_served.end(), booster_robots.begin(), booster_robots.end());
   net::SimServer server(simulation, cfg);
   // Images still on their way reach the transports (their sinks) before those
@@ -156,9 +147,13 @@ int serve(int argc, char** argv, int first) {
   std::unique_ptr<referee::GameControllerLink> gc_link;
   if (officials) {
     server.publishGameState(officials->controlData(), officials->leftTeam());  // before agents
-    if (opt.has("gc-address")) {
+    // On the Booster robots' field network the packets go to its broadcast
+    // address (unless --gc-address says otherwise), as a GameController's do.
+    const bool field = booster && booster->bridge && !external_gc;
+    if (opt.has("gc-address") || field) {
       referee::GameControllerLinkConfig gcfg;
-      gcfg.address = opt.get("gc-address", "");
+      gcfg.address = opt.get("gc-address", field ? booster->bridge->network().broadcast() : "");
+      if (field) gcfg.return_bind = booster->bridge->network().hostAddress();
       gcfg.control_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
       gcfg.return_port = static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
       gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
@@ -191,18 +186,9 @@ int serve(int argc, char** argv, int first) {
   simulation.flushCameras();
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), run.wall_s,
               w.time() / run.wall_s);
-  if (const world::CameraSystem* cams = simulation.cameras()) {
-    const world::CameraStats c = cams->stats();
-    std::printf(
-        "cameras (%s): %llu images in %llu batched frames, %.1f ms draw + %.1f ms readback + "
-        "%.1f ms conversion per frame, %llu captures dropped\n",
-        cams->glRenderer().c_str(), (unsigned long long)c.views, (unsigned long long)c.captures,
-        c.draw_ms / std::max<double>(1, c.captures),
-        c.readback_ms / std::max<double>(1, c.captures),
-        c.convert_ms / std::max<double>(1, c.captures), (unsigned long long)c.dropped);
-  }
+  printCameraStats(simulation);
   printCounters(w, server);
-  if (booster) printBoosterStats(*booster, w);
+  if (booster) printBoosterStats(*booster);
   for (const match::LolaResult& l : lola_robots ? lola_robots->results()
                                                  : std::vector<match::LolaResult>{})
     std::printf("  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
