@@ -22,6 +22,7 @@
 #include "simsoccer/booster/endpoint.hpp"
 #include "simsoccer/lola/field_network.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
+#include "simsoccer/sim/officials.hpp"
 #include "simsoccer/net/dds.hpp"
 #include "child_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
@@ -394,6 +395,14 @@ TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespac
     char buffer[512];
     const ssize_t n = ::recv(s, buffer, sizeof buffer, 0);
     if (n > 0) received.assign(buffer, static_cast<size_t>(n));
+    // Then a team message to its teammates, broadcast on the team port (10000 + 3).
+    ::setsockopt(s, SOL_SOCKET, SO_BROADCAST, &one, sizeof one);
+    sockaddr_in team{};
+    team.sin_family = AF_INET;
+    team.sin_port = htons(10003);
+    ::inet_pton(AF_INET, net.broadcast().c_str(), &team.sin_addr);
+    const char message[] = "team message";
+    ::sendto(s, message, sizeof message, 0, reinterpret_cast<const sockaddr*>(&team), sizeof team);
     ::close(s);
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -404,7 +413,9 @@ TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespac
   gc.address = net.broadcast();
   gc.return_bind = net.hostAddress();
   gc.return_port = 0;
+  gc.team_message_bind = net.broadcast();  // as serve --booster-netns has it
   referee::GameControllerLink link(gc);
+  const sim::FieldTeamMessages counted(link, game);
   for (int i = 0; i < 10 && received.empty(); ++i) {
     link.update(game);
     game.advance(0.5);
@@ -414,6 +425,13 @@ TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespac
   ASSERT_GE(received.size(), 8u);
   EXPECT_EQ(received.substr(0, 4), "RGme");
   EXPECT_EQ(static_cast<uint8_t>(received[4]), 19);  // the HSL's version
+  // The team message counts against team 3's budget, the officials' way.
+  for (int i = 0; i < 20 && counted.teamMessagesSent(0) == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    link.update(game);
+  }
+  EXPECT_EQ(counted.teamMessagesSent(0), 1u);
+  EXPECT_EQ(counted.teamMessagesSent(1), 0u);
 
   ClientProcess client({"/usr/sbin/ip", "netns", "exec", ns.name(), SIMSOCCER_BOOSTER_CLIENT,
                         "--domain", "0", "--dds-config",

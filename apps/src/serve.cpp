@@ -145,6 +145,7 @@ int serve(int argc, char** argv, int first) {
   // go, also when the run ends with an exception.
   const FlushCamerasOnExit flush_cameras{simulation};
   std::unique_ptr<referee::GameControllerLink> gc_link;
+  std::unique_ptr<sim::FieldTeamMessages> team_messages;
   if (officials) {
     server.publishGameState(officials->controlData(), officials->leftTeam());  // before agents
     // On the Booster robots' field network the packets go to its broadcast
@@ -153,11 +154,19 @@ int serve(int argc, char** argv, int first) {
     if (opt.has("gc-address") || field) {
       referee::GameControllerLinkConfig gcfg;
       gcfg.address = opt.get("gc-address", field ? booster->bridge->network().broadcast() : "");
-      if (field) gcfg.return_bind = booster->bridge->network().hostAddress();
+      if (field) {
+        gcfg.return_bind = booster->bridge->network().hostAddress();
+        gcfg.team_message_bind = booster->bridge->network().broadcast();
+      }
       gcfg.control_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
       gcfg.return_port = static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
       gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
       gc_link->update(officials->game());
+      // The programs' team messages count against each team's budget.
+      if (field) {
+        team_messages = std::make_unique<sim::FieldTeamMessages>(*gc_link, officials->game());
+        simulation.addSource(*team_messages);
+      }
     }
   }
 

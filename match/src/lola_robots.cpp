@@ -10,20 +10,6 @@ std::filesystem::path lolaSocketPath(const std::filesystem::path& out, const Lol
          ("robot_" + std::to_string(p.team_number) + "_" + std::to_string(p.player) + ".sock");
 }
 
-// The team messages the binaries broadcast on the field network, counted
-// against each team's budget like the DDS agents' (a command source without robots).
-struct LolaRobots::FieldTeamMessages : sim::CommandSource {
-  FieldTeamMessages(const referee::GameControllerLink& link, const MatchSession& session)
-      : link(link), session(session) {}
-  void observe(const sim::Observation&) override {}
-  void collect(uint64_t, sim::CommandGate&, std::span<sim::CommandSlot>) override {}
-  uint64_t teamMessagesSent(int team) const override {
-    return link.teamMessages(session.game().teamNumber(team));
-  }
-  const referee::GameControllerLink& link;
-  const MatchSession& session;
-};
-
 LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
                        const std::filesystem::path& out, bool lockstep,
                        const std::function<void(const std::string&)>& notice)
@@ -51,7 +37,8 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
       gc.team_message_bind = net.broadcast();
       link_ = std::make_unique<referee::GameControllerLink>(gc);
       link_->update(session.game());  // binds every port now, and sends the first packet
-      team_messages_ = std::make_unique<FieldTeamMessages>(*link_, session);
+      // The binaries' team messages count against each team's budget.
+      team_messages_ = std::make_unique<sim::FieldTeamMessages>(*link_, session.game());
     }
   }
   lola::EndpointConfig ec;

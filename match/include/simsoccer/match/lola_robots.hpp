@@ -49,13 +49,12 @@ class LolaRobots {
   std::optional<std::array<uint8_t, 9>> leds(world::RobotId r) const;
 
  private:
-  struct FieldTeamMessages;
   const MatchSession& session_;
   std::unique_ptr<lola::Endpoint> endpoint_;
   std::unique_ptr<lola::ImageStreams> images_;
   std::unique_ptr<lola::FieldBridge> bridge_;
   std::unique_ptr<referee::GameControllerLink> link_;
-  std::unique_ptr<FieldTeamMessages> team_messages_;
+  std::unique_ptr<sim::FieldTeamMessages> team_messages_;
 };
 
 // The session's LoLA robots, or null when it has none.

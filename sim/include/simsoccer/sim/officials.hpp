@@ -70,4 +70,23 @@ class GameOfficials : public Officials {
   double last_change_ = 0.0;  // game time of the external GameController's last new state
 };
 
+// The team messages robots broadcast on a field network, as a GameController
+// link counts them on the team ports, counted against each team's budget
+// like the DDS agents' (a command source without robots). The link and the
+// game must outlive it.
+class FieldTeamMessages : public CommandSource {
+ public:
+  FieldTeamMessages(const referee::GameControllerLink& link, const referee::Game& game)
+      : link_(link), game_(game) {}
+  void observe(const Observation&) override {}
+  void collect(uint64_t, CommandGate&, std::span<CommandSlot>) override {}
+  uint64_t teamMessagesSent(int team) const override {
+    return link_.teamMessages(game_.teamNumber(team));
+  }
+
+ private:
+  const referee::GameControllerLink& link_;
+  const referee::Game& game_;
+};
+
 }  // namespace simsoccer::sim
