@@ -214,12 +214,18 @@ int main(int argc, char** argv) {
   auto call = [&](int api, const json& body) {
     Rpc req{"fastdds-" + std::to_string(++serial),
             json{{"api_id", api}, {"expect_response", true}}.dump(), body.dump()};
-    // Until the answer reader is matched the request could go nowhere: wait for the match.
+    // As the SDK's RPC client waits for the service: until both topics are
+    // matched (a request written before would go nowhere, and a volatile
+    // answer reader matched late would miss the answer).
     const auto end = Clock::now() + std::chrono::seconds(10);
-    PublicationMatchedStatus matched;
-    while (request->get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
-           matched.current_count == 0 && Clock::now() < end)
+    for (;;) {
+      PublicationMatchedStatus out;
+      SubscriptionMatchedStatus in;
+      request->get_publication_matched_status(out);
+      response->get_subscription_matched_status(in);
+      if ((out.current_count > 0 && in.current_count > 0) || Clock::now() >= end) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     request->write(&req);
     while (Clock::now() < end) {
       Rpc r;

@@ -55,8 +55,21 @@ dds_entity_t endpoint(bool reader, const dds_topic_descriptor_t* desc, const cha
 struct Rpc {
   dds_entity_t request, response;
   int serial = 0;
-  // Sends one request and waits up to 5 s for the answer with its uuid.
+  // Sends one request and waits up to 5 s for the answer with its uuid. As
+  // the SDK's RPC client waits for the service: first until both topics are
+  // matched (a request written before would go nowhere, and a volatile answer
+  // reader matched late would miss the answer).
   json call(const std::string& header, const std::string& body) {
+    const auto matched_by = Clock::now() + std::chrono::seconds(5);
+    for (;;) {
+      dds_publication_matched_status_t out{};
+      dds_subscription_matched_status_t in{};
+      dds_get_publication_matched_status(request, &out);
+      dds_get_subscription_matched_status(response, &in);
+      if (out.current_count > 0 && in.current_count > 0) break;
+      if (Clock::now() > matched_by) fail("the locomotion service is not there");
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     const std::string uuid = "test-" + std::to_string(++serial);
     booster_msgs_msg_dds__RpcReqMsg_ req{};
     req.uuid = const_cast<char*>(uuid.c_str());

@@ -234,7 +234,12 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   q.depth = 64;
   net::Reader<sensor_msgs_msg_dds__Image_> reader(participant, sensor_msgs_msg_dds__Image__desc,
                                                  "rt/StereoNetNode/rectified_image", q);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery
+  for (int i = 0; i < 500; ++i) {  // discovery: matched with the robot's image writer
+    dds_subscription_matched_status_t matched{};
+    dds_get_subscription_matched_status(reader.get(), &matched);
+    if (matched.current_count > 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   for (int i = 0; i < 40; ++i) {
     simulation.period();
     simulation.flushCameras();
@@ -326,7 +331,13 @@ TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
   reliable.depth = 10;
   net::Writer<booster_msgs_msg_dds__RpcReqMsg_> request(
       client, booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", reliable);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery
+  // Discovery: the service's request reader matched.
+  for (int i = 0; i < 500; ++i) {
+    dds_publication_matched_status_t matched{};
+    dds_get_publication_matched_status(request.get(), &matched);
+    if (matched.current_count > 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   auto changeMode = [&](int mode) {
     const std::string header = R"({"api_id": 2000, "expect_response": false})";
     const std::string body = json{{"mode", mode}}.dump();
