@@ -126,7 +126,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       throw std::invalid_argument("Booster endpoint: DDS domain " + std::to_string(b.domain) +
                                   " is beyond 230 (the RTPS port mapping)");
     const robots::RobotModel& model = *world.robot(b.robot).model;
-    model.pose("stand");  // throws if the model has none
+    const std::vector<double>& stand = model.pose("stand");  // throws if the model has none
     net::DomainConfig dds;
     dds.domain = b.domain;
     dds.config_file = config_.dds_config;
@@ -157,8 +157,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       }).join();
       if (failed) std::rethrow_exception(failed);
     }
-    r->stats.mode = r->loco.mode();
-    r->stand = &model.pose("stand");
+    r->stand = &stand;
     robots_.push_back(std::move(r));
   }
   // Lockstep waits on every robot's commands at once.
@@ -372,7 +371,6 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
   for (auto& rp : robots_) {
     Robot& r = *rp;
     sim::CommandSlot& slot = slots[r.config.robot];
-    r.stats.mode = r.loco.mode();
     if (r.loco.mode() != RobotMode::Custom) {
       r.stats.ignored += r.pending;
       r.pending = 0;

@@ -67,7 +67,7 @@ struct EndpointConfig {
 };
 
 struct RobotBoosterStats {
-  RobotMode mode = RobotMode::Prepare;
+  RobotMode mode = RobotMode::Prepare;  // the locomotion service's, when asked
   uint64_t states_sent = 0;       // LowState_ samples
   uint64_t commands = 0;          // LowCmd_ samples received
   uint64_t applied = 0;           // periods a LowCmd drove the robot (CUSTOM)
