@@ -110,6 +110,16 @@ TEST_F(ConfigErrors, UnknownLinkName) {
   expectError("robot.yaml", "joints[15].parent", "unknown link 'LThig'");
 }
 
+TEST_F(ConfigErrors, UnknownFootLink) {
+  replace(robot_, "legs: {left: LFoot, right: RFoot}", "legs: {left: LFot, right: RFoot}");
+  expectError("robot.yaml", "legs.left", "unknown foot link 'LFot'");
+}
+
+TEST_F(ConfigErrors, BothLegsOnOneFoot) {
+  replace(robot_, "legs: {left: LFoot, right: RFoot}", "legs: {left: LFoot, right: LFoot}");
+  expectError("robot.yaml", "legs.right", "the right foot is the left foot's link");
+}
+
 TEST_F(ConfigErrors, NonPositiveMass) {
   replace(robot_, "mass: 0.65973", "mass: 0");
   expectError("robot.yaml", "links[2].mass", "must be > 0");

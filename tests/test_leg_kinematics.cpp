@@ -1,9 +1,11 @@
 // Leg kinematics on the robot models' own data: forward kinematics against
-// the model's frames, inverse kinematics round trips, limits, the shared
-// HipYawPitch.
+// the model's frames, inverse kinematics round trips, limits, the Nao's shared
+// HipYawPitch, the Booster K1's independent legs in another joint order.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
+#include <tuple>
 
 #include "simsoccer/agents/motion/leg_kinematics.hpp"
 #include "test_support.hpp"
@@ -20,8 +22,10 @@ LegAngles randomLeg(const agents::LegKinematics& k, Leg leg, std::mt19937_64& rn
   for (int i = 0; i < 6; ++i) {
     // Inside the limits, knee bent (a standing or walking leg, not a folded one).
     double lo = k.lower(leg, i), hi = k.upper(leg, i);
-    if (i == 3) lo = std::max(lo, 0.2);
-    if (i == 0) lo = std::max(lo, -0.6), hi = std::min(hi, 0.2);
+    if (i == k.index(agents::LegJoint::Knee)) lo = std::max(lo, 0.2);
+    if (i == k.index(agents::LegJoint::HipYaw)) lo = std::max(lo, -0.6), hi = std::min(hi, 0.2);
+    // The K1's hip pitch reaches -3 rad (the thigh folded up): a walking leg's range.
+    if (i == k.index(agents::LegJoint::HipPitch)) lo = std::max(lo, -1.2), hi = std::min(hi, 0.5);
     q[i] = std::uniform_real_distribution<double>(lo + 0.02, hi - 0.02)(rng);
   }
   return q;
@@ -91,4 +95,55 @@ TEST(LegKinematics, UnreachableTargetsStayWithinLimits) {
     EXPECT_LE(s.left[i], k.upper(Leg::Left, i));
   }
   EXPECT_NEAR(s.left[3], 0.0, 0.1);  // the knee as straight as it goes
+}
+
+TEST(LegKinematics, TheBoosterK1sLegsInItsOwnJointOrderAndIndependent) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  const agents::LegKinematics k(model);
+  // The chain: hip pitch, roll, yaw, knee, ankle pitch, roll (the Nao: yaw-pitch, roll, pitch).
+  using agents::LegJoint;
+  EXPECT_EQ(k.index(LegJoint::HipPitch), 0);
+  EXPECT_EQ(k.index(LegJoint::HipRoll), 1);
+  EXPECT_EQ(k.index(LegJoint::HipYaw), 2);
+  EXPECT_EQ(k.index(LegJoint::Knee), 3);
+  EXPECT_EQ(k.index(LegJoint::AnklePitch), 4);
+  EXPECT_EQ(k.index(LegJoint::AnkleRoll), 5);
+  EXPECT_EQ(model.body->joints[static_cast<size_t>(k.joints(Leg::Left)[0])].name, "LeftHipPitch");
+  EXPECT_EQ(model.body->joints[static_cast<size_t>(k.joints(Leg::Right)[2])].name, "RightHipYaw");
+  EXPECT_EQ(k.footLink(Leg::Right), model.body->linkIndex("RightFoot"));
+  EXPECT_NEAR(k.soleDepth(), 0.038, 1e-9);  // the foot box's face
+  const agents::LegKinematics nao(robots::loadRobotModel(test::naoH25()));
+  EXPECT_EQ(nao.index(LegJoint::HipYaw), 0);
+  EXPECT_EQ(nao.index(LegJoint::HipPitch), 2);
+  // Forward against the model's frames; inverse round trips with the two hip yaws apart (a
+  // pair the Nao's one HipYawPitch motor could not reach).
+  std::mt19937_64 rng(5);
+  std::vector<double> q(model.body->joints.size(), 0.0);
+  double worst_position = 0, worst_orientation = 0, yaws_apart = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const LegAngles l = randomLeg(k, Leg::Left, rng), r = randomLeg(k, Leg::Right, rng);
+    for (int i = 0; i < 6; ++i) {
+      q[static_cast<size_t>(k.joints(Leg::Left)[i])] = l[i];
+      q[static_cast<size_t>(k.joints(Leg::Right)[i])] = r[i];
+    }
+    const auto frames = model.body->linkFramesAt(q);
+    const agents::Pose fl = k.forward(Leg::Left, l), fr = k.forward(Leg::Right, r);
+    EXPECT_TRUE(fl.isApprox(frames[static_cast<size_t>(k.footLink(Leg::Left))], 1e-12));
+    EXPECT_TRUE(fr.isApprox(frames[static_cast<size_t>(k.footLink(Leg::Right))], 1e-12));
+    const agents::LegSolution s = k.inverse(fl, fr);
+    for (const auto& [leg, a, target] :
+         {std::tuple{Leg::Left, s.left, fl}, std::tuple{Leg::Right, s.right, fr}}) {
+      const agents::Pose got = k.forward(leg, a);
+      worst_position = std::max(worst_position, (got.translation() - target.translation()).norm());
+      worst_orientation =
+          std::max(worst_orientation,
+                   Eigen::AngleAxisd(got.linear() * target.linear().transpose()).angle());
+    }
+    yaws_apart = std::max(yaws_apart, std::abs(s.left[2] - s.right[2]));
+  }
+  std::printf("booster_k1: 300 random foot pairs, worst position error %.2e m, orientation %.2e rad\n",
+              worst_position, worst_orientation);
+  EXPECT_LT(worst_position, 1e-4);
+  EXPECT_LT(worst_orientation, 1e-3);
+  EXPECT_GT(yaws_apart, 0.3);
 }

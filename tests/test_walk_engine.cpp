@@ -4,11 +4,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
 
+#include "simsoccer/agents/motion/gait.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/engine/config.hpp"
 #include "test_support.hpp"
 
 using namespace simsoccer;
@@ -294,4 +297,29 @@ TEST(WalkEngine, PlannedZmpAgainstTheSupportPolygon) {
     EXPECT_GT(m.zmp_mean, 0.0);
     EXPECT_LE(m.zmp_outside, m.ticks / 5);  // measured: 6, 107, 23 and 61 of 549-599 ticks
   }
+}
+
+TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
+  test::TempDir dir("gait");
+  EXPECT_EQ(agents::loadGaitIn(dir.path()).walk.step_period, agents::WalkParameters{}.step_period);
+  std::ofstream(dir.path() / "gait.yaml") << "walk: {step_period: 0.3, sway: 0.02}\nkick: {reach: 0.2}\n";
+  const agents::Gait g = agents::loadGaitIn(dir.path());
+  EXPECT_EQ(g.walk.step_period, 0.3);
+  EXPECT_EQ(g.walk.sway, 0.02);
+  EXPECT_EQ(g.walk.foot_lift, agents::WalkParameters{}.foot_lift);  // not named: the default
+  EXPECT_EQ(g.kick.reach, 0.2);
+  std::ofstream(dir.path() / "gait.yaml") << "walk: {step_perod: 0.3}\n";
+  try {
+    agents::loadGaitIn(dir.path());
+    ADD_FAILURE() << "an unknown parameter was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "walk.step_perod");
+    EXPECT_NE(std::string(e.what()).find("unknown parameter"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gait.yaml"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir.path() / "gait.yaml") << "walk: {step_period: -0.3}\n";
+  EXPECT_THROW(agents::loadGaitIn(dir.path()), engine::ConfigError);
+  // The Booster K1's gait in the repository loads.
+  EXPECT_GT(agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1").walk.step_width,
+            0.15);
 }

@@ -1,5 +1,7 @@
 #include "simsoccer/agents/soccer_agent.hpp"
 
+#include "simsoccer/agents/motion/gait.hpp"
+
 namespace simsoccer::agents {
 
 MotionController loadMotionController(const robots::RobotModel& model,
@@ -8,11 +10,12 @@ MotionController loadMotionController(const robots::RobotModel& model,
   const auto load = [&](const char* name) {
     return loadKeyframeMotion(motions_dir / (std::string(name) + ".yaml"), model);
   };
+  const Gait gait = loadGaitIn(motions_dir);
   return MotionController(
       model,
       KeyframeMotions{load("get_up_front"), load("get_up_back"), load("block"), load("dive_left"),
                       load("dive_right"), load("sit_down"), load("stand_up")},
-      WalkParameters{}, KickParameters{}, fall);
+      gait.walk, gait.kick, fall);
 }
 
 namespace {

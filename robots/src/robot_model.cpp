@@ -119,7 +119,7 @@ double RobotModel::soleDepth(const std::vector<double>& q) const {
 RobotModel loadRobotModel(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"robot", "material", "encoder", "imu", "sonar", "thermal", "motors", "links",
-                  "joints", "actuators", "absent_actuators", "hands", "sensors", "poses"});
+                  "joints", "actuators", "absent_actuators", "hands", "sensors", "poses", "legs"});
   RobotModel robot;
   robot.name = root["robot"].string();
   robot.source_file = file.string();
@@ -431,6 +431,24 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
       }
       robot.poses[pose_name] = q;
     }
+  }
+  // The legs: each foot link's chain of joints up to the trunk.
+  if (auto legs = root.optional("legs")) {
+    legs->allowOnly({"left", "right"});
+    for (size_t side = 0; side < 2; ++side) {
+      const ConfigNode n = (*legs)[side == 0 ? "left" : "right"];
+      LegChain& chain = robot.legs[side];
+      chain.foot_link = body->linkIndex(n.string());
+      if (chain.foot_link <= 0) n.fail("unknown foot link '" + n.string() + "' (or the trunk)");
+      // joints[i] moves link i + 1: walk up from the foot to the root.
+      for (int link = chain.foot_link; link > 0;) {
+        const int joint = link - 1;
+        chain.joints.insert(chain.joints.begin(), joint);
+        link = body->joints[static_cast<size_t>(joint)].parent_link;
+      }
+    }
+    if (robot.legs[0].foot_link == robot.legs[1].foot_link)
+      (*legs)["right"].fail("the right foot is the left foot's link");
   }
   robot.body = std::move(body);
   return robot;

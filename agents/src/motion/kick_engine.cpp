@@ -78,9 +78,10 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
   LegSolution out = s;
   // The support leg: hip roll against the sag, ankle against the torso's rotation.
   LegAngles& sq = foot_ == Leg::Left ? out.right : out.left;
-  sq[1] += (foot_ == Leg::Left ? -1.0 : 1.0) * p_.hip_roll_compensation * shift;
-  sq[4] += stance_.ankle_pitch_gyro * gyro.y();
-  sq[5] += stance_.ankle_roll_gyro * gyro.x();
+  const auto at = [&](LegJoint part) { return static_cast<size_t>(kinematics_.index(part)); };
+  sq[at(LegJoint::HipRoll)] += (foot_ == Leg::Left ? -1.0 : 1.0) * p_.hip_roll_compensation * shift;
+  sq[at(LegJoint::AnklePitch)] += stance_.ankle_pitch_gyro * gyro.y();
+  sq[at(LegJoint::AnkleRoll)] += stance_.ankle_roll_gyro * gyro.x();
   kinematics_.writeTargets(out, targets);
 }
 

@@ -9,42 +9,68 @@ namespace simsoccer::agents {
 
 namespace {
 
-constexpr const char* kJointNames[6] = {"HipYawPitch", "HipRoll",    "HipPitch",
-                                        "KneePitch",   "AnklePitch", "AnkleRoll"};
-
 // Orientation error as a rotation vector: the rotation taking `current` to `target`.
 Vec3 rotationError(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
   const Eigen::AngleAxisd aa(target * current.transpose());
   return aa.angle() * aa.axis();
 }
 
+// A joint's part from its axis at zero angles: along y a pitch, along x a roll, else the yaw.
+enum class AxisKind { Pitch, Roll, Yaw };
+AxisKind axisKind(const Vec3& axis) {
+  if (std::abs(axis.y()) > 0.9) return AxisKind::Pitch;
+  if (std::abs(axis.x()) > 0.9) return AxisKind::Roll;
+  return AxisKind::Yaw;
+}
+
 }  // namespace
 
 LegKinematics::LegKinematics(const robots::RobotModel& model) {
   const auto& body = *model.body;
-  for (int side = 0; side < 2; ++side) {
-    Chain& c = legs_[static_cast<size_t>(side)];
-    const std::string prefix = side == 0 ? "L" : "R";
-    for (int i = 0; i < 6; ++i) {
-      const std::string name = prefix + kJointNames[i];
-      const int j = body.jointIndex(name);
-      if (j < 0)
-        throw std::invalid_argument("leg kinematics: robot model " + model.name + " has no joint " +
-                                    name);
-      const engine::Joint& joint = body.joints[static_cast<size_t>(j)];
-      if (i > 0 && joint.parent_link != body.joints[static_cast<size_t>(c.joint[i - 1])].child_link)
-        throw std::invalid_argument("leg kinematics: " + name + " does not follow " + prefix +
-                                    kJointNames[i - 1]);
-      c.joint[i] = j;
+  const auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("leg kinematics: robot model " + model.name + " (" +
+                                model.source_file + "): " + why);
+  };
+  if (!model.hasLegs()) fail("no `legs` (each foot's link)");
+  for (size_t side = 0; side < 2; ++side) {
+    const robots::LegChain& leg = model.legs[side];
+    if (leg.joints.size() != 6)
+      fail(std::string(side == 0 ? "left" : "right") + " leg has " +
+           std::to_string(leg.joints.size()) + " joints from the trunk to the foot, not 6");
+    Chain& c = legs_[side];
+    foot_link_[side] = leg.foot_link;
+    for (size_t i = 0; i < 6; ++i) {
+      const engine::Joint& joint = body.joints[static_cast<size_t>(leg.joints[i])];
+      c.joint[i] = leg.joints[i];
       c.origin[i] = joint.origin;
       c.axis[i] = joint.axis.normalized();
       c.lower[i] = joint.lower;
       c.upper[i] = joint.upper;
     }
   }
+  // The parts, from the left leg's axes: pitch joints hip, knee, ankle in
+  // that order; roll joints hip, ankle; one yaw; the ankle's pitch and roll last.
+  std::vector<int> pitch, roll, yaw;
+  for (int i = 0; i < 6; ++i) {
+    const AxisKind k = axisKind(legs_[0].axis[static_cast<size_t>(i)]);
+    if (axisKind(legs_[1].axis[static_cast<size_t>(i)]) != k)
+      fail("the legs' joint " + std::to_string(i + 1) + " turn about different axes");
+    (k == AxisKind::Pitch ? pitch : k == AxisKind::Roll ? roll : yaw).push_back(i);
+  }
+  if (pitch.size() != 3 || roll.size() != 2 || yaw.size() != 1 || pitch[2] != 4 || roll[1] != 5)
+    fail("a leg must have three pitch joints (hip, knee, ankle), two roll joints (hip, ankle) "
+         "and a hip yaw, the ankle's pitch and roll last");
+  part_ = {yaw[0], roll[0], pitch[0], pitch[1], pitch[2], roll[1]};
+  // Joints of the right leg that follow the left one's (one motor).
+  for (size_t i = 0; i < 6; ++i) {
+    const engine::Joint& right = body.joints[static_cast<size_t>(legs_[1].joint[i])];
+    shared_[i] = right.mimic_of == legs_[0].joint[i];
+    mimic_[i] = shared_[i] ? right.mimic_multiplier : 0.0;
+    if (right.mimic_of >= 0 && !shared_[i])
+      fail("the right leg's " + right.name + " mimics a joint other than the left leg's twin");
+  }
   // The sole: the lowest point of the foot's collision shapes in its frame.
-  const int foot = body.joints[static_cast<size_t>(legs_[0].joint[5])].child_link;
-  for (const engine::Shape& s : body.links[static_cast<size_t>(foot)].shapes) {
+  for (const engine::Shape& s : body.links[static_cast<size_t>(foot_link_[0])].shapes) {
     double bottom = s.pose.translation().z();
     if (s.type == engine::ShapeType::Box) bottom -= 0.5 * s.extents.z();
     if (s.type == engine::ShapeType::Sphere) bottom -= s.radius;
@@ -64,21 +90,38 @@ Pose LegKinematics::forward(Leg leg, const LegAngles& q) const {
 
 LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot,
                                    const LegSolution* start) const {
-  // Both legs at once: 11 unknowns (the shared HipYawPitch and five joints
-  // per leg) for 12 equations (two foot poses), damped least squares with
+  // Both legs at once: one unknown per motor (a Nao: 11, its HipYawPitch
+  // shared; a K1: 12) for 12 equations (two foot poses), damped least squares with
   // joints at a limit they push against taken out; restarts from other
   // knee bends if it stalls. Positions weigh more than orientations (0.05 m
   // per rad), so when the feet's yaws disagree the positions are kept.
   // Weights (m per rad) of the orientation error, in the target foot's
   // frame: a foot must land flat (roll, pitch), its yaw may give where the
-  // shared HipYawPitch cannot serve both feet.
+  // shared hinge cannot serve both feet.
   const double w = 0.05;
   const Eigen::Vector3d w_axes(0.2, 0.2, 0.03);
   const std::array<const Pose*, 2> targets{&left_foot, &right_foot};
+  // The unknowns: the left leg's six joints, then the right leg's own (not shared).
+  std::array<std::array<int, 6>, 2> column{};
+  std::vector<std::pair<int, int>> unknown;  // column -> (side, index)
+  for (int side = 0; side < 2; ++side)
+    for (int i = 0; i < 6; ++i) {
+      if (side == 1 && shared_[static_cast<size_t>(i)]) {
+        column[1][static_cast<size_t>(i)] = column[0][static_cast<size_t>(i)];
+        continue;
+      }
+      column[static_cast<size_t>(side)][static_cast<size_t>(i)] = static_cast<int>(unknown.size());
+      unknown.emplace_back(side, i);
+    }
+  const int n = static_cast<int>(unknown.size());
+  // How a column's step moves a joint of `side` (the mimic's multiplier on the right).
+  const auto gain = [&](int side, int i) {
+    return side == 1 && shared_[static_cast<size_t>(i)] ? mimic_[static_cast<size_t>(i)] : 1.0;
+  };
   auto run = [&](std::array<LegAngles, 2> q, double& pe, double& oe) {
     std::array<Vec3, 2> pos_err{}, rot_err{};
     for (int iter = 0; iter < 80; ++iter) {
-      Eigen::Matrix<double, 12, 11> jac = Eigen::Matrix<double, 12, 11>::Zero();
+      Eigen::Matrix<double, 12, Eigen::Dynamic> jac = Eigen::MatrixXd::Zero(12, n);
       Eigen::Matrix<double, 12, 1> e;
       for (int side = 0; side < 2; ++side) {
         const Chain& c = legs_[static_cast<size_t>(side)];
@@ -96,22 +139,18 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
         const Eigen::Matrix3d to_foot = targets[side]->linear().transpose();
         e.segment<3>(6 * side + 3) = w_axes.asDiagonal() * (to_foot * rot_err[side]);
         for (int i = 0; i < 6; ++i) {
-          const int col = i == 0 ? 0 : 1 + 5 * side + (i - 1);
-          jac.block<3, 1>(6 * side, col) = a[i].cross(t.translation() - p[i]);
-          jac.block<3, 1>(6 * side + 3, col) = w_axes.asDiagonal() * (to_foot * a[i]);
+          const int col = column[static_cast<size_t>(side)][static_cast<size_t>(i)];
+          const double g = gain(side, i);
+          jac.block<3, 1>(6 * side, col) = g * a[i].cross(t.translation() - p[i]);
+          jac.block<3, 1>(6 * side + 3, col) = g * (w_axes.asDiagonal() * (to_foot * a[i]));
         }
       }
       if (e.norm() < 1e-10) break;
-      // Column k's joint: (side, index).
-      auto joint = [](int k) {
-        return k == 0 ? std::pair{0, 0} : std::pair{(k - 1) / 5, 1 + (k - 1) % 5};
-      };
-      std::array<bool, 11> active;
-      active.fill(true);
-      Eigen::VectorXd dq = Eigen::VectorXd::Zero(11);
-      for (int pass = 0; pass < 11; ++pass) {
+      std::vector<bool> active(static_cast<size_t>(n), true);
+      Eigen::VectorXd dq = Eigen::VectorXd::Zero(n);
+      for (int pass = 0; pass < n; ++pass) {
         std::vector<int> cols;
-        for (int k = 0; k < 11; ++k)
+        for (int k = 0; k < n; ++k)
           if (active[static_cast<size_t>(k)]) cols.push_back(k);
         if (cols.empty()) break;
         Eigen::MatrixXd j(12, static_cast<int>(cols.size()));
@@ -122,7 +161,7 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
             (jt * j + damping * Eigen::MatrixXd::Identity(j.cols(), j.cols())).ldlt().solve(jt * e);
         bool changed = false;
         for (size_t k = 0; k < cols.size(); ++k) {
-          const auto [side, i] = joint(cols[k]);
+          const auto [side, i] = unknown[static_cast<size_t>(cols[k])];
           const Chain& c = legs_[static_cast<size_t>(side)];
           const double v = q[static_cast<size_t>(side)][static_cast<size_t>(i)];
           const double step = d[static_cast<int>(k)];
@@ -141,33 +180,45 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
       const double step = dq.norm();
       if (step < 1e-13) break;
       const double scale = step > 0.3 ? 0.3 / step : 1.0;  // no wild jumps far from the goal
-      for (int k = 0; k < 11; ++k) {
-        const auto [side, i] = joint(k);
-        for (int s2 = 0; s2 < 2; ++s2) {
-          if (k != 0 && s2 != side) continue;  // the shared hinge moves both legs
-          const Chain& c = legs_[static_cast<size_t>(s2)];
-          double& v = q[static_cast<size_t>(s2)][static_cast<size_t>(i)];
-          v = std::clamp(v + scale * dq[k], c.lower[static_cast<size_t>(i)],
-                         c.upper[static_cast<size_t>(i)]);
+      for (int side = 0; side < 2; ++side) {
+        const Chain& c = legs_[static_cast<size_t>(side)];
+        for (size_t i = 0; i < 6; ++i) {
+          double& v = q[static_cast<size_t>(side)][i];
+          if (side == 1 && shared_[i]) {
+            v = mimic_[i] * q[0][i];  // one motor: the mimic follows exactly
+            continue;
+          }
+          v = std::clamp(v + scale * dq[column[static_cast<size_t>(side)][i]], c.lower[i],
+                         c.upper[i]);
         }
       }
-      q[1][0] = q[0][0];  // one motor (the limits are the same; keep them equal exactly)
     }
     pe = std::max(pos_err[0].norm(), pos_err[1].norm());
     oe = std::max(rot_err[0].norm(), rot_err[1].norm());
     return q;
   };
-  const LegAngles bent{0.0, 0.0, -0.45, 0.9, -0.45, 0.0};
-  std::array<LegAngles, 2> q0{start ? start->left : bent, start ? start->right : bent};
-  q0[1][0] = q0[0][0];
+  // Starts: the legs bent at the knee by `knee` (rad), the feet flat.
+  const auto bent = [&](double knee) {
+    LegAngles q{};
+    q[static_cast<size_t>(index(LegJoint::HipPitch))] = -0.5 * knee;
+    q[static_cast<size_t>(index(LegJoint::Knee))] = knee;
+    q[static_cast<size_t>(index(LegJoint::AnklePitch))] = -0.5 * knee;
+    return q;
+  };
+  const auto share = [&](std::array<LegAngles, 2> q) {
+    for (size_t i = 0; i < 6; ++i)
+      if (shared_[i]) q[1][i] = mimic_[i] * q[0][i];
+    return q;
+  };
+  const std::array<LegAngles, 2> q0 =
+      share({start ? start->left : bent(0.9), start ? start->right : bent(0.9)});
   double pe = 0, oe = 0;
   std::array<LegAngles, 2> best = run(q0, pe, oe);
   double best_cost = pe + w * oe;
   for (double knee : {0.6, 1.4, 0.2, 2.0}) {
     if (best_cost < 1e-8) break;
-    const LegAngles k{0.0, 0.0, -0.5 * knee, knee, -0.5 * knee, 0.0};
     double p2 = 0, o2 = 0;
-    const auto r = run({k, k}, p2, o2);
+    const auto r = run(share({bent(knee), bent(knee)}), p2, o2);
     if (p2 + w * o2 < best_cost) {
       best = r;
       best_cost = p2 + w * o2;

@@ -48,12 +48,8 @@ MotionController::MotionController(const robots::RobotModel& model, KeyframeMoti
       targets_(model.pose("stand")) {
   head_yaw_ = model.body->jointIndex("HeadYaw");
   head_pitch_ = model.body->jointIndex("HeadPitch");
-  for (const char* side : {"L", "R"})
-    for (const char* name :
-         {"HipYawPitch", "HipRoll", "HipPitch", "KneePitch", "AnklePitch", "AnkleRoll"}) {
-      const int j = model.body->jointIndex(std::string(side) + name);
-      if (j >= 0) leg_joints_.push_back(j);
-    }
+  for (const robots::LegChain& leg : model.legs)
+    leg_joints_.insert(leg_joints_.end(), leg.joints.begin(), leg.joints.end());
 }
 
 void MotionController::restart() {

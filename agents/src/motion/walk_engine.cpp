@@ -150,15 +150,17 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
     lift[swing] = p_.foot_lift * std::sin(M_PI * ph);
     s = solve(body, sway, feet[0], feet[1], lift[0], lift[1]);
     LegAngles& support_q = support_ == Leg::Left ? s.left : s.right;
-    support_q[1] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
+    support_q[static_cast<size_t>(kinematics_.index(LegJoint::HipRoll))] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
   }
   // Balance: the support ankle (both while standing) leans against the
   // torso's rotation rate.
   for (int leg = 0; leg < 2; ++leg) {
     LegAngles& q = leg == 0 ? s.left : s.right;
     if (walking_ && static_cast<int>(support_) != leg) continue;
-    q[4] += p_.ankle_pitch_gyro * gyro_filtered_.y();
-    q[5] += p_.ankle_roll_gyro * gyro_filtered_.x();
+    q[static_cast<size_t>(kinematics_.index(LegJoint::AnklePitch))] +=
+        p_.ankle_pitch_gyro * gyro_filtered_.y();
+    q[static_cast<size_t>(kinematics_.index(LegJoint::AnkleRoll))] +=
+        p_.ankle_roll_gyro * gyro_filtered_.x();
   }
   kinematics_.writeTargets(s, targets);
 }

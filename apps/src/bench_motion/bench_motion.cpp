@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "simsoccer/agents/motion/gait.hpp"
 #include "motion_table.hpp"
 #include "trial.hpp"
 
@@ -12,13 +13,17 @@ namespace simsoccer::apps {
 namespace {
 
 const char* kHelp =
-    "usage: simsoccer bench motion [--random-minutes M] [--seed N] [--csv FILE]\n"
+    "usage: simsoccer bench motion [--robot R] [--random-minutes M] [--seed N] [--csv FILE]\n"
     "       simsoccer bench motion --vx V [--vy V] [--turn W] [--seconds S] [--verbose]\n"
     "\n"
-    "One Nao on an empty SPL field, driven by the walk engine at the control rate through\n"
+    "One robot on an empty field, driven by the walk engine at the control rate through\n"
     "joint targets only (the agents' motion, in this process). Per test: commanded and achieved\n"
-    "speed, path deviation, falls: forward 0.25 m/s over 5 m, sideways 0.1 m/s, turning 0.8\n"
-    "rad/s, and M minutes (default 10) of random velocity commands.\n"
+    "speed, path deviation, falls: forward over 5 m, sideways, turning, and M minutes (default\n"
+    "10) of random velocity commands; kicks, get-ups, the behaviours.\n"
+    "  --robot R     nao_v6_h25 (default: a Nao on the SPL field, forward 0.25 m/s) or\n"
+    "                booster_k1 (on the HSL M-Field, forward 0.5 m/s): configs/bench/motion_R.yaml\n"
+    "                names the robot, field, motions, agent config and targets\n"
+    "  --bench FILE  another such file\n"
     "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
     "[--ball-gap M]:\n"
     "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
@@ -31,8 +36,9 @@ const char* kHelp =
     "play: it blocks; in the shoot-out: it also dives).\n"
     "  --get-up-trials N, --sit-trials N  get-up trials per side, sit trials, in the table\n"
     "                (default 20, 20)\n"
-    "  --motions DIR the motions from DIR (default configs/motions; for tuning them): all of\n"
-    "                get_up_front, get_up_back, block, dive_left, dive_right, sit_down, stand_up\n"
+    "  --motions DIR the motions from DIR (default: the bench file's; for tuning them): all of\n"
+    "                get_up_front, get_up_back, block, dive_left, dive_right, sit_down, stand_up,\n"
+    "                and the gait (gait.yaml) where there is one\n"
     "  --snapshots F.png  with --get-up: the robot seen from its side every 0.2 s (the first\n"
     "                7.2 s), tiled\n"
     "  --striker-trials N, --penalty-trials N, --block-trials N  trials in the table (default\n"
@@ -67,7 +73,9 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation},
       {"kick-swing-height", &kp.swing_height}};
-  std::vector<std::string> valued{"seconds",
+  std::vector<std::string> valued{"robot",
+                                  "bench",
+                                  "seconds",
                                   "csv",
                                   "vx",
                                   "vy",
@@ -95,14 +103,26 @@ int benchMotion(int argc, char** argv, int first) {
   std::snprintf(help, sizeof help, kHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
   opt.noPositional();
-  for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
   motion::TrialContext c;
+  if (opt.has("robot") && opt.has("bench")) throw UsageError("--robot and --bench exclude each other");
+  const std::string robot = opt.get("robot", "nao_v6_h25");
+  const std::filesystem::path bench_file =
+      opt.has("bench") ? std::filesystem::path(opt.get("bench", ""))
+                       : findConfig("", "configs/bench/motion_" + robot + ".yaml");
+  if (!std::filesystem::exists(bench_file))
+    throw UsageError("--robot " + robot + ": no " + bench_file.string() +
+                     " (robots with a motion bench: nao_v6_h25, booster_k1)");
+  c.bench = motion::loadMotionBench(bench_file);
+  // Another motions folder (same file names) for tuning get-up motions.
+  c.motions_dir = opt.has("motions") ? opt.get("motions", "") : c.bench.motions.string();
+  // The robot's gait, then any knob given.
+  const agents::Gait gait = agents::loadGaitIn(c.motions_dir);
+  wp = gait.walk;
+  kp = gait.kick;
+  for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
   c.walk = wp;
   c.kick = kp;
   c.verbose = opt.flag("verbose");
-  // Another motions folder (same file names) for tuning get-up motions.
-  c.motions_dir =
-      opt.has("motions") ? opt.get("motions", "") : findConfig("", "configs/motions").string();
   try {
     c.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
   } catch (const std::invalid_argument& e) {

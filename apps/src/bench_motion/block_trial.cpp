@@ -16,10 +16,10 @@ namespace simsoccer::apps::motion {
 // not, and the keeper touched it. In reach: aimed within the block's reach
 // of the keeper's middle.
 BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
-  const auto config = agents::loadBehaviourConfig(findConfig("", "configs/agents/soccer.yaml"));
+  const auto config = agents::loadBehaviourConfig(c.bench.agents);
   // Where the behaviour's keeper stands.
   const double line =
       -f.halfLength() + (shootout ? config.shootout_keeper_line : config.keeper_line);

@@ -84,7 +84,7 @@ void writeTiles(std::vector<cv::Mat>& tiles, const std::string& file) {
 // Success: standing (world truth) in the controller's stance for 1 s within 12 s.
 GetUpResult getUpTrial(const TrialContext& c, bool front, uint64_t seed,
                        const std::string& snapshots) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   TrialWorld t(s, c);
   world::World& w = t.world;

@@ -1,5 +1,6 @@
 // Kicking: one kick from the walk's stance with the ball in front of the
 // kicking foot; the ball's travel after 6 s.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -37,11 +38,20 @@ void traceKick(const world::World& w, int foot_link, const Vec3& start, double d
   last_foot = foot;
 }
 
+// How far the foot's collision shapes reach ahead of its frame (m).
+double toe(const robots::RobotModel& model, int foot_link) {
+  double x = 0.0;
+  for (const engine::Shape& s : model.body->links[static_cast<size_t>(foot_link)].shapes)
+    if (s.type == engine::ShapeType::Box)
+      x = std::max(x, s.pose.translation().x() + 0.5 * s.extents.x());
+  return x;
+}
+
 }  // namespace
 
 KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
                      double gap) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   TrialWorld t(s, c);
   world::World& w = t.world;
@@ -50,11 +60,11 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
   agents::KickEngine engine(model, c.walk, c.kick);
   std::vector<double> targets = model.pose("stand");
   settleIntoStance(t, walk, targets);
-  const char* link = foot == agents::Leg::Left ? "LFoot" : "RFoot";
-  const Vec3 f = w.linkPose(0, model.body->linkIndex(link)).translation();
+  const int foot_link = engine.kinematics().footLink(foot);
+  const Vec3 f = w.linkPose(0, foot_link).translation();
   engine::RigidBodyState b;
-  b.pose.translation() = Vec3(f.x() + 0.1025 + w.field().ball.radius + gap, f.y() + ball_offset,
-                              w.field().ball.radius);
+  b.pose.translation() = Vec3(f.x() + toe(model, foot_link) + w.field().ball.radius + gap,
+                              f.y() + ball_offset, w.field().ball.radius);
   w.setBallState(b);
   const Vec3 start = b.pose.translation();
   engine.start(foot);
@@ -67,7 +77,6 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
     bodyTargetsToCommand(model, targets, 1.0, p, k);
     return true;
   });
-  const int foot_link = model.body->linkIndex(link);
   Vec3 last_foot = w.linkPose(0, foot_link).translation();  // for the trace
   for (int i = 0; i < static_cast<int>(std::lround(6.0 / dt)); ++i) {
     t.period();

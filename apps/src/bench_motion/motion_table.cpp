@@ -15,10 +15,12 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
   TrialContext quiet = c;  // the table's trials print no traces
   quiet.verbose = false;
   const double random_minutes = opt.number("random-minutes", 10.0);
+  const MotionBench& b = c.bench;
   std::printf(
-      "simsoccer bench motion: one Nao H25 on an empty SPL field, walk engine (%.0f ms steps), "
+      "simsoccer bench motion: one %s on an empty field (%s), walk engine (%.0f ms steps), "
       "joint targets only, %s periods\n",
-      c.walk.step_period * 1e3, sim::modeName(c.mode));
+      b.robot.c_str(), b.field.filename().string().c_str(), c.walk.step_period * 1e3,
+      sim::modeName(c.mode));
   std::fflush(stdout);
   Table table;
   table.header = {"robots", "test",          "commanded", "achieved",
@@ -30,19 +32,20 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
     std::fprintf(stderr, "  %s done\n", test.c_str());
   };
   {
-    const double v = 0.25, seconds = 22.0;  // 5 m and more
+    const double v = b.walk_forward, seconds = std::ceil(5.0 / v) + 2.0;  // 5 m and more
     const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(v, 0, 0); }, seconds);
     row("walk_forward", v, r.speed, "m/s", 100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9),
         r.fell, seconds);
   }
   {
-    const double v = 0.1, seconds = 10.0;
+    const double v = b.walk_sideways, seconds = 10.0;
     const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(0, v, 0); }, seconds);
     row("walk_sideways", v, r.speed, "m/s",
         100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9), r.fell, seconds);
   }
   {
-    const double w = 0.8, seconds = 5.0;  // 4 rad: less than a turn, so the angle is unambiguous
+    // Less than a turn, so the angle is unambiguous.
+    const double w = b.turn, seconds = std::min(5.0, 5.0 / w);
     const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(0, 0, w); }, seconds);
     double turned = r.turned;
     if (turned < 0) turned += 2 * M_PI;
@@ -51,7 +54,8 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
   }
   {
     // 20 kicks, 10 with each foot, the ball up to 2 cm either side of the
-    // foot's middle (seeded); a success: >= 3 m within 15 degrees of straight.
+    // foot's middle (seeded); a success: the target distance (a Nao 3 m, a K1 4 m) within 15
+    // degrees of straight.
     std::mt19937_64 rng(seed + 100);
     double sum = 0, worst_angle = 0;
     int ok = 0, falls = 0;
@@ -61,10 +65,10 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
                                      seed + static_cast<uint64_t>(i));
       sum += k.distance;
       worst_angle = std::max(worst_angle, std::abs(k.direction));
-      ok += k.distance >= 3.0 && std::abs(k.direction) <= 15 * M_PI / 180;
+      ok += k.distance >= b.kick_distance && std::abs(k.direction) <= 15 * M_PI / 180;
       falls += k.fell;
     }
-    row("kick_distance", 3.0, sum / 20, "m", worst_angle * 180 / M_PI, falls, 20 * 9.0);
+    row("kick_distance", b.kick_distance, sum / 20, "m", worst_angle * 180 / M_PI, falls, 20 * 9.0);
     row("kick_success", 0.9, ok / 20.0, "share", 0, falls, 20 * 9.0);
   }
   {
@@ -154,8 +158,9 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
     }
   }
   {
-    // Random commands (seeded), a new one every 2 s: forward -0.1..0.3 m/s,
-    // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s, each with a 1 in 4 chance of 0.
+    // Random commands (seeded), a new one every 2 s in the bench file's ranges (a Nao:
+    // forward -0.1..0.3 m/s, sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s), each with a 1 in
+    // 4 chance of 0.
     std::mt19937_64 rng(seed);
     std::vector<Eigen::Vector3d> commands;
     const double seconds = random_minutes * 60.0;
@@ -164,18 +169,21 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
       auto pick = [&](double lo, double hi) {
         return u(rng) < 0.25 ? 0.0 : lo + (hi - lo) * u(rng);
       };
-      commands.emplace_back(pick(-0.1, 0.3), pick(-0.1, 0.1), pick(-0.8, 0.8));
+      commands.emplace_back(pick(b.random_forward[0], b.random_forward[1]),
+                            pick(b.random_sideways[0], b.random_sideways[1]),
+                            pick(b.random_turn[0], b.random_turn[1]));
     }
     int falls = 0;
     walkTrial(c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
     row("random_commands", 0, 0, "-", 0, falls, seconds);
   }
   table.finish(
-      "walk_forward: 0.25 m/s for 22 s (over 5 m), achieved = torso displacement / time (the speed "
-      "ramp included), deviation = sideways drift / distance; walk_sideways likewise at 0.1 m/s; "
-      "turn: 0.8 rad/s for 5 s; kick_distance: mean ball travel of 20 kicks (10 per foot, the "
-      "ball up to 2 cm sideways of the foot's middle), deviation = the largest angle off "
-      "straight (deg); kick_success: share of kicks >= 3 m within 15 deg; get_up_front / "
+      "walk_forward: the commanded speed for 5 m / speed + 2 s, achieved = torso displacement / "
+      "time (the speed ramp included), deviation = sideways drift / distance; walk_sideways "
+      "likewise for 10 s; turn: for 5 s (at most 5 rad); kick_distance: mean ball travel of 20 "
+      "kicks (10 per foot, the ball up to 2 cm sideways of the foot's middle), deviation = the "
+      "largest angle off straight (deg); kick_success: share of kicks >= the commanded distance "
+      "within 15 deg; get_up_front / "
       "get_up_back: share of trials (robot dropped on its front / back, seeded) standing in the "
       "stance within 8 s, deviation column = the slowest trial's seconds (12: failed); "
       "sit_and_stand: share of trials (2 s walking at a seeded velocity, 5 s sitting, 5 s "
@@ -188,7 +196,7 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
       "shootout_keeper_saves: share of balls rolled at the goal (seeded, 1.6-2.4 m/s from 2.5 m, "
       "aimed inside the posts) the goalkeeper behaviour keeps out in play (it blocks) / in the "
       "shoot-out (it also dives), deviation column = % of those aimed within its reach "
-      "(block_reach / dive_reach of configs/agents/soccer.yaml from its middle), falls = falls "
+      "(block_reach / dive_reach of the agent config from its middle), falls = falls "
       "besides dives; "
       "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "

@@ -13,7 +13,7 @@ namespace simsoccer::apps::motion {
 // keeper (team 1) on that goal line; ends on a goal, the ball out or stopped
 // after the kick, or after `limit` s.
 PenaltyOutcome penaltyTrial(const TrialContext& c, uint64_t seed, double limit) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
   const double mark = f.halfLength() - f.penalty_mark_distance.value_or(1.3);

@@ -10,7 +10,7 @@ namespace simsoccer::apps::motion {
 // Success: on its feet throughout (World::isStanding, as the referee counts
 // it), the torso at least 5 cm lower when seated, and back in the stance.
 SitResult sitTrial(const TrialContext& c, uint64_t seed) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   TrialWorld t(s, c);
   world::World& w = t.world;

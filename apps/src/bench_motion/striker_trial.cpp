@@ -13,7 +13,7 @@ namespace simsoccer::apps::motion {
 // A striker alone (team 0, attacking +x): robot and ball at seeded random
 // spots in the field; up to `limit` s to score.
 StrikerResult strikerTrial(const TrialContext& c, uint64_t seed, double limit) {
-  world::Scenario s = emptyField();
+  world::Scenario s = emptyField(c);
   s.seed = seed;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);

@@ -3,15 +3,51 @@
 #include <algorithm>
 
 #include "cli.hpp"
+#include "simsoccer/engine/config.hpp"
 #include "simsoccer/referee/referee.hpp"
+#include "simsoccer/robots/robot_model.hpp"
 
 namespace simsoccer::apps::motion {
 
-world::Scenario emptyField() {
+MotionBench loadMotionBench(const std::filesystem::path& file) {
+  const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
+  root.allowOnly({"robot_model", "field", "motions", "agents", "targets", "random_commands"});
+  MotionBench b;
+  b.file = file.string();
+  const auto path = [&](const char* key) {
+    const std::filesystem::path p = engine::resolveBeside(root.file(), root[key].string());
+    if (!std::filesystem::exists(p)) root[key].fail("no such file or folder: " + p.string());
+    return p;
+  };
+  b.robot_model = path("robot_model");
+  b.field = path("field");
+  b.motions = path("motions");
+  b.agents = path("agents");
+  b.robot = robots::loadRobotModel(b.robot_model).name;
+  const engine::ConfigNode t = root["targets"];
+  t.allowOnly({"walk_forward", "walk_sideways", "turn", "kick_distance"});
+  b.walk_forward = t["walk_forward"].positive();
+  b.walk_sideways = t["walk_sideways"].positive();
+  b.turn = t["turn"].positive();
+  b.kick_distance = t["kick_distance"].positive();
+  const engine::ConfigNode r = root["random_commands"];
+  r.allowOnly({"forward", "sideways", "turn"});
+  const auto range = [&](const char* key) {
+    const std::vector<double> v = r[key].numbers(2);
+    if (!(v[0] <= v[1])) r[key].fail("expected [lowest, highest]");
+    return std::array<double, 2>{v[0], v[1]};
+  };
+  b.random_forward = range("forward");
+  b.random_sideways = range("sideways");
+  b.random_turn = range("turn");
+  return b;
+}
+
+world::Scenario emptyField(const TrialContext& c) {
   world::Scenario s;
   s.name = "bench_motion";
-  s.field_file = findConfig("", "fields/spl.yaml");
-  s.robot_model_file = findConfig("", "robots/nao_v6_h25.yaml");
+  s.field_file = c.bench.field;
+  s.robot_model_file = c.bench.robot_model;
   s.ball_position = {4.0, 2.5, -1.0};
   world::RobotPlacement p;
   p.x = -3.0;
@@ -44,15 +80,16 @@ world::Scenario withTiming(world::Scenario s, const TrialContext& c) {
 }  // namespace
 
 TrialWorld::TrialWorld(const world::Scenario& scenario, const TrialContext& context)
-    : world(withTiming(scenario, context)), simulation(world, simulationConfig(context.mode)) {
+    : world(withTiming(scenario, context)),
+      simulation(world, simulationConfig(context.mode)),
+      context_(context) {
   simulation.addSource(driver);
 }
 
 void TrialWorld::addAgents(std::vector<agents::Role> roles, uint64_t seed) {
   agents = std::make_unique<match::InProcessAgents>(
       world, match::InProcessSetup{std::move(roles), seed, true,
-                                   findConfig("", "configs/agents/soccer.yaml"),
-                                   findConfig("", "configs/motions")});
+                                   context_.bench.agents, context_.motions_dir});
   simulation.addSource(*agents);
 }
 

@@ -1,10 +1,12 @@
-// bench motion's trials: one Nao (or a striker and a keeper) on an empty SPL
-// field, driven through the same period pipeline as a match (the gate, the
+// bench motion's trials: one robot (or a striker and a keeper) on an empty
+// field (a Nao on the SPL field, a K1 on the HSL M-Field), driven through the same period pipeline as a match (the gate, the
 // quantisation and the mode's actuation timing), one file per trial.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <span>
@@ -23,8 +25,24 @@ namespace simsoccer::apps::motion {
 
 using engine::Vec3;
 
-// What every trial shares: the period mode, the motions, the tuning knobs.
+// What bench motion runs for one robot, from configs/bench/motion_<robot>.yaml:
+// the robot, its field, its motions (keyframes and gait) and agent config,
+// and the table's targets.
+struct MotionBench {
+  std::string file, robot;  // the file read, the robot's name (its model's)
+  std::filesystem::path robot_model, field, motions, agents;
+  double walk_forward = 0.25, walk_sideways = 0.1, turn = 0.8;  // m/s, m/s, rad/s
+  double kick_distance = 3.0;                                    // m, a successful kick
+  // The random walk's commands: [lowest, highest] forward, sideways (m/s), turn (rad/s).
+  std::array<double, 2> random_forward{-0.1, 0.3}, random_sideways{-0.1, 0.1},
+      random_turn{-0.8, 0.8};
+};
+// Throws engine::ConfigError naming the file, key and reason.
+MotionBench loadMotionBench(const std::filesystem::path& file);
+
+// What every trial shares: the robot's bench, the period mode, the motions, the tuning knobs.
 struct TrialContext {
+  MotionBench bench;
   sim::Mode mode = sim::kDefaultMode;
   std::string motions_dir;  // configs/motions, or another folder for tuning
   agents::WalkParameters walk;
@@ -35,8 +53,8 @@ struct TrialContext {
   double dt = 0.0, control_period = 0.0;
 };
 
-// One Nao at (-3, 0) facing +x on an empty SPL field, the ball out of the way.
-world::Scenario emptyField();
+// The bench's robot at (-3, 0) facing +x on its empty field, the ball out of the way.
+world::Scenario emptyField(const TrialContext& c);
 
 // Robot 0 driven by code in this process: at each period's observe stage,
 // `control` computes the robot's command (actuator order) from the state of
@@ -69,6 +87,9 @@ struct TrialWorld {
   sim::Simulation simulation;
   DriverSource driver;
   std::unique_ptr<match::InProcessAgents> agents;
+
+ private:
+  TrialContext context_;
 };
 
 // Body joint targets as robot 0's command in actuator order at one stiffness

@@ -7,7 +7,7 @@
 
 namespace simsoccer::apps::motion {
 WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds, int* falls) {
-  TrialWorld t(emptyField(), c);
+  TrialWorld t(emptyField(c), c);
   world::World& w = t.world;
   const auto& model = *w.robot(0).model;
   agents::WalkEngine engine(model, c.walk);
@@ -52,12 +52,19 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
       t.driver.setControl(walkControl);
       continue;
     }
-    if (c.verbose && i % 25 == 0) {  // a trace every 0.25 s, for tuning
-      const Vec3 p = w.torsoPose(0).translation();
+    if (c.verbose && i % 5 == 0) {  // a trace every 0.05 s, for tuning
+      const engine::Pose torso = w.torsoPose(0);
+      const Vec3 p = torso.translation();
       const auto& f = w.sensorFrame(0);
-      std::fprintf(stderr, "t %.2f torso %.3f %.3f %.3f  odometry %.3f  feet %.1f / %.1f N\n",
-                   static_cast<double>(i) * dt, p.x(), p.y(), p.z(), engine.odometry().x,
-                   f.foot_weight[0], f.foot_weight[1]);
+      const auto& kin = engine.kinematics();
+      std::fprintf(stderr,
+                   "t %.2f torso %.3f %.3f %.3f roll %+.3f pitch %+.3f odometry %.3f phase %.2f "
+                   "support %s  feet z %.3f / %.3f\n",
+                   static_cast<double>(i) * dt, p.x(), p.y(), p.z(), f.angles[0], f.angles[1],
+                   engine.odometry().x, engine.phase(),
+                   engine.supportLeg() == agents::Leg::Left ? "L" : "R",
+                   w.linkPose(0, kin.footLink(agents::Leg::Left)).translation().z(),
+                   w.linkPose(0, kin.footLink(agents::Leg::Right)).translation().z());
     }
   }
   const engine::Pose end = w.torsoPose(0);

@@ -17,7 +17,7 @@ namespace simsoccer::agents {
 
 // A motion controller with the keyframe motions of `motions_dir`
 // (get_up_front.yaml, get_up_back.yaml, block.yaml, dive_left.yaml, dive_right.yaml,
-// sit_down.yaml, stand_up.yaml).
+// sit_down.yaml, stand_up.yaml) and its gait.yaml if it has one (gait.hpp).
 MotionController loadMotionController(const robots::RobotModel& model,
                                       const std::filesystem::path& motions_dir,
                                       const FallDetectorParameters& fall = {});

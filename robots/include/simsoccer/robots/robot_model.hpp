@@ -4,6 +4,7 @@
 // named poses.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -56,6 +57,14 @@ struct SensorSpec {
   double temperature_hot = 70.0, temperature_very_hot = 80.0, temperature_critical = 90.0;
 };
 
+// One leg, for software that walks and kicks: its foot link and the joints
+// from the trunk down to it (kinematic order, every hinge of the chain,
+// mimic joints included).
+struct LegChain {
+  int foot_link = -1;
+  std::vector<int> joints;
+};
+
 struct RobotModel {
   std::string name;
   std::string source_file;
@@ -65,6 +74,10 @@ struct RobotModel {
   std::vector<SensorFrame> sensors;
   SensorSpec sensor_spec;
   std::map<std::string, std::vector<double>> poses;  // per body joint, rad
+  // The legs (left, right) from the file's `legs: {left: FOOT, right: FOOT}`;
+  // empty chains where the file names none.
+  std::array<LegChain, 2> legs;
+  bool hasLegs() const { return legs[0].foot_link >= 0; }
 
   // Joint angles (one per body joint) of a named pose; throws if unknown.
   const std::vector<double>& pose(const std::string& pose_name) const;

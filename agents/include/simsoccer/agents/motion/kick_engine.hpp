@@ -43,6 +43,7 @@ class KickEngine {
   void start(Leg foot);
   bool active() const { return active_; }
   double duration() const;
+  const LegKinematics& kinematics() const { return kinematics_; }
   // Advances by dt and writes the legs' targets (body joint order).
   void update(double dt, const Vec3& gyro, std::vector<double>& targets);
 

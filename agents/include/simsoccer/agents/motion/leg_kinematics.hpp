@@ -1,14 +1,20 @@
-// Forward and inverse kinematics of a Nao's legs from the robot model's data
-// (joint origins, axes and limits), so the H25 and H21 files both work.
+// Forward and inverse kinematics of a robot's legs from the robot model's
+// data: its `legs` (six hinges from the trunk down to each foot) with their
+// origins, axes and limits, so the Nao H25 and H21 and the Booster K1 all work.
 //
 // Frames: the torso frame (x forward, y left, z up, origin at the torso
-// joint frame); a foot's frame is its AnkleRoll joint frame (at the ankle,
-// axes aligned with the torso at zero angles), the sole `soleDepth()` below.
+// joint frame); a foot's frame is its last joint's frame (the ankle roll, at
+// the ankle, axes aligned with the torso at zero angles), the sole
+// `soleDepth()` below.
 //
-// The two HipYawPitch hinges share one motor (nao.md 2.4), so the legs are
-// not independent: inverse() solves both at once, 11 joints for two foot
-// poses (12 numbers), positions first, orientations as close as the shared
-// hinge allows. Poses reachable with one HipYawPitch angle (stepping
+// A leg joint's part (hip yaw, roll and pitch, knee, ankle pitch and roll)
+// is read from its axis at zero angles, so the chain's order is the robot's
+// own (the Nao: yaw-pitch, roll, pitch, ...; the K1: pitch, roll, yaw, ...).
+// A right-leg joint that mimics the left one's (the Nao's two HipYawPitch
+// hinges share one motor, nao.md 2.4) makes the legs dependent: inverse()
+// solves both at once, one unknown per motor (11 on a Nao, 12 on a K1) for
+// two foot poses (12 numbers), positions first, orientations as close as a
+// shared hinge allows. Poses reachable with one shared angle (stepping
 // straight, or any pair the robot can actually hold) are reached exactly.
 #pragma once
 
@@ -24,8 +30,12 @@ using engine::Vec3;
 
 enum class Leg { Left = 0, Right = 1 };
 
-// HipYawPitch, HipRoll, HipPitch, KneePitch, AnklePitch, AnkleRoll (rad).
+// One leg's six joint angles in its chain's order, trunk to foot (rad).
 using LegAngles = std::array<double, 6>;
+
+// A leg joint's part in walking. HipYaw: the hinge about the vertical (the
+// Nao's HipYawPitch, at 45 degrees, counts as it).
+enum class LegJoint { HipYaw, HipRoll, HipPitch, Knee, AnklePitch, AnkleRoll };
 
 struct LegSolution {
   LegAngles left{}, right{};
@@ -48,6 +58,10 @@ class LegKinematics {
   // the joint limits.
   void writeTargets(const LegSolution& legs, std::vector<double>& targets) const;
 
+  // Where a joint of each part sits in LegAngles (the same for both legs).
+  int index(LegJoint part) const { return part_[static_cast<size_t>(part)]; }
+  // The foot's link (its last joint's child).
+  int footLink(Leg leg) const { return foot_link_[static_cast<size_t>(leg)]; }
   // Body joint indices of a leg's six joints (for commands and sensor frames).
   const std::array<int, 6>& joints(Leg leg) const { return legs_[static_cast<size_t>(leg)].joint; }
   double lower(Leg leg, int i) const { return legs_[static_cast<size_t>(leg)].lower[i]; }
@@ -63,6 +77,11 @@ class LegKinematics {
     std::array<double, 6> lower{}, upper{};
   };
   std::array<Chain, 2> legs_;
+  std::array<int, 6> part_{};       // LegJoint -> position in the chain
+  std::array<int, 2> foot_link_{};  // left, right
+  // shared_[i]: the right leg's joint i mimics the left's (multiplier mimic_[i]).
+  std::array<bool, 6> shared_{};
+  std::array<double, 6> mimic_{};
   double sole_depth_ = 0.0;
 };
 
