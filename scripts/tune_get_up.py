@@ -20,6 +20,8 @@ generation: the kept motions are means). Environment:
               scored by how far onto the front it leaves the robot, plus 2 for standing
               (after the get-up from the front) and up to +0.5 the sooner (-1 at 10 s)
   SQUAT_TAIL=1  every candidate ends in a fixed deep squat and the stand
+  ROBOT=NAME  nao_v6_h25 (default) or booster_k1: the robot, its motions folder
+              (configs/bench/motion_NAME.yaml) and the joints searched
   SIM=PATH    the simsoccer binary (default build/apps/simsoccer)
 Needs python3-yaml; runs two trials at a time."""
 import atexit, math, os, random, re, shutil, subprocess, sys, tempfile, concurrent.futures as cf
@@ -27,25 +29,45 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SIM = os.environ.get("SIM", os.path.join(ROOT, "build/apps/simsoccer"))
-MOTIONS = os.path.join(ROOT, "configs/motions")
 EVAL = tempfile.mkdtemp(prefix="tune_get_up.")  # candidates' motion folders, removed at exit
 atexit.register(shutil.rmtree, EVAL, True)
-JOINTS = ["HeadPitch", "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LHipYawPitch",
-          "LHipRoll", "LHipPitch", "LKneePitch", "LAnklePitch", "LAnkleRoll"]
-MIRROR = {"LShoulderPitch": ("RShoulderPitch", 1), "LShoulderRoll": ("RShoulderRoll", -1),
-          "LElbowYaw": ("RElbowYaw", -1), "LElbowRoll": ("RElbowRoll", -1), "LHipRoll": ("RHipRoll", -1),
-          "LHipPitch": ("RHipPitch", 1), "LKneePitch": ("RKneePitch", 1), "LAnklePitch": ("RAnklePitch", 1),
-          "LAnkleRoll": ("RAnkleRoll", -1)}
+# The robot (ROBOT=nao_v6_h25 or booster_k1): the joints searched (the head's pitch and the
+# left side; the right side mirrors them, with the sign of MIRROR), the torso's height standing
+# (m, the score's scale), and the left-to-right name change.
+ROBOT = os.environ.get("ROBOT", "nao_v6_h25")
+_BENCH = yaml.safe_load(open(os.path.join(ROOT, "configs/bench/motion_%s.yaml" % ROBOT)))
+MOTIONS = os.path.normpath(os.path.join(ROOT, "configs/bench", _BENCH["motions"]))
+if ROBOT == "booster_k1":
+    JOINTS = ["HeadPitch", "LeftShoulderPitch", "LeftShoulderRoll", "LeftElbowPitch", "LeftElbowYaw",
+              "LeftHipPitch", "LeftHipRoll", "LeftHipYaw", "LeftKneePitch", "LeftAnklePitch",
+              "LeftAnkleRoll"]
+    SIGNS = {"ShoulderPitch": 1, "ShoulderRoll": -1, "ElbowPitch": -1, "ElbowYaw": -1, "HipPitch": 1,
+             "HipRoll": -1, "HipYaw": -1, "KneePitch": 1, "AnklePitch": 1, "AnkleRoll": -1}
+    right = lambda j: "Right" + j[4:]
+    MIRROR = {j: (right(j), SIGNS[j[4:]]) for j in JOINTS if j.startswith("Left")}
+    STAND_HEIGHT = 0.51
+    ARMS = 5  # JOINTS[1:ARMS] are the left arm's, JOINTS[ARMS:] the left leg's
+else:
+    JOINTS = ["HeadPitch", "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LHipYawPitch",
+              "LHipRoll", "LHipPitch", "LKneePitch", "LAnklePitch", "LAnkleRoll"]
+    MIRROR = {"LShoulderPitch": ("RShoulderPitch", 1), "LShoulderRoll": ("RShoulderRoll", -1),
+              "LElbowYaw": ("RElbowYaw", -1), "LElbowRoll": ("RElbowRoll", -1), "LHipRoll": ("RHipRoll", -1),
+              "LHipPitch": ("RHipPitch", 1), "LKneePitch": ("RKneePitch", 1), "LAnklePitch": ("RAnklePitch", 1),
+              "LAnkleRoll": ("RAnkleRoll", -1)}
+    right = lambda j: "R" + j[1:]
+    STAND_HEIGHT = 0.33
+    ARMS = 5
 # ASYM=1: every joint searched on its own (no mirroring), for a motion that is not
 # symmetric (the roll onto the front that starts the get-up from the back).
 ASYM = bool(os.environ.get("ASYM"))
 if ASYM:
-    JOINTS = ["HeadYaw"] + JOINTS[:5] + ["R" + j[1:] for j in JOINTS[1:5]] + JOINTS[5:] + \
-             ["R" + j[1:] for j in JOINTS[6:]]
+    # The Nao's right HipYawPitch is its left one's (one motor, no MIRROR entry): not searched.
+    legs = [right(j) for j in JOINTS[ARMS:] if j in MIRROR]
+    JOINTS = ["HeadYaw"] + JOINTS[:ARMS] + [right(j) for j in JOINTS[1:ARMS]] + JOINTS[ARMS:] + legs
     MIRROR = {}
 # The stand pose and the joint limits from the robot model (a left joint's range is
 # narrowed to what its mirrored right joint also allows).
-_ROBOT = yaml.safe_load(open(os.path.join(ROOT, "robots/nao_v6_h25.yaml")))
+_ROBOT = yaml.safe_load(open(os.path.normpath(os.path.join(ROOT, "configs/bench", _BENCH["robot_model"]))))
 _RANGE = {j["name"]: tuple(j["limits"]) for j in _ROBOT["joints"] if "limits" in j}
 STAND = {j: float(_ROBOT["poses"]["stand"].get(j, 0.0)) for j in JOINTS}
 LIMITS = {}
@@ -82,7 +104,7 @@ def write_yaml(side, frames, path, tail):
     out = [f"motion: get_up_{side}"] + (["interpolation: linear"] if LINEAR else []) + \
           (["ends: front"] if ROLL else []) + ["frames:"]
     for f in frames:
-        js = dict(HeadYaw=0.0)
+        js = {} if "HeadYaw" in f["joints"] else dict(HeadYaw=0.0)
         for j, x in f["joints"].items():
             js[j] = x
             if j in MIRROR:
@@ -101,7 +123,7 @@ TAIL = ["  - duration: 1.0", "    pose: stand"]
 ROLL = bool(os.environ.get("ROLL"))
 if ROLL:
     TAIL = []
-if os.environ.get("SQUAT_TAIL"):
+if os.environ.get("SQUAT_TAIL") and ROBOT == "nao_v6_h25":
     TAIL = ["  - duration: 0.5",
             "    joints: {HeadYaw: 0.0, HeadPitch: 0.0, LShoulderPitch: 0.6, RShoulderPitch: 0.6, LShoulderRoll: 0.1, RShoulderRoll: -0.1,",
             "             LElbowYaw: 0.0, RElbowYaw: 0.0, LElbowRoll: -0.04, RElbowRoll: 0.04, LHipYawPitch: 0.0, LHipRoll: 0.0, RHipRoll: 0.0,",
@@ -112,7 +134,7 @@ if os.environ.get("SQUAT_TAIL"):
             "  - duration: 1.0", "    pose: stand"]
 
 def run(side, motions_dir, seed):
-    p = subprocess.run([SIM, "bench", "motion", "--get-up", side, "--seed", str(seed), "--motions",
+    p = subprocess.run([SIM, "bench", "motion", "--robot", ROBOT, "--get-up", side, "--seed", str(seed), "--motions",
                         motions_dir, "--verbose"], capture_output=True, text=True)
     rows = []
     for line in p.stderr.splitlines():
@@ -135,7 +157,7 @@ def run(side, motions_dir, seed):
             score += 2.0 + max(-1.0, min(0.5, 0.5 * (8.0 - float(ok.group(1)))))
         return score, success
     window = rows[start:min(len(rows), end + 15)]
-    h = [min(r[2], 0.33) / 0.33 * (0.4 + 0.6 * max(r[3], 0.0)) for r in window]
+    h = [min(r[2], STAND_HEIGHT) / STAND_HEIGHT * (0.4 + 0.6 * max(r[3], 0.0)) for r in window]
     last = h[-10:]
     score = 0.5 * max(h) + 0.5 * sum(last) / len(last)
     success = bool(ok) and float(ok.group(1)) < 8.0

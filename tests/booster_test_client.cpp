@@ -108,11 +108,13 @@ int main(int argc, char** argv) {
   uint32_t domain = 0;
   std::string config;
   int periods = 300;
+  double walk = 0.0;  // --walk V: walk with Booster's locomotion API at V m/s instead
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--domain") domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
     else if (a == "--dds-config") config = argv[i + 1];
     else if (a == "--periods") periods = std::stoi(argv[i + 1]);
+    else if (a == "--walk") walk = std::stod(argv[i + 1]);
   }
   if (!config.empty()) {
     std::ifstream f(config);
@@ -171,6 +173,26 @@ int main(int argc, char** argv) {
   const json mode = rpc.api(2017, json::object());
   expect("get_mode_first", mode, 0);
   if (json::parse(mode.at("body").get<std::string>()).at("mode") != 1) ok = false;
+  if (walk != 0.0) {
+    // As team code that uses Booster's walk: walking mode, the head turned, Move repeated at
+    // about 50 Hz (every 2 LowStates of a 10 ms period) for `periods` LowStates, then a stop.
+    expect("walking", rpc.api(2000, {{"mode", 2}}), 0);
+    expect("head", rpc.api(2004, {{"pitch", 0.1}, {"yaw", 0.3}}), 0);
+    for (int k = 0; k < periods; ++k) {
+      if (k % 2 == 0 && rpc.api(2001, {{"vx", walk}, {"vy", 0.0}, {"vyaw", 0.0}}).at("status") != 0)
+        ok = false;
+      if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+    }
+    expect("stop", rpc.api(2001, {{"vx", 0.0}, {"vy", 0.0}, {"vyaw", 0.0}}), 0);
+    const json walking = rpc.api(2017, json::object());
+    expect("get_mode_walking", walking, 0);
+    if (json::parse(walking.at("body").get<std::string>()).at("mode") != 2) ok = false;
+    out["ok"] = ok;
+    std::printf("%s\n", out.dump().c_str());
+    std::fflush(stdout);
+    dds_delete(g_participant);
+    return ok ? 0 : 1;
+  }
   expect("walking", rpc.api(2000, {{"mode", 2}}), 501);
   expect("mode_out_of_range", rpc.api(2000, {{"mode", 9}}), 400);
   expect("garbage_header", rpc.call("{not json", "{}"), 400);

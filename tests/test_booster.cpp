@@ -157,6 +157,38 @@ TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
   EXPECT_TRUE(w.isStanding(0));
 }
 
+// Team code that uses Booster's walk: WALKING mode and Move, answered by simsoccer's own K1
+// walk (configs/motions/booster_k1); the robot walks forward, its head turned as asked.
+TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
+  booster::BoosterRobot robot = served(0, 174);
+  robot.motions = test::sourceDir() / "configs/motions/booster_k1";
+  ServedK1 k1(robot, /*lockstep=*/false);
+  auto& [w, simulation, endpoint] = k1;
+  const engine::Vec3 start = w.torsoPose(0).translation();
+  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "174", "--dds-config",
+                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
+                        "600", "--walk", "0.3"});
+  ASSERT_TRUE(client.process.started());
+  const int status = runUntilTheClientEnds(simulation, endpoint, client);
+  const json r = client.result();
+  std::printf("client: %s\n", r.dump().c_str());
+  ASSERT_EQ(status, 0) << r.dump();
+  const engine::Pose torso = w.torsoPose(0);
+  const engine::Vec3 moved = torso.translation() - start;
+  const auto s = endpoint.stats(0);
+  std::printf("walked %.2f m forward, %.2f m sideways in %.1f s; requests %llu\n", moved.x(),
+              moved.y(), w.time(), (unsigned long long)s.requests);
+  EXPECT_EQ(s.mode, booster::RobotMode::Walking);
+  EXPECT_EQ(s.requests_refused, 0u);
+  EXPECT_EQ(s.requests_malformed, 0u);
+  // 6 s of LowStates at 0.3 m/s, the walk's speed ramp and the stop included.
+  EXPECT_GT(moved.x(), 1.0);
+  EXPECT_LT(std::abs(moved.y()), 0.3);
+  EXPECT_TRUE(w.isStanding(0));
+  const int head = w.robot(0).model->body->jointIndex("HeadYaw");
+  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.3, 0.05);
+}
+
 // Two robots cannot share a domain (the SDK's topics carry no robot id), and
 // a robot is served once.
 TEST(BoosterEndpoint, OneRobotPerDomain) {

@@ -26,11 +26,11 @@ TEST(BoosterLoco, ModesAsTheSdkNamesThem) {
   EXPECT_EQ(json::parse(call(s, 2017, json::object()).body).at("mode"), 3);
   EXPECT_EQ(call(s, 2000, {{"mode", 0}}).status, kStatusSuccess);
   EXPECT_EQ(s.mode(), RobotMode::Damping);
-  // Walking and soccer need Booster's walk: refused, the mode stays.
+  // Walking and soccer need a walk, which this robot has not: refused, the mode stays.
   for (int m : {2, 4}) {
     a = call(s, 2000, {{"mode", m}});
     EXPECT_EQ(a.status, kStatusServerRefused) << m;
-    EXPECT_NE(a.body.find("walking controller"), std::string::npos) << a.body;
+    EXPECT_NE(a.body.find("has no walk"), std::string::npos) << a.body;
     EXPECT_EQ(s.mode(), RobotMode::Damping);
   }
   EXPECT_EQ(s.refused(), 2u);
@@ -70,4 +70,38 @@ TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
   EXPECT_EQ(s.mode(), RobotMode::Custom);
   // GetMode may come with an empty body.
   EXPECT_EQ(s.handle(R"({"api_id": 2017, "expect_response": true})", "").status, kStatusSuccess);
+}
+
+// A robot with simsoccer's walk (the K1): Walking and Soccer are served, Move sets the walk's
+// velocity there and only there, the head turns, GetUp is the walk's own fall recovery.
+TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
+  LocoService s(RobotMode::Prepare, /*walk=*/true);
+  EXPECT_FALSE(s.walking());
+  // Move and GetUp outside walking and soccer: refused, nothing changes.
+  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", 0.0}, {"vyaw", 0.0}}).status, kStatusServerRefused);
+  EXPECT_EQ(call(s, 2008, json::object()).status, kStatusServerRefused);
+  EXPECT_EQ(s.velocity().vx, 0.0);
+  EXPECT_EQ(call(s, 2000, {{"mode", 2}}).status, kStatusSuccess);
+  EXPECT_TRUE(s.walking());
+  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", -0.1}, {"vyaw", 0.5}}).status, kStatusSuccess);
+  EXPECT_DOUBLE_EQ(s.velocity().vx, 0.3);
+  EXPECT_DOUBLE_EQ(s.velocity().vy, -0.1);
+  EXPECT_DOUBLE_EQ(s.velocity().vyaw, 0.5);
+  EXPECT_EQ(call(s, 2004, {{"pitch", 0.3}, {"yaw", 0.2}}).status, kStatusSuccess);
+  ASSERT_TRUE(s.headTarget());
+  EXPECT_EQ(call(s, 2008, json::object()).status, kStatusSuccess);
+  // Walking to soccer keeps walking at the same velocity; a bad Move changes nothing.
+  EXPECT_EQ(call(s, 2000, {{"mode", 4}}).status, kStatusSuccess);
+  EXPECT_DOUBLE_EQ(s.velocity().vx, 0.3);
+  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", "fast"}, {"vyaw", 0.0}}).status, kStatusBadRequest);
+  EXPECT_EQ(call(s, 2001, {{"vx", 1e9}, {"vy", 0.0}, {"vyaw", 0.0}}).status, kStatusBadRequest);
+  EXPECT_DOUBLE_EQ(s.velocity().vx, 0.3);
+  // Kicks are not served yet; LieDown neither.
+  EXPECT_EQ(call(s, 2038, {{"start", true}}).status, kStatusServerRefused);
+  EXPECT_EQ(call(s, 2007, json::object()).status, kStatusServerRefused);
+  // Back to prepare: standing, the velocity forgotten; walking again starts from rest.
+  EXPECT_EQ(call(s, 2000, {{"mode", 1}}).status, kStatusSuccess);
+  EXPECT_FALSE(s.walking());
+  EXPECT_EQ(call(s, 2000, {{"mode", 2}}).status, kStatusSuccess);
+  EXPECT_EQ(s.velocity().vx, 0.0);
 }

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
+#include "cli.hpp"
 #include "simsoccer/match/match_session.hpp"
 
 namespace simsoccer::apps {
@@ -90,6 +92,11 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
     booster::BoosterRobot b;
     b.robot = robots[i];
     b.domain = base + static_cast<uint32_t>(i);
+    // The robot's own walk for the locomotion service's Walking and Soccer modes, where
+    // simsoccer has motions for its model (configs/motions/booster_k1).
+    const std::filesystem::path motions =
+        findConfig("", "configs/motions/" + w.robot(b.robot).model->name);
+    if (std::filesystem::is_directory(motions)) b.motions = motions;
     if (netns) {
       // Its own namespace on the field network (a killed run's is replaced);
       // DDS stays on the namespace's loopback.

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "booster_sdk.h"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/net/dds.hpp"
 
 namespace simsoccer::booster {
@@ -71,6 +72,10 @@ struct Endpoint::Robot {
   bool unresponsive = false;
   dds_entity_t command_condition = 0;  // data on rt/joint_ctrl (owned by the reader)
   const std::vector<double>* stand = nullptr;  // the model's stand pose
+  // Walking and Soccer: simsoccer's walk (the built-in agents' motion layer),
+  // made on first use and restarted from the measured joints on each entry.
+  std::unique_ptr<agents::MotionController> motion;
+  bool was_walking = false;
 
   // LowState buffers (the sample points at them) and the last joint speeds.
   std::vector<MotorState> motors;
@@ -79,7 +84,7 @@ struct Endpoint::Robot {
   int fall_state = -1;
   double fall_sent_at = -1e9;
 
-  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds)
+  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds, bool walk)
       : config(c),
         actuators(n),
         participant(dds),
@@ -95,7 +100,7 @@ struct Endpoint::Robot {
                 qos(true, 10, true)),
         fall(participant, booster_interface_msg_dds__FallDownState__desc, "rt/fall_down",
              qos(true, 1)),
-        loco(c.initial_mode),
+        loco(c.initial_mode, walk),
         pending_pool(kMaxPending, Command{std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n)}),
@@ -127,12 +132,13 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
                                   " is beyond 230 (the RTPS port mapping)");
     const robots::RobotModel& model = *world.robot(b.robot).model;
     const std::vector<double>& stand = model.pose("stand");  // throws if the model has none
+    const bool walk = !b.motions.empty();
     net::DomainConfig dds;
     dds.domain = b.domain;
     dds.config_file = config_.dds_config;
     std::unique_ptr<Robot> r;
     if (b.network_namespace.empty()) {
-      r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+      r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk);
     } else {
       // Cyclone opens the domain's sockets and starts its threads when the
       // domain is made: made on a thread inside the namespace, they stay
@@ -150,7 +156,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
           if (rc != 0)
             throw std::runtime_error("Booster endpoint: cannot enter network namespace " +
                                      b.network_namespace + " (needs CAP_SYS_ADMIN)");
-          r = std::make_unique<Robot>(b, model.actuators.size(), dds);
+          r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk);
         } catch (...) {
           failed = std::current_exception();
         }
@@ -324,7 +330,8 @@ void Endpoint::observe(const sim::Observation& o) {
     if (fallen != r.fall_state || o.time - r.fall_sent_at >= config_.fall_down_interval) {
       FallDown fd{};
       fd.fall_down_state = static_cast<booster_interface_msg_dds__FallDownStateType>(fallen);
-      fd.is_recovery_available = false;  // no get-up service (LocoService refuses GetUp)
+      // Walking and Soccer get up (the walk's fall detector); other modes do not.
+      fd.is_recovery_available = r.loco.walking();
       r.fall.write(fd);
       r.fall_state = fallen;
       r.fall_sent_at = o.time;
@@ -414,6 +421,35 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
 std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGate& gate) const {
   const robots::RobotModel& model = *world_.robot(r.config.robot).model;
   const size_t n = r.actuators;
+  const bool walking = r.loco.walking();
+  if (walking) {
+    // Walking and Soccer: simsoccer's walk at Move's velocity, the head
+    // where RotateHead turned it; from standing still it eases into the
+    // walk's stance (and after a fall it gets up).
+    if (!r.motion)
+      r.motion = std::make_unique<agents::MotionController>(
+          agents::loadMotionController(model, r.config.motions));
+    if (!r.was_walking) r.motion->restart();
+    r.was_walking = true;
+    const WalkVelocity& v = r.loco.velocity();
+    agents::MotionRequest request;
+    request.kind = v.vx == 0.0 && v.vy == 0.0 && v.vyaw == 0.0 ? agents::MotionRequest::Kind::Stand
+                                                               : agents::MotionRequest::Kind::Walk;
+    request.forward = v.vx;
+    request.left = v.vy;
+    request.turn = v.vyaw;
+    if (const auto& head = r.loco.headTarget()) {
+      request.head_yaw = head->yaw;
+      request.head_pitch = head->pitch;
+    }
+    std::array<float, world::kActuators> position{}, stiffness{};
+    r.motion->update(world_.scenario().physics.control_period,
+                     agents::motionSensors(world_.sensorFrame(r.config.robot)), request, position,
+                     stiffness);
+    return gate.check(r.config.robot, std::span<const float>(position),
+                      std::span<const float>(stiffness));
+  }
+  r.was_walking = false;
   if (r.loco.mode() == RobotMode::Prepare) {
     // Standing: the stand pose on the robot's own servos, the head where
     // RotateHead turned it (clamped to the joints' limits).

@@ -72,8 +72,13 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
   };
   const auto unavailable = [&](const std::string& what) {
     ++refused_;
-    a = error(kStatusServerRefused,
-              what + " needs Booster's walking controller, which simsoccer does not have yet");
+    a = error(kStatusServerRefused, what + " is not available in simsoccer" +
+                                        (walk_ ? "" : " for this robot (it has no walk)"));
+  };
+  const auto walkingOnly = [&](const char* what) {
+    ++refused_;
+    a = error(kStatusServerRefused, std::string(what) + ": the robot is in " + modeName(mode_) +
+                                        " mode, not walking or soccer");
   };
   if (!body) {
     bad("the body is not a JSON object");
@@ -85,11 +90,13 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
           bad("ChangeMode: \"mode\" must be 0..4 (damping, prepare, walking, custom, soccer)");
         } else {
           const auto mode = static_cast<RobotMode>(static_cast<int>(*m));
-          if (mode == RobotMode::Walking || mode == RobotMode::Soccer) {
+          if ((mode == RobotMode::Walking || mode == RobotMode::Soccer) && !walk_) {
             unavailable(std::string("the ") + modeName(mode) + " mode");
           } else {
+            const bool was_walking = walking();
             mode_ = mode;
-            if (mode_ != RobotMode::Prepare) head_.reset();
+            if (mode_ == RobotMode::Damping || mode_ == RobotMode::Custom) head_.reset();
+            if (!(was_walking && walking())) velocity_ = WalkVelocity{};
           }
         }
         break;
@@ -101,19 +108,37 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
         const std::optional<double> pitch = number(*body, "pitch"), yaw = number(*body, "yaw");
         if (!pitch || !yaw)
           bad("RotateHead: \"pitch\" and \"yaw\" must be numbers (rad)");
-        else if (mode_ != RobotMode::Prepare)
-          a = error(kStatusServerRefused, "RotateHead: simsoccer turns the head in prepare mode");
+        else if (mode_ != RobotMode::Prepare && !walking())
+          a = error(kStatusServerRefused,
+                    "RotateHead: simsoccer turns the head in prepare, walking and soccer mode");
         else
           head_ = HeadTarget{*pitch, *yaw};
         break;
       }
-      case LocoApi::Move:
-        unavailable("Move");
+      case LocoApi::Move: {
+        const std::optional<double> vx = number(*body, "vx"), vy = number(*body, "vy"),
+                                    vyaw = number(*body, "vyaw");
+        if (!walk_)
+          unavailable("Move");
+        else if (!vx || !vy || !vyaw || std::abs(*vx) > 10 || std::abs(*vy) > 10 ||
+                 std::abs(*vyaw) > 20)
+          bad("Move: \"vx\", \"vy\" (m/s) and \"vyaw\" (rad/s) must be numbers of a walk");
+        else if (!walking())
+          walkingOnly("Move");
+        else
+          velocity_ = WalkVelocity{*vx, *vy, *vyaw};  // the walk clamps to what it can
         break;
-      case LocoApi::LieDown:
+      }
       case LocoApi::GetUp:
       case LocoApi::GetUpWithMode:
-        unavailable("Getting up and lying down");
+        if (!walk_)
+          unavailable("Getting up");
+        else if (!walking())
+          walkingOnly("GetUp");
+        // else: the walk's fall detector gets the robot up once it lies still.
+        break;
+      case LocoApi::LieDown:
+        unavailable("Lying down");
         break;
       case LocoApi::Shoot:
       case LocoApi::VisualKick:

@@ -124,6 +124,8 @@ GetUpResult getUpTrial(const TrialContext& c, bool front, uint64_t seed,
   std::vector<cv::Mat> tiles;
   if (!snapshots.empty()) renderer = std::make_unique<engine::OffscreenRenderer>();
   const Vec3 side(-std::sin(yaw), std::cos(yaw), 0.0);
+  // The view's distance and aim scale with the robot (a Nao's stance: 0.9 m away, 0.2 m up).
+  const double size = model.soleDepth(model.pose("stand")) / 0.31;
   for (int i = 0; i < 1200; ++i) {
     t.period();
     if (c.verbose && i % 10 == 0) {
@@ -138,9 +140,9 @@ GetUpResult getUpTrial(const TrialContext& c, bool front, uint64_t seed,
     }
     if (renderer && i % 20 == 0 && i >= 20 && tiles.size() < 36) {
       const Vec3 centre = w.torsoPose(0).translation();
-      const Vec3 at(centre.x(), centre.y(), 0.2);
+      const Vec3 at(centre.x(), centre.y(), 0.2 * size);
       const engine::RenderView view =
-          engine::pinholeView(world::lookAtPose(at + 0.9 * side, at), 320, 240, 0.75, 0.57);
+          engine::pinholeView(world::lookAtPose(at + 0.9 * size * side, at), 320, 240, 0.75, 0.57);
       std::vector<engine::DrawItem> scene;
       world::buildRenderScene(w, scene);
       renderer->render(scene, std::span<const engine::RenderView>(&view, 1));

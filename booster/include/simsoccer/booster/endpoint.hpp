@@ -10,7 +10,8 @@
 //                         period gives the robot's 500 Hz)
 //   rt/joint_ctrl         LowCmd_ in: obeyed in CUSTOM mode, SERIAL command
 //                         type, per joint q, dq, tau, kp, kd
-//   rt/LocoApiTopicReq    RpcReqMsg_ in (LocoService: modes, head)
+//   rt/LocoApiTopicReq    RpcReqMsg_ in (LocoService: modes, head, Move: in
+//                         Walking and Soccer simsoccer's own walk drives)
 //   rt/LocoApiTopicResp   RpcRespMsg_ out (reliable, transient-local: the
 //                         C++ SDK's volatile and the Rust SDK's
 //                         transient-local readers both match)
@@ -49,6 +50,10 @@ struct BoosterRobot {
   // process knows the robot's domain by (unique). Needs CAP_SYS_ADMIN.
   std::string network_namespace;
   uint32_t namespace_domain = 0;
+  // The robot's motions folder (keyframes and gait.yaml, e.g.
+  // configs/motions/booster_k1): simsoccer's walk for the locomotion
+  // service's Walking and Soccer modes. Empty: those modes answer 501.
+  std::filesystem::path motions;
 };
 
 struct EndpointConfig {
@@ -107,7 +112,8 @@ class Endpoint : public sim::CommandSource {
   struct Robot;
   void answerRequests(Robot& r);
   void publishImage(const world::CameraImage& image);
-  // The command of robot r's mode outside CUSTOM (prepare: stand, damping).
+  // The command of robot r's mode outside CUSTOM (prepare: stand; damping;
+  // walking and soccer: the walk).
   std::optional<sim::RobotCommand> modeCommand(Robot& r, sim::CommandGate& gate) const;
   const world::World& world_;
   EndpointConfig config_;

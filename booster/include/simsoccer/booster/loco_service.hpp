@@ -5,11 +5,14 @@
 //
 // Modes (RobotMode): Damping (joints limp but damped), Prepare (standing,
 // holding the stand pose: the robot's own position servos), Custom (the
-// client's LowCmd joint commands, rt/joint_ctrl). Walking and Soccer need
-// Booster's walking controller, which runs only on Booster's tools: they,
-// Move, GetUp, kicks and the other motion calls are refused with status 501
-// (server refused) until simsoccer has its own K1 walk. Malformed requests
-// get 400; unknown api ids 400.
+// client's LowCmd joint commands, rt/joint_ctrl), Walking and Soccer
+// (Booster's walking controller, which runs only on Booster's tools: here
+// simsoccer's own walk for the robot, the built-in agents' motion layer,
+// where the robot has one). Move sets the walk's velocity in Walking and
+// Soccer; RotateHead turns the head in Prepare, Walking and Soccer; GetUp
+// answers 0 there (the walk's fall detector gets the robot up once it lies
+// still). Kicks, LieDown and the other motion calls are refused with status
+// 501 (server refused). Malformed requests get 400; unknown api ids 400.
 #pragma once
 
 #include <cstdint>
@@ -54,16 +57,27 @@ struct HeadTarget {
   double pitch = 0.0, yaw = 0.0;  // rad
 };
 
+// Move's velocity in the robot frame: m/s forward, m/s left, rad/s.
+struct WalkVelocity {
+  double vx = 0.0, vy = 0.0, vyaw = 0.0;
+};
+
 class LocoService {
  public:
-  explicit LocoService(RobotMode initial = RobotMode::Prepare) : mode_(initial) {}
+  // `walk`: the robot has simsoccer's walk (Walking and Soccer are served).
+  explicit LocoService(RobotMode initial = RobotMode::Prepare, bool walk = false)
+      : mode_(initial), walk_(walk) {}
 
   // One request: its header and body as the client sent them (any bytes).
   RpcAnswer handle(std::string_view header, std::string_view body);
 
   RobotMode mode() const { return mode_; }
-  // The head turn RotateHead asked for (held in Prepare), if any.
+  // The head turn RotateHead asked for (held in Prepare, Walking, Soccer), if any.
   const std::optional<HeadTarget>& headTarget() const { return head_; }
+  // Walking or Soccer: simsoccer's walk drives the robot.
+  bool walking() const { return mode_ == RobotMode::Walking || mode_ == RobotMode::Soccer; }
+  // The velocity of the last Move (zero on entering Walking or Soccer).
+  const WalkVelocity& velocity() const { return velocity_; }
 
   uint64_t requests() const { return requests_; }
   uint64_t refused() const { return refused_; }      // 501: not available in simsoccer
@@ -71,7 +85,9 @@ class LocoService {
 
  private:
   RobotMode mode_;
+  bool walk_ = false;
   std::optional<HeadTarget> head_;
+  WalkVelocity velocity_;
   uint64_t requests_ = 0, refused_ = 0, malformed_ = 0;
 };
 
