@@ -148,6 +148,43 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
   EXPECT_EQ(rows.at("sit_and_stand")[6], "0");
 }
 
+// The Booster K1's table (configs/bench/motion_booster_k1.yaml): the 0.5 m/s over 5 m,
+// sideways and random walking without a fall, kicks of 4 m with the size 3 ball.
+TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondAndKicksFourMetres) {
+  const test::BenchRun run = test::runBench(
+      SIMSOCCER_BIN,
+      "bench motion --robot booster_k1 --random-minutes 1 --get-up-trials 1 --sit-trials 1 "
+      "--striker-trials 1 --penalty-trials 1 --block-trials 1");
+  ASSERT_EQ(run.status, 0) << run.out;
+  EXPECT_NE(run.out.find("one booster_k1 on an empty field (hsl_m.yaml)"), std::string::npos)
+      << run.out;
+  std::map<std::string, std::vector<std::string>> rows;
+  for (size_t i = 1; i < run.lines.size(); ++i) {
+    std::vector<std::string> cells;
+    std::stringstream ss(run.lines[i]);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    ASSERT_EQ(cells.size(), 8u) << run.lines[i];
+    rows[cells[1]] = cells;
+  }
+  ASSERT_EQ(rows.size(), 13u);
+  EXPECT_EQ(rows.at("walk_forward")[2], "0.500");
+  EXPECT_GE(std::stod(rows.at("walk_forward")[3]), 0.49);
+  EXPECT_GE(std::stod(rows.at("walk_sideways")[3]), 0.15);
+  for (const char* t : {"walk_forward", "walk_sideways", "turn", "random_commands"})
+    EXPECT_EQ(rows.at(t)[6], "0") << t;
+  EXPECT_LT(std::stod(rows.at("walk_forward")[5]), 10.0);
+  EXPECT_EQ(rows.at("kick_distance")[2], "4.000");
+  EXPECT_GE(std::stod(rows.at("kick_distance")[3]), 4.0);
+  EXPECT_GE(std::stod(rows.at("kick_success")[3]), 0.9);
+  EXPECT_EQ(rows.at("kick_distance")[6], "0");
+  // A robot without a motion bench is named.
+  int status = 0;
+  const std::string out =
+      test::runCommand(std::string(SIMSOCCER_BIN) + " bench motion --robot nao_h99 2>&1", status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("--robot nao_h99"), std::string::npos) << out;
+}
+
 // The get-up tuning aids: another motions folder, the side-view snapshots
 // (real EGL rendering, tiled), the support trace; a bad motion file is named.
 TEST(BenchMotionApp, GetUpTuningTraceSnapshotsAndMotionsFolder) {

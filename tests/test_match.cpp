@@ -448,6 +448,28 @@ TEST(BenchScalingApp, OneAndTwoRobotsWriteCsvAndPlot) {
   EXPECT_GT(std::filesystem::file_size(dir / "scaling.png"), 1000u);
 }
 
+// Booster K1s (--robot booster_k1): their agent processes get the K1's model, gait, motions
+// and agent config, and answer every period.
+TEST(BenchScalingApp, BoosterK1AgentsOnTheMField) {
+  const test::TempDir dir("scaling_k1");
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " bench scaling --robot booster_k1 --robots 2 --seconds 3 --modes serial --domain 143 "
+             "--csv " + (dir / "scaling.csv").string() + " --png " + (dir / "scaling.png").string(),
+      status);
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("booster_k1"), std::string::npos) << out;
+  const auto lines = test::readLines(dir / "scaling.csv");
+  ASSERT_EQ(lines.size(), 2u);
+  const auto header = test::splitCsv(lines[0]), cells = test::splitCsv(lines[1]);
+  const auto missed = std::find(header.begin(), header.end(), "missed") - header.begin();
+  ASSERT_LT(static_cast<size_t>(missed), cells.size());
+  EXPECT_EQ(cells[static_cast<size_t>(missed)], "0") << lines[1];
+  EXPECT_NE(test::runCommand(kBin + " bench scaling --robot nao_h99 2>&1", status).find("nao_h99"),
+            std::string::npos);
+  EXPECT_NE(status, 0);
+}
+
 // `serve` given a match config, with the agents the match would start (the
 // match library's command lines), plays the same game as `match`: the same
 // config and seed give the same final state hash, and twice the same.

@@ -18,6 +18,12 @@ MotionController loadMotionController(const robots::RobotModel& model,
       gait.walk, gait.kick, fall);
 }
 
+std::filesystem::path motionsFolder(const std::filesystem::path& root,
+                                    const robots::RobotModel& model) {
+  const std::filesystem::path own = root / model.name;
+  return std::filesystem::is_directory(own) ? own : root;
+}
+
 namespace {
 FallDetectorParameters fallParameters(bool get_up) {
   FallDetectorParameters f;

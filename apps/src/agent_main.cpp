@@ -46,7 +46,9 @@ const char* kHelp =
     "                   penalty-kicker or penalty-goalkeeper. Needs perception on in the\n"
     "                   scenario; obeys the GameState (team number --team-number, default T+1).\n"
     "                   --config: the behaviour (default configs/agents/soccer.yaml); --field:\n"
-    "                   the field (default fields/spl.yaml). After a fall the robot gets up\n"
+    "                   the field (default fields/spl.yaml). --robot: the robot model (default\n"
+    "                   robots/nao_v6_h25.yaml; its motions and gait from configs/motions/NAME/\n"
+    "                   where there is one, e.g. booster_k1). After a fall the robot gets up\n"
     "                   (from the back: rolls onto its front first); --no-get-up: it stays\n"
     "                   down, soft (--get-up, the default, is accepted)\n"
     "Without --role, --mode (default nod): the stand pose and a nodding head (0.2 rad at 0.5 Hz).\n"
@@ -137,7 +139,7 @@ int main(int argc, char** argv) {
           agents::loadBehaviourConfig(
               apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml")),
           fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml")),
-          apps::findConfig("", "configs/motions"), setup);
+          agents::motionsFolder(apps::findConfig("", "configs/motions"), model), setup);
     }
     const bool verbose = opt.flag("verbose");
     std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);

@@ -3,6 +3,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "cli.hpp"
+#include "simsoccer/agents/motion/gait.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/protocol/wire.hpp"
 
 namespace simsoccer::apps {
@@ -16,7 +19,10 @@ SimpleModes::SimpleModes(const robots::RobotModel& model, std::string mode, doub
       turn_(turn),
       position_(protocol::kActuators, 0.0f),
       stiffness_(protocol::kActuators, 1.0f),
-      walk_(model),
+      // The robot's gait (configs/motions/NAME/gait.yaml where it has one).
+      walk_(model,
+            agents::loadGaitIn(agents::motionsFolder(findConfig("", "configs/motions"), model))
+                .walk),
       targets_(model.pose("stand")) {
   const auto& stand = model.pose("stand");
   for (size_t a = 0; a < model.actuators.size() && a < protocol::kActuators; ++a) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_motion/trial.hpp"
 #include "cli.hpp"
 #include "scaling_plot.hpp"
 #include "simsoccer/match/agent_process.hpp"
@@ -25,13 +26,14 @@ namespace {
 using namespace simsoccer::match;
 
 const char* kHelp =
-    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--seconds S] [--cameras]\n"
+    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--robot R] [--seconds S] [--cameras]\n"
     "                               [--modes serial,pipelined] [--threads N] [--csv FILE]\n"
     "                               [--png FILE] [--domain D]\n"
     "\n"
     "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
-    "3D-league-sized field beyond), perception on, the automatic referee (simleague rule book),\n"
-    "and N simsoccer-agent processes (--role auto: walking, kicking, team messages) over\n"
+    "3D-league-sized field beyond; --robot booster_k1: K1s on the HSL M-Field with their agent\n"
+    "config, from configs/bench/motion_R.yaml), perception on, the automatic referee (simleague\n"
+    "rule book), and N simsoccer-agent processes (--role auto: walking, kicking, team messages) over\n"
     "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
     "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
     "the answers to this period's frames) and pipelined (with the answers to the last\n"
@@ -55,12 +57,21 @@ struct Row {
   double cpu_ms = -1;  // CPU time of the simulator and all agents per period (-1: unknown)
 };
 
-world::Scenario scalingScenario(int n, bool cameras, int threads) {
+// The robot: a Nao on the SPL field (the 3D-league-sized field beyond 14 robots) with the
+// default agent config, or another robot with its motion bench's field and agent config
+// (configs/bench/motion_<robot>.yaml: the K1 on the HSL M-Field).
+struct ScalingRobot {
+  std::filesystem::path robot_model, field, agents;  // empty field: the Nao's choice
+};
+
+world::Scenario scalingScenario(int n, bool cameras, int threads, const ScalingRobot& robot) {
   world::Scenario s;
   s.name = "bench_scaling";
   const bool large = n > 14;
-  s.field_file = findConfig("", large ? "fields/simleague.yaml" : "fields/spl.yaml");
-  s.robot_model_file = findConfig("", "robots/nao_v6_h25.yaml");
+  s.field_file = !robot.field.empty()
+                     ? robot.field
+                     : findConfig("", large ? "fields/simleague.yaml" : "fields/spl.yaml");
+  s.robot_model_file = robot.robot_model;
   s.seed = 1;
   s.perception.enabled = true;
   s.perception.realistic = true;
@@ -86,8 +97,9 @@ world::Scenario scalingScenario(int n, bool cameras, int threads) {
   return s;
 }
 
-Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uint32_t domain) {
-  world::Scenario s = scalingScenario(n, cameras, threads);
+Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uint32_t domain,
+           const ScalingRobot& robot) {
+  world::Scenario s = scalingScenario(n, cameras, threads, robot);
   world::World w(s);
   sim::SimulationConfig simc;
   simc.mode = mode;
@@ -111,6 +123,8 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uin
     ao.player = w.robot(r).number;
     ao.domain = domain;
     ao.field = s.field_file;
+    ao.robot = w.robot(r).model->source_file;
+    ao.config = robot.agents;
     agents.push_back(std::make_unique<ChildProcess>(soccerAgentCommand(ao)));
   }
   const auto t_wait = Clock::now();
@@ -154,7 +168,7 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uin
 
 int benchScaling(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "cameras"},
-                    {"robots", "seconds", "csv", "png", "domain", "modes", "threads"});
+                    {"robots", "seconds", "csv", "png", "domain", "modes", "threads", "robot"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
@@ -178,12 +192,24 @@ int benchScaling(int argc, char** argv, int first) {
       start = comma + 1;
     }
   }
+  ScalingRobot robot;
+  const std::string robot_name = opt.get("robot", "nao_v6_h25");
+  if (robot_name == "nao_v6_h25") {
+    robot.robot_model = findConfig("", "robots/nao_v6_h25.yaml");
+  } else {
+    const std::filesystem::path bench = findConfig("", "configs/bench/motion_" + robot_name + ".yaml");
+    if (!std::filesystem::exists(bench))
+      throw UsageError("--robot " + robot_name + ": no " + bench.string() +
+                       " (robots: nao_v6_h25, booster_k1)");
+    const motion::MotionBench b = motion::loadMotionBench(bench);
+    robot = {b.robot_model, b.field, b.agents};
+  }
   const auto domain = opt.domain("domain", 43);
   const std::filesystem::path png = opt.get("png", "scaling.png");
   std::printf(
-      "simsoccer bench scaling: full pipeline (physics, sensors, perception, DDS lockstep with N "
-      "soccer agent processes, referee%s), %.0f s simulated per row\n",
-      cameras ? ", cameras" : "", seconds);
+      "simsoccer bench scaling: %s, full pipeline (physics, sensors, perception, DDS lockstep "
+      "with N soccer agent processes, referee%s), %.0f s simulated per row\n",
+      robot_name.c_str(), cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
   table.header = {"robots",     "mode",       "steps_per_s",  "fps",
@@ -192,7 +218,7 @@ int benchScaling(int argc, char** argv, int first) {
   std::vector<Row> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {
-      const Row r = runRow(n, seconds, cameras, mode, threads, domain);
+      const Row r = runRow(n, seconds, cameras, mode, threads, domain, robot);
       rows.push_back(r);
       if (mode == modes.back()) plotted.push_back(r);
       table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),

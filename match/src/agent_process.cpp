@@ -80,6 +80,7 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
                              std::to_string(o.game_state_wait)};
   if (o.team_number) a.insert(a.end(), {"--team-number", std::to_string(*o.team_number)});
   if (o.seed) a.insert(a.end(), {"--seed", std::to_string(*o.seed)});
+  if (!o.robot.empty()) a.insert(a.end(), {"--robot", o.robot.string()});
   if (!o.config.empty()) a.insert(a.end(), {"--config", o.config.string()});
   if (!o.dds_config.empty()) a.insert(a.end(), {"--dds-config", o.dds_config.string()});
   if (!o.get_up) a.push_back("--no-get-up");

@@ -26,7 +26,8 @@ InProcessAgents::InProcessAgents(const world::World& world, const InProcessSetup
     s.seed = setup.seed * 131 + r;
     s.get_up = setup.get_up;
     agents_.push_back(
-        std::make_unique<SoccerAgent>(*info.model, config, world.field(), setup.motions_dir, s));
+        std::make_unique<SoccerAgent>(*info.model, config, world.field(),
+                                      motionsFolder(setup.motions_dir, *info.model), s));
   }
 }
 

@@ -88,6 +88,10 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
                                    : net::credentialConfig(o.secure, net::teamIdentity(team));
   ao.role = c.role;
   ao.field = session.world().scenario().field_file;
+  for (world::RobotId r = 0; r < session.world().robotCount(); ++r) {
+    const auto& info = session.world().robot(r);
+    if (info.team == team && info.number == number) ao.robot = info.model->source_file;
+  }
   ao.config = c.agent_config;
   ao.team_number = c.team_numbers[static_cast<size_t>(team)];
   ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);

@@ -22,6 +22,12 @@ MotionController loadMotionController(const robots::RobotModel& model,
                                       const std::filesystem::path& motions_dir,
                                       const FallDetectorParameters& fall = {});
 
+// A robot's motions folder under `root` (configs/motions): root/<model name>
+// where that folder exists (configs/motions/booster_k1), else root itself
+// (the Nao's motions).
+std::filesystem::path motionsFolder(const std::filesystem::path& root,
+                                    const robots::RobotModel& model);
+
 struct SoccerAgentSetup {
   int team = 0, team_number = 1, player = 1;
   Role role = Role::Auto;

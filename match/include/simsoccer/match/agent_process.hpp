@@ -46,6 +46,7 @@ struct SoccerAgentOptions {
   int team = 0, player = 0, domain = 0;
   std::string role = "auto";
   std::filesystem::path field;
+  std::filesystem::path robot;       // the robot model's file; empty: the agent's default (Nao)
   std::filesystem::path config;      // empty: the agent's default
   std::filesystem::path dds_config;  // Cyclone configuration; empty: the agent's default
   std::optional<int> team_number;    // GameController team number
