@@ -170,6 +170,14 @@ int main(int argc, char** argv) {
     out[what] = answer;
     if (answer.at("status") != status) ok = false;
   };
+  // The result as one JSON line; the exit status says whether every answer was as expected.
+  const auto finish = [&] {
+    out["ok"] = ok;
+    std::printf("%s\n", out.dump().c_str());
+    std::fflush(stdout);
+    dds_delete(g_participant);
+    return ok ? 0 : 1;
+  };
   const json mode = rpc.api(2017, json::object());
   expect("get_mode_first", mode, 0);
   if (json::parse(mode.at("body").get<std::string>()).at("mode") != 1) ok = false;
@@ -187,11 +195,7 @@ int main(int argc, char** argv) {
     const json walking = rpc.api(2017, json::object());
     expect("get_mode_walking", walking, 0);
     if (json::parse(walking.at("body").get<std::string>()).at("mode") != 2) ok = false;
-    out["ok"] = ok;
-    std::printf("%s\n", out.dump().c_str());
-    std::fflush(stdout);
-    dds_delete(g_participant);
-    return ok ? 0 : 1;
+    return finish();
   }
   expect("walking", rpc.api(2000, {{"mode", 2}}), 501);
   expect("mode_out_of_range", rpc.api(2000, {{"mode", 9}}), 400);
@@ -239,9 +243,5 @@ int main(int argc, char** argv) {
   const json custom = rpc.api(2017, json::object());
   expect("get_mode_custom", custom, 0);
   if (json::parse(custom.at("body").get<std::string>()).at("mode") != 3) ok = false;
-  out["ok"] = ok;
-  std::printf("%s\n", out.dump().c_str());
-  std::fflush(stdout);
-  dds_delete(g_participant);
-  return ok ? 0 : 1;
+  return finish();
 }

@@ -81,6 +81,7 @@ const std::vector<Field<KickParameters>>& kickFields() {
       {"retract_time", &K::retract_time, Range::Positive},
       {"lower_time", &K::lower_time, Range::Positive},
       {"return_time", &K::return_time, Range::Positive},
+      {"settle_time", &K::settle_time, Range::NonNegative},
       {"hip_roll_compensation", &K::hip_roll_compensation, Range::Any},
       {"swing_height", &K::swing_height, Range::Any}};
   return f;

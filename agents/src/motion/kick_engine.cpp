@@ -29,17 +29,18 @@ void KickEngine::start(Leg foot) {
 
 double KickEngine::duration() const {
   return p_.shift_time + p_.lift_time + p_.swing_time + p_.retract_time + p_.lower_time +
-         p_.return_time;
+         p_.return_time + p_.settle_time;
 }
 
 void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets) {
-  const std::array<Key, 7> keys{{{0, 0, 0, 0},
+  const std::array<Key, 8> keys{{{0, 0, 0, 0},
                                  {1, 0, 0, p_.shift_time},
                                  {1, -p_.draw_back, p_.lift, p_.lift_time},
                                  {1, p_.reach, p_.swing_height, p_.swing_time},
                                  {1, 0, p_.lift, p_.retract_time},
                                  {1, 0, 0, p_.lower_time},
-                                 {0, 0, 0, p_.return_time}}};
+                                 {0, 0, 0, p_.return_time},
+                                 {0, 0, 0, p_.settle_time}}};
   if (active_) t_ += dt;
   // Where in the keyframes we are.
   double shift = 0, along = 0, up = 0, t = t_;

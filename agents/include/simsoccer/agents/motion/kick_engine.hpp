@@ -28,6 +28,9 @@ struct KickParameters {
   double retract_time = 0.3;  // s
   double lower_time = 0.3;    // s
   double return_time = 0.6;   // s
+  // s held in the stance after the kick before the robot may walk again (a K1 that walked off
+  // at once after its kick fell now and then; the Nao needs none).
+  double settle_time = 0.0;
   double hip_roll_compensation = 0.07;  // rad, the support hip's sag (see WalkParameters)
   double swing_height = 0.02;  // m, the kicking foot up at the swing's end (the servos lag the
                                // path: measured, the sole meets the ball about 0.03 m up, the
