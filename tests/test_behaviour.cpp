@@ -645,7 +645,7 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   const auto model = robots::loadRobotModel(test::naoH25());
   const test::TempDir dir("roll_motions");
   for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
-    std::filesystem::copy_file(f.path(), dir / f.path().filename());
+    if (f.is_regular_file()) std::filesystem::copy_file(f.path(), dir / f.path().filename());
   std::filesystem::remove(dir / "get_up_back.yaml");
   std::ofstream(dir / "get_up_back.yaml") << "motion: get_up_back\nends: front\nframes:\n  - "
                                              "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
