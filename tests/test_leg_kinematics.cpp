@@ -24,8 +24,9 @@ LegAngles randomLeg(const agents::LegKinematics& k, Leg leg, std::mt19937_64& rn
     double lo = k.lower(leg, i), hi = k.upper(leg, i);
     if (i == k.index(agents::LegJoint::Knee)) lo = std::max(lo, 0.2);
     if (i == k.index(agents::LegJoint::HipYaw)) lo = std::max(lo, -0.6), hi = std::min(hi, 0.2);
-    // The K1's hip pitch reaches -3 rad (the thigh folded up): a walking leg's range.
-    if (i == k.index(agents::LegJoint::HipPitch)) lo = std::max(lo, -1.2), hi = std::min(hi, 0.5);
+    // The K1's hip pitch reaches -3 rad (the thigh folded up to the chest): a walking leg's
+    // range instead (the Nao's, -1.54 at most, is sampled whole).
+    if (i == k.index(agents::LegJoint::HipPitch) && lo < -2.0) lo = -1.2, hi = std::min(hi, 0.5);
     q[i] = std::uniform_real_distribution<double>(lo + 0.02, hi - 0.02)(rng);
   }
   return q;

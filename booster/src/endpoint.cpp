@@ -378,6 +378,8 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
   for (auto& rp : robots_) {
     Robot& r = *rp;
     sim::CommandSlot& slot = slots[r.config.robot];
+    // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
+    if (!r.loco.walking()) r.was_walking = false;
     if (r.loco.mode() != RobotMode::Custom) {
       r.stats.ignored += r.pending;
       r.pending = 0;
@@ -449,7 +451,6 @@ std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGat
     return gate.check(r.config.robot, std::span<const float>(position),
                       std::span<const float>(stiffness));
   }
-  r.was_walking = false;
   if (r.loco.mode() == RobotMode::Prepare) {
     // Standing: the stand pose on the robot's own servos, the head where
     // RotateHead turned it (clamped to the joints' limits).

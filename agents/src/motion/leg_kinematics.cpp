@@ -31,11 +31,11 @@ LegKinematics::LegKinematics(const robots::RobotModel& model) {
     throw std::invalid_argument("leg kinematics: robot model " + model.name + " (" +
                                 model.source_file + "): " + why);
   };
-  if (!model.hasLegs()) fail("no `legs` (each foot's link)");
+  if (!model.hasLegs()) fail("no `legs` key (each foot's link)");
   for (size_t side = 0; side < 2; ++side) {
     const robots::LegChain& leg = model.legs[side];
     if (leg.joints.size() != 6)
-      fail(std::string(side == 0 ? "left" : "right") + " leg has " +
+      fail(std::string("legs.") + (side == 0 ? "left" : "right") + ": the leg has " +
            std::to_string(leg.joints.size()) + " joints from the trunk to the foot, not 6");
     Chain& c = legs_[side];
     foot_link_[side] = leg.foot_link;
@@ -54,12 +54,14 @@ LegKinematics::LegKinematics(const robots::RobotModel& model) {
   for (int i = 0; i < 6; ++i) {
     const AxisKind k = axisKind(legs_[0].axis[static_cast<size_t>(i)]);
     if (axisKind(legs_[1].axis[static_cast<size_t>(i)]) != k)
-      fail("the legs' joint " + std::to_string(i + 1) + " turn about different axes");
+      fail("legs: " + body.joints[static_cast<size_t>(legs_[0].joint[static_cast<size_t>(i)])].name +
+           " and " + body.joints[static_cast<size_t>(legs_[1].joint[static_cast<size_t>(i)])].name +
+           " turn about different axes");
     (k == AxisKind::Pitch ? pitch : k == AxisKind::Roll ? roll : yaw).push_back(i);
   }
   if (pitch.size() != 3 || roll.size() != 2 || yaw.size() != 1 || pitch[2] != 4 || roll[1] != 5)
-    fail("a leg must have three pitch joints (hip, knee, ankle), two roll joints (hip, ankle) "
-         "and a hip yaw, the ankle's pitch and roll last");
+    fail("legs: a leg must have three pitch joints (hip, knee, ankle), two roll joints (hip, "
+         "ankle) and a hip yaw, the ankle's pitch and roll last");
   part_ = {yaw[0], roll[0], pitch[0], pitch[1], pitch[2], roll[1]};
   // Joints of the right leg that follow the left one's (one motor).
   for (size_t i = 0; i < 6; ++i) {

@@ -110,8 +110,9 @@ int benchMotion(int argc, char** argv, int first) {
       opt.has("bench") ? std::filesystem::path(opt.get("bench", ""))
                        : findConfig("", "configs/bench/motion_" + robot + ".yaml");
   if (!std::filesystem::exists(bench_file))
-    throw UsageError("--robot " + robot + ": no " + bench_file.string() +
-                     " (robots with a motion bench: nao_v6_h25, booster_k1)");
+    throw UsageError(opt.has("bench") ? "--bench: no such file " + bench_file.string()
+                                      : "--robot " + robot + ": no " + bench_file.string() +
+                                            " (robots with a motion bench: nao_v6_h25, booster_k1)");
   c.bench = motion::loadMotionBench(bench_file);
   // Another motions folder (same file names) for tuning get-up motions.
   c.motions_dir = opt.has("motions") ? opt.get("motions", "") : c.bench.motions.string();

@@ -13,7 +13,6 @@ MotionBench loadMotionBench(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   root.allowOnly({"robot_model", "field", "motions", "agents", "targets", "random_commands"});
   MotionBench b;
-  b.file = file.string();
   const auto path = [&](const char* key) {
     const std::filesystem::path p = engine::resolveBeside(root.file(), root[key].string());
     if (!std::filesystem::exists(p)) root[key].fail("no such file or folder: " + p.string());

@@ -29,7 +29,7 @@ using engine::Vec3;
 // the robot, its field, its motions (keyframes and gait) and agent config,
 // and the table's targets.
 struct MotionBench {
-  std::string file, robot;  // the file read, the robot's name (its model's)
+  std::string robot;  // the robot's name (its model's)
   std::filesystem::path robot_model, field, motions, agents;
   double walk_forward = 0.25, walk_sideways = 0.1, turn = 0.8;  // m/s, m/s, rad/s
   double kick_distance = 3.0;                                    // m, a successful kick

@@ -67,7 +67,8 @@ class LegKinematics {
   double lower(Leg leg, int i) const { return legs_[static_cast<size_t>(leg)].lower[i]; }
   double upper(Leg leg, int i) const { return legs_[static_cast<size_t>(leg)].upper[i]; }
   double soleDepth() const { return sole_depth_; }  // m, foot frame to the sole
-  // Hip joint centre in the torso frame.
+  // The leg's first joint's origin in the torso frame (a Nao: the hip joint centre, where its
+  // three hip axes meet; a K1: the hip pitch joint, above the roll and yaw joints).
   Vec3 hip(Leg leg) const { return legs_[static_cast<size_t>(leg)].origin[0]; }
 
  private:
