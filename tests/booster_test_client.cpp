@@ -109,12 +109,14 @@ int main(int argc, char** argv) {
   std::string config;
   int periods = 300;
   double walk = 0.0;  // --walk V: walk with Booster's locomotion API at V m/s instead
+  int custom_between = 0;  // with --walk: N LowStates in CUSTOM between two walks
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--domain") domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
     else if (a == "--dds-config") config = argv[i + 1];
     else if (a == "--periods") periods = std::stoi(argv[i + 1]);
     else if (a == "--walk") walk = std::stod(argv[i + 1]);
+    else if (a == "--custom-between") custom_between = std::stoi(argv[i + 1]);
   }
   if (!config.empty()) {
     std::ifstream f(config);
@@ -186,12 +188,42 @@ int main(int argc, char** argv) {
     // about 50 Hz (every 2 LowStates of a 10 ms period) for `periods` LowStates, then a stop.
     expect("walking", rpc.api(2000, {{"mode", 2}}), 0);
     expect("head", rpc.api(2004, {{"pitch", 0.1}, {"yaw", 0.3}}), 0);
-    for (int k = 0; k < periods; ++k) {
-      if (k % 2 == 0 && rpc.api(2001, {{"vx", walk}, {"vy", 0.0}, {"vyaw", 0.0}}).at("status") != 0)
-        ok = false;
-      if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+    const auto walkFor = [&](int states) {
+      for (int k = 0; k < states; ++k) {
+        if (k % 2 == 0 &&
+            rpc.api(2001, {{"vx", walk}, {"vy", 0.0}, {"vyaw", 0.0}}).at("status") != 0)
+          ok = false;
+        if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+      }
+      expect("stop", rpc.api(2001, {{"vx", 0.0}, {"vy", 0.0}, {"vyaw", 0.0}}), 0);
+    };
+    walkFor(periods);
+    if (custom_between > 0) {
+      // CUSTOM for a while, holding the posture found with the robot's own gains (as team
+      // code that switches to its own controller), then walking again.
+      for (int k = 0; k < 300; ++k) nextState(0.05);  // the stop settles: feet together
+      expect("custom", rpc.api(2000, {{"mode", 3}}), 0);
+      if (!nextState(5.0)) fail("no LowState in custom mode");
+      std::vector<booster_interface_msg_dds__MotorCmd_> hold(motors.size());
+      for (size_t i = 0; i < motors.size(); ++i) {
+        hold[i].q = motors[i].q;
+        hold[i].kp = i >= 10 ? 300.0f : 40.0f;  // JointIndexK1: 10.. are the legs
+        hold[i].kd = i >= 10 ? 6.0f : 1.0f;
+        hold[i].weight = 1.0f;
+      }
+      for (int k = 0; k < custom_between; ++k) {
+        booster_interface_msg_dds__LowCmd_ c{};
+        c.cmd_type = booster_interface_msg_dds__SERIAL;
+        c.motor_cmd._buffer = hold.data();
+        c.motor_cmd._length = c.motor_cmd._maximum = static_cast<uint32_t>(hold.size());
+        c.motor_cmd._release = false;
+        if (dds_write(command, &c) < 0) fail("write LowCmd");
+        if (!nextState(5.0)) fail("LowStates stopped in custom mode");
+      }
+      expect("walking_again", rpc.api(2000, {{"mode", 2}}), 0);
+      expect("head_again", rpc.api(2004, {{"pitch", 0.1}, {"yaw", 0.3}}), 0);  // CUSTOM forgot it
+      walkFor(periods);
     }
-    expect("stop", rpc.api(2001, {{"vx", 0.0}, {"vy", 0.0}, {"vyaw", 0.0}}), 0);
     const json walking = rpc.api(2017, json::object());
     expect("get_mode_walking", walking, 0);
     if (json::parse(walking.at("body").get<std::string>()).at("mode") != 2) ok = false;

@@ -158,7 +158,8 @@ TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
 }
 
 // Team code that uses Booster's walk: WALKING mode and Move, answered by simsoccer's own K1
-// walk (configs/motions/booster_k1); the robot walks forward, its head turned as asked.
+// walk (configs/motions/booster_k1); the robot walks forward, its head turned as asked, then
+// CUSTOM for a second, then walks on.
 TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   booster::BoosterRobot robot = served(0, 174);
   robot.motions = test::sourceDir() / "configs/motions/booster_k1";
@@ -167,7 +168,7 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   const engine::Vec3 start = w.torsoPose(0).translation();
   ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "174", "--dds-config",
                         (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "600", "--walk", "0.3"});
+                        "400", "--walk", "0.3", "--custom-between", "100"});
   ASSERT_TRUE(client.process.started());
   const int status = runUntilTheClientEnds(simulation, endpoint, client);
   const json r = client.result();
@@ -176,13 +177,20 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   const engine::Pose torso = w.torsoPose(0);
   const engine::Vec3 moved = torso.translation() - start;
   const auto s = endpoint.stats(0);
-  std::printf("walked %.2f m forward, %.2f m sideways in %.1f s; requests %llu\n", moved.x(),
-              moved.y(), w.time(), (unsigned long long)s.requests);
+  std::printf("walked %.2f m forward, %.2f m sideways in %.1f s; requests %llu, walk starts %llu, "
+              "custom commands applied %llu\n",
+              moved.x(), moved.y(), w.time(), (unsigned long long)s.requests,
+              (unsigned long long)s.walk_starts, (unsigned long long)s.applied);
   EXPECT_EQ(s.mode, booster::RobotMode::Walking);
   EXPECT_EQ(s.requests_refused, 0u);
   EXPECT_EQ(s.requests_malformed, 0u);
-  // 6 s of LowStates at 0.3 m/s, the walk's speed ramp and the stop included.
-  EXPECT_GT(moved.x(), 1.0);
+  // Twice 4 s of LowStates at 0.3 m/s, the walk's speed ramp and the stops included, and
+  // CUSTOM in between; the walk starts over on its second entry (from the joints as CUSTOM
+  // left them, not where its steps had stopped).
+  EXPECT_EQ(s.walk_starts, 2u);
+  EXPECT_EQ(s.refused, 0u);
+  EXPECT_GT(s.applied, 50u);
+  EXPECT_GT(moved.x(), 1.5);
   EXPECT_LT(std::abs(moved.y()), 0.3);
   EXPECT_TRUE(w.isStanding(0));
   const int head = w.robot(0).model->body->jointIndex("HeadYaw");

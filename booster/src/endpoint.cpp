@@ -431,7 +431,10 @@ std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGat
     if (!r.motion)
       r.motion = std::make_unique<agents::MotionController>(
           agents::loadMotionController(model, r.config.motions));
-    if (!r.was_walking) r.motion->restart();
+    if (!r.was_walking) {
+      r.motion->restart();
+      ++r.stats.walk_starts;
+    }
     r.was_walking = true;
     const WalkVelocity& v = r.loco.velocity();
     agents::MotionRequest request;

@@ -82,6 +82,8 @@ struct RobotBoosterStats {
   uint64_t late = 0;              // lockstep: LowCmds that came after their period (dropped)
   uint64_t requests = 0, requests_refused = 0, requests_malformed = 0;
   uint64_t images = 0;            // camera images published
+  uint64_t walk_starts = 0;       // times simsoccer's walk (re)started: each entry into WALKING
+                                  // or SOCCER from another mode
 };
 
 class Endpoint : public sim::CommandSource {
