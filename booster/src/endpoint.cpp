@@ -73,7 +73,7 @@ struct Endpoint::Robot {
   dds_entity_t command_condition = 0;  // data on rt/joint_ctrl (owned by the reader)
   const std::vector<double>* stand = nullptr;  // the model's stand pose
   // Walking and Soccer: simsoccer's walk (the built-in agents' motion layer),
-  // made on first use and restarted from the measured joints on each entry.
+  // loaded with the endpoint and restarted from the measured joints on each entry.
   std::unique_ptr<agents::MotionController> motion;
   bool was_walking = false;
 
@@ -164,6 +164,11 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       if (failed) std::rethrow_exception(failed);
     }
     r->stand = &stand;
+    // The walk's motions are read here, so a bad motions folder refuses to start (not the
+    // first period in WALKING).
+    if (walk)
+      r->motion = std::make_unique<agents::MotionController>(
+          agents::loadMotionController(model, b.motions));
     robots_.push_back(std::move(r));
   }
   // Lockstep waits on every robot's commands at once.
@@ -428,9 +433,6 @@ std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGat
     // Walking and Soccer: simsoccer's walk at Move's velocity, the head
     // where RotateHead turned it; from standing still it eases into the
     // walk's stance (and after a fall it gets up).
-    if (!r.motion)
-      r.motion = std::make_unique<agents::MotionController>(
-          agents::loadMotionController(model, r.config.motions));
     if (!r.was_walking) {
       r.motion->restart();
       ++r.stats.walk_starts;

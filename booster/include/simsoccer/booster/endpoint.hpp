@@ -90,7 +90,8 @@ class Endpoint : public sim::CommandSource {
  public:
   // Joins every robot's domain. Throws std::invalid_argument for a robot
   // index out of range or served twice, or two robots on one domain,
-  // std::out_of_range for a robot model without a stand pose, net::DdsError
+  // std::out_of_range for a robot model without a stand pose, engine::ConfigError
+  // for a bad motions folder (a robot's `motions`), net::DdsError
   // if DDS fails.
   Endpoint(const world::World& world, EndpointConfig config);
   ~Endpoint() override;
