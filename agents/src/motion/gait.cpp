@@ -12,8 +12,8 @@ namespace {
 
 using engine::ConfigNode;
 
-// What a parameter may be: any finite number, >= 0, or > 0.
-enum class Range { Any, NonNegative, Positive };
+// What a parameter may be: any finite number, >= 0, > 0, or a share in (0, 1].
+enum class Range { Any, NonNegative, Positive, Share };
 
 template <class Parameters>
 struct Field {
@@ -34,9 +34,12 @@ void read(const ConfigNode& map, const std::vector<Field<Parameters>>& fields, P
       for (const auto& f : fields) known += (known.empty() ? "" : ", ") + std::string(f.name);
       value.fail("unknown parameter (known: " + known + ")");
     }
-    p.*(field->member) = field->range == Range::Positive      ? value.positive()
+    p.*(field->member) = field->range == Range::Positive || field->range == Range::Share
+                             ? value.positive()
                          : field->range == Range::NonNegative ? value.nonNegative()
                                                               : value.number();
+    if (field->range == Range::Share && p.*(field->member) > 1.0)
+      value.fail("must be a share in (0, 1]");
     if (!std::isfinite(p.*(field->member))) value.fail("must be a finite number");
   }
 }
@@ -64,6 +67,7 @@ const std::vector<Field<WalkParameters>>& walkFields() {
       {"stop_heading_tolerance", &W::stop_heading_tolerance, Range::NonNegative},
       {"ankle_pitch_gyro", &W::ankle_pitch_gyro, Range::Any},
       {"ankle_roll_gyro", &W::ankle_roll_gyro, Range::Any},
+      {"gyro_smoothing", &W::gyro_smoothing, Range::Share},
       {"stiffness", &W::stiffness, Range::Positive}};
   return f;
 }

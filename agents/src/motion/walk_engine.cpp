@@ -107,7 +107,7 @@ void WalkEngine::easeIn(const std::vector<double>& from, double t, std::vector<d
 }
 
 void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets) {
-  gyro_filtered_ += 0.5 * (gyro - gyro_filtered_);
+  gyro_filtered_ += p_.gyro_smoothing * (gyro - gyro_filtered_);
   if (!yaw_known_) {
     yaw_offset_ = yaw - body_.yaw;
     intended_yaw_ = body_.yaw;

@@ -28,9 +28,10 @@ const char* kHelp =
     "[--ball-gap M]:\n"
     "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
     "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
-    "--ankle-roll-gyro, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
+    "--ankle-roll-gyro, --gyro-smoothing, --forward-scale, --max-forward, --max-turn, --max-turn-accel, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
     "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
+    "With --random [--random-minutes M] [--seed N] [--verbose]: the random-commands trial alone.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
@@ -63,6 +64,11 @@ int benchMotion(int argc, char** argv, int first) {
       {"height", &wp.ankle_height},
       {"ankle-pitch-gyro", &wp.ankle_pitch_gyro},
       {"ankle-roll-gyro", &wp.ankle_roll_gyro},
+      {"gyro-smoothing", &wp.gyro_smoothing},
+      {"forward-scale", &wp.forward_scale},
+      {"max-forward", &wp.max_forward},
+      {"max-turn", &wp.max_turn},
+      {"max-turn-accel", &wp.max_turn_accel},
       {"lean", &wp.torso_lean},
       {"hip-roll", &wp.hip_roll_compensation},
       {"heading-gain", &wp.heading_gain},
@@ -98,7 +104,7 @@ int benchMotion(int argc, char** argv, int first) {
                                   "control-period"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(argc, argv, first,
-                    {"help", "verbose", "kick", "striker", "penalty", "block", "shootout"}, valued);
+                    {"help", "verbose", "kick", "striker", "penalty", "block", "shootout", "random"}, valued);
   char help[8192];
   std::snprintf(help, sizeof help, kHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -163,6 +169,12 @@ int benchMotion(int argc, char** argv, int first) {
         motion::kickTrial(c, opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
                           opt.number("ball-offset", 0), 1, opt.number("ball-gap", 0.015));
     std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
+    return 0;
+  }
+  if (opt.flag("random")) {  // the random-commands trial alone, for tuning
+    const double seconds = opt.number("random-minutes", 10.0) * 60.0;
+    std::printf("random commands: %d falls in %.0f s\n", motion::randomCommandsTrial(c, seed, seconds),
+                seconds);
     return 0;
   }
   if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning

@@ -158,24 +158,8 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
     }
   }
   {
-    // Random commands (seeded), a new one every 2 s in the bench file's ranges (a Nao:
-    // forward -0.1..0.3 m/s, sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s), each with a 1 in
-    // 4 chance of 0.
-    std::mt19937_64 rng(seed);
-    std::vector<Eigen::Vector3d> commands;
     const double seconds = random_minutes * 60.0;
-    for (int i = 0; i < static_cast<int>(seconds / 2.0) + 1; ++i) {
-      std::uniform_real_distribution<double> u(0, 1);
-      auto pick = [&](double lo, double hi) {
-        return u(rng) < 0.25 ? 0.0 : lo + (hi - lo) * u(rng);
-      };
-      commands.emplace_back(pick(b.random_forward[0], b.random_forward[1]),
-                            pick(b.random_sideways[0], b.random_sideways[1]),
-                            pick(b.random_turn[0], b.random_turn[1]));
-    }
-    int falls = 0;
-    walkTrial(c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
-    row("random_commands", 0, 0, "-", 0, falls, seconds);
+    row("random_commands", 0, 0, "-", 0, randomCommandsTrial(c, seed, seconds), seconds);
   }
   table.finish(
       "walk_forward: the commanded speed for 5 m / speed + 2 s, achieved = torso displacement / "

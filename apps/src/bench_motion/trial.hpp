@@ -119,6 +119,10 @@ struct WalkResult {
 WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds,
                      int* falls = nullptr);
 
+// The table's random walk: a new seeded command every 2 s in the bench file's ranges for
+// `seconds`; the falls (the robot is put back up after each).
+int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds);
+
 struct KickResult {
   double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)
   bool fell = false;

@@ -1,7 +1,10 @@
 // Walking: the walk engine alone at a commanded velocity (or a schedule of
 // them), from the stand pose eased into the walk's stance.
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <vector>
 
 #include "trial.hpp"
 
@@ -75,6 +78,24 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   const Eigen::Matrix3d rel = start.linear().transpose() * end.linear();
   r.turned = std::atan2(rel(1, 0), rel(0, 0));
   return r;
+}
+
+int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds) {
+  // A new command every 2 s in the bench file's ranges (a Nao: forward -0.1..0.3 m/s,
+  // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s), each part with a 1 in 4 chance of 0.
+  const MotionBench& b = c.bench;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto pick = [&](const std::array<double, 2>& range) {
+    return u(rng) < 0.25 ? 0.0 : range[0] + (range[1] - range[0]) * u(rng);
+  };
+  std::vector<Eigen::Vector3d> commands;
+  for (int i = 0; i < static_cast<int>(seconds / 2.0) + 1; ++i) {
+    commands.emplace_back(pick(b.random_forward), pick(b.random_sideways), pick(b.random_turn));
+  }
+  int falls = 0;
+  walkTrial(c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
+  return falls;
 }
 
 }  // namespace simsoccer::apps::motion

@@ -20,7 +20,7 @@ namespace simsoccer::agents {
 
 struct WalkParameters {
   double step_period = 0.25;    // s, one step (half a gait cycle)
-  double foot_lift = 0.012;     // m, swing apex
+  double foot_lift = 0.016;     // m, swing apex
   double ankle_height = 0.255;  // m, ankle below the torso origin while walking
   double step_width = 0.10;     // m, between the feet's centres
   double sway = 0.018;          // m, torso over the support foot at mid-step
@@ -54,6 +54,9 @@ struct WalkParameters {
   double stop_heading_tolerance = 0.03;
   double ankle_pitch_gyro = 0.05;  // rad per rad/s of torso pitch rate
   double ankle_roll_gyro = 0.05;   // rad per rad/s of torso roll rate
+  // The gyro's low-pass for that feedback: the share of each new reading
+  // (1: none). Smoothing delays the feedback, as the actuation delay does.
+  double gyro_smoothing = 0.5;
   double stiffness = 1.0;
 };
 
