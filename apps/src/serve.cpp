@@ -118,7 +118,7 @@ int serve(int argc, char** argv, int first) {
   sim::SimulationConfig simc;
   simc.lockstep = cfg.lockstep;
   try {
-    simc.mode = sim::parseMode(opt.get("mode", "serial"));
+    simc.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }

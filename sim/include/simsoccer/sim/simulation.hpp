@@ -35,13 +35,17 @@
 namespace simsoccer::sim {
 
 enum class Mode : uint8_t { Serial, Pipelined };
-// The mode of matches, benchmarks and in-process agents unless they are told otherwise.
-inline constexpr Mode kDefaultMode = Mode::Serial;
+// The mode of matches, benchmarks and in-process agents unless they are told otherwise:
+// pipelined, as on a real robot, where a command computed from one sensor packet acts in a
+// later cycle; physics and agents overlap on two cores.
+inline constexpr Mode kDefaultMode = Mode::Pipelined;
 const char* modeName(Mode m);
 // "serial" or "pipelined"; throws std::invalid_argument naming the value.
 Mode parseMode(const std::string& name);
 
 struct SimulationConfig {
+  // The plain period (no delay) unless a program asks: programs pass kDefaultMode or their
+  // --mode; replay is serial (the log holds the commands each period applied).
   Mode mode = Mode::Serial;
   // Lockstep: cameras wait for the renderer when it falls behind. Real
   // time: captures are dropped (and counted) instead.
