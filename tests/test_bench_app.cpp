@@ -151,7 +151,7 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
 // The Booster K1's table (configs/bench/motion_booster_k1.yaml): the 0.5 m/s over 5 m,
 // sideways and random walking without a fall, kicks of 4 m with the size 3 ball. Serial
 // periods: the K1's kick was tuned without the pipelined mode's period of delay (with it,
-// 55 % of its kicks reach 4 m; docs/agents.md).
+// 55 % of its kicks reach 4 m; docs/benchmarks.md).
 TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondAndKicksFourMetres) {
   const test::BenchRun run = test::runBench(
       SIMSOCCER_BIN,

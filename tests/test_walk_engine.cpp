@@ -302,7 +302,8 @@ TEST(WalkEngine, PlannedZmpAgainstTheSupportPolygon) {
 TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
   test::TempDir dir("gait");
   EXPECT_EQ(agents::loadGaitIn(dir.path()).walk.step_period, agents::WalkParameters{}.step_period);
-  std::ofstream(dir.path() / "gait.yaml") << "walk: {step_period: 0.3, sway: 0.02}\nkick: {reach: 0.2}\n";
+  std::ofstream(dir.path() / "gait.yaml")
+      << "walk: {step_period: 0.3, sway: 0.02}\nkick: {reach: 0.2}\n";
   const agents::Gait g = agents::loadGaitIn(dir.path());
   EXPECT_EQ(g.walk.step_period, 0.3);
   EXPECT_EQ(g.walk.sway, 0.02);
@@ -319,6 +320,18 @@ TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
   }
   std::ofstream(dir.path() / "gait.yaml") << "walk: {step_period: -0.3}\n";
   EXPECT_THROW(agents::loadGaitIn(dir.path()), engine::ConfigError);
+  // A share: the gyro smoothing in (0, 1].
+  std::ofstream(dir.path() / "gait.yaml") << "walk: {gyro_smoothing: 1}\n";
+  EXPECT_EQ(agents::loadGaitIn(dir.path()).walk.gyro_smoothing, 1.0);
+  for (const char* bad : {"1.5", "0"}) {
+    std::ofstream(dir.path() / "gait.yaml") << "walk: {gyro_smoothing: " << bad << "}\n";
+    try {
+      agents::loadGaitIn(dir.path());
+      ADD_FAILURE() << "gyro_smoothing " << bad << " was accepted";
+    } catch (const engine::ConfigError& e) {
+      EXPECT_EQ(e.key(), "walk.gyro_smoothing") << e.what();
+    }
+  }
   // The Booster K1's gait in the repository loads.
   EXPECT_GT(agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1").walk.step_width,
             0.15);

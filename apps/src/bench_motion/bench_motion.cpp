@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "cli.hpp"
-#include "simsoccer/agents/motion/gait.hpp"
 #include "motion_table.hpp"
+#include "simsoccer/agents/motion/gait.hpp"
 #include "trial.hpp"
 
 namespace simsoccer::apps {
@@ -21,14 +21,16 @@ const char* kHelp =
     "speed, path deviation, falls: forward over 5 m, sideways, turning, and M minutes (default\n"
     "10) of random velocity commands; kicks, get-ups, the behaviours.\n"
     "  --robot R     nao_v6_h25 (default: a Nao on the SPL field, forward 0.25 m/s) or\n"
-    "                booster_k1 (on the HSL M-Field, forward 0.5 m/s): configs/bench/motion_R.yaml\n"
+    "                booster_k1 (on the HSL M-Field, forward 0.5 m/s): "
+    "configs/bench/motion_R.yaml\n"
     "                names the robot, field, motions, agent config and targets\n"
     "  --bench FILE  another such file\n"
     "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
     "[--ball-gap M]:\n"
     "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
     "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
-    "--ankle-roll-gyro, --gyro-smoothing, --forward-scale, --max-forward, --max-turn, --max-turn-accel, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
+    "--ankle-roll-gyro, --gyro-smoothing, --forward-scale, --max-forward, --max-turn,\n"
+    "--max-turn-accel, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
     "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --random [--random-minutes M] [--seed N] [--verbose]: the random-commands trial alone.\n"
@@ -103,22 +105,25 @@ int benchMotion(int argc, char** argv, int first) {
                                   "dt",
                                   "control-period"};
   for (const auto& k : knobs) valued.push_back(k.first);
-  const Options opt(argc, argv, first,
-                    {"help", "verbose", "kick", "striker", "penalty", "block", "shootout", "random"}, valued);
+  const Options opt(
+      argc, argv, first,
+      {"help", "verbose", "kick", "striker", "penalty", "block", "shootout", "random"}, valued);
   char help[8192];
   std::snprintf(help, sizeof help, kHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
   opt.noPositional();
   motion::TrialContext c;
-  if (opt.has("robot") && opt.has("bench")) throw UsageError("--robot and --bench exclude each other");
+  if (opt.has("robot") && opt.has("bench"))
+    throw UsageError("--robot and --bench exclude each other");
   const std::string robot = opt.get("robot", "nao_v6_h25");
   const std::filesystem::path bench_file =
       opt.has("bench") ? std::filesystem::path(opt.get("bench", ""))
                        : findConfig("", "configs/bench/motion_" + robot + ".yaml");
   if (!std::filesystem::exists(bench_file))
-    throw UsageError(opt.has("bench") ? "--bench: no such file " + bench_file.string()
-                                      : "--robot " + robot + ": no " + bench_file.string() +
-                                            " (robots with a motion bench: nao_v6_h25, booster_k1)");
+    throw UsageError(opt.has("bench")
+                         ? "--bench: no such file " + bench_file.string()
+                         : "--robot " + robot + ": no " + bench_file.string() +
+                               " (robots with a motion bench: nao_v6_h25, booster_k1)");
   c.bench = motion::loadMotionBench(bench_file);
   // Another motions folder (same file names) for tuning get-up motions.
   c.motions_dir = opt.has("motions") ? opt.get("motions", "") : c.bench.motions.string();
@@ -173,14 +178,14 @@ int benchMotion(int argc, char** argv, int first) {
   }
   if (opt.flag("random")) {  // the random-commands trial alone, for tuning
     const double seconds = opt.number("random-minutes", 10.0) * 60.0;
-    std::printf("random commands: %d falls in %.0f s\n", motion::randomCommandsTrial(c, seed, seconds),
-                seconds);
+    std::printf("random commands: %d falls in %.0f s\n",
+                motion::randomCommandsTrial(c, seed, seconds), seconds);
     return 0;
   }
   if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning
     const Eigen::Vector3d v(opt.number("vx", 0), opt.number("vy", 0), opt.number("turn", 0));
-    const motion::WalkResult r =
-        motion::walkTrial(c, [&](double) { return v; }, opt.number("seconds", 10.0));
+    const motion::WalkResult r = motion::walkTrial(
+        c, [&](double) { return v; }, opt.number("seconds", 10.0));
     std::printf(
         "distance %.3f m, speed %.3f m/s, lateral %.3f m, turned %.3f rad, fell %d at %.2f\n",
         r.distance, r.speed, r.lateral, r.turned, r.fell, r.fell_at);

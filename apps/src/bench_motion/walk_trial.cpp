@@ -23,8 +23,7 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   WalkResult r;
   const long periods = static_cast<long>(seconds / dt);
   long i = 0;
-  const auto walkControl = [&](const world::World& world, std::span<float> p,
-                               std::span<float> k) {
+  const auto walkControl = [&](const world::World& world, std::span<float> p, std::span<float> k) {
     const Eigen::Vector3d v = schedule(static_cast<double>(i) * dt);
     engine.setVelocity(v.x(), v.y(), v.z());
     const auto& f = world.sensorFrame(0);
@@ -94,7 +93,8 @@ int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds) {
     commands.emplace_back(pick(b.random_forward), pick(b.random_sideways), pick(b.random_turn));
   }
   int falls = 0;
-  walkTrial(c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
+  walkTrial(
+      c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
   return falls;
 }
 
