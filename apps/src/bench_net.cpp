@@ -82,7 +82,10 @@ int benchNet(int argc, char** argv, int first) {
     net::ServerConfig server_cfg;
     server_cfg.dds = dds;
     server_cfg.command_timeout = 1.0;
-    sim::Simulation simulation(w);
+    // Serial: the overhead measured is the messaging alone, not overlapped with the step.
+    sim::SimulationConfig simc;
+    simc.mode = sim::Mode::Serial;
+    sim::Simulation simulation(w, simc);
     net::SimServer server(simulation, server_cfg);
     sim::RunLoop loop(simulation, sim::Pacing::Lockstep);
     std::vector<std::unique_ptr<ChildProcess>> agents;

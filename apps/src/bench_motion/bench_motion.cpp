@@ -132,6 +132,8 @@ int benchMotion(int argc, char** argv, int first) {
   wp = gait.walk;
   kp = gait.kick;
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
+  if (!(wp.gyro_smoothing > 0.0 && wp.gyro_smoothing <= 1.0))
+    throw UsageError("--gyro-smoothing must be a share in (0, 1]");
   c.walk = wp;
   c.kick = kp;
   c.verbose = opt.flag("verbose");
