@@ -34,12 +34,36 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   EXPECT_NE(row2.find(",2/2,"), std::string::npos) << row2;
 }
 
+// --dt adds rows at other steps; the project's default step (5 ms) is always
+// run first, and the summary gives each other step's real-time factor against it.
+TEST(BenchPhysicsApp, OtherStepsBesideTheDefaultStep) {
+  const test::BenchRun run = test::runBench(
+      SIMSOCCER_BIN, "bench physics --robots 1 --seconds 0.2 --dt 0.01 --iterations 5");
+  ASSERT_EQ(run.status, 0) << run.out;
+  EXPECT_NE(run.out.find("5 solver iterations"), std::string::npos) << run.out;
+  ASSERT_GE(run.lines.size(), 3u);
+  EXPECT_EQ(run.lines[0].rfind("robots,dt_ms,steps_per_s,", 0), 0u) << run.lines[0];
+  EXPECT_EQ(run.lines[1].rfind("1,5,", 0), 0u) << run.lines[1];
+  EXPECT_EQ(run.lines[2].rfind("1,10,", 0), 0u) << run.lines[2];
+  EXPECT_NE(run.out.find("1 robots: real-time factor "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(" at the default step (5 ms); "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(" at 10 ms ("), std::string::npos) << run.out;
+}
+
 TEST(BenchPhysicsApp, RejectsBadOptions) {
   int status = -1;
   const std::string out =
       runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 0", status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--robots"), std::string::npos) << out;
+  for (const char* bad : {"--dt 0", "--dt 0.005,x", "--dt 1", "--iterations 0"}) {
+    const std::string refused =
+        runCommand(std::string(SIMSOCCER_BIN) + " bench physics " + bad, status);
+    EXPECT_NE(status, 0) << bad;
+    EXPECT_NE(refused.find(std::string(bad).substr(0, std::string(bad).find(' '))),
+              std::string::npos)
+        << refused;
+  }
   const std::string help = runCommand(std::string(SIMSOCCER_BIN) + " bench physics --help", status);
   EXPECT_EQ(status, 0);
   EXPECT_NE(help.find("--csv"), std::string::npos);
@@ -257,10 +281,8 @@ TEST(ServeApp, CommandLineNumbersAreRangeChecked) {
   };
   for (const auto& [options, message] : cases) {
     int status = -1;
-    const std::string out =
-        test::runCommand(std::string(SIMSOCCER_BIN) + " serve " + scenario + " --domain 149 " +
-                             options,
-                         status);
+    const std::string out = test::runCommand(
+        std::string(SIMSOCCER_BIN) + " serve " + scenario + " --domain 149 " + options, status);
     EXPECT_EQ(WEXITSTATUS(status), 2) << options << ": " << out;
     EXPECT_NE(out.find(message), std::string::npos) << options << ": " << out;
   }

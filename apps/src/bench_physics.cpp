@@ -18,28 +18,44 @@ namespace {
 
 const char* kHelp =
     "usage: simsoccer bench physics [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
-    "                               [--threads N] [--repeat N] [--csv FILE]\n"
+    "                               [--dt 0.005,0.01] [--iterations N] [--threads N]\n"
+    "                               [--repeat N] [--csv FILE]\n"
     "\n"
     "Places N Naos on the field in side-by-side pairs, all joints tracking slow sinusoids\n"
-    "around the stand pose, runs the settling time and then the timed interval. Prints per N:\n"
-    "steps/s, real-time factor, ms per step, contacts per step (all, and robot against robot),\n"
-    "the constraint batches solved side by side per step, robots standing at the end, and the\n"
-    "share of the step spent in each stage.\n"
+    "around the stand pose, runs the settling time and then the timed interval. Prints per N\n"
+    "and physics step: steps/s, real-time factor, ms per step, contacts per step (all, and\n"
+    "robot against robot), the constraint batches solved side by side per step, robots\n"
+    "standing at the end, and the share of the step spent in each stage; then, per N, the\n"
+    "real-time factor at the project's default step (5 ms, run as well when --dt leaves it\n"
+    "out) and each other step's against it.\n"
     "\n"
     "  --config FILE   benchmark scenario (default configs/bench/physics.yaml)\n"
     "  --robots LIST   robot counts (default from the config)\n"
     "  --seconds S     simulated seconds timed per robot count (default from the config)\n"
+    "  --dt LIST       physics steps in seconds (default: the config's); the control period\n"
+    "                  is the config's, rounded to a whole number of steps\n"
+    "  --iterations N  constraint solver iterations (default: the config's)\n"
     "  --threads N     solver threads (default: the config's physics.threads, else one per\n"
     "                  core up to 4); the result is the same for any number\n"
     "  --repeat N      time each robot count N times (fresh world each) and report the run\n"
     "                  with the median steps/s (default 1)\n"
-    "  --csv FILE      also write the table as CSV (one row per robot count)\n";
+    "  --csv FILE      also write the table as CSV (one row per robot count and step)\n";
+
+// The physics settings of one row: the config's with this step, the control
+// period a whole number of steps.
+world::PhysicsConfig withStep(world::PhysicsConfig physics, double dt) {
+  const double steps = std::max(1.0, std::round(physics.control_period / dt));
+  physics.dt = dt;
+  physics.control_period = steps * dt;
+  return physics;
+}
 
 }  // namespace
 
 int benchPhysics(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help"},
-                    {"config", "robots", "seconds", "threads", "repeat", "csv"});
+  const Options opt(
+      argc, argv, first, {"help"},
+      {"config", "robots", "seconds", "dt", "iterations", "threads", "repeat", "csv"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
@@ -49,22 +65,34 @@ int benchPhysics(int argc, char** argv, int first) {
   if (!(cfg.seconds > 0)) throw UsageError("--seconds must be > 0");
   cfg.base.physics.threads =
       opt.wholeNumber("threads", cfg.base.physics.threads, 1, world::PhysicsConfig::kMaxThreads);
+  cfg.base.physics.solver_iterations =
+      opt.wholeNumber("iterations", cfg.base.physics.solver_iterations, 1, 1000);
   const int threads = world::solverThreads(cfg.base.physics);
+  // The project's default step is always measured, first, as the reference.
+  const double default_dt = world::PhysicsConfig{}.dt;
+  std::vector<double> steps = opt.positiveList("dt", {cfg.base.physics.dt});
+  for (const double dt : steps)
+    if (dt > 0.05) throw UsageError("--dt: at most 0.05 s, got " + std::to_string(dt));
+  std::erase_if(steps, [&](double dt) { return std::abs(dt - default_dt) < 1e-12; });
+  steps.insert(steps.begin(), default_dt);
   const std::string csv = opt.get("csv", "");
   const int repeat = opt.wholeNumber("repeat", 1, 1, 1000);
 
   const fields::FieldModel field = fields::loadFieldModel(cfg.base.field_file);
-  const double dt = cfg.base.physics.dt;
+  std::string step_list;
+  for (const double dt : steps)
+    step_list += (step_list.empty() ? "" : ", ") + engine::formatNumber(dt * 1e3);
   std::printf(
-      "simsoccer bench physics: %s, field %s, dt %.1f ms, control %.1f ms, %d solver "
+      "simsoccer bench physics: %s, field %s, dt %s ms, control %.1f ms, %d solver "
       "iterations, %d solver thread%s, %.1f s settling + %.1f s timed per row\n",
-      config_file.string().c_str(), field.name.c_str(), dt * 1e3,
+      config_file.string().c_str(), field.name.c_str(), step_list.c_str(),
       cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, threads,
       threads == 1 ? "" : "s", cfg.settle, cfg.seconds);
   std::fflush(stdout);
 
   Table table;
   table.header = {"robots",
+                  "dt_ms",
                   "steps_per_s",
                   "real_time_factor",
                   "ms_per_step",
@@ -78,9 +106,11 @@ int benchPhysics(int argc, char** argv, int first) {
                   "integrate_pct",
                   "servo_pct",
                   "other_pct"};
-  // One timed run with n robots: (steps/s, table row).
-  auto measure = [&](int n) {
-    world::World w(placeRobots(cfg, n, field.halfLength(), field.halfWidth()));
+  // One timed run with n robots at step dt: (steps/s, table row).
+  auto measure = [&](int n, double dt) {
+    BenchConfig run_cfg = cfg;
+    run_cfg.base.physics = withStep(cfg.base.physics, dt);
+    world::World w(placeRobots(run_cfg, n, field.halfLength(), field.halfWidth()));
     const BenchMotion motion(cfg, w);
     const int per_control = w.stepsPerControlPeriod();
     const auto settle_steps = static_cast<long>(std::lround(cfg.settle / dt));
@@ -113,23 +143,37 @@ int benchPhysics(int argc, char** argv, int first) {
         wall - st.collision_s - st.dynamics_s - st.solver_s - st.integrate_s - st.servo_s;
     return std::pair<double, std::vector<std::string>>{
         steps_per_s,
-        {std::to_string(n), fmt(steps_per_s, 0), fmt(steps_per_s * dt, 2),
-         fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
+        {std::to_string(n), engine::formatNumber(dt * 1e3), fmt(steps_per_s, 0),
+         fmt(steps_per_s * dt, 2), fmt(1e3 * wall / static_cast<double>(timed_steps), 3),
          fmt(static_cast<double>(contacts) / static_cast<double>(timed_steps), 1),
          fmt(static_cast<double>(robot_contacts) / static_cast<double>(timed_steps), 2),
          fmt(static_cast<double>(batches) / static_cast<double>(timed_steps), 1),
          std::to_string(standing) + "/" + std::to_string(n), pct(st.collision_s),
          pct(st.dynamics_s), pct(st.solver_s), pct(st.integrate_s), pct(st.servo_s), pct(other)}};
   };
+  std::string summary;  // per N: the default step's real-time factor, the others against it
   for (const int n : counts) {
-    std::vector<std::pair<double, std::vector<std::string>>> runs;
-    for (int rep = 0; rep < repeat; ++rep) runs.push_back(measure(n));
-    std::sort(runs.begin(), runs.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    const auto& median = runs[runs.size() / 2];
-    table.rows.push_back(median.second);
-    std::fprintf(stderr, "  %d robots done: %.0f steps/s (median of %d)\n", n, median.first,
-                 repeat);
+    double default_rtf = 0.0;
+    for (const double dt : steps) {
+      std::vector<std::pair<double, std::vector<std::string>>> runs;
+      for (int rep = 0; rep < repeat; ++rep) runs.push_back(measure(n, dt));
+      std::sort(runs.begin(), runs.end(),
+                [](const auto& a, const auto& b) { return a.first < b.first; });
+      const auto& median = runs[runs.size() / 2];
+      table.rows.push_back(median.second);
+      std::fprintf(stderr, "  %d robots, dt %s ms done: %.0f steps/s (median of %d)\n", n,
+                   engine::formatNumber(dt * 1e3).c_str(), median.first, repeat);
+      const double rtf = median.first * dt;
+      if (dt == steps.front()) {
+        default_rtf = rtf;
+        summary += std::to_string(n) + " robots: real-time factor " + fmt(rtf, 2) +
+                   " at the default step (" + engine::formatNumber(dt * 1e3) + " ms)";
+      } else {
+        summary += "; " + fmt(rtf, 2) + " at " + engine::formatNumber(dt * 1e3) + " ms (" +
+                   fmt(rtf / default_rtf, 2) + "x)";
+      }
+    }
+    summary += "\n";
   }
   table.finish(
       "Stages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
@@ -138,6 +182,7 @@ int benchPhysics(int argc, char** argv, int first) {
       "positions; servo = joint PD torques; other = everything else in the step and the "
       "loop (commands, contact counting).",
       csv);
+  std::printf("\n%s", summary.c_str());
   return 0;
 }
 

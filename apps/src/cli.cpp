@@ -90,8 +90,8 @@ uint64_t Options::seed(const std::string& name, uint64_t fallback) const {
   uint64_t seed = 0;
   const auto [end, error] = std::from_chars(v.data(), v.data() + v.size(), seed);
   if (v.empty() || error != std::errc() || end != v.data() + v.size())
-    throw UsageError("--" + name + ": expected a whole number from 0 to 18446744073709551615, got '" +
-                     v + "'");
+    throw UsageError("--" + name +
+                     ": expected a whole number from 0 to 18446744073709551615, got '" + v + "'");
   return seed;
 }
 
@@ -112,6 +112,27 @@ std::vector<int> Options::intList(const std::string& name, const std::vector<int
       out.push_back(v);
     } catch (const std::exception&) {
       throw UsageError("--" + name + ": expected positive integers separated by commas, got '" +
+                       values_.at(name) + "'");
+    }
+  }
+  if (out.empty()) throw UsageError("--" + name + ": empty list");
+  return out;
+}
+
+std::vector<double> Options::positiveList(const std::string& name,
+                                          const std::vector<double>& fallback) const {
+  if (!has(name)) return fallback;
+  std::vector<double> out;
+  std::stringstream ss(values_.at(name));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !(v > 0) || !std::isfinite(v)) throw std::invalid_argument(item);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw UsageError("--" + name + ": expected numbers > 0 separated by commas, got '" +
                        values_.at(name) + "'");
     }
   }

@@ -35,6 +35,9 @@ class Options {
   // A DDS domain id: 0..232 (the RTPS port mapping's range).
   uint32_t domain(const std::string& name, uint32_t fallback) const;
   std::vector<int> intList(const std::string& name, const std::vector<int>& fallback) const;
+  // Finite numbers > 0 separated by commas, or a usage error naming the option.
+  std::vector<double> positiveList(const std::string& name,
+                                   const std::vector<double>& fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
   // --help given: prints `text` and returns true.
   bool help(const char* text) const;
