@@ -117,7 +117,7 @@ ParallelIslandSolver::ParallelIslandSolver(int threads) : threads_(threads) {
   shares_.resize(static_cast<size_t>(threads));
   load_.resize(shares_.size());
   job_ = [this](int t) {
-    for (const size_t i : shares_[static_cast<size_t>(t)]) solveBatch(*solvers_[t], batches_[i]);
+    for (const size_t i : shares_[static_cast<size_t>(t)]) solveBatch(t, batches_[i]);
   };
 }
 
@@ -169,17 +169,20 @@ void ParallelIslandSolver::processIsland(btCollisionObject** bodies, int num_bod
     batch_open_ = false;
 }
 
-void ParallelIslandSolver::solveBatch(btMultiBodyConstraintSolver& solver, Batch& batch) {
+void ParallelIslandSolver::solveBatch(int thread, Batch& batch) {
   const auto data = [](auto& a) { return a.size() ? &a[0] : nullptr; };
-  solver.solveMultiBodyGroup(data(batch.bodies), batch.bodies.size(), data(batch.manifolds),
+  if (prologue_) (*prologue_)(data(batch.bodies), batch.bodies.size(), thread);
+  solvers_[static_cast<size_t>(thread)]->solveMultiBodyGroup(data(batch.bodies), batch.bodies.size(), data(batch.manifolds),
                              batch.manifolds.size(), data(batch.constraints),
                              batch.constraints.size(), data(batch.multibody_constraints),
                              batch.multibody_constraints.size(), *info_, debug_draw_, dispatcher_);
 }
 
-void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher) {
+void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher,
+                                 const Prologue* prologue) {
   debug_draw_ = debug_draw;
   dispatcher_ = dispatcher;
+  prologue_ = prologue;
   // Largest batch first, each to the thread with the least work so far (the
   // arrays keep their capacity: no allocation once warmed up).
   order_.resize(batch_count_);

@@ -71,8 +71,12 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
              btMultiBodyConstraint** multibody_constraints, int num_multibody_constraints);
   void processIsland(btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds,
                      int num_manifolds, int island_id) override;
-  // Solves every batch collected since setup().
-  void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher);
+  // Solves every batch collected since setup(). `prologue` (if set) runs on
+  // the batch's thread just before it is solved, with the batch's bodies and
+  // the thread's index (0 .. threads - 1).
+  using Prologue = std::function<void(btCollisionObject** bodies, int num_bodies, int thread)>;
+  void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher, const Prologue* prologue = nullptr);
+  int threadCount() const { return threads_.count(); }
   void clear() { batch_count_ = 0; }  // a step solved without it
   int batchCount() const { return static_cast<int>(batch_count_); }
 
@@ -85,7 +89,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
     long cost = 0;  // about the number of solver rows
   };
   Batch& openBatch();  // the batch islands are appended to
-  void solveBatch(btMultiBodyConstraintSolver& solver, Batch& batch);
+  void solveBatch(int thread, Batch& batch);
 
   std::vector<std::unique_ptr<btMultiBodyConstraintSolver>> solvers_;  // one per thread
   std::vector<Batch> batches_;                                         // reused step to step
@@ -103,6 +107,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   const btContactSolverInfo* info_ = nullptr;
   btIDebugDraw* debug_draw_ = nullptr;
   btDispatcher* dispatcher_ = nullptr;
+  const Prologue* prologue_ = nullptr;
 };
 
 }  // namespace simsoccer::engine

@@ -5,6 +5,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyInplaceSolverIslandCallback.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
@@ -13,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -132,10 +134,13 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
         return;
       }
       // Bullet's three stages, the islands solved on the threads in between:
-      // the forward dynamics (which also sorts the constraints by island),
-      // the islands, and what follows Bullet's last batch (joint feedback,
-      // the solver's velocity changes applied; its own batch is empty).
-      solveExternalForces(info);
+      // what precedes the forward dynamics (which also sorts the constraints
+      // by island), the islands, each batch's forward dynamics on its thread
+      // just before it is solved, and what follows Bullet's last batch
+      // (joint feedback, the solver's velocity changes applied; its own
+      // batch is empty). The forward dynamics of a robot reads and writes
+      // that robot alone, so where it runs changes nothing in the result.
+      timed(&StageTimes::dynamics_s, [&] { prepareConstraints(info); });
       islands->setup(
           info, m_sortedConstraints.size() ? &m_sortedConstraints[0] : nullptr,
           m_sortedConstraints.size(),
@@ -143,7 +148,17 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
           m_sortedMultiBodyConstraints.size());
       m_islandManager->buildAndProcessIslands(getCollisionWorld()->getDispatcher(),
                                               getCollisionWorld(), islands);
-      islands->solve(getDebugDrawer(), getCollisionWorld()->getDispatcher());
+      dynamics_done_.assign(static_cast<size_t>(m_multiBodies.size()), 0);
+      scratch_.resize(static_cast<size_t>(islands->threadCount()));
+      const ParallelIslandSolver::Prologue prologue = [&](btCollisionObject** bodies, int n,
+                                                          int thread) {
+        for (int i = 0; i < n; ++i)
+          if (const btMultiBodyLinkCollider* link = btMultiBodyLinkCollider::upcast(bodies[i]))
+            forwardDynamics(link->m_multiBody, info, thread);
+      };
+      islands->solve(getDebugDrawer(), getCollisionWorld()->getDispatcher(), &prologue);
+      for (int i = 0; i < m_multiBodies.size(); ++i)  // those in no island
+        forwardDynamics(m_multiBodies[i], info, 0);
       solveInternalConstraints(info);
     });
     if (times) times->solver_s -= times->dynamics_s - dynamics_before;
@@ -153,6 +168,60 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   }
 
  private:
+  // Per solver thread: Bullet's scratch arrays for the forward dynamics.
+  struct Scratch {
+    btAlignedObjectArray<btScalar> r;
+    btAlignedObjectArray<btVector3> v;
+    btAlignedObjectArray<btMatrix3x3> m;
+  };
+  std::vector<Scratch> scratch_;
+  std::vector<uint8_t> dynamics_done_;  // per multibody (its user index), this step
+
+  // btMultiBodyDynamicsWorld::solveExternalForces without its forward-dynamics
+  // loop (gravity and force clearing are Bullet's virtual applyGravity and
+  // clearForces in this build, BT_USE_VIRTUAL_CLEARFORCES_AND_GRAVITY).
+  void prepareConstraints(btContactSolverInfo& info) {
+    forwardKinematics();
+    clearMultiBodyConstraintForces();
+    m_sortedConstraints.resize(m_constraints.size());
+    for (int i = 0; i < m_constraints.size(); ++i) m_sortedConstraints[i] = m_constraints[i];
+    m_sortedConstraints.quickSort(btSortConstraintOnIslandPredicate2());
+    m_sortedMultiBodyConstraints.resize(m_multiBodyConstraints.size());
+    for (int i = 0; i < m_multiBodyConstraints.size(); ++i)
+      m_sortedMultiBodyConstraints[i] = m_multiBodyConstraints[i];
+    m_sortedMultiBodyConstraints.quickSort(btSortMultiBodyConstraintOnIslandPredicate());
+    m_solverMultiBodyIslandCallback->setup(
+        &info, m_sortedConstraints.size() ? &m_sortedConstraints[0] : nullptr,
+        m_sortedConstraints.size(),
+        m_sortedMultiBodyConstraints.size() ? &m_sortedMultiBodyConstraints[0] : nullptr,
+        m_sortedMultiBodyConstraints.size(), getDebugDrawer());
+    m_constraintSolver->prepareSolve(getCollisionWorld()->getNumCollisionObjects(),
+                                     getCollisionWorld()->getDispatcher()->getNumManifolds());
+  }
+
+  // One multibody's step of Bullet's forward-dynamics loop, once per step.
+  void forwardDynamics(btMultiBody* body, const btContactSolverInfo& info, int thread) {
+    uint8_t& done = dynamics_done_[static_cast<size_t>(body->getUserIndex())];
+    if (done) return;
+    done = 1;
+    bool sleeping = body->getBaseCollider() &&
+                    body->getBaseCollider()->getActivationState() == ISLAND_SLEEPING;
+    for (int b = 0; b < body->getNumLinks(); ++b)
+      if (body->getLink(b).m_collider &&
+          body->getLink(b).m_collider->getActivationState() == ISLAND_SLEEPING)
+        sleeping = true;
+    if (sleeping) return;
+    if (body->isUsingRK4Integration())
+      throw std::logic_error("RK4 multibody integration is not supported");
+    Scratch& s = scratch_[static_cast<size_t>(thread)];
+    s.r.resize(body->getNumLinks() + 1);
+    s.v.resize(body->getNumLinks() + 1);
+    s.m.resize(body->getNumLinks() + 1);
+    body->computeAccelerationsArticulatedBodyAlgorithmMultiDof(
+        info.m_timeStep, s.r, s.v, s.m, /*isConstraintPass=*/false,
+        getSolverInfo().m_jointFeedbackInWorldSpace, getSolverInfo().m_jointFeedbackInJointFrame);
+  }
+
   template <class F>
   void timed(double StageTimes::*field, F&& f) {
     if (!times) {
@@ -420,6 +489,8 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;
+  if (const char* e = std::getenv("XP_ITER")) info.m_numIterations = std::atoi(e);
+  if (const char* e = std::getenv("XP_RESID")) info.m_leastSquaresResidualThreshold = std::atof(e);
   // Two friction rows per contact: Bullet's multibody contacts take their
   // friction directions from the contact normal alone (btPlaneSpace1), so a
   // single row would resist slip along one fixed tangent only.
@@ -549,6 +620,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   mb->setUseGyroTerm(true);
 
   btMultiBody* raw = mb.get();
+  raw->setUserIndex(static_cast<int>(m.multibodies.size()));  // its place in the world's list
   art.body = raw;
   m.multibodies.push_back(std::move(mb));  // owned before the world points to it
   m.world->addMultiBody(raw);
@@ -563,6 +635,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     col->setUserIndex2(static_cast<int>(i));                       // link index in the model
     col->setUserIndex3(static_cast<int>(m.articulations.size()));  // articulation id
     applyMaterial(col.get(), link.material.value_or(model.material));
+    if (const char* e = std::getenv("XP_PROC")) col->setContactProcessingThreshold(std::atof(e));
     m.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter,
                                 btBroadphaseProxy::AllFilter);
     if (i == 0)
