@@ -111,9 +111,10 @@ void appendIsland(T** sorted, int n, int island, btAlignedObjectArray<T*>& out) 
 
 }  // namespace
 
-ParallelIslandSolver::ParallelIslandSolver(int threads) : threads_(threads) {
-  for (int i = 0; i < threads; ++i)
-    solvers_.push_back(std::make_unique<btMultiBodyConstraintSolver>());
+ParallelIslandSolver::ParallelIslandSolver(
+    int threads, const std::function<std::unique_ptr<btMultiBodyConstraintSolver>()>& make_solver)
+    : threads_(threads) {
+  for (int i = 0; i < threads; ++i) solvers_.push_back(make_solver());
   shares_.resize(static_cast<size_t>(threads));
   load_.resize(shares_.size());
   job_ = [this](int t) {
@@ -172,10 +173,10 @@ void ParallelIslandSolver::processIsland(btCollisionObject** bodies, int num_bod
 void ParallelIslandSolver::solveBatch(int thread, Batch& batch) {
   const auto data = [](auto& a) { return a.size() ? &a[0] : nullptr; };
   if (prologue_) (*prologue_)(data(batch.bodies), batch.bodies.size(), thread);
-  solvers_[static_cast<size_t>(thread)]->solveMultiBodyGroup(data(batch.bodies), batch.bodies.size(), data(batch.manifolds),
-                             batch.manifolds.size(), data(batch.constraints),
-                             batch.constraints.size(), data(batch.multibody_constraints),
-                             batch.multibody_constraints.size(), *info_, debug_draw_, dispatcher_);
+  solvers_[static_cast<size_t>(thread)]->solveMultiBodyGroup(
+      data(batch.bodies), batch.bodies.size(), data(batch.manifolds), batch.manifolds.size(),
+      data(batch.constraints), batch.constraints.size(), data(batch.multibody_constraints),
+      batch.multibody_constraints.size(), *info_, debug_draw_, dispatcher_);
 }
 
 void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher,

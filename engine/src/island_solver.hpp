@@ -63,7 +63,11 @@ class WorkerThreads {
 // ids are then >= 0 here).
 class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
  public:
-  explicit ParallelIslandSolver(int threads);
+  // make_solver: one constraint solver per thread.
+  ParallelIslandSolver(
+      int threads,
+      const std::function<std::unique_ptr<btMultiBodyConstraintSolver>()>& make_solver);
+  btMultiBodyConstraintSolver& solver(int thread) { return *solvers_[static_cast<size_t>(thread)]; }
 
   // Before the islands are built: the solver settings and the world's
   // constraints, sorted by island (as Bullet sorts them for its own callback).
@@ -75,7 +79,8 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   // the batch's thread just before it is solved, with the batch's bodies and
   // the thread's index (0 .. threads - 1).
   using Prologue = std::function<void(btCollisionObject** bodies, int num_bodies, int thread)>;
-  void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher, const Prologue* prologue = nullptr);
+  void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher,
+             const Prologue* prologue = nullptr);
   int threadCount() const { return threads_.count(); }
   void clear() { batch_count_ = 0; }  // a step solved without it
   int batchCount() const { return static_cast<int>(batch_count_); }

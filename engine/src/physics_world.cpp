@@ -21,6 +21,7 @@
 #include <string>
 
 #include "island_solver.hpp"
+#include "link_contact_solver.hpp"
 
 namespace simsoccer::engine {
 namespace {
@@ -204,8 +205,8 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
     uint8_t& done = dynamics_done_[static_cast<size_t>(body->getUserIndex())];
     if (done) return;
     done = 1;
-    bool sleeping = body->getBaseCollider() &&
-                    body->getBaseCollider()->getActivationState() == ISLAND_SLEEPING;
+    bool sleeping =
+        body->getBaseCollider() && body->getBaseCollider()->getActivationState() == ISLAND_SLEEPING;
     for (int b = 0; b < body->getNumLinks(); ++b)
       if (body->getLink(b).m_collider &&
           body->getLink(b).m_collider->getActivationState() == ISLAND_SLEEPING)
@@ -383,7 +384,7 @@ struct PhysicsWorld::Impl {
   std::unique_ptr<btDefaultCollisionConfiguration> config;
   std::unique_ptr<btCollisionDispatcher> dispatcher;
   std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
+  std::unique_ptr<LinkContactSolver> solver;
   std::unique_ptr<TimedMultiBodyWorld> world;
   std::unique_ptr<ParallelIslandSolver> islands;  // with solver_threads > 1
   SameRobotFilter filter;
@@ -465,12 +466,15 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.config->setPlaneConvexMultipointIterations(3, 3);
   m.dispatcher = std::make_unique<btCollisionDispatcher>(m.config.get());
   m.broadphase = std::make_unique<btDbvtBroadphase>();
-  m.solver = std::make_unique<btMultiBodyConstraintSolver>();
+  m.solver = std::make_unique<LinkContactSolver>(settings.link_contact_basis);
   m.world = std::make_unique<TimedMultiBodyWorld>(m.dispatcher.get(), m.broadphase.get(),
                                                   m.solver.get(), m.config.get());
   m.world->getPairCache()->setOverlapFilterCallback(&m.filter);
   if (settings.solver_threads > 1) {
-    m.islands = std::make_unique<ParallelIslandSolver>(settings.solver_threads);
+    m.islands = std::make_unique<ParallelIslandSolver>(
+        settings.solver_threads, [basis = settings.link_contact_basis] {
+          return std::make_unique<LinkContactSolver>(basis);
+        });
     m.world->islands = m.islands.get();
   }
   // Restitution: the bouncier of the two materials decides (Bullet's default
@@ -723,8 +727,8 @@ void PhysicsWorld::setJointTarget(ArticulationId a, int joint, double target_rad
   if (s >= 0) m.servos.setTarget(static_cast<size_t>(s), target_rad, stiffness);
 }
 
-void PhysicsWorld::setJointCommand(ArticulationId a, int joint, double target_rad,
-                                   double velocity, double torque, double kp, double kd) {
+void PhysicsWorld::setJointCommand(ArticulationId a, int joint, double target_rad, double velocity,
+                                   double torque, double kp, double kd) {
   Impl& m = *impl_;
   const int s = commandedServo(m.articulations.at(a), joint);
   if (s >= 0) m.servos.setCommand(static_cast<size_t>(s), target_rad, velocity, torque, kp, kd);
@@ -786,6 +790,10 @@ void PhysicsWorld::step() {
   // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
   // integrate); exactly one dt.
   const auto dt = static_cast<btScalar>(settings_.dt);
+  m.solver->resetBasisRows();
+  if (m.islands)
+    for (int t = 0; t < m.islands->threadCount(); ++t)
+      static_cast<LinkContactSolver&>(m.islands->solver(t)).resetBasisRows();
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
@@ -796,6 +804,15 @@ void PhysicsWorld::step() {
     m.times.total_s += std::chrono::duration<double>(Clock::now() - t0).count();
     ++m.times.steps;
   }
+}
+
+long PhysicsWorld::lastStepBasisRows() const {
+  const Impl& m = *impl_;
+  long rows = m.solver->basisRows();
+  if (m.islands)
+    for (int t = 0; t < m.islands->threadCount(); ++t)
+      rows += static_cast<const LinkContactSolver&>(m.islands->solver(t)).basisRows();
+  return rows;
 }
 
 int PhysicsWorld::lastStepSolverBatches() const {

@@ -32,6 +32,10 @@ struct PhysicsSettings {
   // Threads that solve the simulation islands (robots and what touches them)
   // side by side; 1: Bullet's own loop. The result is the same bit for bit.
   int solver_threads = 1;
+  // Rows of a link's multi-point contact with static ground built from the
+  // link's spatial basis (one articulated-body pass per basis direction, not
+  // per row); false: Bullet's own rows. Equal up to rounding.
+  bool link_contact_basis = true;
   Vec3 gravity{0.0, 0.0, -9.81};
 };
 
@@ -117,6 +121,9 @@ class PhysicsWorld {
   // Constraint batches the last step's solver solved side by side (0 with one
   // thread: Bullet's own loop).
   int lastStepSolverBatches() const;
+  // Contact rows built from a link's spatial basis in the last step (0 with
+  // link_contact_basis off).
+  long lastStepBasisRows() const;
 
   // --- reading -----------------------------------------------------------------
   // Joint frame of a link in the world.
