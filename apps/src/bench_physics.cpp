@@ -177,10 +177,10 @@ int benchPhysics(int argc, char** argv, int first) {
   }
   table.finish(
       "Stages: collision = broadphase + narrowphase; dynamics = articulated-body forward "
-      "dynamics; solver = contact and joint-limit constraints (their batches side by side "
-      "on the solver threads; 0 batches: one thread, Bullet's own loop); integrate = "
-      "positions; servo = joint PD torques; other = everything else in the step and the "
-      "loop (commands, contact counting).",
+      "dynamics (the part outside the batches: each robot's own runs with its batch); "
+      "solver = contact, joint-limit and implicit servo constraints (their batches side by "
+      "side on the solver threads); integrate = positions; servo = joint PD torques; other "
+      "= everything else in the step and the loop (commands, contact counting).",
       csv);
   std::printf("\n%s", summary.c_str());
   return 0;

@@ -124,7 +124,8 @@ ParallelIslandSolver::ParallelIslandSolver(
 
 void ParallelIslandSolver::setup(const btContactSolverInfo& info, btTypedConstraint** constraints,
                                  int num_constraints, btMultiBodyConstraint** multibody_constraints,
-                                 int num_multibody_constraints) {
+                                 int num_multibody_constraints, const int* multibody_islands) {
+  multibody_islands_ = multibody_islands;
   info_ = &info;
   constraints_ = constraints;
   num_constraints_ = num_constraints;
@@ -160,8 +161,15 @@ void ParallelIslandSolver::processIsland(btCollisionObject** bodies, int num_bod
   const int constraints_before = batch.constraints.size(),
             multibody_before = batch.multibody_constraints.size();
   appendIsland(constraints_, num_constraints_, island_id, batch.constraints);
-  appendIsland(multibody_constraints_, num_multibody_constraints_, island_id,
-               batch.multibody_constraints);
+  if (multibody_islands_) {
+    const int* end = multibody_islands_ + num_multibody_constraints_;
+    for (const int* i = std::lower_bound(multibody_islands_, end, island_id);
+         i != end && *i == island_id; ++i)
+      batch.multibody_constraints.push_back(multibody_constraints_[i - multibody_islands_]);
+  } else {
+    appendIsland(multibody_constraints_, num_multibody_constraints_, island_id,
+                 batch.multibody_constraints);
+  }
   batch.cost += (batch.constraints.size() - constraints_before) +
                 (batch.multibody_constraints.size() - multibody_before) + 1;
   // Bullet's rule (MultiBodyInplaceSolverIslandCallback::processIsland).

@@ -71,8 +71,11 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
 
   // Before the islands are built: the solver settings and the world's
   // constraints, sorted by island (as Bullet sorts them for its own callback).
+  // `multibody_islands` (may be null): the island of each multibody
+  // constraint, as they are sorted (saves asking each constraint again).
   void setup(const btContactSolverInfo& info, btTypedConstraint** constraints, int num_constraints,
-             btMultiBodyConstraint** multibody_constraints, int num_multibody_constraints);
+             btMultiBodyConstraint** multibody_constraints, int num_multibody_constraints,
+             const int* multibody_islands = nullptr);
   void processIsland(btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds,
                      int num_manifolds, int island_id) override;
   // Solves every batch collected since setup(). `prologue` (if set) runs on
@@ -109,6 +112,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   int num_constraints_ = 0;
   btMultiBodyConstraint** multibody_constraints_ = nullptr;
   int num_multibody_constraints_ = 0;
+  const int* multibody_islands_ = nullptr;
   const btContactSolverInfo* info_ = nullptr;
   btIDebugDraw* debug_draw_ = nullptr;
   btDispatcher* dispatcher_ = nullptr;

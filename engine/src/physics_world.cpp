@@ -20,8 +20,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "articulation_solver.hpp"
 #include "island_solver.hpp"
-#include "link_contact_solver.hpp"
 
 namespace simsoccer::engine {
 namespace {
@@ -125,9 +125,8 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   void solveConstraints(btContactSolverInfo& info) override {
     const double dynamics_before = times ? times->dynamics_s : 0.0;
     timed(&StageTimes::solver_s, [&] {
-      // Bullet's own loop with one thread, and where batches could share
-      // state: a randomised row order (one seed across batches) or islands
-      // not split (one group).
+      // Bullet's own loop where batches could share state: a randomised row
+      // order (one seed across batches) or islands not split (one group).
       if (!islands || (info.m_solverMode & SOLVER_RANDMIZE_ORDER) ||
           !m_islandManager->getSplitIslands()) {
         btMultiBodyDynamicsWorld::solveConstraints(info);
@@ -146,7 +145,7 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
           info, m_sortedConstraints.size() ? &m_sortedConstraints[0] : nullptr,
           m_sortedConstraints.size(),
           m_sortedMultiBodyConstraints.size() ? &m_sortedMultiBodyConstraints[0] : nullptr,
-          m_sortedMultiBodyConstraints.size());
+          m_sortedMultiBodyConstraints.size(), islands_of_sorted_.data());
       m_islandManager->buildAndProcessIslands(getCollisionWorld()->getDispatcher(),
                                               getCollisionWorld(), islands);
       dynamics_done_.assign(static_cast<size_t>(m_multiBodies.size()), 0);
@@ -177,6 +176,12 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   };
   std::vector<Scratch> scratch_;
   std::vector<uint8_t> dynamics_done_;  // per multibody (its user index), this step
+  struct Keyed {
+    btMultiBodyConstraint* constraint;
+    int island;
+  };
+  btAlignedObjectArray<Keyed> keyed_;
+  std::vector<int> islands_of_sorted_;  // island of each of m_sortedMultiBodyConstraints
 
   // btMultiBodyDynamicsWorld::solveExternalForces without its forward-dynamics
   // loop (gravity and force clearing are Bullet's virtual applyGravity and
@@ -187,10 +192,21 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
     m_sortedConstraints.resize(m_constraints.size());
     for (int i = 0; i < m_constraints.size(); ++i) m_sortedConstraints[i] = m_constraints[i];
     m_sortedConstraints.quickSort(btSortConstraintOnIslandPredicate2());
-    m_sortedMultiBodyConstraints.resize(m_multiBodyConstraints.size());
-    for (int i = 0; i < m_multiBodyConstraints.size(); ++i)
-      m_sortedMultiBodyConstraints[i] = m_multiBodyConstraints[i];
-    m_sortedMultiBodyConstraints.quickSort(btSortMultiBodyConstraintOnIslandPredicate());
+    // By island, each constraint asked for its island once (Bullet's
+    // predicate asks twice per comparison): the same comparisons on the same
+    // keys, so Bullet's quick sort gives the same order.
+    const int n = m_multiBodyConstraints.size();
+    keyed_.resize(n);
+    for (int i = 0; i < n; ++i)
+      keyed_[i] = {m_multiBodyConstraints[i],
+                   btGetMultiBodyConstraintIslandId(m_multiBodyConstraints[i])};
+    keyed_.quickSort([](const Keyed& a, const Keyed& b) { return a.island < b.island; });
+    m_sortedMultiBodyConstraints.resize(n);
+    islands_of_sorted_.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      m_sortedMultiBodyConstraints[i] = keyed_[i].constraint;
+      islands_of_sorted_[static_cast<size_t>(i)] = keyed_[i].island;
+    }
     m_solverMultiBodyIslandCallback->setup(
         &info, m_sortedConstraints.size() ? &m_sortedConstraints[0] : nullptr,
         m_sortedConstraints.size(),
@@ -384,9 +400,9 @@ struct PhysicsWorld::Impl {
   std::unique_ptr<btDefaultCollisionConfiguration> config;
   std::unique_ptr<btCollisionDispatcher> dispatcher;
   std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<LinkContactSolver> solver;
+  std::unique_ptr<ArticulationSolver> solver;
   std::unique_ptr<TimedMultiBodyWorld> world;
-  std::unique_ptr<ParallelIslandSolver> islands;  // with solver_threads > 1
+  std::unique_ptr<ParallelIslandSolver> islands;  // the batches, on solver_threads threads
   SameRobotFilter filter;
 
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -466,17 +482,17 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.config->setPlaneConvexMultipointIterations(3, 3);
   m.dispatcher = std::make_unique<btCollisionDispatcher>(m.config.get());
   m.broadphase = std::make_unique<btDbvtBroadphase>();
-  m.solver = std::make_unique<LinkContactSolver>(settings.link_contact_basis);
+  m.solver = std::make_unique<ArticulationSolver>(!settings.bullet_solver);
   m.world = std::make_unique<TimedMultiBodyWorld>(m.dispatcher.get(), m.broadphase.get(),
                                                   m.solver.get(), m.config.get());
   m.world->getPairCache()->setOverlapFilterCallback(&m.filter);
-  if (settings.solver_threads > 1) {
-    m.islands = std::make_unique<ParallelIslandSolver>(
-        settings.solver_threads, [basis = settings.link_contact_basis] {
-          return std::make_unique<LinkContactSolver>(basis);
-        });
-    m.world->islands = m.islands.get();
-  }
+  // The batches are formed and solved by the engine's own loop for any
+  // number of threads (one: one after the other on the caller's thread), so
+  // every thread count runs the same code.
+  m.islands = std::make_unique<ParallelIslandSolver>(
+      settings.solver_threads,
+      [own = !settings.bullet_solver] { return std::make_unique<ArticulationSolver>(own); });
+  m.world->islands = m.islands.get();
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it
   // bounces off anything hard, at its own restitution, while robots, the
@@ -793,7 +809,7 @@ void PhysicsWorld::step() {
   m.solver->resetBasisRows();
   if (m.islands)
     for (int t = 0; t < m.islands->threadCount(); ++t)
-      static_cast<LinkContactSolver&>(m.islands->solver(t)).resetBasisRows();
+      static_cast<ArticulationSolver&>(m.islands->solver(t)).resetBasisRows();
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
@@ -811,7 +827,7 @@ long PhysicsWorld::lastStepBasisRows() const {
   long rows = m.solver->basisRows();
   if (m.islands)
     for (int t = 0; t < m.islands->threadCount(); ++t)
-      rows += static_cast<const LinkContactSolver&>(m.islands->solver(t)).basisRows();
+      rows += static_cast<const ArticulationSolver&>(m.islands->solver(t)).basisRows();
   return rows;
 }
 

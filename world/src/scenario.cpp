@@ -105,8 +105,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
     if (!std::filesystem::exists(path)) root.failKey(key, "file not found: " + path.string());
 
   const ConfigNode ph = root["physics"];
-  ph.allowOnly({"dt", "control_period", "solver_iterations", "friction_directions",
-                "link_contact_basis", "gravity", "threads"});
+  ph.allowOnly({"dt", "control_period", "solver_iterations", "friction_directions", "bullet_solver",
+                "gravity", "threads"});
   s.physics.dt = ph["dt"].positive();
   s.physics.control_period = ph["control_period"].positive();
   s.physics.solver_iterations = ph.integer("solver_iterations", s.physics.solver_iterations);
@@ -114,7 +114,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
   s.physics.friction_directions = ph.integer("friction_directions", s.physics.friction_directions);
   if (s.physics.friction_directions != 1 && s.physics.friction_directions != 2)
     ph.failKey("friction_directions", "must be 1 or 2");
-  s.physics.link_contact_basis = ph.boolean("link_contact_basis", s.physics.link_contact_basis);
+  s.physics.bullet_solver = ph.boolean("bullet_solver", s.physics.bullet_solver);
   s.physics.gravity = ph.number("gravity", s.physics.gravity);
   if (const auto threads = ph.optional("threads")) {
     const std::string text = threads->raw().IsScalar() ? threads->raw().Scalar() : "";

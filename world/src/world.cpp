@@ -49,7 +49,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   settings.dt = pc.dt;
   settings.solver_iterations = pc.solver_iterations;
   settings.friction_directions = pc.friction_directions;
-  settings.link_contact_basis = pc.link_contact_basis;
+  settings.bullet_solver = pc.bullet_solver;
   settings.gravity = Vec3(0, 0, pc.gravity);
   settings.solver_threads = solverThreads(pc);
   physics_ = std::make_unique<engine::PhysicsWorld>(settings);

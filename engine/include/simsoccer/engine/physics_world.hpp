@@ -32,10 +32,10 @@ struct PhysicsSettings {
   // Threads that solve the simulation islands (robots and what touches them)
   // side by side; 1: Bullet's own loop. The result is the same bit for bit.
   int solver_threads = 1;
-  // Rows of a link's multi-point contact with static ground built from the
-  // link's spatial basis (one articulated-body pass per basis direction, not
-  // per row); false: Bullet's own rows. Equal up to rounding.
-  bool link_contact_basis = true;
+  // true: Bullet's own contact rows and iterations; false: the engine's
+  // (a foot's rows from its link's spatial basis, a leaner iteration loop),
+  // equal up to rounding.
+  bool bullet_solver = false;
   Vec3 gravity{0.0, 0.0, -9.81};
 };
 
@@ -118,11 +118,11 @@ class PhysicsWorld {
   void enableStageTimers(bool on) { timers_on_ = on; }
   const StageTimes& stageTimes() const;
   void resetStageTimes();
-  // Constraint batches the last step's solver solved side by side (0 with one
-  // thread: Bullet's own loop).
+  // Constraint batches the last step's solver formed (solved side by side on
+  // the solver threads; 0: Bullet's own loop, for a randomised row order).
   int lastStepSolverBatches() const;
   // Contact rows built from a link's spatial basis in the last step (0 with
-  // link_contact_basis off).
+  // bullet_solver).
   long lastStepBasisRows() const;
 
   // --- reading -----------------------------------------------------------------

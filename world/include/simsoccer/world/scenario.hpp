@@ -30,11 +30,10 @@ struct PhysicsConfig {
   // slip: feet hold sideways but slide freely forward and back, so robots
   // cannot walk. Kept for comparisons only.
   int friction_directions = 2;
-  // The rows of a link's contact of three or more points with the ground (a
-  // foot flat on the carpet) from the link's spatial basis: six articulated-
-  // body passes per link instead of one per row. Off: Bullet's own rows (for
-  // comparisons; the same physics up to rounding).
-  bool link_contact_basis = true;
+  // true: Bullet's own contact rows and solver iterations throughout, for
+  // comparisons; false (the default): the engine's (engine/src/
+  // articulation_solver.hpp), the same physics up to rounding, faster.
+  bool bullet_solver = false;
   double gravity = -9.81;  // m/s^2 along z
   // Threads that solve the constraint batches (groups of robots and what
   // touches them) side by side; 0 (`auto`, the default): see solverThreads().

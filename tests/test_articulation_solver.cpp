@@ -23,9 +23,9 @@ struct Outcome {
 
 // Two Naos standing for `steps` steps (5 ms), head and arms on sinusoids
 // around the stand pose, the legs still (feet flat: four points each).
-Outcome run(bool basis, int steps) {
+Outcome run(bool own, int steps) {
   world::Scenario s = test::scenario(2, 3);
-  s.physics.link_contact_basis = basis;
+  s.physics.bullet_solver = !own;
   world::World w(s);
   for (int i = 0; i < steps; ++i) {
     if (i % w.stepsPerControlPeriod() == 0)
@@ -56,7 +56,7 @@ Outcome run(bool basis, int steps) {
 
 }  // namespace
 
-TEST(LinkContactBasis, TheFeetsRowsMatchBulletsOwnUpToRounding) {
+TEST(ArticulationSolver, MatchesBulletsOwnRowsAndIterationsUpToRounding) {
   const int steps = 200;  // 1 s
   const Outcome bullet = run(false, steps), basis = run(true, steps);
   double joint_gap = 0.0;

@@ -1,0 +1,443 @@
+#include "articulation_solver.hpp"
+
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+namespace simsoccer::engine {
+namespace {
+
+// Below three points the basis (six passes) costs as much as the rows.
+constexpr int kMinPoints = 3;
+// Per-point settings Bullet honours that the basis path does not implement.
+constexpr int kOwnSettings = BT_CONTACT_FLAG_HAS_CONTACT_CFM | BT_CONTACT_FLAG_HAS_CONTACT_ERP |
+                             BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING |
+                             BT_CONTACT_FLAG_FRICTION_ANCHOR;
+constexpr int kAnisotropic =
+    btCollisionObject::CF_ANISOTROPIC_FRICTION | btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION;
+
+// a . b over n entries in four interleaved partial sums (a fixed order, so
+// the result is the same on every run; the compiler can vectorise it).
+btScalar dot(const btScalar* a, const btScalar* b, int n) {
+  btScalar s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  int i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
+  }
+  for (; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
+void touched(const btMultiBodySolverConstraint& row) {
+  if (row.m_multiBodyA) row.m_multiBodyA->setPosUpdated(false);
+  if (row.m_multiBodyB) row.m_multiBodyB->setPosUpdated(false);
+}
+
+}  // namespace
+
+void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int num_manifolds,
+                                         const btContactSolverInfo& info) {
+  if (!own_ || (info.m_solverMode &
+                (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING | SOLVER_USE_ARTICULATED_WARMSTARTING))) {
+    btMultiBodyConstraintSolver::convertContacts(manifolds, num_manifolds, info);
+    return;
+  }
+  // Manifold by manifold in Bullet's order, so the rows come in its order.
+  for (int i = 0; i < num_manifolds; ++i) {
+    btPersistentManifold* manifold = manifolds[i];
+    int link_side = 0;
+    if (takesBasisPath(*manifold, link_side))
+      convertLinkContact(*manifold, link_side, info);
+    else if (btMultiBodyLinkCollider::upcast(manifold->getBody0()) ||
+             btMultiBodyLinkCollider::upcast(manifold->getBody1()))
+      convertMultiBodyContact(manifold, info);
+    else
+      convertContact(manifold, info);
+  }
+  // The articulations' own constraints (limits, servos, gears); without
+  // articulated warm starting their rows start from zero impulse.
+  for (int i = 0; i < m_tmpNumMultiBodyConstraints; ++i) {
+    m_data.m_solverBodyPool = &m_tmpSolverBodyPool;
+    m_data.m_fixedBodyId = m_fixedBodyId;
+    m_tmpMultiBodyConstraints[i]->createConstraintRows(m_multiBodyNonContactConstraints, m_data,
+                                                       info);
+  }
+  for (int i = 0; i < m_multiBodyNonContactConstraints.size(); ++i)
+    m_multiBodyNonContactConstraints[i].m_appliedImpulse = 0;
+}
+
+bool ArticulationSolver::takesBasisPath(const btPersistentManifold& manifold,
+                                        int& link_side) const {
+  const btCollisionObject* body[2] = {manifold.getBody0(), manifold.getBody1()};
+  const bool is_link[2] = {btMultiBodyLinkCollider::upcast(body[0]) != nullptr,
+                           btMultiBodyLinkCollider::upcast(body[1]) != nullptr};
+  if (is_link[0] == is_link[1]) return false;  // one articulation link, one other object
+  const btCollisionObject* other = is_link[0] ? body[1] : body[0];
+  if (btRigidBody::upcast(other) != nullptr || !other->isStaticOrKinematicObject()) return false;
+  if (body[0]->hasAnisotropicFriction(kAnisotropic) ||
+      body[1]->hasAnisotropicFriction(kAnisotropic))
+    return false;
+  int points = 0;
+  for (int j = 0; j < manifold.getNumContacts(); ++j) {
+    const btManifoldPoint& p = manifold.getContactPoint(j);
+    if (p.m_combinedRollingFriction > 0 || p.m_combinedSpinningFriction > 0 ||
+        (p.m_contactPointFlags & kOwnSettings))
+      return false;
+    if (p.getDistance() <= manifold.getContactProcessingThreshold()) ++points;
+  }
+  link_side = is_link[0] ? 0 : 1;
+  return points >= kMinPoints;
+}
+
+void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int link_side,
+                                            const btContactSolverInfo& info) {
+  const btMultiBodyLinkCollider* collider =
+      btMultiBodyLinkCollider::upcast(link_side == 0 ? manifold.getBody0() : manifold.getBody1());
+  body_ = collider->m_multiBody;
+  link_ = collider->m_link;
+  auto* other =
+      const_cast<btCollisionObject*>(link_side == 0 ? manifold.getBody1() : manifold.getBody0());
+  const int static_body = getOrInitSolverBody(*other, info.m_timeStep);
+
+  // The link's spatial basis at its origin (the frame Bullet measures the
+  // contact's lever arm from): Jacobians and their responses.
+  ndof_ = body_->getNumDofs() + 6;
+  basis_origin_ =
+      link_ < 0 ? body_->getBasePos() : body_->getLink(link_).m_cachedWorldTransform.getOrigin();
+  basis_jacobian_.resize(6 * ndof_);
+  basis_response_.resize(6 * ndof_);
+  for (int k = 0; k < 6; ++k) {
+    btVector3 angular(0, 0, 0), linear(0, 0, 0);
+    (k < 3 ? angular : linear)[k % 3] = 1;
+    btScalar* jacobian = &basis_jacobian_[k * ndof_];
+    body_->fillConstraintJacobianMultiDof(link_, basis_origin_, angular, linear, jacobian,
+                                          m_data.scratch_r, m_data.scratch_v, m_data.scratch_m);
+    body_->calcAccelerationDeltasMultiDof(jacobian, &basis_response_[k * ndof_], m_data.scratch_r,
+                                          m_data.scratch_v);
+  }
+
+  const bool two_directions = info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS;
+  for (int j = 0; j < manifold.getNumContacts(); ++j) {
+    btManifoldPoint& point = manifold.getContactPoint(j);
+    if (point.getDistance() > manifold.getContactProcessingThreshold()) {
+      point.m_appliedImpulse = 0;  // no row: nothing to start the next step from
+      point.m_prevRHS = 0;
+      continue;
+    }
+    const int normal_index = m_multiBodyNormalContactConstraints.size();
+    btMultiBodySolverConstraint& normal =
+        m_multiBodyNormalContactConstraints.expandNonInitializing();
+    addRow(normal, point, point.m_normalWorldOnB, /*friction=*/false, link_side, static_body, info);
+    normal.m_frictionIndex = m_multiBodyFrictionContactConstraints.size();
+    // Friction along two fixed tangents of the normal, as Bullet's multibody
+    // contacts; the solver clamps the pair to the friction cone.
+    btPlaneSpace1(point.m_normalWorldOnB, point.m_lateralFrictionDir1, point.m_lateralFrictionDir2);
+    point.m_lateralFrictionDir1.normalize();
+    point.m_lateralFrictionDir2.normalize();
+    for (int d = 0; d < (two_directions ? 2 : 1); ++d) {
+      btMultiBodySolverConstraint& row =
+          m_multiBodyFrictionContactConstraints.expandNonInitializing();
+      addRow(row, point, d == 0 ? point.m_lateralFrictionDir1 : point.m_lateralFrictionDir2,
+             /*friction=*/true, link_side, static_body, info);
+      row.m_frictionIndex = normal_index;
+    }
+    if (two_directions &&
+        (info.m_solverMode & SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION))
+      point.m_contactPointFlags |= BT_CONTACT_FLAG_LATERAL_FRICTION_INITIALIZED;
+  }
+}
+
+void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoint& point,
+                                const btVector3& direction, bool friction, int link_side,
+                                int static_body, const btContactSolverInfo& info) {
+  const bool link_is_a = link_side == 0;
+  row.m_orgConstraint = nullptr;
+  row.m_orgDofIndex = -1;
+  row.m_originalContactPoint = &point;
+  row.m_overrideNumSolverIterations = -1;
+  row.m_solverBodyIdA = link_is_a ? -1 : static_body;
+  row.m_solverBodyIdB = link_is_a ? static_body : -1;
+  row.m_multiBodyA = link_is_a ? body_ : nullptr;
+  row.m_multiBodyB = link_is_a ? nullptr : body_;
+  row.m_linkA = link_is_a ? link_ : -1;
+  row.m_linkB = link_is_a ? -1 : link_;
+
+  // The link's row: along +direction at its point on side A, along
+  // -direction on side B; the basis combination (lever arm x direction,
+  // direction) gives its Jacobian and response.
+  const btVector3 link_direction = link_is_a ? direction : -direction;
+  const btVector3 link_arm =
+      (link_is_a ? point.getPositionWorldOnA() : point.getPositionWorldOnB()) - basis_origin_;
+  const btVector3 moment = link_arm.cross(link_direction);
+  const btScalar weight[6] = {moment.x(),         moment.y(),         moment.z(),
+                              link_direction.x(), link_direction.y(), link_direction.z()};
+  int block = body_->getCompanionId();
+  if (block < 0) {  // the articulation's first row in this group: its delta velocities
+    block = m_data.m_deltaVelocities.size();
+    body_->setCompanionId(block);
+    m_data.m_deltaVelocities.resize(block + ndof_);
+  }
+  const int index = m_data.m_jacobians.size();
+  m_data.m_jacobians.resize(index + ndof_);
+  m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof_);
+  btScalar* jacobian = &m_data.m_jacobians[index];
+  btScalar* response = &m_data.m_deltaVelocitiesUnitImpulse[index];
+  for (int i = 0; i < ndof_; ++i) {
+    btScalar j = 0, r = 0;
+    for (int k = 0; k < 6; ++k) {
+      j += weight[k] * basis_jacobian_[k * ndof_ + i];
+      r += weight[k] * basis_response_[k * ndof_ + i];
+    }
+    jacobian[i] = j;
+    response[i] = r;
+  }
+  if (link_is_a) {
+    row.m_deltaVelAindex = block;
+    row.m_jacAindex = index;
+  } else {
+    row.m_deltaVelBindex = block;
+    row.m_jacBindex = index;
+  }
+
+  // Lever arms and normals as the solver's feedback and rigid-body paths
+  // read them: from the link's origin, and from the static body's.
+  const btVector3 static_origin = m_tmpSolverBodyPool[static_body].getWorldTransform().getOrigin();
+  const btVector3 arm_a = point.getPositionWorldOnA() - (link_is_a ? basis_origin_ : static_origin);
+  const btVector3 arm_b = point.getPositionWorldOnB() - (link_is_a ? static_origin : basis_origin_);
+  row.m_relpos1CrossNormal = arm_a.cross(direction);
+  row.m_contactNormal1 = direction;
+  row.m_relpos2CrossNormal = -arm_b.cross(direction);
+  row.m_contactNormal2 = -direction;
+  row.m_angularComponentA.setZero();
+  row.m_angularComponentB.setZero();
+
+  // Effective mass (J M^-1 J^T plus the softness), the velocity error with
+  // restitution and Baumgarte stabilisation, and the impulse bounds.
+  const btScalar dt = info.m_timeStep;
+  const btScalar cfm = (friction ? info.m_frictionCFM : info.m_globalCfm) / dt;
+  const btScalar erp = friction ? info.m_frictionERP : info.m_erp2;
+  btScalar inverse_mass = 0, velocity = 0;
+  const btScalar* qdot = body_->getVelocityVector();
+  for (int i = 0; i < ndof_; ++i) {
+    inverse_mass += jacobian[i] * response[i];
+    velocity += qdot[i] * jacobian[i];
+  }
+  const btScalar denominator = inverse_mass + cfm;
+  row.m_jacDiagABInv = denominator > SIMD_EPSILON ? info.m_sor / denominator : btScalar(0);
+  row.m_friction = point.m_combinedFriction;
+  btScalar velocity_error = -velocity, position_error = 0;
+  if (!friction) {
+    const btScalar bounce = restitutionCurve(velocity, point.m_combinedRestitution,
+                                             info.m_restitutionVelocityThreshold);
+    if (bounce > 0) velocity_error += bounce;
+    const btScalar distance = point.getDistance() + info.m_linearSlop;
+    if (distance > 0)
+      velocity_error -= distance / dt;  // separated: close the gap this step, no push
+    else
+      position_error = -distance * erp / dt;
+  }
+  row.m_rhs = position_error * row.m_jacDiagABInv + velocity_error * row.m_jacDiagABInv;
+  row.m_rhsPenetration = 0;
+  row.m_lowerLimit = friction ? -row.m_friction : btScalar(0);
+  row.m_upperLimit = friction ? row.m_friction : btScalar(1e10f);
+  row.m_cfm = cfm * row.m_jacDiagABInv;
+  row.m_appliedImpulse = 0;
+  row.m_appliedPushImpulse = 0;
+  ++basis_rows_;
+}
+
+btScalar ArticulationSolver::rowVelocity(const btMultiBodySolverConstraint& row) {
+  btScalar v = 0;
+  if (row.m_multiBodyA) {
+    v += dot(&m_data.m_jacobians[row.m_jacAindex], &m_data.m_deltaVelocities[row.m_deltaVelAindex],
+             row.m_multiBodyA->getNumDofs() + 6);
+  } else if (row.m_solverBodyIdA >= 0) {
+    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdA];
+    v += row.m_contactNormal1.dot(body.internalGetDeltaLinearVelocity()) +
+         row.m_relpos1CrossNormal.dot(body.internalGetDeltaAngularVelocity());
+  }
+  if (row.m_multiBodyB) {
+    v += dot(&m_data.m_jacobians[row.m_jacBindex], &m_data.m_deltaVelocities[row.m_deltaVelBindex],
+             row.m_multiBodyB->getNumDofs() + 6);
+  } else if (row.m_solverBodyIdB >= 0) {
+    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdB];
+    v += row.m_contactNormal2.dot(body.internalGetDeltaLinearVelocity()) +
+         row.m_relpos2CrossNormal.dot(body.internalGetDeltaAngularVelocity());
+  }
+  return v;
+}
+
+void ArticulationSolver::applyImpulse(const btMultiBodySolverConstraint& row, btScalar impulse) {
+  auto axpy = [&](btMultiBody* body, int response, int block) {
+    const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response];
+    btScalar* dv = &m_data.m_deltaVelocities[block];
+    const int n = body->getNumDofs() + 6;
+    for (int i = 0; i < n; ++i) dv[i] += r[i] * impulse;
+  };
+  if (row.m_multiBodyA) {
+    axpy(row.m_multiBodyA, row.m_jacAindex, row.m_deltaVelAindex);
+  } else if (row.m_solverBodyIdA >= 0) {
+    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdA];
+    body.internalApplyImpulse(row.m_contactNormal1 * body.internalGetInvMass(),
+                              row.m_angularComponentA, impulse);
+  }
+  if (row.m_multiBodyB) {
+    axpy(row.m_multiBodyB, row.m_jacBindex, row.m_deltaVelBindex);
+  } else if (row.m_solverBodyIdB >= 0) {
+    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdB];
+    body.internalApplyImpulse(row.m_contactNormal2 * body.internalGetInvMass(),
+                              row.m_angularComponentB, impulse);
+  }
+}
+
+btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
+  // Projected Gauss-Seidel: the impulse that removes the row's velocity
+  // error (softened by its cfm), clamped to its bounds.
+  btScalar delta = row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm -
+                   rowVelocity(row) * row.m_jacDiagABInv;
+  const btScalar total = btScalar(row.m_appliedImpulse) + delta;
+  btScalar bounded = total;
+  if (total < row.m_lowerLimit)
+    bounded = row.m_lowerLimit;
+  else if (total > row.m_upperLimit)
+    bounded = row.m_upperLimit;
+  if (bounded != total) delta = bounded - btScalar(row.m_appliedImpulse);
+  row.m_appliedImpulse = bounded;
+  applyImpulse(row, delta);
+  touched(row);
+  return delta / row.m_jacDiagABInv;
+}
+
+btScalar ArticulationSolver::resolveFrictionPair(btMultiBodySolverConstraint& a,
+                                                 btMultiBodySolverConstraint& b) {
+  // Both rows' unclamped updates from the same velocities, then the pair
+  // scaled back onto the circle of radius mu N (the rows' bounds) along its
+  // own direction, as Bullet's implicit friction cone.
+  btScalar delta_a =
+      a.m_rhs - btScalar(a.m_appliedImpulse) * a.m_cfm - rowVelocity(a) * a.m_jacDiagABInv;
+  btScalar delta_b =
+      b.m_rhs - btScalar(b.m_appliedImpulse) * b.m_cfm - rowVelocity(b) * b.m_jacDiagABInv;
+  btScalar total_a = btScalar(a.m_appliedImpulse) + delta_a;
+  btScalar total_b = btScalar(b.m_appliedImpulse) + delta_b;
+  if (total_a * total_a + total_b * total_b >= a.m_lowerLimit * b.m_lowerLimit) {
+    const btScalar angle = btAtan2(total_a, total_b);
+    const btScalar limit_a = btFabs(a.m_lowerLimit * btSin(angle));
+    const btScalar limit_b = btFabs(b.m_lowerLimit * btCos(angle));
+    const btScalar clamped_a = btMin(btMax(total_a, -limit_a), limit_a);
+    const btScalar clamped_b = btMin(btMax(total_b, -limit_b), limit_b);
+    if (clamped_a != total_a) delta_a = clamped_a - btScalar(a.m_appliedImpulse);
+    if (clamped_b != total_b) delta_b = clamped_b - btScalar(b.m_appliedImpulse);
+    total_a = clamped_a;
+    total_b = clamped_b;
+  }
+  a.m_appliedImpulse = total_a;
+  b.m_appliedImpulse = total_b;
+  applyImpulse(a, delta_a);
+  applyImpulse(b, delta_b);
+  touched(a);
+  touched(b);
+  return delta_a / a.m_jacDiagABInv + delta_b / b.m_jacDiagABInv;
+}
+
+btScalar ArticulationSolver::solveSingleIteration(
+    int iteration, btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds,
+    int num_manifolds, btTypedConstraint** constraints, int num_constraints,
+    const btContactSolverInfo& info, btIDebugDraw* debug_draw) {
+  if (!lean(info))
+    return btMultiBodyConstraintSolver::solveSingleIteration(iteration, bodies, num_bodies,
+                                                             manifolds, num_manifolds, constraints,
+                                                             num_constraints, info, debug_draw);
+  // Rigid bodies against each other (the ball on the carpet): Bullet's.
+  btScalar residual = btSequentialImpulseConstraintSolver::solveSingleIteration(
+      iteration, bodies, num_bodies, manifolds, num_manifolds, constraints, num_constraints, info,
+      debug_draw);
+  auto track = [&residual](btScalar change) { residual = btMax(residual, change * change); };
+
+  // The articulations' own constraints, in alternating order.
+  btScalar own = 0;
+  const int num_own = m_multiBodyNonContactConstraints.size();
+  for (int inner = 0; inner < info.m_numNonContactInnerIterations; ++inner) {
+    own = 0;
+    for (int j = 0; j < num_own; ++j) {
+      const btScalar change =
+          resolveRow(m_multiBodyNonContactConstraints[(iteration & 1) ? j : num_own - 1 - j]);
+      own = btMax(own, change * change);
+    }
+  }
+  residual = btMax(residual, own);
+  if (iteration >= info.m_numIterations) return residual;
+
+  for (int j = 0; j < m_multiBodyNormalContactConstraints.size(); ++j)
+    track(resolveRow(m_multiBodyNormalContactConstraints[j]));
+
+  // Friction bounded by its contact's normal impulse.
+  auto bound = [this](btMultiBodySolverConstraint& row) {
+    const btScalar normal =
+        m_multiBodyNormalContactConstraints[row.m_frictionIndex].m_appliedImpulse;
+    row.m_lowerLimit = -(row.m_friction * normal);
+    row.m_upperLimit = row.m_friction * normal;
+    return normal;
+  };
+  if ((info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS) &&
+      !(info.m_solverMode & SOLVER_DISABLE_IMPLICIT_CONE_FRICTION)) {
+    for (int j = 0; j < m_multiBodySpinningFrictionContactConstraints.size(); ++j) {
+      btMultiBodySolverConstraint& row = m_multiBodySpinningFrictionContactConstraints[j];
+      if (bound(row) > 0) track(resolveRow(row));
+    }
+    for (int j = 0; j + 1 < m_multiBodyTorsionalFrictionContactConstraints.size(); j += 2) {
+      btMultiBodySolverConstraint& a = m_multiBodyTorsionalFrictionContactConstraints[j];
+      btMultiBodySolverConstraint& b = m_multiBodyTorsionalFrictionContactConstraints[j + 1];
+      if (a.m_frictionIndex != b.m_frictionIndex) continue;
+      if (bound(a) > 0) {
+        bound(b);
+        track(resolveFrictionPair(a, b));
+      }
+    }
+    for (int j = 0; j + 1 < m_multiBodyFrictionContactConstraints.size(); j += 2) {
+      btMultiBodySolverConstraint& a = m_multiBodyFrictionContactConstraints[j];
+      btMultiBodySolverConstraint& b = m_multiBodyFrictionContactConstraints[j + 1];
+      if (a.m_frictionIndex != b.m_frictionIndex) continue;
+      bound(a);
+      bound(b);
+      track(resolveFrictionPair(a, b));
+    }
+  } else {
+    for (int j = 0; j < m_multiBodyFrictionContactConstraints.size(); ++j) {
+      btMultiBodySolverConstraint& row = m_multiBodyFrictionContactConstraints[j];
+      if (bound(row) > 0) track(resolveRow(row));
+    }
+  }
+  return residual;
+}
+
+btScalar ArticulationSolver::solveGroupCacheFriendlyIterations(
+    btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds, int num_manifolds,
+    btTypedConstraint** constraints, int num_constraints, const btContactSolverInfo& info,
+    btIDebugDraw* debug_draw) {
+  const btScalar residual = btSequentialImpulseConstraintSolver::solveGroupCacheFriendlyIterations(
+      bodies, num_bodies, manifolds, num_manifolds, constraints, num_constraints, info, debug_draw);
+  if (!lean(info)) return residual;
+  // Each articulation's accumulated velocity change, once, where Bullet
+  // would have added it row by row.
+  applied_.assign(static_cast<size_t>(m_data.m_deltaVelocities.size()), 0);
+  auto add = [&](btMultiBody* body, int block) {
+    if (!body || applied_[static_cast<size_t>(block)]) return;
+    applied_[static_cast<size_t>(block)] = 1;
+    body->applyDeltaVeeMultiDof2(&m_data.m_deltaVelocities[block], 1);
+  };
+  for (const btMultiBodyConstraintArray* rows :
+       {&m_multiBodyNonContactConstraints, &m_multiBodyNormalContactConstraints,
+        &m_multiBodyFrictionContactConstraints, &m_multiBodyTorsionalFrictionContactConstraints,
+        &m_multiBodySpinningFrictionContactConstraints})
+    for (int j = 0; j < rows->size(); ++j) {
+      add((*rows)[j].m_multiBodyA, (*rows)[j].m_deltaVelAindex);
+      add((*rows)[j].m_multiBodyB, (*rows)[j].m_deltaVelBindex);
+    }
+  return residual;
+}
+
+}  // namespace simsoccer::engine
