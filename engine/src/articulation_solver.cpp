@@ -186,14 +186,19 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof_);
   btScalar* jacobian = &m_data.m_jacobians[index];
   btScalar* response = &m_data.m_deltaVelocitiesUnitImpulse[index];
+  // Basis row by basis row over contiguous arrays (the compiler vectorises
+  // these), the same sums in the same order for every entry.
   for (int i = 0; i < ndof_; ++i) {
-    btScalar j = 0, r = 0;
-    for (int k = 0; k < 6; ++k) {
-      j += weight[k] * basis_jacobian_[k * ndof_ + i];
-      r += weight[k] * basis_response_[k * ndof_ + i];
+    jacobian[i] = weight[0] * basis_jacobian_[i];
+    response[i] = weight[0] * basis_response_[i];
+  }
+  for (int k = 1; k < 6; ++k) {
+    const btScalar* bj = &basis_jacobian_[k * ndof_];
+    const btScalar* br = &basis_response_[k * ndof_];
+    for (int i = 0; i < ndof_; ++i) {
+      jacobian[i] += weight[k] * bj[i];
+      response[i] += weight[k] * br[i];
     }
-    jacobian[i] = j;
-    response[i] = r;
   }
   if (link_is_a) {
     row.m_deltaVelAindex = block;
