@@ -72,6 +72,39 @@ TEST(Determinism, AnyNumberOfSolverThreadsGivesTheSameHash) {
   EXPECT_EQ(one, three);
 }
 
+// The engine's batch loop against Bullet's own island loop, both with
+// Bullet's rows and iterations (bullet_solver): one thread runs Bullet's
+// loop, two the engine's, and the states agree bit for bit.
+TEST(Determinism, TheEnginesBatchLoopIsBulletsIslandLoop) {
+  auto hash = [](int threads) {
+    world::Scenario s = test::scenario(10, 21);
+    s.physics.threads = threads;
+    s.physics.bullet_solver = true;
+    s.ball_position = {-3.2, -0.6, -1.0};
+    world::World w(s);
+    int most_batches = 0;
+    for (int i = 0; i < 600; ++i) {
+      if (i % w.stepsPerControlPeriod() == 0)
+        for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+          const auto& model = *w.robot(r).model;
+          const auto& stand = model.pose("stand");
+          for (size_t j = 0; j < model.body->joints.size(); ++j)
+            if (model.body->joints[j].mimic_of < 0)
+              w.setJointTarget(r, static_cast<int>(j),
+                               stand[j] + 0.5 * std::sin(6.0 * w.time() + 0.7 * r + 0.3 * j), 1.0);
+        }
+      w.step();
+      most_batches = std::max(most_batches, w.physics().lastStepSolverBatches());
+    }
+    return std::pair{w.stateHash(), most_batches};
+  };
+  const auto [bullets, no_batches] = hash(1);
+  const auto [engines, batches] = hash(2);
+  EXPECT_EQ(no_batches, 0);  // Bullet's own loop
+  EXPECT_GE(batches, 2);
+  EXPECT_EQ(bullets, engines);
+}
+
 TEST(Determinism, DifferentSeedGivesDifferentHash) {
   EXPECT_NE(run(11, 0.1), run(12, 0.1));
 }

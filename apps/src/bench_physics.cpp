@@ -73,8 +73,13 @@ int benchPhysics(int argc, char** argv, int first) {
   std::vector<double> steps = opt.positiveList("dt", {cfg.base.physics.dt});
   for (const double dt : steps)
     if (dt > 0.05) throw UsageError("--dt: at most 0.05 s, got " + std::to_string(dt));
-  std::erase_if(steps, [&](double dt) { return std::abs(dt - default_dt) < 1e-12; });
-  steps.insert(steps.begin(), default_dt);
+  // Each step once, the default first, the others in the order given.
+  std::vector<double> unique{default_dt};
+  for (const double dt : steps)
+    if (std::none_of(unique.begin(), unique.end(),
+                     [&](double u) { return std::abs(dt - u) < 1e-12; }))
+      unique.push_back(dt);
+  steps = unique;
   const std::string csv = opt.get("csv", "");
   const int repeat = opt.wholeNumber("repeat", 1, 1, 1000);
 
@@ -83,7 +88,7 @@ int benchPhysics(int argc, char** argv, int first) {
   for (const double dt : steps)
     step_list += (step_list.empty() ? "" : ", ") + engine::formatNumber(dt * 1e3);
   std::printf(
-      "simsoccer bench physics: %s, field %s, dt %s ms, control %.1f ms, %d solver "
+      "simsoccer bench physics: %s, field %s, dt %s ms, control %.1f ms (whole steps), %d solver "
       "iterations, %d solver thread%s, %.1f s settling + %.1f s timed per row\n",
       config_file.string().c_str(), field.name.c_str(), step_list.c_str(),
       cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, threads,

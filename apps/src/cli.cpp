@@ -99,45 +99,49 @@ uint32_t Options::domain(const std::string& name, uint32_t fallback) const {
   return static_cast<uint32_t>(wholeNumber(name, static_cast<int>(fallback), 0, 232));
 }
 
-std::vector<int> Options::intList(const std::string& name, const std::vector<int>& fallback) const {
-  if (!has(name)) return fallback;
-  std::vector<int> out;
-  std::stringstream ss(values_.at(name));
+namespace {
+
+// A comma-separated list of values, each read by `parse` (which throws on a
+// bad one), or a usage error naming the option and what was expected.
+template <class T, class Parse>
+std::vector<T> parseList(const std::string& name, const std::string& text, const char* expected,
+                         Parse parse) {
+  std::vector<T> out;
+  std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
     try {
-      size_t used = 0;
-      const int v = std::stoi(item, &used);
-      if (used != item.size() || v < 1) throw std::invalid_argument(item);
-      out.push_back(v);
+      out.push_back(parse(item));
     } catch (const std::exception&) {
-      throw UsageError("--" + name + ": expected positive integers separated by commas, got '" +
-                       values_.at(name) + "'");
+      throw UsageError("--" + name + ": expected " + expected + " separated by commas, got '" +
+                       text + "'");
     }
   }
   if (out.empty()) throw UsageError("--" + name + ": empty list");
   return out;
 }
 
+}  // namespace
+
+std::vector<int> Options::intList(const std::string& name, const std::vector<int>& fallback) const {
+  if (!has(name)) return fallback;
+  return parseList<int>(name, values_.at(name), "positive integers", [](const std::string& item) {
+    size_t used = 0;
+    const int v = std::stoi(item, &used);
+    if (used != item.size() || v < 1) throw std::invalid_argument(item);
+    return v;
+  });
+}
+
 std::vector<double> Options::positiveList(const std::string& name,
                                           const std::vector<double>& fallback) const {
   if (!has(name)) return fallback;
-  std::vector<double> out;
-  std::stringstream ss(values_.at(name));
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size() || !(v > 0) || !std::isfinite(v)) throw std::invalid_argument(item);
-      out.push_back(v);
-    } catch (const std::exception&) {
-      throw UsageError("--" + name + ": expected numbers > 0 separated by commas, got '" +
-                       values_.at(name) + "'");
-    }
-  }
-  if (out.empty()) throw UsageError("--" + name + ": empty list");
-  return out;
+  return parseList<double>(name, values_.at(name), "numbers > 0", [](const std::string& item) {
+    size_t used = 0;
+    const double v = std::stod(item, &used);
+    if (used != item.size() || !(v > 0) || !std::isfinite(v)) throw std::invalid_argument(item);
+    return v;
+  });
 }
 
 std::filesystem::path findConfig(const std::string& given, const std::string& default_relative) {

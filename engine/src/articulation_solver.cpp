@@ -8,7 +8,9 @@
 namespace simsoccer::engine {
 namespace {
 
-// Below three points the basis (six passes) costs as much as the rows.
+// The basis costs six passes; a point's rows one each (three with two
+// friction directions, two with one): from three points on it pays with two
+// directions, and costs the same as the rows with one.
 constexpr int kMinPoints = 3;
 // Per-point settings Bullet honours that the basis path does not implement.
 constexpr int kOwnSettings = BT_CONTACT_FLAG_HAS_CONTACT_CFM | BT_CONTACT_FLAG_HAS_CONTACT_ERP |
@@ -38,6 +40,16 @@ void touched(const btMultiBodySolverConstraint& row) {
 }
 
 }  // namespace
+
+int deltaVelocityBlock(btMultiBody* body, btMultiBodyJacobianData& data) {
+  int block = body->getCompanionId();
+  if (block < 0) {
+    block = data.m_deltaVelocities.size();
+    body->setCompanionId(block);
+    data.m_deltaVelocities.resize(block + body->getNumDofs() + 6);
+  }
+  return block;
+}
 
 void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int num_manifolds,
                                          const btContactSolverInfo& info) {
@@ -175,12 +187,7 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   const btVector3 moment = link_arm.cross(link_direction);
   const btScalar weight[6] = {moment.x(),         moment.y(),         moment.z(),
                               link_direction.x(), link_direction.y(), link_direction.z()};
-  int block = body_->getCompanionId();
-  if (block < 0) {  // the articulation's first row in this group: its delta velocities
-    block = m_data.m_deltaVelocities.size();
-    body_->setCompanionId(block);
-    m_data.m_deltaVelocities.resize(block + ndof_);
-  }
+  const int block = deltaVelocityBlock(body_, m_data);
   const int index = m_data.m_jacobians.size();
   m_data.m_jacobians.resize(index + ndof_);
   m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof_);
@@ -223,7 +230,7 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   // Effective mass (J M^-1 J^T plus the softness), the velocity error with
   // restitution and Baumgarte stabilisation, and the impulse bounds.
   const btScalar dt = info.m_timeStep;
-  const btScalar cfm = (friction ? info.m_frictionCFM : info.m_globalCfm) / dt;
+  const btScalar cfm = (friction ? info.m_frictionCFM : info.m_globalCfm) * (btScalar(1) / dt);
   const btScalar erp = friction ? info.m_frictionERP : info.m_erp2;
   btScalar inverse_mass = 0, velocity = 0;
   const btScalar* qdot = body_->getVelocityVector();
@@ -256,24 +263,22 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
 }
 
 btScalar ArticulationSolver::rowVelocity(const btMultiBodySolverConstraint& row) {
-  btScalar v = 0;
-  if (row.m_multiBodyA) {
-    v += dot(&m_data.m_jacobians[row.m_jacAindex], &m_data.m_deltaVelocities[row.m_deltaVelAindex],
-             row.m_multiBodyA->getNumDofs() + 6);
-  } else if (row.m_solverBodyIdA >= 0) {
-    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdA];
-    v += row.m_contactNormal1.dot(body.internalGetDeltaLinearVelocity()) +
-         row.m_relpos1CrossNormal.dot(body.internalGetDeltaAngularVelocity());
-  }
-  if (row.m_multiBodyB) {
-    v += dot(&m_data.m_jacobians[row.m_jacBindex], &m_data.m_deltaVelocities[row.m_deltaVelBindex],
-             row.m_multiBodyB->getNumDofs() + 6);
-  } else if (row.m_solverBodyIdB >= 0) {
-    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdB];
-    v += row.m_contactNormal2.dot(body.internalGetDeltaLinearVelocity()) +
-         row.m_relpos2CrossNormal.dot(body.internalGetDeltaAngularVelocity());
-  }
-  return v;
+  // One side: an articulation through its Jacobian, a rigid body through
+  // the row's normal and lever arm, a static body not at all.
+  auto side = [&](const btMultiBody* body, int jacobian, int block, int solver_body,
+                  const btVector3& normal, const btVector3& arm) -> btScalar {
+    if (body)
+      return dot(&m_data.m_jacobians[jacobian], &m_data.m_deltaVelocities[block],
+                 body->getNumDofs() + 6);
+    if (solver_body < 0) return 0;
+    btSolverBody& b = m_tmpSolverBodyPool[solver_body];
+    return normal.dot(b.internalGetDeltaLinearVelocity()) +
+           arm.dot(b.internalGetDeltaAngularVelocity());
+  };
+  return side(row.m_multiBodyA, row.m_jacAindex, row.m_deltaVelAindex, row.m_solverBodyIdA,
+              row.m_contactNormal1, row.m_relpos1CrossNormal) +
+         side(row.m_multiBodyB, row.m_jacBindex, row.m_deltaVelBindex, row.m_solverBodyIdB,
+              row.m_contactNormal2, row.m_relpos2CrossNormal);
 }
 
 void ArticulationSolver::applyImpulse(const btMultiBodySolverConstraint& row, btScalar impulse) {

@@ -36,6 +36,10 @@
 
 namespace simsoccer::engine {
 
+// The articulation's block of velocity changes in the solver's data (its
+// companion id), made at its first row of the group.
+int deltaVelocityBlock(btMultiBody* body, btMultiBodyJacobianData& data);
+
 class ArticulationSolver : public btMultiBodyConstraintSolver {
  public:
   explicit ArticulationSolver(bool own) : own_(own) {}

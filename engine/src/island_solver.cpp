@@ -211,6 +211,7 @@ void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatc
     job_(0);
   else
     threads_.run(job_);
+  prologue_ = nullptr;  // the caller's, for this call only
 }
 
 }  // namespace simsoccer::engine

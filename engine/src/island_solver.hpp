@@ -7,8 +7,9 @@
 // holds more than m_minimumSolverBatchSize manifolds and constraints, solves
 // it, and starts the next. Here the batches are formed the same way, then
 // solved side by side on several threads, each with its own solver. A batch
-// reads and writes only its own bodies, so the result is Bullet's, bit for
-// bit, whatever the number of threads (the tests hold it to that). (Solving
+// reads and writes only its own bodies, so the result is the same, bit for
+// bit, whatever the number of threads, and the same as Bullet's own loop
+// with the same solver (the tests hold it to both). (Solving
 // each island on its own would not be: a batch iterates until all its rows
 // have converged, which differs in the last bits from stopping each island
 // when its own rows have.)

@@ -14,7 +14,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -125,8 +124,9 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   void solveConstraints(btContactSolverInfo& info) override {
     const double dynamics_before = times ? times->dynamics_s : 0.0;
     timed(&StageTimes::solver_s, [&] {
-      // Bullet's own loop where batches could share state: a randomised row
-      // order (one seed across batches) or islands not split (one group).
+      // Bullet's own loop where batches could share state (a randomised row
+      // order: one seed across batches; islands not split: one group), and
+      // without the engine's loop (bullet_solver with one thread).
       if (!islands || (info.m_solverMode & SOLVER_RANDMIZE_ORDER) ||
           !m_islandManager->getSplitIslands()) {
         btMultiBodyDynamicsWorld::solveConstraints(info);
@@ -176,6 +176,9 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   };
   std::vector<Scratch> scratch_;
   std::vector<uint8_t> dynamics_done_;  // per multibody (its user index), this step
+  // Per multibody: asleep when the step's constraints were prepared (where
+  // Bullet's own loop decides; building the islands can change it).
+  std::vector<uint8_t> sleeping_;
   struct Keyed {
     btMultiBodyConstraint* constraint;
     int island;
@@ -187,6 +190,17 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   // loop (gravity and force clearing are Bullet's virtual applyGravity and
   // clearForces in this build, BT_USE_VIRTUAL_CLEARFORCES_AND_GRAVITY).
   void prepareConstraints(btContactSolverInfo& info) {
+    sleeping_.assign(static_cast<size_t>(m_multiBodies.size()), 0);
+    for (int i = 0; i < m_multiBodies.size(); ++i) {
+      const btMultiBody* body = m_multiBodies[i];
+      bool sleeping = body->getBaseCollider() &&
+                      body->getBaseCollider()->getActivationState() == ISLAND_SLEEPING;
+      for (int b = 0; b < body->getNumLinks(); ++b)
+        if (body->getLink(b).m_collider &&
+            body->getLink(b).m_collider->getActivationState() == ISLAND_SLEEPING)
+          sleeping = true;
+      sleeping_[static_cast<size_t>(body->getUserIndex())] = sleeping;
+    }
     forwardKinematics();
     clearMultiBodyConstraintForces();
     m_sortedConstraints.resize(m_constraints.size());
@@ -218,16 +232,10 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
 
   // One multibody's step of Bullet's forward-dynamics loop, once per step.
   void forwardDynamics(btMultiBody* body, const btContactSolverInfo& info, int thread) {
-    uint8_t& done = dynamics_done_[static_cast<size_t>(body->getUserIndex())];
-    if (done) return;
-    done = 1;
-    bool sleeping =
-        body->getBaseCollider() && body->getBaseCollider()->getActivationState() == ISLAND_SLEEPING;
-    for (int b = 0; b < body->getNumLinks(); ++b)
-      if (body->getLink(b).m_collider &&
-          body->getLink(b).m_collider->getActivationState() == ISLAND_SLEEPING)
-        sleeping = true;
-    if (sleeping) return;
+    const auto index = static_cast<size_t>(body->getUserIndex());
+    if (dynamics_done_[index]) return;
+    dynamics_done_[index] = 1;
+    if (sleeping_[index]) return;
     if (body->isUsingRK4Integration())
       throw std::logic_error("RK4 multibody integration is not supported");
     Scratch& s = scratch_[static_cast<size_t>(thread)];
@@ -286,12 +294,7 @@ class ServoConstraint : public btMultiBodyJointMotor {
     row.m_orgConstraint = this;
     row.m_orgDofIndex = 0;
     // Both sides share the articulation's delta-velocity block.
-    int block = mb->getCompanionId();
-    if (block < 0) {
-      block = data.m_deltaVelocities.size();
-      mb->setCompanionId(block);
-      data.m_deltaVelocities.resize(block + ndof);
-    }
+    const int block = deltaVelocityBlock(mb, data);
     row.m_deltaVelAindex = row.m_deltaVelBindex = block;
     // Jacobians: 1 at the joint's coordinate (side A), zero (side B).
     row.m_jacAindex = data.m_jacobians.size();
@@ -488,11 +491,14 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world->getPairCache()->setOverlapFilterCallback(&m.filter);
   // The batches are formed and solved by the engine's own loop for any
   // number of threads (one: one after the other on the caller's thread), so
-  // every thread count runs the same code.
-  m.islands = std::make_unique<ParallelIslandSolver>(
-      settings.solver_threads,
-      [own = !settings.bullet_solver] { return std::make_unique<ArticulationSolver>(own); });
-  m.world->islands = m.islands.get();
+  // every thread count runs the same code; bullet_solver with one thread
+  // keeps Bullet's own loop, to compare the two.
+  if (!settings.bullet_solver || settings.solver_threads > 1) {
+    m.islands = std::make_unique<ParallelIslandSolver>(
+        settings.solver_threads,
+        [own = !settings.bullet_solver] { return std::make_unique<ArticulationSolver>(own); });
+    m.world->islands = m.islands.get();
+  }
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it
   // bounces off anything hard, at its own restitution, while robots, the
@@ -509,8 +515,6 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;
-  if (const char* e = std::getenv("XP_ITER")) info.m_numIterations = std::atoi(e);
-  if (const char* e = std::getenv("XP_RESID")) info.m_leastSquaresResidualThreshold = std::atof(e);
   // Two friction rows per contact: Bullet's multibody contacts take their
   // friction directions from the contact normal alone (btPlaneSpace1), so a
   // single row would resist slip along one fixed tangent only.
@@ -655,7 +659,6 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
     col->setUserIndex2(static_cast<int>(i));                       // link index in the model
     col->setUserIndex3(static_cast<int>(m.articulations.size()));  // articulation id
     applyMaterial(col.get(), link.material.value_or(model.material));
-    if (const char* e = std::getenv("XP_PROC")) col->setContactProcessingThreshold(std::atof(e));
     m.world->addCollisionObject(col.get(), btBroadphaseProxy::DefaultFilter,
                                 btBroadphaseProxy::AllFilter);
     if (i == 0)

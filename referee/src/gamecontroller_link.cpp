@@ -18,6 +18,9 @@ uint16_t GameControllerLink::returnPort() const {
 }
 
 void GameControllerLink::update(const Game& game) {
+  // The team ports are bound before the first packet goes out: a robot may
+  // answer it with a team message at once.
+  bindTeamPorts(game);
   if (sent_ == 0 || game.time() >= next_send_ - 1e-9) {
     // The packet number is a u8 that wraps at 256, as the GameController's.
     const ControlData d = game.packet(static_cast<uint8_t>(sent_));
@@ -31,16 +34,19 @@ void GameControllerLink::update(const Game& game) {
   countTeamMessages(game);
 }
 
+void GameControllerLink::bindTeamPorts(const Game& game) {
+  if (config_.team_message_bind.empty() || !team_ports_.empty()) return;
+  for (int t = 0; t < 2; ++t) {
+    TeamPort p;
+    p.team_number = game.teamNumber(t);
+    p.receiver = std::make_unique<UdpReceiver>(static_cast<uint16_t>(10000 + p.team_number),
+                                               config_.team_message_bind);
+    team_ports_.push_back(std::move(p));
+  }
+}
+
 void GameControllerLink::countTeamMessages(const Game& game) {
-  if (config_.team_message_bind.empty()) return;
-  if (team_ports_.empty())
-    for (int t = 0; t < 2; ++t) {
-      TeamPort p;
-      p.team_number = game.teamNumber(t);
-      p.receiver = std::make_unique<UdpReceiver>(static_cast<uint16_t>(10000 + p.team_number),
-                                                 config_.team_message_bind);
-      team_ports_.push_back(std::move(p));
-    }
+  bindTeamPorts(game);
   std::array<uint8_t, 1024> buffer{};
   for (TeamPort& p : team_ports_)
     while (p.receiver->receive(buffer, 0.0) > 0) ++p.messages;
@@ -51,7 +57,6 @@ uint64_t GameControllerLink::teamMessages(uint8_t team_number) const {
     if (p.team_number == team_number) return p.messages;
   return 0;
 }
-
 
 void GameControllerLink::receiveReturns(const Game& game) {
   std::array<uint8_t, 512> buffer{};  // larger than any packet: an oversized one shows its size

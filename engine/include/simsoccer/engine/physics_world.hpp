@@ -30,11 +30,13 @@ struct PhysicsSettings {
   int solver_iterations = 10;   // sequential-impulse iterations per step
   int friction_directions = 2;  // friction rows per contact (see world::PhysicsConfig)
   // Threads that solve the simulation islands (robots and what touches them)
-  // side by side; 1: Bullet's own loop. The result is the same bit for bit.
+  // side by side. The result is the same bit for bit for any number.
   int solver_threads = 1;
-  // true: Bullet's own contact rows and iterations; false: the engine's
-  // (a foot's rows from its link's spatial basis, a leaner iteration loop),
-  // equal up to rounding.
+  // false (the default): the engine's solver (a foot's rows from its link's
+  // spatial basis, a leaner iteration loop, the engine's batch loop with
+  // each robot's forward dynamics in its batch). true: Bullet's own rows and
+  // iterations, and with one thread Bullet's own island loop (for
+  // comparisons). The two agree up to rounding.
   bool bullet_solver = false;
   Vec3 gravity{0.0, 0.0, -9.81};
 };
@@ -43,8 +45,10 @@ struct PhysicsSettings {
 struct StageTimes {
   double servo_s = 0.0;      // joint servo torques
   double collision_s = 0.0;  // broadphase + narrowphase
-  double dynamics_s = 0.0;   // articulated-body forward dynamics
-  double solver_s = 0.0;     // contact/limit constraint solve
+  // Forward dynamics; in the engine's batch loop only what precedes the
+  // batches (each robot's own forward dynamics runs in its batch, as solver).
+  double dynamics_s = 0.0;
+  double solver_s = 0.0;     // contact, limit and implicit servo constraints
   double integrate_s = 0.0;  // position integration
   double total_s = 0.0;      // the whole step
   uint64_t steps = 0;

@@ -53,6 +53,7 @@ class GameControllerLink {
 
  private:
   void receiveReturns(const Game& game);
+  void bindTeamPorts(const Game& game);  // once, at the first update
   void countTeamMessages(const Game& game);
   struct TeamPort {
     uint8_t team_number = 0;
