@@ -132,13 +132,16 @@ int main(int argc, char** argv) {
   int periods = 200;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--domain") domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
-    else if (a == "--periods") periods = std::stoi(argv[i + 1]);
+    if (a == "--domain")
+      domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
+    else if (a == "--periods")
+      periods = std::stoi(argv[i + 1]);
   }
   auto* factory = DomainParticipantFactory::get_instance();
   // As the SDK: the profile "booster_dds" from $FASTRTPS_DEFAULT_PROFILES_FILE.
   DomainParticipant* participant = factory->create_participant_with_profile(domain, "booster_dds");
-  if (!participant) fail("no participant from profile booster_dds ($FASTRTPS_DEFAULT_PROFILES_FILE)");
+  if (!participant)
+    fail("no participant from profile booster_dds ($FASTRTPS_DEFAULT_PROFILES_FILE)");
 
   TypeSupport state_type(new CdrType<LowState>(
       "booster_interface::msg::dds_::LowState_", [](Cdr&, const LowState&) {},
@@ -160,7 +163,8 @@ int main(int argc, char** argv) {
   auto rpcWrite = [](Cdr& c, const Rpc& r) { c << r.uuid << r.header << r.body; };
   auto rpcRead = [](Cdr& c, Rpc& r) { c >> r.uuid >> r.header >> r.body; };
   TypeSupport req_type(new CdrType<Rpc>("booster_msgs::msg::dds_::RpcReqMsg_", rpcWrite, rpcRead));
-  TypeSupport resp_type(new CdrType<Rpc>("booster_msgs::msg::dds_::RpcRespMsg_", rpcWrite, rpcRead));
+  TypeSupport resp_type(
+      new CdrType<Rpc>("booster_msgs::msg::dds_::RpcRespMsg_", rpcWrite, rpcRead));
   for (TypeSupport* t : {&state_type, &cmd_type, &req_type, &resp_type})
     if (t->register_type(participant) != ReturnCode_t::RETCODE_OK) fail("register type");
 
@@ -244,7 +248,8 @@ int main(int argc, char** argv) {
   bool ok = last.serial.size() == 22;
   const json first = call(2017, json::object());
   out["get_mode_first"] = first;
-  ok = ok && first.at("status") == 0 && json::parse(first.at("body").get<std::string>()).at("mode") == 1;
+  ok = ok && first.at("status") == 0 &&
+       json::parse(first.at("body").get<std::string>()).at("mode") == 1;
   const json custom = call(2000, {{"mode", 3}});
   out["custom"] = custom;
   ok = ok && custom.at("status") == 0;

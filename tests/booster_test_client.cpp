@@ -108,15 +108,20 @@ int main(int argc, char** argv) {
   uint32_t domain = 0;
   std::string config;
   int periods = 300;
-  double walk = 0.0;  // --walk V: walk with Booster's locomotion API at V m/s instead
+  double walk = 0.0;       // --walk V: walk with Booster's locomotion API at V m/s instead
   int custom_between = 0;  // with --walk: N LowStates in CUSTOM between two walks
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--domain") domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
-    else if (a == "--dds-config") config = argv[i + 1];
-    else if (a == "--periods") periods = std::stoi(argv[i + 1]);
-    else if (a == "--walk") walk = std::stod(argv[i + 1]);
-    else if (a == "--custom-between") custom_between = std::stoi(argv[i + 1]);
+    if (a == "--domain")
+      domain = static_cast<uint32_t>(std::stoul(argv[i + 1]));
+    else if (a == "--dds-config")
+      config = argv[i + 1];
+    else if (a == "--periods")
+      periods = std::stoi(argv[i + 1]);
+    else if (a == "--walk")
+      walk = std::stod(argv[i + 1]);
+    else if (a == "--custom-between")
+      custom_between = std::stoi(argv[i + 1]);
   }
   if (!config.empty()) {
     std::ifstream f(config);
@@ -126,14 +131,13 @@ int main(int argc, char** argv) {
   }
   g_participant = dds_create_participant(domain, nullptr, nullptr);
   if (g_participant < 0) fail("create participant");
-  const dds_entity_t state = endpoint(true, &booster_interface_msg_dds__LowState__desc,
-                                      "rt/low_state", false, 64);
+  const dds_entity_t state =
+      endpoint(true, &booster_interface_msg_dds__LowState__desc, "rt/low_state", false, 64);
   // Reliable as Booster's deploy code, 4 deep: two commands sent back to back both arrive.
-  const dds_entity_t command = endpoint(false, &booster_interface_msg_dds__LowCmd__desc,
-                                        "rt/joint_ctrl", true, 4);
+  const dds_entity_t command =
+      endpoint(false, &booster_interface_msg_dds__LowCmd__desc, "rt/joint_ctrl", true, 4);
   Rpc rpc{endpoint(false, &booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", true, 10),
-          endpoint(true, &booster_msgs_msg_dds__RpcRespMsg__desc, "rt/LocoApiTopicResp", true,
-                   10)};
+          endpoint(true, &booster_msgs_msg_dds__RpcRespMsg__desc, "rt/LocoApiTopicResp", true, 10)};
 
   json out;
   // The latest LowState (waits up to 10 s for a new one).
@@ -262,9 +266,9 @@ int main(int argc, char** argv) {
       cmd[i].kd = leg ? 2.0f : 1.0f;
       cmd[i].weight = 1.0f;
     }
-    cmd[0].q = static_cast<float>(0.4 * std::min(1.0, k / 100.0));  // head yaw
-    if (k == 50) send(n - 1, booster_interface_msg_dds__SERIAL, 0);    // one entry short
-    if (k == 60) send(n, booster_interface_msg_dds__PARALLEL, 0);      // motor space
+    cmd[0].q = static_cast<float>(0.4 * std::min(1.0, k / 100.0));      // head yaw
+    if (k == 50) send(n - 1, booster_interface_msg_dds__SERIAL, 0);     // one entry short
+    if (k == 60) send(n, booster_interface_msg_dds__PARALLEL, 0);       // motor space
     send(n, booster_interface_msg_dds__SERIAL, k == 70 ? 1.0f : 0.0f);  // a NaN at 70
     ++answered;
     if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));

@@ -17,7 +17,8 @@
 int main(int argc, char** argv) {
   using namespace simsoccer;
   if (argc != 7) {
-    std::fprintf(stderr, "usage: %s DDS_CONFIG DOMAIN TEAM PLAYER COMMANDS CLAIM_SECONDS\n", argv[0]);
+    std::fprintf(stderr, "usage: %s DDS_CONFIG DOMAIN TEAM PLAYER COMMANDS CLAIM_SECONDS\n",
+                 argv[0]);
     return 2;
   }
   net::DomainConfig dds;

@@ -13,8 +13,8 @@
 // alone, split over two writes, LEDs in a second map), probe (read one map,
 // disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
 // (unknown keys in every map), silent (stop answering for K cycles after K),
-// bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a field
-// network, receive a GameController packet on 3838, send a status packet to
+// bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a
+// field network, receive a GameController packet on 3838, send a status packet to
 // --gc-host:3939, broadcast team messages to --broadcast:10000+team until
 // one from a teammate arrives; --team-number, --player).
 // Exit: 0 done, 1 expectation not met, 2 usage, 3 protocol violation, 4 no server.
@@ -25,13 +25,12 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <msgpack.hpp>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <msgpack.hpp>
 #include <string>
 #include <thread>
 #include <vector>
@@ -123,7 +122,8 @@ int fieldNetwork(const Options& o) {
   const ssize_t n = ::recv(gc, buffer, sizeof buffer, 0);
   simsoccer::test::GcPacket packet;
   try {
-    packet = simsoccer::test::readGcPacket(std::span<const uint8_t>(buffer, static_cast<std::size_t>(n)));
+    packet = simsoccer::test::readGcPacket(
+        std::span<const uint8_t>(buffer, static_cast<std::size_t>(n)));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "lola client: bad GameController packet: %s\n", e.what());
     return 3;
@@ -146,7 +146,8 @@ int fieldNetwork(const Options& o) {
     pollfd t{team, POLLIN, 0};
     while (::poll(&t, 1, 250) > 0) {
       const ssize_t m = ::recv(team, buffer, sizeof buffer, 0);
-      const std::string got(reinterpret_cast<char*>(buffer), static_cast<std::size_t>(std::max<ssize_t>(m, 0)));
+      const std::string got(reinterpret_cast<char*>(buffer),
+                            static_cast<std::size_t>(std::max<ssize_t>(m, 0)));
       if (got.rfind("hello from ", 0) == 0 && got != hello) {
         std::printf("lola client: teammate said '%s'\n", got.c_str());
         // A few more, so the teammate hears this one too.
@@ -174,25 +175,39 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--socket") o.socket = value();
-    else if (a == "--mode") o.mode = value();
-    else if (a == "--cycles") o.cycles = std::stol(value());
-    else if (a == "--after") o.after = std::stol(value());
-    else if (a == "--stiffness") o.stiffness = std::stof(value());
-    else if (a == "--expect-chest") o.expect_chest = true;
-    else if (a == "--print-id") o.print_id = true;
-    else if (a == "--ramp") o.ramp = true;
-    else if (a == "--expect-id") o.expect_id = value();
-    else if (a == "--team-number") o.team_number = std::stoi(value());
-    else if (a == "--player") o.player = std::stoi(value());
-    else if (a == "--gc-host") o.gc_host = value();
-    else if (a == "--broadcast") o.broadcast = value();
+    if (a == "--socket")
+      o.socket = value();
+    else if (a == "--mode")
+      o.mode = value();
+    else if (a == "--cycles")
+      o.cycles = std::stol(value());
+    else if (a == "--after")
+      o.after = std::stol(value());
+    else if (a == "--stiffness")
+      o.stiffness = std::stof(value());
+    else if (a == "--expect-chest")
+      o.expect_chest = true;
+    else if (a == "--print-id")
+      o.print_id = true;
+    else if (a == "--ramp")
+      o.ramp = true;
+    else if (a == "--expect-id")
+      o.expect_id = value();
+    else if (a == "--team-number")
+      o.team_number = std::stoi(value());
+    else if (a == "--player")
+      o.player = std::stoi(value());
+    else if (a == "--gc-host")
+      o.gc_host = value();
+    else if (a == "--broadcast")
+      o.broadcast = value();
     else if (a == "--joint") {
       const std::string v = value();
       const auto eq = v.find('=');
       int index = -1;
       for (std::size_t j = 0; j < kNaoActuatorOrder.size(); ++j)
-        if (eq != std::string::npos && v.substr(0, eq) == kNaoActuatorOrder[j]) index = static_cast<int>(j);
+        if (eq != std::string::npos && v.substr(0, eq) == kNaoActuatorOrder[j])
+          index = static_cast<int>(j);
       if (index < 0) {
         std::fprintf(stderr, "--joint %s: not NAME=RAD with a LoLA joint name\n", v.c_str());
         return 2;
@@ -231,7 +246,8 @@ int main(int argc, char** argv) {
     }
     simsoccer::test::LolaSensors s;
     try {
-      s = simsoccer::test::readLolaSensors(std::span<const uint8_t>(packet.data(), static_cast<std::size_t>(std::max<ssize_t>(n, 0))));
+      s = simsoccer::test::readLolaSensors(std::span<const uint8_t>(
+          packet.data(), static_cast<std::size_t>(std::max<ssize_t>(n, 0))));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "lola client: protocol violation in map %ld: %s\n", cycle, e.what());
       return 3;
@@ -265,7 +281,7 @@ int main(int argc, char** argv) {
       faulted = true;
       silent_until = cycle + o.after;
     }
-    if (cycle < silent_until) continue;  // reads, does not answer
+    if (cycle < silent_until) continue;   // reads, does not answer
     if (o.mode == "late" && fault_now) {  // one answer after the simulator's timeout
       faulted = true;
       std::this_thread::sleep_for(std::chrono::milliseconds(800));

@@ -19,12 +19,12 @@
 #include <thread>
 
 #include "booster_sdk.h"
+#include "child_process.hpp"
 #include "simsoccer/booster/endpoint.hpp"
 #include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/net/dds.hpp"
 #include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/sim/officials.hpp"
-#include "simsoccer/net/dds.hpp"
-#include "child_process.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "test_support.hpp"
 
@@ -83,11 +83,12 @@ struct ServedK1 {
   booster::Endpoint endpoint;
   ServedK1(const booster::BoosterRobot& robot, bool lockstep)
       : w(k1Scenario()),
-        simulation(w, [&] {
-          sim::SimulationConfig c;
-          c.lockstep = lockstep;
-          return c;
-        }()),
+        simulation(w,
+                   [&] {
+                     sim::SimulationConfig c;
+                     c.lockstep = lockstep;
+                     return c;
+                   }()),
         endpoint(w, [&] {
           booster::EndpointConfig c;
           c.robots = {robot};
@@ -177,10 +178,11 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   const engine::Pose torso = w.torsoPose(0);
   const engine::Vec3 moved = torso.translation() - start;
   const auto s = endpoint.stats(0);
-  std::printf("walked %.2f m forward, %.2f m sideways in %.1f s; requests %llu, walk starts %llu, "
-              "custom commands applied %llu\n",
-              moved.x(), moved.y(), w.time(), (unsigned long long)s.requests,
-              (unsigned long long)s.walk_starts, (unsigned long long)s.applied);
+  std::printf(
+      "walked %.2f m forward, %.2f m sideways in %.1f s; requests %llu, walk starts %llu, "
+      "custom commands applied %llu\n",
+      moved.x(), moved.y(), w.time(), (unsigned long long)s.requests,
+      (unsigned long long)s.walk_starts, (unsigned long long)s.applied);
   EXPECT_EQ(s.mode, booster::RobotMode::Walking);
   EXPECT_EQ(s.requests_refused, 0u);
   EXPECT_EQ(s.requests_malformed, 0u);
@@ -273,7 +275,7 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   q.reliable = false;
   q.depth = 64;
   net::Reader<sensor_msgs_msg_dds__Image_> reader(participant, sensor_msgs_msg_dds__Image__desc,
-                                                 "rt/StereoNetNode/rectified_image", q);
+                                                  "rt/StereoNetNode/rectified_image", q);
   for (int i = 0; i < 500; ++i) {  // discovery: matched with the robot's image writer
     dds_subscription_matched_status_t matched{};
     dds_get_subscription_matched_status(reader.get(), &matched);
@@ -299,12 +301,11 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
     const auto tick = static_cast<uint64_t>(std::lround(t / 0.01));
     std::lock_guard lock(mutex);
     const auto it = rendered.find(tick);
-    if (it != rendered.end() &&
-        std::equal(it->second.begin(), it->second.end(), m.data._buffer))
+    if (it != rendered.end() && std::equal(it->second.begin(), it->second.end(), m.data._buffer))
       ++matched;
   });
-  std::printf("%d images received, %d equal to the rendered ones, %llu published\n", got,
-              matched, (unsigned long long)endpoint.stats(0).images);
+  std::printf("%d images received, %d equal to the rendered ones, %llu published\n", got, matched,
+              (unsigned long long)endpoint.stats(0).images);
   EXPECT_GE(got, 10);  // 30 Hz over 0.4 s: 12 or 13
   EXPECT_EQ(matched, got);
   EXPECT_EQ(endpoint.stats(0).images, rendered.size());
@@ -351,9 +352,8 @@ TEST(BoosterEndpoint, ARobotInItsOwnNamespaceIsDomainZeroThere) {
   EXPECT_NEAR(r.at("head_yaw").get<double>(), 0.4, 0.03);
   EXPECT_EQ(endpoint.stats(0).mode, booster::RobotMode::Custom);
   int seen = 0;
-  stranger.take([&](const booster_interface_msg_dds__LowState_&, const dds_sample_info_t&) {
-    ++seen;
-  });
+  stranger.take(
+      [&](const booster_interface_msg_dds__LowState_&, const dds_sample_info_t&) { ++seen; });
   EXPECT_EQ(seen, 0);
   std::printf("client in %s on domain 0: %llu states, %llu applied; outside: %d states\n",
               ns.c_str(), (unsigned long long)endpoint.stats(0).states_sent,
@@ -407,9 +407,9 @@ TEST(BoosterEndpoint, DampingDropsTheRobotAndPrepareStandsIt) {
   w.setJointTarget(0, w.robot(0).model->body->jointIndex("HeadYaw"), 0.8, 1.0);
   run(3.0);
   EXPECT_TRUE(w.isStanding(0));
-  EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body,
-                                        w.robot(0).model->body->jointIndex("HeadYaw")),
-              0.0, 0.02);
+  EXPECT_NEAR(
+      w.physics().jointPosition(w.robot(0).body, w.robot(0).model->body->jointIndex("HeadYaw")),
+      0.0, 0.02);
 }
 
 // With the field network (`serve --booster-netns`): the robot's namespace sits

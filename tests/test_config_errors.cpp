@@ -250,7 +250,8 @@ TEST_F(ConfigErrors, DenormalAndAbsurdSizes) {
     ADD_FAILURE() << to << " was accepted";
     return std::string();
   };
-  EXPECT_NE(fieldError("radius: 0.05", "radius: 1e-320").find("normal positive"), std::string::npos);
+  EXPECT_NE(fieldError("radius: 0.05", "radius: 1e-320").find("normal positive"),
+            std::string::npos);
   EXPECT_NE(fieldError("border: 0.7", "border: 1.2e11").find("border"), std::string::npos);
   EXPECT_NE(fieldError("width: 6.0", "width: 600.0").find("no soccer field"), std::string::npos);
 }

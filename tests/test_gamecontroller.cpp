@@ -273,8 +273,8 @@ TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
 TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
   for (const char* book : {"spl.yaml", "hsl_small_foundation.yaml", "hsl_middle_foundation.yaml",
                            "hsl_middle_advanced.yaml"}) {
-    const RuleBook rules = loadRuleBook(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs" /
-                                        "rules" / book);
+    const RuleBook rules =
+        loadRuleBook(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs" / "rules" / book);
     const std::string name = book;
     // HSL divisions on the wire (RoboCupGameControlData.h v19): SMALL 0, MIDDLE 1;
     // the Middle division plays 3 v 3 (Foundation) and 5 v 5 (Advanced).

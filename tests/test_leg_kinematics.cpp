@@ -136,14 +136,14 @@ TEST(LegKinematics, TheBoosterK1sLegsInItsOwnJointOrderAndIndependent) {
          {std::tuple{Leg::Left, s.left, fl}, std::tuple{Leg::Right, s.right, fr}}) {
       const agents::Pose got = k.forward(leg, a);
       worst_position = std::max(worst_position, (got.translation() - target.translation()).norm());
-      worst_orientation =
-          std::max(worst_orientation,
-                   Eigen::AngleAxisd(got.linear() * target.linear().transpose()).angle());
+      worst_orientation = std::max(
+          worst_orientation, Eigen::AngleAxisd(got.linear() * target.linear().transpose()).angle());
     }
     yaws_apart = std::max(yaws_apart, std::abs(s.left[2] - s.right[2]));
   }
-  std::printf("booster_k1: 300 random foot pairs, worst position error %.2e m, orientation %.2e rad\n",
-              worst_position, worst_orientation);
+  std::printf(
+      "booster_k1: 300 random foot pairs, worst position error %.2e m, orientation %.2e rad\n",
+      worst_position, worst_orientation);
   EXPECT_LT(worst_position, 1e-4);
   EXPECT_LT(worst_orientation, 1e-3);
   EXPECT_GT(yaws_apart, 0.3);

@@ -3,17 +3,16 @@
 // follows its command, stiffness 0 collapses the robot, the chest button is
 // seen, the same client and seed give the same state, and no client fault
 // stops the simulation or moves the robot.
-#include <gtest/gtest.h>
-
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
@@ -22,9 +21,9 @@
 
 #include "simsoccer/lola/endpoint.hpp"
 #include "simsoccer/lola/field_network.hpp"
-#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/lola/image_stream.hpp"
 #include "simsoccer/match/agent_process.hpp"
+#include "simsoccer/referee/gamecontroller_link.hpp"
 #include "simsoccer/sim/simulation.hpp"
 #include "test_support.hpp"
 
@@ -365,12 +364,30 @@ TEST(LolaRun, TeamBinariesOnTheFieldNetworkGetTheGameAndTalk) {
   referee::GameControllerLink link(gc);
   std::vector<std::unique_ptr<match::ChildProcess>> binaries;
   for (int player = 1; player <= 2; ++player)
-    binaries.push_back(std::make_unique<match::ChildProcess>(std::vector<std::string>{
-        SIMSOCCER_BIN, "lola-run", "--robot", "5:" + std::to_string(player), "--socket",
-        c.robots[static_cast<size_t>(player - 1)].socket.string(), "--net", "--bridge", net.bridge,
-        "--prefix", net.prefix, "--", SIMSOCCER_LOLA_CLIENT, "--mode", "gc", "--team-number", "5",
-        "--player", std::to_string(player), "--gc-host", net.hostAddress(), "--broadcast",
-        net.broadcast()}));
+    binaries.push_back(std::make_unique<match::ChildProcess>(
+        std::vector<std::string>{SIMSOCCER_BIN,
+                                 "lola-run",
+                                 "--robot",
+                                 "5:" + std::to_string(player),
+                                 "--socket",
+                                 c.robots[static_cast<size_t>(player - 1)].socket.string(),
+                                 "--net",
+                                 "--bridge",
+                                 net.bridge,
+                                 "--prefix",
+                                 net.prefix,
+                                 "--",
+                                 SIMSOCCER_LOLA_CLIENT,
+                                 "--mode",
+                                 "gc",
+                                 "--team-number",
+                                 "5",
+                                 "--player",
+                                 std::to_string(player),
+                                 "--gc-host",
+                                 net.hostAddress(),
+                                 "--broadcast",
+                                 net.broadcast()}));
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while ((binaries[0]->running() || binaries[1]->running()) &&
          std::chrono::steady_clock::now() < until) {

@@ -3,19 +3,18 @@
 // fed whole, split, partial, mistyped and hostile maps packed with msgpack-c.
 #include <gtest/gtest.h>
 
-#include <msgpack.hpp>
-
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <msgpack.hpp>
 #include <numeric>
 #include <string>
 #include <vector>
 
 #include "lola_reader.hpp"
+#include "simsoccer/engine/config.hpp"
 #include "simsoccer/lola/actuator_stream.hpp"
 #include "simsoccer/lola/sensor_packet.hpp"
-#include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/match_session.hpp"
 #include "simsoccer/world/render_scene.hpp"
 #include "test_support.hpp"
@@ -44,7 +43,8 @@ TEST(LolaWire, SensorMapIsExactly896BytesInLolasTypesWithTheRobotsValues) {
   lola::BatteryModel battery(0.8);
   battery.update(f, 0.012);
   const lola::RobotIdentity id = lola::defaultIdentity(12, 3);
-  const lola::SensorPacket packet = lola::encodeSensorPacket(lola::fromFrame(f, battery.reading()), id);
+  const lola::SensorPacket packet =
+      lola::encodeSensorPacket(lola::fromFrame(f, battery.reading()), id);
   const test::LolaSensors s = test::readLolaSensors(packet);  // throws on any deviation
 
   EXPECT_EQ(s.robot_config[0], "SIMSOCCERT012P030000");
@@ -68,8 +68,8 @@ TEST(LolaWire, SensorMapIsExactly896BytesInLolasTypesWithTheRobotsValues) {
 
   w.setTouch(0, world::Touch::ChestButton, true);
   w.stepControlPeriod();
-  const test::LolaSensors pressed = test::readLolaSensors(
-      lola::encodeSensorPacket(lola::fromFrame(w.sensorFrame(0), {}), id));
+  const test::LolaSensors pressed =
+      test::readLolaSensors(lola::encodeSensorPacket(lola::fromFrame(w.sensorFrame(0), {}), id));
   EXPECT_EQ(pressed["Touch"][0], 1.0f);
 }
 
@@ -194,11 +194,11 @@ TEST(LolaWire, AnUnreadableStreamEndsWithoutBufferingWhatItClaims) {
     }
     return false;
   };
-  EXPECT_TRUE(fails({0xc1, 0x00}));                          // never used in MessagePack
-  EXPECT_TRUE(fails({0x2a}));                                // an integer, not a map
-  EXPECT_TRUE(fails({0xdf, 0x7f, 0xff, 0xff, 0xff}));        // map32 of 2^31 entries
+  EXPECT_TRUE(fails({0xc1, 0x00}));                    // never used in MessagePack
+  EXPECT_TRUE(fails({0x2a}));                          // an integer, not a map
+  EXPECT_TRUE(fails({0xdf, 0x7f, 0xff, 0xff, 0xff}));  // map32 of 2^31 entries
   EXPECT_TRUE(fails({0x81, 0xa8, 'P', 'o', 's', 'i', 't', 'i', 'o', 'n',  //
-                     0xdd, 0x00, 0x20, 0x00, 0x00}));        // array32 of 2 million
+                     0xdd, 0x00, 0x20, 0x00, 0x00}));                     // array32 of 2 million
   // A 10 MB string value: refused at its header, long before 10 MB arrive.
   const uint8_t header[] = {0x81, 0xa3, 'F', 'a', 'n', 0xdb, 0x00, 0xa0, 0x00, 0x00};
   std::vector<uint8_t> big(sizeof header + 100 * 1024, 'x');
@@ -221,14 +221,16 @@ TEST(LolaWire, LedColoursAreDrawnOnTheRobot) {
   ASSERT_EQ(lit.size(), plain.size() + 3);
   std::vector<Eigen::Vector3f> colours;
   for (const engine::DrawItem& item : lit)
-    if (item.shape == engine::Primitive::Sphere && item.colour != c.ball) colours.push_back(item.colour);
+    if (item.shape == engine::Primitive::Sphere && item.colour != c.ball)
+      colours.push_back(item.colour);
   ASSERT_EQ(colours.size(), 3u);
   EXPECT_EQ(colours[0], c.leds[1]->chest);
   // On robot 1: within 0.25 m of its torso (the eyes are 0.2 m above it).
   for (const engine::DrawItem& item : lit)
     if (item.shape == engine::Primitive::Sphere && item.colour != c.ball) {
-      EXPECT_LT((item.transform.block<3, 1>(0, 3).cast<double>() - w.torsoPose(1).translation()).norm(),
-                0.25);
+      EXPECT_LT(
+          (item.transform.block<3, 1>(0, 3).cast<double>() - w.torsoPose(1).translation()).norm(),
+          0.25);
     }
 }
 
@@ -245,8 +247,9 @@ TEST(LolaWire, AMatchConfigGivesEachLolaRobotItsIdentity) {
   absolute("scenarios/match_2v2.yaml");
   absolute("rules/spl.yaml");
   absolute("agents/soccer.yaml");
-  const std::string good = text + "lola:\n  robots: [\"2:1\"]\n  identities:\n    \"2:1\": "
-                                  "{body_id: P0000073A03S83I00011, head_id: P0000074A03S84F00006}\n";
+  const std::string good = text +
+                           "lola:\n  robots: [\"2:1\"]\n  identities:\n    \"2:1\": "
+                           "{body_id: P0000073A03S83I00011, head_id: P0000074A03S84F00006}\n";
   std::ofstream(dir.path() / "good.yaml") << good;
   const match::MatchConfig c = match::loadMatchConfig(dir.path() / "good.yaml");
   ASSERT_EQ(c.lola.identities.count("2:1"), 1u);

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -237,10 +236,10 @@ TEST(MatchApp, KilledAndStoppedAgentsNeverStallTheMatch) {
   ASSERT_TRUE(m.waitForLog(100000)) << "the game did not start";
   const auto pidOf = [](int team, int player) {
     int status = 0;
-    const std::string out = test::runCommand(
-        "pgrep -f '^[^ ]*simsoccer-agent --team " + std::to_string(team) + " --player " +
-            std::to_string(player) + " --domain 147 '",
-        status);
+    const std::string out =
+        test::runCommand("pgrep -f '^[^ ]*simsoccer-agent --team " + std::to_string(team) +
+                             " --player " + std::to_string(player) + " --domain 147 '",
+                         status);
     return status == 0 ? std::atoi(out.c_str()) : 0;
   };
   // Ten kills, round robin over the four agents (at most 3 each: the restart limit).
@@ -454,8 +453,10 @@ TEST(BenchScalingApp, BoosterK1AgentsOnTheMField) {
   const test::TempDir dir("scaling_k1");
   int status = -1;
   const std::string out = test::runCommand(
-      kBin + " bench scaling --robot booster_k1 --robots 2 --seconds 3 --modes serial --domain 143 "
-             "--csv " + (dir / "scaling.csv").string() + " --png " + (dir / "scaling.png").string(),
+      kBin +
+          " bench scaling --robot booster_k1 --robots 2 --seconds 3 --modes serial --domain 143 "
+          "--csv " +
+          (dir / "scaling.csv").string() + " --png " + (dir / "scaling.png").string(),
       status);
   ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("booster_k1"), std::string::npos) << out;
@@ -543,11 +544,12 @@ TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
   EXPECT_NE(m.out.find("LoLA robot 2:1 at"), std::string::npos) << m.out;
   const std::string summary = test::readFile(m.dir / "summary.json");
   EXPECT_EQ(jsonValue(summary, "control_period"), "0.012");
-  const std::regex lola("\"lola\": \\[\\s*\\{\"team\": 2, \"player\": 1, \"socket\": \"[^\"]+\", "
-                        "\"address\": null, \"sessions\": 1, \"packets_sent\": ([0-9]+), "
-                        "\"packets_dropped\": 0, \"answered\": ([0-9]+), \"missed\": 0, "
-                        "\"no_client\": [0-9]+, \"maps\": [0-9]+, \"bad_maps\": 0, "
-                        "\"unknown_keys\": ([0-9]+)");
+  const std::regex lola(
+      "\"lola\": \\[\\s*\\{\"team\": 2, \"player\": 1, \"socket\": \"[^\"]+\", "
+      "\"address\": null, \"sessions\": 1, \"packets_sent\": ([0-9]+), "
+      "\"packets_dropped\": 0, \"answered\": ([0-9]+), \"missed\": 0, "
+      "\"no_client\": [0-9]+, \"maps\": [0-9]+, \"bad_maps\": 0, "
+      "\"unknown_keys\": ([0-9]+)");
   std::smatch match;
   ASSERT_TRUE(std::regex_search(summary, match, lola)) << summary;
   EXPECT_GE(std::stoi(match[1].str()), 1000);  // 20 s at 12 ms, less the wait

@@ -17,11 +17,11 @@
 #include <thread>
 #include <vector>
 
+#include "agent_process.hpp"
+#include "gc_reader.hpp"
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/net/sim_server.hpp"
-#include "agent_process.hpp"
-#include "gc_reader.hpp"
 #include "test_support.hpp"
 
 extern char** environ;
@@ -48,7 +48,6 @@ net::ServerConfig serverConfig(uint32_t domain,
   cfg.command_timeout = command_timeout;
   return cfg;
 }
-
 
 // An agent in this process claims its robot (in a thread) while the server
 // handles claims; true if granted within `timeout` s.
@@ -178,7 +177,8 @@ TEST(Net, AReservedRobotAnswersOnlyItsKey) {
   playing.state = 3;  // PLAYING
   server.setGameState(playing);
   const auto keyVariable = [&](int team, int player) {
-    return std::string(net::kRobotKeyVariable) + "=" + net::toHex(net::robotKey(secret, team, player));
+    return std::string(net::kRobotKeyVariable) + "=" +
+           net::toHex(net::robotKey(secret, team, player));
   };
   auto owner = std::make_unique<AgentProcess>(domain, 0, 1, std::vector<std::string>{},
                                               std::vector<std::string>{keyVariable(0, 1)});
@@ -209,10 +209,11 @@ TEST(Net, AReservedRobotAnswersOnlyItsKey) {
   }
   for (int i = 0; i < 20; ++i) simulation.period();
   const uint64_t refused = server.stats(0).refused - refused_before;
-  std::printf("unauthorised claims %llu; of 10000 strangers' commands %llu accepted, %llu refused\n",
-              (unsigned long long)server.stats(0).unauthorised,
-              (unsigned long long)(server.stats(0).accepted - accepted_before),
-              (unsigned long long)refused);
+  std::printf(
+      "unauthorised claims %llu; of 10000 strangers' commands %llu accepted, %llu refused\n",
+      (unsigned long long)server.stats(0).unauthorised,
+      (unsigned long long)(server.stats(0).accepted - accepted_before),
+      (unsigned long long)refused);
   EXPECT_EQ(server.stats(0).accepted, accepted_before);
   EXPECT_GE(refused, 9000u);  // the rest may still be in flight: none applied
   EXPECT_NEAR(w.jointPosition(0, 0), 0.0, 0.05);
@@ -672,10 +673,11 @@ TEST(NetApps, ServeWithTheRefereeBroadcastsTheGame) {
   EXPECT_EQ(last.competition_phase, 0);  // round robin
   // GameController3 refuses a colour clash: four different colours.
   const std::set<int> colours = {last.teams[0].field_player_colour, last.teams[0].goalkeeper_colour,
-                                 last.teams[1].field_player_colour, last.teams[1].goalkeeper_colour};
+                                 last.teams[1].field_player_colour,
+                                 last.teams[1].goalkeeper_colour};
   EXPECT_EQ(colours.size(), 4u);
   EXPECT_EQ(last.teams[0].message_budget, 1200);  // no agents, no messages
-  EXPECT_EQ(dds_state, 3);  // the agent saw Playing on the GameState topic
+  EXPECT_EQ(dds_state, 3);                        // the agent saw Playing on the GameState topic
 }
 
 TEST(NetCameras, ImagesReachASubscriberAtTheCameraRates) {

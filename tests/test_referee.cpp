@@ -439,7 +439,9 @@ namespace {
 
 bool hasEvent(const Game& g, const std::string& type, const std::string& detail) {
   for (const auto& e : g.events())
-    if (referee::eventName(e.type) == std::string(type) && e.detail.find(detail) != std::string::npos) return true;
+    if (referee::eventName(e.type) == std::string(type) &&
+        e.detail.find(detail) != std::string::npos)
+      return true;
   return false;
 }
 
@@ -569,7 +571,8 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
     }
     run(w, ref, 2.0);  // removal to the penalty spot, the free kick
     std::string log;
-    for (const auto& e : g.events()) log += std::to_string(e.time) + referee::eventName(e.type) + e.detail + ";";
+    for (const auto& e : g.events())
+      log += std::to_string(e.time) + referee::eventName(e.type) + e.detail + ";";
     return std::make_pair(w.stateHash(), log);
   };
   const auto a = play(), b = play();

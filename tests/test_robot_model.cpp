@@ -276,17 +276,17 @@ TEST(RobotModel, ALinksOwnMaterialReachesTheContacts) {
 TEST(BoosterK1, MassJointsAndTheSdksJointOrder) {
   const auto k1 = robots::loadRobotModel(test::boosterK1());
   EXPECT_NEAR(k1.body->totalMass(), 19.67, 0.01 * 19.67);  // booster_assets: 19.67 kg
-  EXPECT_EQ(k1.body->links.size(), 23u);                  // trunk + 22 hinge links
+  EXPECT_EQ(k1.body->links.size(), 23u);                   // trunk + 22 hinge links
   EXPECT_EQ(k1.body->joints.size(), 22u);
   EXPECT_TRUE(k1.hands.empty());
   // JointIndexK1: the order of LowState's and LowCmd's 22 motor entries.
   const char* sdk[22] = {
-      "HeadYaw",           "HeadPitch",         "LeftShoulderPitch", "LeftShoulderRoll",
-      "LeftElbowPitch",    "LeftElbowYaw",      "RightShoulderPitch", "RightShoulderRoll",
-      "RightElbowPitch",   "RightElbowYaw",     "LeftHipPitch",      "LeftHipRoll",
-      "LeftHipYaw",        "LeftKneePitch",     "LeftAnklePitch",    "LeftAnkleRoll",
-      "RightHipPitch",     "RightHipRoll",      "RightHipYaw",       "RightKneePitch",
-      "RightAnklePitch",   "RightAnkleRoll"};
+      "HeadYaw",         "HeadPitch",     "LeftShoulderPitch",  "LeftShoulderRoll",
+      "LeftElbowPitch",  "LeftElbowYaw",  "RightShoulderPitch", "RightShoulderRoll",
+      "RightElbowPitch", "RightElbowYaw", "LeftHipPitch",       "LeftHipRoll",
+      "LeftHipYaw",      "LeftKneePitch", "LeftAnklePitch",     "LeftAnkleRoll",
+      "RightHipPitch",   "RightHipRoll",  "RightHipYaw",        "RightKneePitch",
+      "RightAnklePitch", "RightAnkleRoll"};
   ASSERT_EQ(k1.actuators.size(), 22u);
   for (size_t a = 0; a < 22; ++a) {
     EXPECT_EQ(k1.actuators[a].name, sdk[a]) << "entry " << a;

@@ -9,15 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "agent_process.hpp"
 #include "simsoccer/net/credentials.hpp"
 #include "simsoccer/net/sim_server.hpp"
-#include "agent_process.hpp"
 #include "test_support.hpp"
 
 using namespace simsoccer;
 
 namespace {
-
 
 // Credentials of one match authority in a folder of the test's own.
 struct Credentials {
@@ -32,8 +31,8 @@ struct Credentials {
 };
 
 // An intruder (tests/dds_intruder.cpp) run while the simulation steps: its report.
-std::future<std::string> intrude(const std::filesystem::path& dds_config, uint32_t domain,
-                                 int team, int player, int commands, double claim_seconds) {
+std::future<std::string> intrude(const std::filesystem::path& dds_config, uint32_t domain, int team,
+                                 int player, int commands, double claim_seconds) {
   const std::string cmd = std::string(SIMSOCCER_INTRUDER_BIN) + " " + dds_config.string() + " " +
                           std::to_string(domain) + " " + std::to_string(team) + " " +
                           std::to_string(player) + " " + std::to_string(commands) + " " +
@@ -93,8 +92,8 @@ TEST(Secure, StrangersAndTheOtherTeamNeverReachARobot) {
   cfg.command_timeout = 0.05;
   sim::Simulation simulation(w);
   net::SimServer server(simulation, cfg);
-  auto owner = std::make_unique<test::AgentProcess>(domain, 0, 1, std::vector<std::string>{},
-                                                    std::vector<std::string>{}, match / "team_0.xml");
+  auto owner = std::make_unique<test::AgentProcess>(
+      domain, 0, 1, std::vector<std::string>{}, std::vector<std::string>{}, match / "team_0.xml");
   ASSERT_TRUE(server.waitForOwners(1, 30.0)) << "the team's own agent did not get its robot";
   const std::filesystem::path plain = test::sourceDir() / "configs" / "dds" / "loopback.xml";
   std::vector<std::future<std::string>> strangers;

@@ -40,8 +40,8 @@ class ScriptedSource : public sim::CommandSource {
       std::vector<double> position(world::kActuators, 0.0), stiffness(world::kActuators, 1.0);
       position[0] = headYaw(tick);
       if (poison_tick_ == tick) position[3] = std::numeric_limits<double>::quiet_NaN();
-      if (auto c = gate.check(r, std::span<const double>(position),
-                              std::span<const double>(stiffness)))
+      if (auto c =
+              gate.check(r, std::span<const double>(position), std::span<const double>(stiffness)))
         slots[r] = {sim::Answer::Given, *c};
     }
   }
@@ -99,7 +99,7 @@ TEST(Simulation, SerialStagesRunInOrderAndTheAnswerActsInItsOwnPeriod) {
   simulation.addRecorder(recorder);
   simulation.period();
   simulation.period();
-  const Trace expected = {"observe 0", "collect 0", "officials", "step 1",    "record 0",
+  const Trace expected = {"observe 0", "collect 0", "officials", "step 1", "record 0",
                           "observe 1", "collect 1", "officials", "step 2", "record 1"};
   EXPECT_EQ(trace, expected);
   EXPECT_TRUE(source.observedGame());  // officials run: sources see the game state
@@ -165,10 +165,11 @@ TEST(Simulation, PipelinedModeIsDeterministicAndDiffersFromSerial) {
     s.ball_position = {-1.0, 0.0, -1.0};
     world::World w(s);
     sim::Simulation simulation(w, modeConfig(mode));
-    match::InProcessAgents agents(
-        w, {{agents::Role::Striker, agents::Role::Goalkeeper}, 5, true,
-            test::sourceDir() / "configs" / "agents" / "soccer.yaml",
-            test::sourceDir() / "configs" / "motions"});
+    match::InProcessAgents agents(w, {{agents::Role::Striker, agents::Role::Goalkeeper},
+                                      5,
+                                      true,
+                                      test::sourceDir() / "configs" / "agents" / "soccer.yaml",
+                                      test::sourceDir() / "configs" / "motions"});
     simulation.addSource(agents);
     sim::RunLoop(simulation, sim::Pacing::Lockstep).run(300);
     // Every in-process command went through the gate: quantised to its resolution.
@@ -305,18 +306,17 @@ TEST(Simulation, GameOfficialsStartTheGameAndTheirEventsAreReadAfterTheStep) {
   EXPECT_NEAR(recorder.events[1].first, 2.0, 0.011);
   EXPECT_EQ(simulation.game()->state, static_cast<uint8_t>(referee::gc::State::Ready));
   // Each event once: the start is not reported again.
-  EXPECT_EQ(std::count_if(recorder.events.begin(), recorder.events.end(),
-                          [](const auto& e) {
-                            return e.second.detail.find("STANDBY") != std::string::npos;
-                          }),
+  EXPECT_EQ(std::count_if(
+                recorder.events.begin(), recorder.events.end(),
+                [](const auto& e) { return e.second.detail.find("STANDBY") != std::string::npos; }),
             1);
 }
 
 // The HSL's GameController has no Standby: the operator goes from Initial to Ready.
 TEST(Simulation, UnderHslRulesTheOperatorSkipsStandby) {
   world::World w(test::scenario(2));
-  const referee::RuleBook rules = referee::loadRuleBook(test::sourceDir() / "configs" / "rules" /
-                                                        "hsl_small_foundation.yaml");
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_small_foundation.yaml");
   sim::GameOfficials officials(w, rules, sim::OfficialsConfig::forTeams(1, 2));
   sim::Simulation simulation(w);
   simulation.setOfficials(&officials);
@@ -396,10 +396,9 @@ TEST(Simulation, AnExternalGameControllerRunsTheGame) {
   })) << "no advisory kick-in";
   // The game's events: the GameController's states and goal, typed.
   const auto& events = officials.game().events();
-  EXPECT_EQ(std::count_if(events.begin(), events.end(),
-                          [](const referee::RefereeEvent& e) {
-                            return e.type == referee::EventType::Goal;
-                          }),
+  EXPECT_EQ(std::count_if(
+                events.begin(), events.end(),
+                [](const referee::RefereeEvent& e) { return e.type == referee::EventType::Goal; }),
             1);
   // A packet for another game is not followed; a malformed one is counted.
   referee::ControlData other = d;

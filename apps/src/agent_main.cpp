@@ -7,9 +7,9 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <csignal>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -149,7 +149,8 @@ int main(int argc, char** argv) {
 
     // Started by a match (which names itself): go when it goes, also when it
     // was killed with SIGKILL and could not stop its agents.
-    if (const char* parent = std::getenv(simsoccer::protocol::kParentPidVariable); parent && *parent) {
+    if (const char* parent = std::getenv(simsoccer::protocol::kParentPidVariable);
+        parent && *parent) {
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);
       if (::getppid() != static_cast<pid_t>(std::atol(parent))) return 4;  // already gone
     }

@@ -20,9 +20,9 @@ SimpleModes::SimpleModes(const robots::RobotModel& model, std::string mode, doub
       position_(protocol::kActuators, 0.0f),
       stiffness_(protocol::kActuators, 1.0f),
       // The robot's gait (configs/motions/NAME/gait.yaml where it has one).
-      walk_(model,
-            agents::loadGaitIn(agents::motionsFolder(findConfig("", "configs/motions"), model))
-                .walk),
+      walk_(
+          model,
+          agents::loadGaitIn(agents::motionsFolder(findConfig("", "configs/motions"), model)).walk),
       targets_(model.pose("stand")) {
   const auto& stand = model.pose("stand");
   for (size_t a = 0; a < model.actuators.size() && a < protocol::kActuators; ++a) {

@@ -26,14 +26,16 @@ namespace {
 using namespace simsoccer::match;
 
 const char* kHelp =
-    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--robot R] [--seconds S] [--cameras]\n"
+    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--robot R] [--seconds S] "
+    "[--cameras]\n"
     "                               [--modes serial,pipelined] [--threads N] [--csv FILE]\n"
     "                               [--png FILE] [--domain D]\n"
     "\n"
     "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
     "3D-league-sized field beyond; --robot booster_k1: K1s on the HSL M-Field with their agent\n"
     "config, from configs/bench/motion_R.yaml), perception on, the automatic referee (simleague\n"
-    "rule book), and N simsoccer-agent processes (--role auto: walking, kicking, team messages) over\n"
+    "rule book), and N simsoccer-agent processes (--role auto: walking, kicking, team messages) "
+    "over\n"
     "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
     "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
     "the answers to this period's frames) and pipelined (with the answers to the last\n"
@@ -197,7 +199,8 @@ int benchScaling(int argc, char** argv, int first) {
   if (robot_name == "nao_v6_h25") {
     robot.robot_model = findConfig("", "robots/nao_v6_h25.yaml");
   } else {
-    const std::filesystem::path bench = findConfig("", "configs/bench/motion_" + robot_name + ".yaml");
+    const std::filesystem::path bench =
+        findConfig("", "configs/bench/motion_" + robot_name + ".yaml");
     if (!std::filesystem::exists(bench))
       throw UsageError("--robot " + robot_name + ": no " + bench.string() +
                        " (robots: nao_v6_h25, booster_k1)");
@@ -212,9 +215,8 @@ int benchScaling(int argc, char** argv, int first) {
       robot_name.c_str(), cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots",     "mode",       "steps_per_s",  "fps",
-                  "rtf",        "physics_ms", "sensors_ms",   "messaging_ms",
-                  "referee_ms", "render_ms",  "missed",       "cpu_ms"};
+  table.header = {"robots",     "mode",         "steps_per_s", "fps",       "rtf",    "physics_ms",
+                  "sensors_ms", "messaging_ms", "referee_ms",  "render_ms", "missed", "cpu_ms"};
   std::vector<Row> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {

@@ -41,8 +41,8 @@ std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World
     }
     if (!found)
       throw UsageError("--booster: no robot " + item + " (team numbers " +
-                       std::to_string(team_numbers[0]) + " and " +
-                       std::to_string(team_numbers[1]) + ")");
+                       std::to_string(team_numbers[0]) + " and " + std::to_string(team_numbers[1]) +
+                       ")");
   }
   return out;
 }
@@ -80,8 +80,8 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
   }
   const auto base = static_cast<uint32_t>(opt.wholeNumber("booster-domain", 0, 0, 230));
   if (base + robots.size() - 1 > 230)
-    throw UsageError("--booster-domain: " + std::to_string(robots.size()) +
-                     " robots from domain " + std::to_string(base) + " pass domain 230");
+    throw UsageError("--booster-domain: " + std::to_string(robots.size()) + " robots from domain " +
+                     std::to_string(base) + " pass domain 230");
   booster::EndpointConfig ec;
   ec.dds_config = dds_config;
   ec.lockstep = opt.flag("booster-lockstep");
@@ -100,8 +100,8 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
     if (netns) {
       // Its own namespace on the field network (a killed run's is replaced);
       // DDS stays on the namespace's loopback.
-      out->namespaces.push_back(std::make_unique<lola::RobotNamespace>(
-          net, teamNumber(b.robot), w.robot(b.robot).number));
+      out->namespaces.push_back(std::make_unique<lola::RobotNamespace>(net, teamNumber(b.robot),
+                                                                       w.robot(b.robot).number));
       b.network_namespace = out->namespaces.back()->name();
     }
     ec.robots.push_back(b);
@@ -116,9 +116,9 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
       std::printf(
           "Booster SDK: robot %d:%d (%s) as DDS domain 0 in network namespace %s at %s: "
           "simsoccer booster-run --robot %d:%d -- PROGRAM\n",
-          teamNumber(b.robot), info.number, info.model->name.c_str(),
-          b.network_namespace.c_str(), net.robotAddress(teamNumber(b.robot), info.number).c_str(),
-          teamNumber(b.robot), info.number);
+          teamNumber(b.robot), info.number, info.model->name.c_str(), b.network_namespace.c_str(),
+          net.robotAddress(teamNumber(b.robot), info.number).c_str(), teamNumber(b.robot),
+          info.number);
     else
       std::printf("Booster SDK: robot %d:%d (%s) on DDS domain %u\n", teamNumber(b.robot),
                   info.number, info.model->name.c_str(), b.domain);
@@ -137,10 +137,10 @@ void printBoosterStats(const BoosterRobots& robots) {
         "%llu images\n",
         robots.names[i].c_str(), b.domain, booster::modeName(s.mode),
         (unsigned long long)s.states_sent, (unsigned long long)s.commands,
-        (unsigned long long)s.applied, (unsigned long long)s.ignored,
-        (unsigned long long)s.refused, (unsigned long long)s.missed,
-        (unsigned long long)s.requests, (unsigned long long)s.requests_refused,
-        (unsigned long long)s.requests_malformed, (unsigned long long)s.images);
+        (unsigned long long)s.applied, (unsigned long long)s.ignored, (unsigned long long)s.refused,
+        (unsigned long long)s.missed, (unsigned long long)s.requests,
+        (unsigned long long)s.requests_refused, (unsigned long long)s.requests_malformed,
+        (unsigned long long)s.images);
   }
 }
 

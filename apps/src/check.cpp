@@ -30,9 +30,9 @@ int check(int argc, char** argv, int first) {
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
     const auto& info = w.robot(r);
     const engine::Vec3 p = w.torsoPose(r).translation();
-    std::printf("  robot %u: team %d number %d, %s (%.3f kg), torso at (%.2f, %.2f, %.3f)\n", r.value(),
-                info.team, info.number, info.model->name.c_str(), info.model->body->totalMass(),
-                p.x(), p.y(), p.z());
+    std::printf("  robot %u: team %d number %d, %s (%.3f kg), torso at (%.2f, %.2f, %.3f)\n",
+                r.value(), info.team, info.number, info.model->name.c_str(),
+                info.model->body->totalMass(), p.x(), p.y(), p.z());
   }
   std::printf("  state hash %016llx\n", static_cast<unsigned long long>(w.stateHash()));
   return 0;

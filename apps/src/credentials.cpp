@@ -1,8 +1,9 @@
 // simsoccer credentials: DDS Security credentials for a match (OpenSSL; net/credentials.hpp).
+#include "simsoccer/net/credentials.hpp"
+
 #include <cstdio>
 
 #include "cli.hpp"
-#include "simsoccer/net/credentials.hpp"
 
 namespace simsoccer::apps {
 

@@ -36,7 +36,8 @@ const char* kHelp =
     "Runs PROGRAM with a simulated robot's LoLA socket at /tmp/robocup, as on a Nao, in a\n"
     "private mount namespace (bubblewrap) with a /tmp of its own, so several team binaries\n"
     "run side by side, each seeing its own robot there (the working directory and the folders\n"
-    "of the program and its file arguments under /tmp stay visible). --robot T:P names the robot (GameController team\n"
+    "of the program and its file arguments under /tmp stay visible). --robot T:P names the robot "
+    "(GameController team\n"
     "number:player) of the match writing to DIR (default runs/serve; the socket is\n"
     "DIR/lola/robot_T_P.sock), --socket gives the socket itself. Waits up to S s (default\n"
     "60) for the simulator to open the socket. The program's exit status is lola-run's.\n"
@@ -79,7 +80,8 @@ int lolaRun(int argc, char** argv, int first) {
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   if (!opt.has("socket") && !opt.has("robot")) throw UsageError("give --socket or --robot");
-  if (opt.flag("net") && !opt.has("robot")) throw UsageError("--net: give --robot T:P (its address)");
+  if (opt.flag("net") && !opt.has("robot"))
+    throw UsageError("--net: give --robot T:P (its address)");
   std::vector<match::LolaPlayer> players;
   if (opt.has("robot")) {
     try {
@@ -89,17 +91,18 @@ int lolaRun(int argc, char** argv, int first) {
     }
     if (players.size() != 1) throw UsageError("--robot: one robot");
   }
-  std::filesystem::path socket = opt.has("socket")
-                                     ? std::filesystem::path(opt.get("socket", ""))
-                                     : match::lolaSocketPath(opt.get("run", "runs/serve"), players[0]);
+  std::filesystem::path socket =
+      opt.has("socket") ? std::filesystem::path(opt.get("socket", ""))
+                        : match::lolaSocketPath(opt.get("run", "runs/serve"), players[0]);
   socket = std::filesystem::absolute(socket);
   const double wait = opt.number("wait", 60.0);
   if (!(wait >= 0)) throw UsageError("--wait must be >= 0 s");
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::milliseconds(static_cast<long>(wait * 1000));
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long>(wait * 1000));
   while (!std::filesystem::is_socket(socket)) {
     if (std::chrono::steady_clock::now() >= deadline)
-      throw std::runtime_error(socket.string() + ": no LoLA socket there (is the simulator running?)");
+      throw std::runtime_error(socket.string() +
+                               ": no LoLA socket there (is the simulator running?)");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   const std::string bwrap = findBwrap();
@@ -135,9 +138,9 @@ int lolaRun(int argc, char** argv, int first) {
     if (s.rfind("/tmp/", 0) == 0 && s != "/tmp/robocup")
       sandbox.insert(sandbox.end(), {"--bind", s, s});
   }
-  sandbox.insert(sandbox.end(), {"--bind", socket.string(), "/tmp/robocup",
-                                   "--chdir", std::filesystem::current_path().string(),
-                                   "--unshare-pid", "--die-with-parent", "--"});
+  sandbox.insert(sandbox.end(), {"--bind", socket.string(), "/tmp/robocup", "--chdir",
+                                 std::filesystem::current_path().string(), "--unshare-pid",
+                                 "--die-with-parent", "--"});
   args.insert(args.end(), sandbox.begin(), sandbox.end());
   for (int i = split + 1; i < argc; ++i) args.push_back(argv[i]);
   std::vector<char*> cargs;

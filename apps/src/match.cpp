@@ -33,8 +33,6 @@ std::filesystem::path defaultOut() {
   return std::filesystem::path("runs") / buf;
 }
 
-
-
 RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
   o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : defaultOut();
@@ -81,10 +79,10 @@ void printStatus(const MatchSession& session, double wall) {
 }  // namespace
 
 int match(int argc, char** argv, int first) {
-  const Options opt(
-      argc, argv, first, {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net"},
-      {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
-       "lola", "external-gc", "secure"});
+  const Options opt(argc, argv, first,
+                    {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net"},
+                    {"out", "seed", "half", "domain", "dds-config", "max-seconds",
+                     "lockstep-timeout", "mode", "lola", "external-gc", "secure"});
   char help[4096];
   std::snprintf(help, sizeof help, kMatchHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -174,13 +172,12 @@ int penalty(int argc, char** argv, int first) {
   if (kicks < 1) throw UsageError("--kicks must be >= 1");
   const int video_kicks = opt.wholeNumber("video-kicks", 3, 0, 100000);
   const RunOptions o = runOptions(opt, config);
-  const match::PenaltyResult r =
-      match::playPenalties(config, o, kicks, video_kicks,
-                           [](int kick, uint64_t seed, const std::string& outcome) {
-                             std::printf("  kick %2d (seed %llu): %s\n", kick,
-                                         static_cast<unsigned long long>(seed), outcome.c_str());
-                             std::fflush(stdout);
-                           });
+  const match::PenaltyResult r = match::playPenalties(
+      config, o, kicks, video_kicks, [](int kick, uint64_t seed, const std::string& outcome) {
+        std::printf("  kick %2d (seed %llu): %s\n", kick, static_cast<unsigned long long>(seed),
+                    outcome.c_str());
+        std::fflush(stdout);
+      });
   const int n = static_cast<int>(r.outcomes.size());
   const match::Proportion p = match::wilsonInterval(r.goals, n);
   std::printf(

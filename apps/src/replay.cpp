@@ -63,9 +63,10 @@ int replay(int argc, char** argv, int first) {
   // A log cut inside a block (its writer was killed) says so, and replay's
   // exit status says the game is not all there.
   if (const auto cut = reader.truncatedAt()) {
-    std::printf("warning: the log is cut inside the block at byte %llu: the frames after %.2f s "
-                "are lost\n",
-                static_cast<unsigned long long>(*cut), last_time);
+    std::printf(
+        "warning: the log is cut inside the block at byte %llu: the frames after %.2f s "
+        "are lost\n",
+        static_cast<unsigned long long>(*cut), last_time);
     status = 4;
   }
   if (opt.flag("physics")) {

@@ -7,9 +7,9 @@
 
 #include "booster_robots.hpp"
 #include "cli.hpp"
-#include "serve_report.hpp"
 #include "help_texts.hpp"
 #include "lola_option.hpp"
+#include "serve_report.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/net/sim_server.hpp"
@@ -19,7 +19,6 @@
 
 namespace simsoccer::apps {
 namespace {
-
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) {
@@ -49,7 +48,8 @@ int serve(int argc, char** argv, int first) {
   if (opt.has("external-gc")) {
     external_gc = static_cast<uint16_t>(opt.wholeNumber("external-gc", 3838, 1, 65535));
     if (opt.has("gc-address"))
-      throw UsageError("--external-gc: an external GameController sends the packets, not --gc-address");
+      throw UsageError(
+          "--external-gc: an external GameController sends the packets, not --gc-address");
   }
   cfg.lockstep = !opt.flag("realtime") && !external_gc;
   cfg.hold_on_release = !opt.flag("limp-on-release");
@@ -69,8 +69,7 @@ int serve(int argc, char** argv, int first) {
     }
     addLolaRobots(opt, mc);
     mc.external_gc_port = external_gc;
-    session = std::make_unique<match::MatchSession>(
-        mc, opt.seed("seed", mc.seed));
+    session = std::make_unique<match::MatchSession>(mc, opt.seed("seed", mc.seed));
     officials = &session->officials();
     cfg.command_timeout = mc.command_timeout;
     cfg.team_message_delay = mc.message_delay;
@@ -100,7 +99,8 @@ int serve(int argc, char** argv, int first) {
   if (external_gc && !officials)
     throw UsageError("--external-gc needs --rules or a match config (the game it runs)");
   if (opt.has("gc-address") && !officials)
-    throw UsageError("--gc-address needs --rules or a match config (the referee makes the packets)");
+    throw UsageError(
+        "--gc-address needs --rules or a match config (the referee makes the packets)");
   world::World& w = session ? session->world() : *own_world;
   // GameController team numbers of the scenario's teams 0 and 1.
   std::array<int, 2> team_numbers{1, 2};
@@ -129,9 +129,9 @@ int serve(int argc, char** argv, int first) {
     simulation.setOfficials(officials);
   std::unique_ptr<match::LolaRobots> lola_robots;
   if (session) {
-    lola_robots = match::openLolaRobots(
-        *session, simulation, opt.get("out", "runs/serve"), cfg.lockstep,
-        [](const std::string& line) { std::printf("%s\n", line.c_str()); });
+    lola_robots =
+        match::openLolaRobots(*session, simulation, opt.get("out", "runs/serve"), cfg.lockstep,
+                              [](const std::string& line) { std::printf("%s\n", line.c_str()); });
     cfg.not_served = session->lolaRobots();
   }
   for (world::RobotId r : booster_robots)
@@ -176,9 +176,9 @@ int serve(int argc, char** argv, int first) {
   const auto wanted = static_cast<size_t>(opt.wholeNumber("agents", servable, 0, servable));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  std::printf("simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",
-              w.robotCount(), cfg.dds.domain,
-              static_cast<unsigned long long>(w.scenario().seed), wanted);
+  std::printf(
+      "simsoccer serve: %zu robots on DDS domain %u, seed %llu, waiting for %zu agents...\n",
+      w.robotCount(), cfg.dds.domain, static_cast<unsigned long long>(w.scenario().seed), wanted);
   std::fflush(stdout);
   while (!g_stop && !server.waitForOwners(wanted, 1.0)) {
   }
@@ -186,24 +186,25 @@ int serve(int argc, char** argv, int first) {
   }
   const auto periods = static_cast<long>(sim_seconds / w.scenario().physics.control_period + 0.5);
   sim::RunLoop loop(simulation, cfg.lockstep ? sim::Pacing::Lockstep : sim::Pacing::RealTime);
-  const sim::RunStats run = loop.run(
-      [&] { return g_stop || (officials && officials->over()); }, periods,
-      [&] {
-        if (gc_link) gc_link->update(officials->game());
-        if (lola_robots) lola_robots->afterPeriod();
-      });
+  const sim::RunStats run =
+      loop.run([&] { return g_stop || (officials && officials->over()); }, periods,
+               [&] {
+                 if (gc_link) gc_link->update(officials->game());
+                 if (lola_robots) lola_robots->afterPeriod();
+               });
   simulation.flushCameras();
   std::printf("simulated %.2f s in %.2f s (real-time factor %.2f)\n", w.time(), run.wall_s,
               w.time() / run.wall_s);
   printCameraStats(simulation);
   printCounters(w, server);
   if (booster) printBoosterStats(*booster);
-  for (const match::LolaResult& l : lola_robots ? lola_robots->results()
-                                                 : std::vector<match::LolaResult>{})
-    std::printf("  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
-                l.player.team_number, l.player.player, (unsigned long long)l.stats.sessions,
-                (unsigned long long)l.stats.maps, (unsigned long long)l.stats.missed,
-                (unsigned long long)l.stats.bad_maps, (unsigned long long)l.stats.refused);
+  for (const match::LolaResult& l :
+       lola_robots ? lola_robots->results() : std::vector<match::LolaResult>{})
+    std::printf(
+        "  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
+        l.player.team_number, l.player.player, (unsigned long long)l.stats.sessions,
+        (unsigned long long)l.stats.maps, (unsigned long long)l.stats.missed,
+        (unsigned long long)l.stats.bad_maps, (unsigned long long)l.stats.refused);
   if (officials) printGame(officials->game());
   if (gc_link) {
     std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",

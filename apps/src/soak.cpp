@@ -1,12 +1,13 @@
 // simsoccer soak: whole matches back to back with agents killed and frozen,
 // the simulator's and agents' memory, descriptors and threads sampled
 // (simsoccer/match/soak.hpp); prints the table and the checks.
+#include "simsoccer/match/soak.hpp"
+
 #include <csignal>
 #include <cstdio>
 #include <ctime>
 
 #include "cli.hpp"
-#include "simsoccer/match/soak.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -66,36 +67,76 @@ int soak(int argc, char** argv, int first) {
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   match::prepareOut(o.run.out);
-  std::printf("simsoccer soak %s: %d games, %d kills and %d stops of %.1f s each per game, "
-              "output %s\n",
-              config.name.c_str(), o.games, o.kills_per_game, o.stops_per_game, o.stop_seconds,
-              o.run.out.string().c_str());
+  std::printf(
+      "simsoccer soak %s: %d games, %d kills and %d stops of %.1f s each per game, "
+      "output %s\n",
+      config.name.c_str(), o.games, o.kills_per_game, o.stops_per_game, o.stop_seconds,
+      o.run.out.string().c_str());
   std::fflush(stdout);
   const match::SoakResult r = match::runSoak(config, o, [](const match::SoakGame& g) {
-    std::printf("  game %d (seed %llu): %s %s after %.1f simulated s in %.1f s; %d kills, %d "
-                "stops, %d restarts; simulator RSS peak %.1f MiB\n",
-                g.index, static_cast<unsigned long long>(g.seed), g.finished ? "finished" : "NOT FINISHED",
-                g.score.c_str(), g.simulated, g.wall, g.kills, g.stops, g.restarts, g.sim_peak_rss);
+    std::printf(
+        "  game %d (seed %llu): %s %s after %.1f simulated s in %.1f s; %d kills, %d "
+        "stops, %d restarts; simulator RSS peak %.1f MiB\n",
+        g.index, static_cast<unsigned long long>(g.seed), g.finished ? "finished" : "NOT FINISHED",
+        g.score.c_str(), g.simulated, g.wall, g.kills, g.stops, g.restarts, g.sim_peak_rss);
     std::fflush(stdout);
   });
   Table t;
-  t.header = {"game", "seed", "score", "sim_s", "wall_s", "kills", "stops", "restarts",
-              "longest_wait_s", "sim_rss_start_mib", "sim_rss_peak_mib", "sim_rss_end_mib",
-              "sim_anon_start_mib", "sim_anon_end_mib", "heap_start_mib", "heap_end_mib", "sim_fds_start", "sim_fds_end", "sim_threads_start", "sim_threads_end",
-              "agent_rss_start_mib", "agent_rss_peak_mib", "agent_rss_end_mib", "finished",
+  t.header = {"game",
+              "seed",
+              "score",
+              "sim_s",
+              "wall_s",
+              "kills",
+              "stops",
+              "restarts",
+              "longest_wait_s",
+              "sim_rss_start_mib",
+              "sim_rss_peak_mib",
+              "sim_rss_end_mib",
+              "sim_anon_start_mib",
+              "sim_anon_end_mib",
+              "heap_start_mib",
+              "heap_end_mib",
+              "sim_fds_start",
+              "sim_fds_end",
+              "sim_threads_start",
+              "sim_threads_end",
+              "agent_rss_start_mib",
+              "agent_rss_peak_mib",
+              "agent_rss_end_mib",
+              "finished",
               "summary_complete"};
   for (const match::SoakGame& g : r.games)
-    t.rows.push_back({std::to_string(g.index), std::to_string(g.seed), g.score, fmt(g.simulated, 1),
-                      fmt(g.wall, 1), std::to_string(g.kills), std::to_string(g.stops),
-                      std::to_string(g.restarts), fmt(g.longest_wait, 3),
-                      fmt(g.sim_start.rss_mib, 1), fmt(g.sim_peak_rss, 1), fmt(g.sim_end.rss_mib, 1),
-                      fmt(g.sim_start.anon_mib, 1), fmt(g.sim_end.anon_mib, 1), fmt(g.heap_start, 1), fmt(g.heap_end, 1), std::to_string(g.sim_start.fds), std::to_string(g.sim_end.fds),
-                      std::to_string(g.sim_start.threads), std::to_string(g.sim_end.threads),
-                      fmt(g.agent_rss_start, 1), fmt(g.agent_rss_peak, 1), fmt(g.agent_rss_end, 1),
-                      g.finished ? "yes" : "no", g.summary_complete ? "yes" : "no"});
-  t.finish("rss: resident memory (MiB); agents: the mean over the game's agents at its first and "
-           "last sample, and the largest; end: after the game's session and agents are gone",
-           opt.get("csv", ""));
+    t.rows.push_back({std::to_string(g.index),
+                      std::to_string(g.seed),
+                      g.score,
+                      fmt(g.simulated, 1),
+                      fmt(g.wall, 1),
+                      std::to_string(g.kills),
+                      std::to_string(g.stops),
+                      std::to_string(g.restarts),
+                      fmt(g.longest_wait, 3),
+                      fmt(g.sim_start.rss_mib, 1),
+                      fmt(g.sim_peak_rss, 1),
+                      fmt(g.sim_end.rss_mib, 1),
+                      fmt(g.sim_start.anon_mib, 1),
+                      fmt(g.sim_end.anon_mib, 1),
+                      fmt(g.heap_start, 1),
+                      fmt(g.heap_end, 1),
+                      std::to_string(g.sim_start.fds),
+                      std::to_string(g.sim_end.fds),
+                      std::to_string(g.sim_start.threads),
+                      std::to_string(g.sim_end.threads),
+                      fmt(g.agent_rss_start, 1),
+                      fmt(g.agent_rss_peak, 1),
+                      fmt(g.agent_rss_end, 1),
+                      g.finished ? "yes" : "no",
+                      g.summary_complete ? "yes" : "no"});
+  t.finish(
+      "rss: resident memory (MiB); agents: the mean over the game's agents at its first and "
+      "last sample, and the largest; end: after the game's session and agents are gone",
+      opt.get("csv", ""));
   std::printf("simulator peak RSS growth from the first game to the last: %+.1f %% (limit 5 %%)\n",
               100.0 * r.rss_growth);
   for (const std::string& f : r.failures) std::printf("FAILED: %s\n", f.c_str());
