@@ -16,11 +16,13 @@ namespace {
 
 // 10 robots, 2,000 steps, every joint driven by a sinusoid (phase per robot).
 // `threads`: the solver threads (0: the default); `most_batches`: the most
-// constraint batches a step solved side by side.
+// constraint batches a step solved side by side; `bullet_solver`: Bullet's
+// own rows and iterations (and island loop with one thread).
 uint64_t run(uint64_t seed, double amplitude, int steps = 2000, int threads = 0,
-             int* most_batches = nullptr) {
+             int* most_batches = nullptr, bool bullet_solver = false) {
   world::Scenario s = test::scenario(10, seed);
   s.physics.threads = threads;
+  s.physics.bullet_solver = bullet_solver;
   s.noise.position = 0.01;
   s.noise.yaw = 0.02;
   s.noise.joints = 0.01;
@@ -76,30 +78,9 @@ TEST(Determinism, AnyNumberOfSolverThreadsGivesTheSameHash) {
 // Bullet's rows and iterations (bullet_solver): one thread runs Bullet's
 // loop, two the engine's, and the states agree bit for bit.
 TEST(Determinism, TheEnginesBatchLoopIsBulletsIslandLoop) {
-  auto hash = [](int threads) {
-    world::Scenario s = test::scenario(10, 21);
-    s.physics.threads = threads;
-    s.physics.bullet_solver = true;
-    s.ball_position = {-3.2, -0.6, -1.0};
-    world::World w(s);
-    int most_batches = 0;
-    for (int i = 0; i < 600; ++i) {
-      if (i % w.stepsPerControlPeriod() == 0)
-        for (world::RobotId r = 0; r < w.robotCount(); ++r) {
-          const auto& model = *w.robot(r).model;
-          const auto& stand = model.pose("stand");
-          for (size_t j = 0; j < model.body->joints.size(); ++j)
-            if (model.body->joints[j].mimic_of < 0)
-              w.setJointTarget(r, static_cast<int>(j),
-                               stand[j] + 0.5 * std::sin(6.0 * w.time() + 0.7 * r + 0.3 * j), 1.0);
-        }
-      w.step();
-      most_batches = std::max(most_batches, w.physics().lastStepSolverBatches());
-    }
-    return std::pair{w.stateHash(), most_batches};
-  };
-  const auto [bullets, no_batches] = hash(1);
-  const auto [engines, batches] = hash(2);
+  int no_batches = 0, batches = 0;
+  const uint64_t bullets = run(21, 0.5, 600, 1, &no_batches, /*bullet_solver=*/true);
+  const uint64_t engines = run(21, 0.5, 600, 2, &batches, /*bullet_solver=*/true);
   EXPECT_EQ(no_batches, 0);  // Bullet's own loop
   EXPECT_GE(batches, 2);
   EXPECT_EQ(bullets, engines);

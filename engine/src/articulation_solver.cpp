@@ -282,26 +282,24 @@ btScalar ArticulationSolver::rowVelocity(const btMultiBodySolverConstraint& row)
 }
 
 void ArticulationSolver::applyImpulse(const btMultiBodySolverConstraint& row, btScalar impulse) {
-  auto axpy = [&](btMultiBody* body, int response, int block) {
-    const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response];
-    btScalar* dv = &m_data.m_deltaVelocities[block];
-    const int n = body->getNumDofs() + 6;
-    for (int i = 0; i < n; ++i) dv[i] += r[i] * impulse;
+  // One side: an articulation's velocity changes through its response, a
+  // rigid body's through the row's normal and angular component.
+  auto side = [&](const btMultiBody* body, int response, int block, int solver_body,
+                  const btVector3& normal, const btVector3& angular) {
+    if (body) {
+      const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response];
+      btScalar* dv = &m_data.m_deltaVelocities[block];
+      const int n = body->getNumDofs() + 6;
+      for (int i = 0; i < n; ++i) dv[i] += r[i] * impulse;
+    } else if (solver_body >= 0) {
+      btSolverBody& b = m_tmpSolverBodyPool[solver_body];
+      b.internalApplyImpulse(normal * b.internalGetInvMass(), angular, impulse);
+    }
   };
-  if (row.m_multiBodyA) {
-    axpy(row.m_multiBodyA, row.m_jacAindex, row.m_deltaVelAindex);
-  } else if (row.m_solverBodyIdA >= 0) {
-    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdA];
-    body.internalApplyImpulse(row.m_contactNormal1 * body.internalGetInvMass(),
-                              row.m_angularComponentA, impulse);
-  }
-  if (row.m_multiBodyB) {
-    axpy(row.m_multiBodyB, row.m_jacBindex, row.m_deltaVelBindex);
-  } else if (row.m_solverBodyIdB >= 0) {
-    btSolverBody& body = m_tmpSolverBodyPool[row.m_solverBodyIdB];
-    body.internalApplyImpulse(row.m_contactNormal2 * body.internalGetInvMass(),
-                              row.m_angularComponentB, impulse);
-  }
+  side(row.m_multiBodyA, row.m_jacAindex, row.m_deltaVelAindex, row.m_solverBodyIdA,
+       row.m_contactNormal1, row.m_angularComponentA);
+  side(row.m_multiBodyB, row.m_jacBindex, row.m_deltaVelBindex, row.m_solverBodyIdB,
+       row.m_contactNormal2, row.m_angularComponentB);
 }
 
 btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
