@@ -135,8 +135,14 @@ void UdpSender::send(std::span<const uint8_t> bytes) {
 UdpReceiver::UdpReceiver(uint16_t port, const std::string& bind_address) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
   if (fd_ < 0) throw std::runtime_error("UDP: socket: " + std::string(std::strerror(errno)));
-  const int yes = 1;
-  ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  // A well-known port (the GameController's 3838, a team port) is shared by
+  // every program on the host that listens to it. A port the system picks
+  // (0) is this socket's alone: shared, a later socket with SO_REUSEADDR
+  // (a DDS participant's) could take it and receive its packets.
+  if (port != 0) {
+    const int yes = 1;
+    ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  }
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(port);
