@@ -68,7 +68,6 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   ParallelIslandSolver(
       int threads,
       const std::function<std::unique_ptr<btMultiBodyConstraintSolver>()>& make_solver);
-  btMultiBodyConstraintSolver& solver(int thread) { return *solvers_[static_cast<size_t>(thread)]; }
 
   // Before the islands are built: the solver settings and the world's
   // constraints, sorted by island (as Bullet sorts them for its own callback).

@@ -406,6 +406,7 @@ struct PhysicsWorld::Impl {
   std::unique_ptr<ArticulationSolver> solver;
   std::unique_ptr<TimedMultiBodyWorld> world;
   std::unique_ptr<ParallelIslandSolver> islands;  // the batches, on solver_threads threads
+  std::vector<ArticulationSolver*> all_solvers;   // the world's and each thread's
   SameRobotFilter filter;
 
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -493,10 +494,14 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   // number of threads (one: one after the other on the caller's thread), so
   // every thread count runs the same code; bullet_solver with one thread
   // keeps Bullet's own loop, to compare the two.
+  m.all_solvers.push_back(m.solver.get());
   if (!settings.bullet_solver || settings.solver_threads > 1) {
     m.islands = std::make_unique<ParallelIslandSolver>(
-        settings.solver_threads,
-        [own = !settings.bullet_solver] { return std::make_unique<ArticulationSolver>(own); });
+        settings.solver_threads, [&m, own = !settings.bullet_solver] {
+          auto solver = std::make_unique<ArticulationSolver>(own);
+          m.all_solvers.push_back(solver.get());
+          return solver;
+        });
     m.world->islands = m.islands.get();
   }
   // Restitution: the bouncier of the two materials decides (Bullet's default
@@ -809,10 +814,7 @@ void PhysicsWorld::step() {
   // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
   // integrate); exactly one dt.
   const auto dt = static_cast<btScalar>(settings_.dt);
-  m.solver->resetBasisRows();
-  if (m.islands)
-    for (int t = 0; t < m.islands->threadCount(); ++t)
-      static_cast<ArticulationSolver&>(m.islands->solver(t)).resetBasisRows();
+  for (ArticulationSolver* solver : m.all_solvers) solver->resetBasisRows();
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
@@ -826,11 +828,8 @@ void PhysicsWorld::step() {
 }
 
 long PhysicsWorld::lastStepBasisRows() const {
-  const Impl& m = *impl_;
-  long rows = m.solver->basisRows();
-  if (m.islands)
-    for (int t = 0; t < m.islands->threadCount(); ++t)
-      rows += static_cast<const ArticulationSolver&>(m.islands->solver(t)).basisRows();
+  long rows = 0;
+  for (const ArticulationSolver* solver : impl_->all_solvers) rows += solver->basisRows();
   return rows;
 }
 
