@@ -21,6 +21,7 @@ struct Outcome {
   std::vector<double> joints;        // rad, every robot's
   engine::Vec3 ball;                 // m
   long most_basis_rows = 0;          // in any step
+  double inertia_mismatch = -1;      // factorised M^-1 against Bullet's pass, relative
   int standing = 0;
 };
 
@@ -33,6 +34,7 @@ Outcome run(const std::filesystem::path& robot, bool own, int friction_direction
   s.physics.bullet_solver = !own;
   s.physics.friction_directions = friction_directions;
   world::World w(s);
+  w.physics().checkInverseInertia(true);
   {
     // The ball rolls into the first robot's feet: a rigid body's rows among
     // the articulations' (Bullet's conversion, the engine's iterations).
@@ -73,6 +75,7 @@ Outcome run(const std::filesystem::path& robot, bool own, int friction_direction
     o.standing += w.isStanding(r) ? 1 : 0;
   }
   o.ball = w.ballState().pose.translation();
+  o.inertia_mismatch = w.physics().inverseInertiaMismatch();
   return o;
 }
 
@@ -88,8 +91,15 @@ void compare(const char* what, const Outcome& own, const Outcome& bullet, double
   const double ball = (own.ball - bullet.ball).norm();
   std::printf(
       "%s after 1 s: torsos %.3g m, joints %.3g rad, ball %.3g m apart; up to %ld basis "
-      "rows a step\n",
-      what, torso, joint, ball, own.most_basis_rows);
+      "rows a step; factorised inverse inertia within %.3g of Bullet's pass\n",
+      what, torso, joint, ball, own.most_basis_rows, own.inertia_mismatch);
+  // Every step's factorisation of each robot, column by column: the same
+  // matrix up to the rounding of Bullet's single-precision pass (its own
+  // inverse is symmetric to about 1e-7 of its largest entry); a wrong axis,
+  // pivot, mass or inertia is off by percent.
+  EXPECT_GE(own.inertia_mismatch, 0.0) << what << ": nothing checked";
+  EXPECT_LT(own.inertia_mismatch, 2e-4) << what;
+  EXPECT_LT(bullet.inertia_mismatch, 0.0) << what << ": Bullet's rows factorise nothing";
   EXPECT_EQ(own.standing, 2) << what;
   EXPECT_EQ(bullet.standing, 2) << what;
   // A wrong sign, lever arm, bound or bias moves a robot by millimetres.

@@ -5,6 +5,8 @@
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
+#include "articulation_inertia.hpp"
+
 namespace simsoccer::engine {
 namespace {
 
@@ -122,14 +124,18 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
       link_ < 0 ? body_->getBasePos() : body_->getLink(link_).m_cachedWorldTransform.getOrigin();
   basis_jacobian_.resize(6 * ndof_);
   basis_response_.resize(6 * ndof_);
+  const ArticulationInertia* inertia = inertias_ ? inertias_->of(*body_) : nullptr;
   for (int k = 0; k < 6; ++k) {
     btVector3 angular(0, 0, 0), linear(0, 0, 0);
     (k < 3 ? angular : linear)[k % 3] = 1;
     btScalar* jacobian = &basis_jacobian_[k * ndof_];
     body_->fillConstraintJacobianMultiDof(link_, basis_origin_, angular, linear, jacobian,
                                           m_data.scratch_r, m_data.scratch_v, m_data.scratch_m);
-    body_->calcAccelerationDeltasMultiDof(jacobian, &basis_response_[k * ndof_], m_data.scratch_r,
-                                          m_data.scratch_v);
+    if (inertia)
+      inertia->solve(jacobian, &basis_response_[k * ndof_], inertia->chainOf(link_));
+    else
+      body_->calcAccelerationDeltasMultiDof(jacobian, &basis_response_[k * ndof_], m_data.scratch_r,
+                                            m_data.scratch_v);
   }
 
   const bool two_directions = info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS;

@@ -36,6 +36,8 @@
 
 namespace simsoccer::engine {
 
+class ArticulationInertias;
+
 // The articulation's block of velocity changes in the solver's data (its
 // companion id), made at its first row of the group.
 int deltaVelocityBlock(btMultiBody* body, btMultiBodyJacobianData& data);
@@ -47,6 +49,9 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   // Rows built from a link basis since the last reset (for tests and reports).
   long basisRows() const { return basis_rows_; }
   void resetBasisRows() { basis_rows_ = 0; }
+  // Responses from these factorised inertias where they support the body
+  // (null: Bullet's articulated-body pass for every row).
+  void setInertias(ArticulationInertias* inertias) { inertias_ = inertias; }
 
  protected:
   void convertContacts(btPersistentManifold** manifolds, int num_manifolds,
@@ -89,6 +94,7 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
               bool friction, int link_side, int static_body, const btContactSolverInfo& info);
 
   bool own_;
+  ArticulationInertias* inertias_ = nullptr;
   long basis_rows_ = 0;
   // The link's basis this manifold: 6 Jacobians and 6 responses, ndof each
   // (angular x, y, z, then linear x, y, z at the link's origin).

@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "articulation_inertia.hpp"
 #include "articulation_solver.hpp"
 #include "island_solver.hpp"
 
@@ -109,8 +110,9 @@ struct SameRobotFilter : btOverlapFilterCallback {
 class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
  public:
   using btMultiBodyDynamicsWorld::btMultiBodyDynamicsWorld;
-  StageTimes* times = nullptr;              // null: timers off
-  ParallelIslandSolver* islands = nullptr;  // null: Bullet solves the islands in turn
+  StageTimes* times = nullptr;               // null: timers off
+  ParallelIslandSolver* islands = nullptr;   // null: Bullet solves the islands in turn
+  ArticulationInertias* inertias = nullptr;  // null: Bullet's pass for every row's response
 
   void performDiscreteCollisionDetection() override {
     timed(&StageTimes::collision_s,
@@ -123,6 +125,7 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   // share is the whole constraint stage less the forward dynamics inside it.
   void solveConstraints(btContactSolverInfo& info) override {
     const double dynamics_before = times ? times->dynamics_s : 0.0;
+    if (inertias) inertias->newStep();  // factorised again at the first row of each
     timed(&StageTimes::solver_s, [&] {
       // Bullet's own loop where batches could share state (a randomised row
       // order: one seed across batches; islands not split: one group), and
@@ -270,8 +273,13 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
 // and that pass was half the cost of the servos.
 class ServoConstraint : public btMultiBodyJointMotor {
  public:
-  ServoConstraint(btMultiBody* body, int link, const JointServoBatch& batch, size_t servo)
-      : btMultiBodyJointMotor(body, link, 0, 1), batch_(batch), servo_(servo) {}
+  // `inertias` null: the response from Bullet's articulated-body pass.
+  ServoConstraint(btMultiBody* body, int link, const JointServoBatch& batch, size_t servo,
+                  ArticulationInertias* inertias)
+      : btMultiBodyJointMotor(body, link, 0, 1),
+        batch_(batch),
+        servo_(servo),
+        inertias_(inertias) {}
 
   // The impulse applied in the last step (0 without a row), N m s.
   btScalar impulse() { return row_made_ ? getAppliedImpulse(0) : btScalar(0); }
@@ -309,8 +317,11 @@ class ServoConstraint : public btMultiBodyJointMotor {
       jac[ndof + i] = 0;
       response[ndof + i] = 0;
     }
-    mb->calcAccelerationDeltasMultiDof(jac, response, data.scratch_r, data.scratch_v);
     const int coordinate = 6 + mb->getLink(m_linkA).m_dofOffset;
+    if (const ArticulationInertia* inertia = inertias_ ? inertias_->of(*mb) : nullptr)
+      inertia->solve(jac, response, coordinate);
+    else
+      mb->calcAccelerationDeltasMultiDof(jac, response, data.scratch_r, data.scratch_v);
     const btScalar inv_mass = response[coordinate];  // J M^-1 J^T
     const btScalar velocity = mb->getJointVel(m_linkA);
     // Soft row: qdot' = beta / dt (target - q) - gamma (dt feedforward + p).
@@ -345,7 +356,95 @@ class ServoConstraint : public btMultiBodyJointMotor {
  private:
   const JointServoBatch& batch_;
   size_t servo_;
+  ArticulationInertias* inertias_;
   bool row_made_ = false;
+};
+
+// A mimic joint's gear row (Bullet's btMultiBodyGearConstraint: qdot_A +
+// ratio qdot_B = 0 with its drift corrected, both joints of one
+// articulation), filled as Bullet's fillMultiBodyConstraint fills it (the
+// same fields, effective mass, bias and bounds) but with the two responses
+// from the articulation's factorised inertia instead of two articulated-body
+// passes. Without the factorisation (bullet_solver), Bullet's own rows.
+class MimicConstraint : public btMultiBodyGearConstraint {
+ public:
+  // Bullet's gear between the joints of two links of one articulation.
+  MimicConstraint(btMultiBody* body, int link_a, int link_b, ArticulationInertias* inertias)
+      : btMultiBodyGearConstraint(body, link_a, body, link_b, btVector3(0, 0, 0),
+                                  btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
+                                  btMatrix3x3::getIdentity()),
+        inertias_(inertias) {}
+
+  void createConstraintRows(btMultiBodyConstraintArray& rows, btMultiBodyJacobianData& data,
+                            const btContactSolverInfo& info) override {
+    btMultiBody* mb = m_bodyA;
+    const ArticulationInertia* inertia = inertias_ ? inertias_->of(*mb) : nullptr;
+    if (!inertia || m_gearAuxLink >= 0) {
+      btMultiBodyGearConstraint::createConstraintRows(rows, data, info);
+      return;
+    }
+    if (m_numDofsFinalized != m_jacSizeBoth) finalizeMultiDof();
+    if (m_maxAppliedImpulse == 0) return;
+    const int ndof = mb->getNumDofs() + 6;
+    const int coordinate_a = 6 + mb->getLink(m_linkA).m_dofOffset;
+    const int coordinate_b = 6 + mb->getLink(m_linkB).m_dofOffset;
+    btMultiBodySolverConstraint& row = rows.expandNonInitializing();
+    row.m_multiBodyA = row.m_multiBodyB = mb;
+    row.m_linkA = m_linkA;
+    row.m_linkB = m_linkB;
+    row.m_solverBodyIdA = row.m_solverBodyIdB = data.m_fixedBodyId;
+    row.m_orgConstraint = this;
+    row.m_orgDofIndex = 0;
+    const int block = deltaVelocityBlock(mb, data);
+    row.m_deltaVelAindex = row.m_deltaVelBindex = block;
+    // Side A: 1 at joint A; side B: the ratio at joint B.
+    row.m_jacAindex = data.m_jacobians.size();
+    row.m_jacBindex = row.m_jacAindex + ndof;
+    data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
+    data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
+    btScalar* jac_a = &data.m_jacobians[row.m_jacAindex];
+    btScalar* jac_b = jac_a + ndof;
+    for (int i = 0; i < 2 * ndof; ++i) jac_a[i] = 0;
+    jac_a[coordinate_a] = 1;
+    jac_b[coordinate_b] = m_gearRatio;
+    btScalar* response_a = &data.m_deltaVelocitiesUnitImpulse[row.m_jacAindex];
+    inertia->solve(jac_a, response_a, coordinate_a);
+    inertia->solve(jac_b, response_a + ndof, coordinate_b);
+    // Bullet's sums: each side's J M^-1 J^T (no cross term between the two
+    // sides of one body, as Bullet), its relative velocity and bias.
+    btScalar denominator = 0, velocity = 0;
+    const btScalar* qdot = mb->getVelocityVector();
+    for (int i = 0; i < ndof; ++i) denominator += jac_a[i] * response_a[i];
+    for (int i = 0; i < ndof; ++i) denominator += jac_b[i] * response_a[ndof + i];
+    for (int i = 0; i < ndof; ++i) velocity += qdot[i] * jac_a[i];
+    for (int i = 0; i < ndof; ++i) velocity += qdot[i] * jac_b[i];
+    row.m_jacDiagABInv = denominator > SIMD_EPSILON ? btScalar(1) / denominator : btScalar(0);
+    btScalar position_error = 0;
+    if (m_erp != 0) {
+      const btScalar difference = m_gearRatio * mb->getJointPos(m_linkB) + mb->getJointPos(m_linkA);
+      position_error = -m_erp * (m_relativePositionTarget - difference);
+    }
+    const btScalar positional = -position_error * info.m_erp / info.m_timeStep;
+    row.m_rhs = positional * row.m_jacDiagABInv + (btScalar(0) - velocity) * row.m_jacDiagABInv;
+    row.m_rhsPenetration = 0;
+    row.m_cfm = 0;
+    row.m_lowerLimit = -m_maxAppliedImpulse;
+    row.m_upperLimit = m_maxAppliedImpulse;
+    row.m_friction = 0;
+    row.m_appliedImpulse = 0;
+    row.m_appliedPushImpulse = 0;
+    const btVector3 axis = quatRotate(mb->getLink(m_linkA).m_cachedWorldTransform.getRotation(),
+                                      mb->getLink(m_linkA).m_axes[0].m_topVec);
+    row.m_contactNormal1.setZero();
+    row.m_contactNormal2.setZero();
+    row.m_relpos1CrossNormal = axis;
+    row.m_relpos2CrossNormal = -axis;
+    row.m_angularComponentA.setZero();
+    row.m_angularComponentB.setZero();
+  }
+
+ private:
+  ArticulationInertias* inertias_;
 };
 
 struct Articulation {
@@ -407,6 +506,7 @@ struct PhysicsWorld::Impl {
   std::unique_ptr<TimedMultiBodyWorld> world;
   std::unique_ptr<ParallelIslandSolver> islands;  // the batches, on solver_threads threads
   std::vector<ArticulationSolver*> all_solvers;   // the world's and each thread's
+  ArticulationInertias inertias;                  // the articulations' (not with bullet_solver)
   SameRobotFilter filter;
 
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -503,6 +603,10 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
           return solver;
         });
     m.world->islands = m.islands.get();
+  }
+  if (!settings.bullet_solver) {
+    m.world->inertias = &m.inertias;
+    for (ArticulationSolver* solver : m.all_solvers) solver->setInertias(&m.inertias);
   }
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it
@@ -652,6 +756,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
   raw->setUserIndex(static_cast<int>(m.multibodies.size()));  // its place in the world's list
   art.body = raw;
   m.multibodies.push_back(std::move(mb));  // owned before the world points to it
+  m.inertias.resize(m.multibodies.size());
   m.world->addMultiBody(raw);
 
   // Colliders, one per link that has shapes; the user index is the group.
@@ -685,9 +790,8 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       // One motor drives both hinges through a rigid linkage: a gear
       // constraint q_mimic = multiplier * q_master (Bullet's rows enforce
       // qdot_A + ratio * qdot_B = 0), with position drift corrected.
-      auto gear = std::make_unique<btMultiBodyGearConstraint>(
-          raw, joint.mimic_of, raw, j, btVector3(0, 0, 0), btVector3(0, 0, 0),
-          btMatrix3x3::getIdentity(), btMatrix3x3::getIdentity());
+      auto gear = std::make_unique<MimicConstraint>(
+          raw, joint.mimic_of, j, settings_.bullet_solver ? nullptr : &m.inertias);
       gear->setGearRatio(static_cast<btScalar>(-1.0 / joint.mimic_multiplier));
       gear->setErp(0.2f);
       gear->setMaxAppliedImpulse(static_cast<btScalar>(1e3 * settings_.dt));
@@ -709,7 +813,8 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       m.servo_body.push_back(raw);
       m.servo_link.push_back(j);
       if (motor.implicit_servo) {
-        auto row = std::make_unique<ServoConstraint>(raw, j, m.servos, s);
+        auto row = std::make_unique<ServoConstraint>(
+            raw, j, m.servos, s, settings_.bullet_solver ? nullptr : &m.inertias);
         m.servo_rows.push_back(row.get());
         m.world->addMultiBodyConstraint(row.get());
         m.constraints.push_back(std::move(row));
@@ -825,6 +930,14 @@ void PhysicsWorld::step() {
     m.times.total_s += std::chrono::duration<double>(Clock::now() - t0).count();
     ++m.times.steps;
   }
+}
+
+void PhysicsWorld::checkInverseInertia(bool on) {
+  impl_->inertias.check(on);
+}
+
+double PhysicsWorld::inverseInertiaMismatch() const {
+  return impl_->inertias.mismatch();
 }
 
 long PhysicsWorld::lastStepBasisRows() const {

@@ -128,6 +128,13 @@ class PhysicsWorld {
   // Contact rows built from a link's spatial basis in the last step (0 with
   // bullet_solver).
   long lastStepBasisRows() const;
+  // Checking (tests): every step's factorised joint-space inertia of each
+  // articulation against Bullet's articulated-body pass; the largest
+  // difference of M^-1 relative to its column's largest entry since checking
+  // was turned on (negative: nothing checked, as with bullet_solver, which
+  // factorises nothing).
+  void checkInverseInertia(bool on);
+  double inverseInertiaMismatch() const;
 
   // --- reading -----------------------------------------------------------------
   // Joint frame of a link in the world.

@@ -1,0 +1,217 @@
+#include "articulation_inertia.hpp"
+
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace simsoccer::engine {
+namespace {
+
+Eigen::Vector3d toEigen(const btVector3& v) {
+  return {double(v.x()), double(v.y()), double(v.z())};
+}
+Eigen::Matrix3d toEigen(const btMatrix3x3& m) {
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = double(m[i][j]);
+  return r;
+}
+
+}  // namespace
+
+bool ArticulationInertia::supports(const btMultiBody& body) {
+  if (body.hasFixedBase() || body.isBaseKinematic()) return false;
+  for (int l = 0; l < body.getNumLinks(); ++l) {
+    const btMultibodyLink& link = body.getLink(l);
+    if (link.m_jointType != btMultibodyLink::eRevolute &&
+        link.m_jointType != btMultibodyLink::eFixed)
+      return false;
+    if (link.m_collider && link.m_collider->isKinematicObject()) return false;
+  }
+  return true;
+}
+
+void ArticulationInertia::factor(const btMultiBody& body) {
+  const int links = body.getNumLinks();
+  n_ = 6 + body.getNumDofs();
+  const auto n = static_cast<size_t>(n_);
+  const auto bodies = static_cast<size_t>(links) + 1;
+  parent_.resize(n);
+  motion_angular_.resize(n);
+  motion_linear_.resize(n);
+  coordinate_body_.resize(n);
+  composite_.resize(bodies);
+  last_coordinate_.resize(bodies);
+  scratch_.resize(n);
+
+  // Each body alone about the base's centre of mass: mass m, first moment
+  // m c, rotational inertia I_c + m (|c|^2 1 - c c^T).
+  const Eigen::Vector3d origin = toEigen(body.getBasePos());
+  {
+    const Eigen::Matrix3d rotation = toEigen(btMatrix3x3(body.getWorldToBaseRot().inverse()));
+    composite_[0] = {double(body.getBaseMass()), Eigen::Vector3d::Zero(),
+                     rotation * toEigen(body.getBaseInertia()).asDiagonal() * rotation.transpose()};
+  }
+  for (int l = 0; l < links; ++l) {
+    const btMultibodyLink& link = body.getLink(l);
+    const Eigen::Matrix3d rotation = toEigen(link.m_cachedWorldTransform.getBasis());
+    const Eigen::Vector3d c = toEigen(link.m_cachedWorldTransform.getOrigin()) - origin;
+    const double m = link.m_mass;
+    const Eigen::Matrix3d inertia =
+        rotation * toEigen(link.m_inertiaLocal).asDiagonal() * rotation.transpose() +
+        m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+    composite_[static_cast<size_t>(l) + 1] = {m, m * c, inertia};
+  }
+
+  // Motion subspaces about the origin: the base's angular coordinates turn
+  // about it, its linear ones translate; a revolute joint turns about its
+  // axis through its pivot p: (axis, p x axis). The coordinates form a tree:
+  // the base's six a chain, each joint's parent the nearest coordinate of
+  // its parent link or the ones above it.
+  for (int a = 0; a < 6; ++a) {
+    const auto k = static_cast<size_t>(a);
+    parent_[k] = a - 1;
+    coordinate_body_[k] = 0;
+    const Eigen::Vector3d unit = Eigen::Vector3d::Unit(a % 3);
+    motion_angular_[k] = a < 3 ? unit : Eigen::Vector3d::Zero();
+    motion_linear_[k] = a < 3 ? Eigen::Vector3d::Zero() : unit;
+  }
+  last_coordinate_[0] = 5;
+  for (int l = 0; l < links; ++l) {
+    const btMultibodyLink& link = body.getLink(l);
+    const auto self = static_cast<size_t>(l) + 1;
+    const auto above = static_cast<size_t>(link.m_parent + 1);
+    if (link.m_dofCount == 0) {
+      last_coordinate_[self] = last_coordinate_[above];
+      continue;
+    }
+    const auto k = static_cast<size_t>(6 + link.m_dofOffset);
+    const Eigen::Matrix3d rotation = toEigen(link.m_cachedWorldTransform.getBasis());
+    const Eigen::Vector3d axis = rotation * toEigen(link.getAxisTop(0));
+    const Eigen::Vector3d pivot = toEigen(link.m_cachedWorldTransform.getOrigin()) -
+                                  rotation * toEigen(link.m_dVector) - origin;
+    parent_[k] = last_coordinate_[above];
+    coordinate_body_[k] = l + 1;
+    motion_angular_[k] = axis;
+    motion_linear_[k] = pivot.cross(axis);
+    last_coordinate_[self] = static_cast<int>(k);
+  }
+
+  // Composite bodies: each link with everything outboard of it (children
+  // come after their parents, so one backward sweep adds them up).
+  for (int l = links - 1; l >= 0; --l) {
+    const Body& child = composite_[static_cast<size_t>(l) + 1];
+    Body& parent = composite_[static_cast<size_t>(body.getLink(l).m_parent + 1)];
+    parent.mass += child.mass;
+    parent.moment += child.moment;
+    parent.inertia += child.inertia;
+  }
+
+  // M: coordinate k moves its body's composite; the momentum that motion
+  // gives it (angular about the origin: I w + h x v; linear: m v + w x h)
+  // paired with each coordinate on the way to the root.
+  matrix_.assign(n * n, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    const Body& c = composite_[static_cast<size_t>(coordinate_body_[k])];
+    const Eigen::Vector3d& w = motion_angular_[k];
+    const Eigen::Vector3d& v = motion_linear_[k];
+    const Eigen::Vector3d angular = c.inertia * w + c.moment.cross(v);
+    const Eigen::Vector3d linear = c.mass * v + w.cross(c.moment);
+    for (int j = static_cast<int>(k); j >= 0; j = parent_[static_cast<size_t>(j)]) {
+      const auto jj = static_cast<size_t>(j);
+      matrix_[k * n + jj] = motion_angular_[jj].dot(angular) + motion_linear_[jj].dot(linear);
+    }
+  }
+
+  // M = L^T D L in place, leaves first (Featherstone's LTDL): only entries
+  // between a coordinate and its ancestors are touched, so none fill in.
+  for (int k = n_ - 1; k >= 0; --k) {
+    const double* row_k = &matrix_[static_cast<size_t>(k) * n];
+    const double diagonal = row_k[k];
+    for (int i = parent_[static_cast<size_t>(k)]; i >= 0; i = parent_[static_cast<size_t>(i)]) {
+      const double a = row_k[i] / diagonal;
+      double* row_i = &matrix_[static_cast<size_t>(i) * n];
+      for (int j = i; j >= 0; j = parent_[static_cast<size_t>(j)]) row_i[j] -= a * row_k[j];
+      matrix_[static_cast<size_t>(k) * n + static_cast<size_t>(i)] = a;
+    }
+  }
+  inverse_d_.resize(n);
+  row_start_.assign(1, 0);
+  column_.clear();
+  entry_.clear();
+  for (size_t k = 0; k < n; ++k) {
+    inverse_d_[k] = 1.0 / matrix_[k * n + k];
+    for (int i = parent_[k]; i >= 0; i = parent_[static_cast<size_t>(i)]) {
+      column_.push_back(i);
+      entry_.push_back(matrix_[k * n + static_cast<size_t>(i)]);
+    }
+    row_start_.push_back(static_cast<int>(column_.size()));
+  }
+}
+
+void ArticulationInertia::solve(const btScalar* force, btScalar* response, int chain) const {
+  double* x = scratch_.data();
+  for (int k = 0; k < n_; ++k) x[k] = force[k];
+  // L^T y = f, leaves first (row k of L reaches only k's ancestors, so with
+  // the force on one path only that path changes); then D; then L x = y,
+  // root first.
+  const auto eliminate = [&](int k) {
+    const double xk = x[k];
+    const auto end = static_cast<size_t>(row_start_[static_cast<size_t>(k) + 1]);
+    for (auto e = static_cast<size_t>(row_start_[static_cast<size_t>(k)]); e < end; ++e)
+      x[column_[e]] -= entry_[e] * xk;
+  };
+  if (chain >= 0)
+    for (int k = chain; k >= 0; k = parent_[static_cast<size_t>(k)]) eliminate(k);
+  else
+    for (int k = n_ - 1; k >= 0; --k) eliminate(k);
+  for (int k = 0; k < n_; ++k) x[k] *= inverse_d_[static_cast<size_t>(k)];
+  for (int k = 0; k < n_; ++k) {
+    double s = x[k];
+    const auto end = static_cast<size_t>(row_start_[static_cast<size_t>(k) + 1]);
+    for (auto e = static_cast<size_t>(row_start_[static_cast<size_t>(k)]); e < end; ++e)
+      s -= entry_[e] * x[column_[e]];
+    x[k] = s;
+    response[k] = static_cast<btScalar>(s);
+  }
+}
+
+const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
+  const auto index = static_cast<size_t>(body.getUserIndex());
+  if (index >= entries_.size()) return nullptr;
+  Entry& e = entries_[index];
+  if (e.step == step_) return e.supported ? &e.inertia : nullptr;
+  e.step = step_;
+  e.supported = ArticulationInertia::supports(body);
+  if (!e.supported) return nullptr;
+  e.inertia.factor(body);
+  if (check_) {
+    const auto n = static_cast<size_t>(e.inertia.size());
+    std::vector<btScalar> unit(n, 0), ours(n), bullets(n);
+    btAlignedObjectArray<btScalar> scratch_r;
+    btAlignedObjectArray<btVector3> scratch_v;
+    for (size_t i = 0; i < n; ++i) {
+      unit[i] = 1;
+      e.inertia.solve(unit.data(), ours.data());
+      body.calcAccelerationDeltasMultiDof(unit.data(), bullets.data(), scratch_r, scratch_v);
+      unit[i] = 0;
+      double scale = 0, difference = 0;
+      for (size_t k = 0; k < n; ++k) {
+        scale = std::max(scale, std::abs(double(bullets[k])));
+        difference = std::max(difference, std::abs(double(ours[k]) - double(bullets[k])));
+      }
+      e.mismatch = std::max({e.mismatch, 0.0, scale > 0 ? difference / scale : difference});
+    }
+  }
+  return &e.inertia;
+}
+
+double ArticulationInertias::mismatch() const {
+  double worst = -1;
+  for (const Entry& e : entries_) worst = std::max(worst, e.mismatch);
+  return worst;
+}
+
+}  // namespace simsoccer::engine
