@@ -91,12 +91,13 @@ void compare(const char* what, const Outcome& own, const Outcome& bullet, double
   const double ball = (own.ball - bullet.ball).norm();
   std::printf(
       "%s after 1 s: torsos %.3g m, joints %.3g rad, ball %.3g m apart; up to %ld basis "
-      "rows a step; factorised inverse inertia within %.3g of Bullet's pass\n",
+      "rows a step; factorised inertia and basis Jacobians within %.3g of Bullet's\n",
       what, torso, joint, ball, own.most_basis_rows, own.inertia_mismatch);
-  // Every step's factorisation of each robot, column by column: the same
-  // matrix up to the rounding of Bullet's single-precision pass (its own
-  // inverse is symmetric to about 1e-7 of its largest entry); a wrong axis,
-  // pivot, mass or inertia is off by percent.
+  // Every step's factorisation of each robot, column by column, and every
+  // link's basis Jacobians: the same up to the rounding of Bullet's
+  // single-precision pass (its own inverse is symmetric to about 1e-7 of its
+  // largest entry); a wrong axis, pivot, lever arm, mass or inertia is off by
+  // percent.
   EXPECT_GE(own.inertia_mismatch, 0.0) << what << ": nothing checked";
   EXPECT_LT(own.inertia_mismatch, 2e-4) << what;
   EXPECT_LT(bullet.inertia_mismatch, 0.0) << what << ": Bullet's rows factorise nothing";

@@ -49,6 +49,7 @@ void ArticulationInertia::factor(const btMultiBody& body) {
   // Each body alone about the base's centre of mass: mass m, first moment
   // m c, rotational inertia I_c + m (|c|^2 1 - c c^T).
   const Eigen::Vector3d origin = toEigen(body.getBasePos());
+  origin_ = origin;
   {
     const Eigen::Matrix3d rotation = toEigen(btMatrix3x3(body.getWorldToBaseRot().inverse()));
     composite_[0] = {double(body.getBaseMass()), Eigen::Vector3d::Zero(),
@@ -178,6 +179,21 @@ void ArticulationInertia::solve(const btScalar* force, btScalar* response, int c
   }
 }
 
+void ArticulationInertia::basisJacobians(int link, const btVector3& point, btScalar* rows) const {
+  const auto n = static_cast<size_t>(n_);
+  std::fill(rows, rows + 6 * n, btScalar(0));
+  const Eigen::Vector3d arm = toEigen(point) - origin_;
+  for (int j = chainOf(link); j >= 0; j = parent_[static_cast<size_t>(j)]) {
+    const auto c = static_cast<size_t>(j);
+    const Eigen::Vector3d& w = motion_angular_[c];
+    const Eigen::Vector3d v = motion_linear_[c] + w.cross(arm);
+    for (size_t a = 0; a < 3; ++a) {
+      rows[a * n + c] = static_cast<btScalar>(w[static_cast<Eigen::Index>(a)]);
+      rows[(3 + a) * n + c] = static_cast<btScalar>(v[static_cast<Eigen::Index>(a)]);
+    }
+  }
+}
+
 const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
   const auto index = static_cast<size_t>(body.getUserIndex());
   if (index >= entries_.size()) return nullptr;
@@ -203,6 +219,25 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
         difference = std::max(difference, std::abs(double(ours[k]) - double(bullets[k])));
       }
       e.mismatch = std::max({e.mismatch, 0.0, scale > 0 ? difference / scale : difference});
+    }
+    std::vector<btScalar> rows(6 * n);
+    btAlignedObjectArray<btMatrix3x3> scratch_m;
+    for (int link = -1; link < body.getNumLinks(); ++link) {
+      const btVector3 point =
+          link < 0 ? body.getBasePos() : body.getLink(link).m_cachedWorldTransform.getOrigin();
+      e.inertia.basisJacobians(link, point, rows.data());
+      for (size_t a = 0; a < 6; ++a) {
+        btVector3 angular(0, 0, 0), linear(0, 0, 0);
+        (a < 3 ? angular : linear)[static_cast<int>(a % 3)] = 1;
+        body.fillConstraintJacobianMultiDof(link, point, angular, linear, bullets.data(), scratch_r,
+                                            scratch_v, scratch_m);
+        double scale = 0, difference = 0;
+        for (size_t k = 0; k < n; ++k) {
+          scale = std::max(scale, std::abs(double(bullets[k])));
+          difference = std::max(difference, std::abs(double(rows[a * n + k]) - double(bullets[k])));
+        }
+        e.mismatch = std::max(e.mismatch, scale > 0 ? difference / scale : difference);
+      }
     }
   }
   return &e.inertia;

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <LinearMath/btScalar.h>
+#include <LinearMath/btVector3.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -48,6 +49,13 @@ class ArticulationInertia {
   // The last coordinate on the path from a link (-1: the base) to the root.
   int chainOf(int link) const { return last_coordinate_[static_cast<size_t>(link + 1)]; }
 
+  // The six rows of a link's spatial basis at a world point fixed to it
+  // (angular x, y, z, then the point's linear x, y, z: the rows
+  // btMultiBody::fillConstraintJacobianMultiDof fills, from the motion
+  // subspaces along the link's path instead of a pass over all links):
+  // 6 x size() entries.
+  void basisJacobians(int link, const btVector3& point, btScalar* rows) const;
+
   int size() const { return n_; }
 
  private:
@@ -57,6 +65,7 @@ class ArticulationInertia {
     Eigen::Matrix3d inertia;
   };
   int n_ = 0;
+  Eigen::Vector3d origin_;      // the base's centre of mass, world
   std::vector<int> parent_;     // per coordinate: the next one toward the root, -1 at the root
   std::vector<double> matrix_;  // n x n, lower triangle: M, then L (D on the diagonal)
   std::vector<double> inverse_d_;
@@ -84,8 +93,9 @@ class ArticulationInertias {
   const ArticulationInertia* of(btMultiBody& body);
 
   // Checking (tests): each factorisation's M^-1 against Bullet's
-  // articulated-body pass, column by column; the largest difference relative
-  // to its column's largest entry, over all factorisations since turned on
+  // articulated-body pass, column by column, and each link's basis rows
+  // against Bullet's Jacobians; the largest difference relative to its
+  // column's (row's) largest entry, over all factorisations since turned on
   // (negative: none checked).
   void check(bool on) { check_ = on; }
   double mismatch() const;

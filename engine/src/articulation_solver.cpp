@@ -125,17 +125,21 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
   basis_jacobian_.resize(6 * ndof_);
   basis_response_.resize(6 * ndof_);
   const ArticulationInertia* inertia = inertias_ ? inertias_->of(*body_) : nullptr;
-  for (int k = 0; k < 6; ++k) {
-    btVector3 angular(0, 0, 0), linear(0, 0, 0);
-    (k < 3 ? angular : linear)[k % 3] = 1;
-    btScalar* jacobian = &basis_jacobian_[k * ndof_];
-    body_->fillConstraintJacobianMultiDof(link_, basis_origin_, angular, linear, jacobian,
-                                          m_data.scratch_r, m_data.scratch_v, m_data.scratch_m);
-    if (inertia)
-      inertia->solve(jacobian, &basis_response_[k * ndof_], inertia->chainOf(link_));
-    else
+  if (inertia) {
+    inertia->basisJacobians(link_, basis_origin_, &basis_jacobian_[0]);
+    for (int k = 0; k < 6; ++k)
+      inertia->solve(&basis_jacobian_[k * ndof_], &basis_response_[k * ndof_],
+                     inertia->chainOf(link_));
+  } else {
+    for (int k = 0; k < 6; ++k) {
+      btVector3 angular(0, 0, 0), linear(0, 0, 0);
+      (k < 3 ? angular : linear)[k % 3] = 1;
+      btScalar* jacobian = &basis_jacobian_[k * ndof_];
+      body_->fillConstraintJacobianMultiDof(link_, basis_origin_, angular, linear, jacobian,
+                                            m_data.scratch_r, m_data.scratch_v, m_data.scratch_m);
       body_->calcAccelerationDeltasMultiDof(jacobian, &basis_response_[k * ndof_], m_data.scratch_r,
                                             m_data.scratch_v);
+    }
   }
 
   const bool two_directions = info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS;

@@ -129,8 +129,9 @@ class PhysicsWorld {
   // bullet_solver).
   long lastStepBasisRows() const;
   // Checking (tests): every step's factorised joint-space inertia of each
-  // articulation against Bullet's articulated-body pass; the largest
-  // difference of M^-1 relative to its column's largest entry since checking
+  // articulation against Bullet's articulated-body pass, and its links' basis
+  // Jacobians against Bullet's; the largest difference (of a column of M^-1,
+  // of a Jacobian row) relative to its largest entry since checking
   // was turned on (negative: nothing checked, as with bullet_solver, which
   // factorises nothing).
   void checkInverseInertia(bool on);
