@@ -44,7 +44,7 @@ void ArticulationInertia::factor(const btMultiBody& body) {
   coordinate_body_.resize(n);
   composite_.resize(bodies);
   last_coordinate_.resize(bodies);
-  scratch_.resize(n);
+  scratch_.resize(6 * n);
 
   // Each body alone about the base's centre of mass: mass m, first moment
   // m c, rotational inertia I_c + m (|c|^2 1 - c c^T).
@@ -113,7 +113,7 @@ void ArticulationInertia::factor(const btMultiBody& body) {
   // M: coordinate k moves its body's composite; the momentum that motion
   // gives it (angular about the origin: I w + h x v; linear: m v + w x h)
   // paired with each coordinate on the way to the root.
-  matrix_.assign(n * n, 0.0);
+  matrix_.resize(n * n);  // only entries between a coordinate and its ancestors are used
   for (size_t k = 0; k < n; ++k) {
     const Body& c = composite_[static_cast<size_t>(coordinate_body_[k])];
     const Eigen::Vector3d& w = motion_angular_[k];
@@ -153,29 +153,54 @@ void ArticulationInertia::factor(const btMultiBody& body) {
 }
 
 void ArticulationInertia::solve(const btScalar* force, btScalar* response, int chain) const {
+  solveBlock<1>(force, response, chain);
+}
+
+void ArticulationInertia::solveSix(const btScalar* forces, btScalar* responses, int chain) const {
+  solveBlock<6>(forces, responses, chain);
+}
+
+// kCount right-hand sides at once, interleaved in the scratch array so that
+// each entry of L is loaded once and applied to all of them (a loop the
+// compiler vectorises).
+template <int kCount>
+void ArticulationInertia::solveBlock(const btScalar* force, btScalar* response, int chain) const {
+  const auto n = static_cast<size_t>(n_);
   double* x = scratch_.data();
-  for (int k = 0; k < n_; ++k) x[k] = force[k];
+  for (size_t k = 0; k < n; ++k)
+    for (size_t r = 0; r < kCount; ++r) x[k * kCount + r] = force[r * n + k];
   // L^T y = f, leaves first (row k of L reaches only k's ancestors, so with
   // the force on one path only that path changes); then D; then L x = y,
   // root first.
-  const auto eliminate = [&](int k) {
-    const double xk = x[k];
-    const auto end = static_cast<size_t>(row_start_[static_cast<size_t>(k) + 1]);
-    for (auto e = static_cast<size_t>(row_start_[static_cast<size_t>(k)]); e < end; ++e)
-      x[column_[e]] -= entry_[e] * xk;
+  const auto eliminate = [&](size_t k) {
+    const double* xk = &x[k * kCount];
+    const auto end = static_cast<size_t>(row_start_[k + 1]);
+    for (auto e = static_cast<size_t>(row_start_[k]); e < end; ++e) {
+      const double l = entry_[e];
+      double* xi = &x[static_cast<size_t>(column_[e]) * kCount];
+      for (size_t r = 0; r < kCount; ++r) xi[r] -= l * xk[r];
+    }
   };
   if (chain >= 0)
-    for (int k = chain; k >= 0; k = parent_[static_cast<size_t>(k)]) eliminate(k);
+    for (int k = chain; k >= 0; k = parent_[static_cast<size_t>(k)])
+      eliminate(static_cast<size_t>(k));
   else
-    for (int k = n_ - 1; k >= 0; --k) eliminate(k);
-  for (int k = 0; k < n_; ++k) x[k] *= inverse_d_[static_cast<size_t>(k)];
-  for (int k = 0; k < n_; ++k) {
-    double s = x[k];
-    const auto end = static_cast<size_t>(row_start_[static_cast<size_t>(k) + 1]);
-    for (auto e = static_cast<size_t>(row_start_[static_cast<size_t>(k)]); e < end; ++e)
-      s -= entry_[e] * x[column_[e]];
-    x[k] = s;
-    response[k] = static_cast<btScalar>(s);
+    for (size_t k = n; k-- > 0;) eliminate(k);
+  for (size_t k = 0; k < n; ++k)
+    for (size_t r = 0; r < kCount; ++r) x[k * kCount + r] *= inverse_d_[k];
+  for (size_t k = 0; k < n; ++k) {
+    double sum[kCount];
+    for (size_t r = 0; r < kCount; ++r) sum[r] = x[k * kCount + r];
+    const auto end = static_cast<size_t>(row_start_[k + 1]);
+    for (auto e = static_cast<size_t>(row_start_[k]); e < end; ++e) {
+      const double l = entry_[e];
+      const double* xi = &x[static_cast<size_t>(column_[e]) * kCount];
+      for (size_t r = 0; r < kCount; ++r) sum[r] -= l * xi[r];
+    }
+    for (size_t r = 0; r < kCount; ++r) {
+      x[k * kCount + r] = sum[r];
+      response[r * n + k] = static_cast<btScalar>(sum[r]);
+    }
   }
 }
 

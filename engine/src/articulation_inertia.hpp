@@ -46,6 +46,8 @@ class ArticulationInertia {
   // any force. Uses a scratch array of this object: one thread at a time (an
   // articulation's rows are built by the thread of its batch).
   void solve(const btScalar* force, btScalar* response, int chain = -1) const;
+  // Six at once (a link's basis), each of size() entries one after the other.
+  void solveSix(const btScalar* forces, btScalar* responses, int chain = -1) const;
   // The last coordinate on the path from a link (-1: the base) to the root.
   int chainOf(int link) const { return last_coordinate_[static_cast<size_t>(link + 1)]; }
 
@@ -59,6 +61,9 @@ class ArticulationInertia {
   int size() const { return n_; }
 
  private:
+  template <int kCount>
+  void solveBlock(const btScalar* force, btScalar* response, int chain) const;
+
   struct Body {  // mass, first moment and rotational inertia about the base's centre of mass
     double mass;
     Eigen::Vector3d moment;

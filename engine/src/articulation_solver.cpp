@@ -127,9 +127,7 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
   const ArticulationInertia* inertia = inertias_ ? inertias_->of(*body_) : nullptr;
   if (inertia) {
     inertia->basisJacobians(link_, basis_origin_, &basis_jacobian_[0]);
-    for (int k = 0; k < 6; ++k)
-      inertia->solve(&basis_jacobian_[k * ndof_], &basis_response_[k * ndof_],
-                     inertia->chainOf(link_));
+    inertia->solveSix(&basis_jacobian_[0], &basis_response_[0], inertia->chainOf(link_));
   } else {
     for (int k = 0; k < 6; ++k) {
       btVector3 angular(0, 0, 0), linear(0, 0, 0);
