@@ -21,20 +21,38 @@ struct Outcome {
   std::vector<double> joints;        // rad, every robot's
   engine::Vec3 ball;                 // m
   long most_basis_rows = 0;          // in any step
+  long solved_rows = 0;              // articulation contact rows solved one by one, all steps
   double inertia_mismatch = -1;      // factorised M^-1 against Bullet's pass, relative
   int standing = 0;
 };
 
 // Two robots side by side for 1 s, the ball rolling into the first one's
 // feet: arms swinging, the legs in a squat that keeps the feet flat (knee +a,
-// hip and ankle pitch -a/2 each), so the feet carry load and friction.
-Outcome run(const std::filesystem::path& robot, bool own, int friction_directions = 2) {
-  world::Scenario s = test::scenario(2, 3);
+// hip and ankle pitch -a/2 each), so the feet carry load and friction. With
+// `touching`, the two stand 0.3 m apart so that their arms hit each other,
+// and a third lies on its back beside them (torso, arms and legs on the
+// carpet at one or two points each).
+Outcome run(const std::filesystem::path& robot, bool own, int friction_directions = 2,
+            bool touching = false) {
+  world::Scenario s = test::scenario(touching ? 3 : 2, 3);
   s.robot_model_file = robot;
   s.physics.bullet_solver = !own;
   s.physics.friction_directions = friction_directions;
+  if (touching) {
+    s.robots[1].x = s.robots[0].x;
+    s.robots[1].y = s.robots[0].y + 0.3;
+    s.robots[1].yaw = s.robots[0].yaw;
+  }
   world::World w(s);
   w.physics().checkInverseInertia(true);
+  if (touching) {
+    const engine::Vec3 torso = w.torsoPose(0).translation();
+    engine::Pose lying = engine::Pose::Identity();
+    lying.linear() = engine::Quat(Eigen::AngleAxisd(-0.5 * M_PI, engine::Vec3::UnitY()))
+                         .toRotationMatrix();  // face up
+    lying.translation() = engine::Vec3(torso.x(), torso.y() - 0.6, 0.12);
+    w.placeRobot(2, lying, "stand");
+  }
   {
     // The ball rolls into the first robot's feet: a rigid body's rows among
     // the articulations' (Bullet's conversion, the engine's iterations).
@@ -67,6 +85,7 @@ Outcome run(const std::filesystem::path& robot, bool own, int friction_direction
       }
     w.step();
     o.most_basis_rows = std::max(o.most_basis_rows, w.physics().lastStepBasisRows());
+    o.solved_rows += w.physics().lastStepSolvedRows();
   }
   for (world::RobotId r = 0; r < w.robotCount(); ++r) {
     o.torsos.push_back(w.torsoPose(r).translation());
@@ -93,6 +112,8 @@ void compare(const char* what, const Outcome& own, const Outcome& bullet, double
       "%s after 1 s: torsos %.3g m, joints %.3g rad, ball %.3g m apart; up to %ld basis "
       "rows a step; factorised inertia and basis Jacobians within %.3g of Bullet's\n",
       what, torso, joint, ball, own.most_basis_rows, own.inertia_mismatch);
+  std::printf("%s: %ld articulation contact rows solved one by one in 1 s\n", what,
+              own.solved_rows);
   // Every step's factorisation of each robot, column by column, and every
   // link's basis Jacobians: the same up to the rounding of Bullet's
   // single-precision pass (its own inverse is symmetric to about 1e-7 of its
@@ -101,6 +122,7 @@ void compare(const char* what, const Outcome& own, const Outcome& bullet, double
   EXPECT_GE(own.inertia_mismatch, 0.0) << what << ": nothing checked";
   EXPECT_LT(own.inertia_mismatch, 2e-4) << what;
   EXPECT_LT(bullet.inertia_mismatch, 0.0) << what << ": Bullet's rows factorise nothing";
+  EXPECT_EQ(bullet.solved_rows, 0) << what;
   EXPECT_EQ(own.standing, 2) << what;
   EXPECT_EQ(bullet.standing, 2) << what;
   // A wrong sign, lever arm, bound or bias moves a robot by millimetres.
@@ -131,4 +153,14 @@ TEST(ArticulationSolver, MatchesBulletWithOneFrictionRowAndForTheBoosterK1) {
   const Outcome own_k1 = run(k1, true), bullet_k1 = run(k1, false);
   compare("Booster K1", own_k1, bullet_k1, 2e-5, 2e-4);
   EXPECT_GT(own_k1.most_basis_rows, 0);
+}
+
+TEST(ArticulationSolver, MatchesBulletWithRobotsTouchingAndOneLying) {
+  // Arms against arms (both sides articulations) and a lying robot's links
+  // on the carpet at one or two points: rows the engine builds from the
+  // factorisation and solves one by one.
+  const Outcome own = run(test::naoH25(), true, 2, true);
+  const Outcome bullet = run(test::naoH25(), false, 2, true);
+  compare("Nao, touching and lying", own, bullet, 2e-5, 2e-4);
+  EXPECT_GT(own.solved_rows, 1000);
 }

@@ -63,9 +63,8 @@ void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int n
   // Manifold by manifold in Bullet's order, so the rows come in its order.
   for (int i = 0; i < num_manifolds; ++i) {
     btPersistentManifold* manifold = manifolds[i];
-    int link_side = 0;
-    if (takesBasisPath(*manifold, link_side))
-      convertLinkContact(*manifold, link_side, info);
+    if (const int points = ownContact(*manifold))
+      convertOwnContact(*manifold, points, info);
     else if (btMultiBodyLinkCollider::upcast(manifold->getBody0()) ||
              btMultiBodyLinkCollider::upcast(manifold->getBody1()))
       convertMultiBodyContact(manifold, info);
@@ -84,59 +83,84 @@ void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int n
     m_multiBodyNonContactConstraints[i].m_appliedImpulse = 0;
 }
 
-bool ArticulationSolver::takesBasisPath(const btPersistentManifold& manifold,
-                                        int& link_side) const {
-  const btCollisionObject* body[2] = {manifold.getBody0(), manifold.getBody1()};
-  const bool is_link[2] = {btMultiBodyLinkCollider::upcast(body[0]) != nullptr,
-                           btMultiBodyLinkCollider::upcast(body[1]) != nullptr};
-  if (is_link[0] == is_link[1]) return false;  // one articulation link, one other object
-  const btCollisionObject* other = is_link[0] ? body[1] : body[0];
-  if (btRigidBody::upcast(other) != nullptr || !other->isStaticOrKinematicObject()) return false;
-  if (body[0]->hasAnisotropicFriction(kAnisotropic) ||
-      body[1]->hasAnisotropicFriction(kAnisotropic))
-    return false;
+int ArticulationSolver::ownContact(const btPersistentManifold& manifold) {
+  const btCollisionObject* object[2] = {manifold.getBody0(), manifold.getBody1()};
+  if (object[0]->hasAnisotropicFriction(kAnisotropic) ||
+      object[1]->hasAnisotropicFriction(kAnisotropic))
+    return 0;
+  int links = 0;
+  bool factorised = true;
+  for (int s = 0; s < 2; ++s) {
+    ContactSide& side = sides_[s];
+    const btMultiBodyLinkCollider* collider = btMultiBodyLinkCollider::upcast(object[s]);
+    if (collider) {
+      side.body = collider->m_multiBody;
+      side.link = collider->m_link;
+      side.inertia = inertias_ ? inertias_->of(*side.body) : nullptr;
+      factorised = factorised && side.inertia;
+      ++links;
+    } else {
+      // A static object (the carpet, a goal); a rigid body (the ball) or a
+      // moving object goes through Bullet.
+      if (btRigidBody::upcast(object[s]) != nullptr || !object[s]->isStaticOrKinematicObject())
+        return 0;
+      side.body = nullptr;
+      side.inertia = nullptr;
+    }
+  }
+  if (links == 0) return 0;
   int points = 0;
   for (int j = 0; j < manifold.getNumContacts(); ++j) {
     const btManifoldPoint& p = manifold.getContactPoint(j);
     if (p.m_combinedRollingFriction > 0 || p.m_combinedSpinningFriction > 0 ||
         (p.m_contactPointFlags & kOwnSettings))
-      return false;
+      return 0;
     if (p.getDistance() <= manifold.getContactProcessingThreshold()) ++points;
   }
-  link_side = is_link[0] ? 0 : 1;
-  return points >= kMinPoints;
+  // Without the factorisation only a link on static ground at three or more
+  // points pays (its basis from Bullet's passes).
+  if (!factorised && (links == 2 || points < kMinPoints)) return 0;
+  return points;
 }
 
-void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int link_side,
-                                            const btContactSolverInfo& info) {
-  const btMultiBodyLinkCollider* collider =
-      btMultiBodyLinkCollider::upcast(link_side == 0 ? manifold.getBody0() : manifold.getBody1());
-  body_ = collider->m_multiBody;
-  link_ = collider->m_link;
-  auto* other =
-      const_cast<btCollisionObject*>(link_side == 0 ? manifold.getBody1() : manifold.getBody0());
-  const int static_body = getOrInitSolverBody(*other, info.m_timeStep);
-
-  // The link's spatial basis at its origin (the frame Bullet measures the
-  // contact's lever arm from): Jacobians and their responses.
-  ndof_ = body_->getNumDofs() + 6;
-  basis_origin_ =
-      link_ < 0 ? body_->getBasePos() : body_->getLink(link_).m_cachedWorldTransform.getOrigin();
-  basis_jacobian_.resize(6 * ndof_);
-  basis_response_.resize(6 * ndof_);
-  const ArticulationInertia* inertia = inertias_ ? inertias_->of(*body_) : nullptr;
-  if (inertia) {
-    inertia->basisJacobians(link_, basis_origin_, &basis_jacobian_[0]);
-    inertia->solveSix(&basis_jacobian_[0], &basis_response_[0], inertia->chainOf(link_));
-  } else {
-    for (int k = 0; k < 6; ++k) {
-      btVector3 angular(0, 0, 0), linear(0, 0, 0);
-      (k < 3 ? angular : linear)[k % 3] = 1;
-      btScalar* jacobian = &basis_jacobian_[k * ndof_];
-      body_->fillConstraintJacobianMultiDof(link_, basis_origin_, angular, linear, jacobian,
-                                            m_data.scratch_r, m_data.scratch_v, m_data.scratch_m);
-      body_->calcAccelerationDeltasMultiDof(jacobian, &basis_response_[k * ndof_], m_data.scratch_r,
-                                            m_data.scratch_v);
+void ArticulationSolver::convertOwnContact(btPersistentManifold& manifold, int points,
+                                           const btContactSolverInfo& info) {
+  btCollisionObject* object[2] = {const_cast<btCollisionObject*>(manifold.getBody0()),
+                                  const_cast<btCollisionObject*>(manifold.getBody1())};
+  for (int s = 0; s < 2; ++s) {
+    ContactSide& side = sides_[s];
+    if (!side.body) {
+      side.solver_body = getOrInitSolverBody(*object[s], info.m_timeStep);
+      side.origin = m_tmpSolverBodyPool[side.solver_body].getWorldTransform().getOrigin();
+      continue;
+    }
+    // The link's spatial basis at its origin (the frame Bullet measures the
+    // contact's lever arm from): six Jacobians, and from three points on
+    // their six responses, every row's being their combination; below
+    // three points each row is solved on its own.
+    side.solver_body = -1;
+    side.ndof = side.body->getNumDofs() + 6;
+    side.origin = side.link < 0 ? side.body->getBasePos()
+                                : side.body->getLink(side.link).m_cachedWorldTransform.getOrigin();
+    side.basis = points >= kMinPoints;
+    side.jacobian.resize(6 * side.ndof);
+    side.response.resize(6 * side.ndof);
+    if (side.inertia) {
+      side.inertia->basisJacobians(side.link, side.origin, &side.jacobian[0]);
+      if (side.basis)
+        side.inertia->solveSix(&side.jacobian[0], &side.response[0],
+                               side.inertia->chainOf(side.link));
+    } else {
+      for (int k = 0; k < 6; ++k) {
+        btVector3 angular(0, 0, 0), linear(0, 0, 0);
+        (k < 3 ? angular : linear)[k % 3] = 1;
+        btScalar* jacobian = &side.jacobian[k * side.ndof];
+        side.body->fillConstraintJacobianMultiDof(side.link, side.origin, angular, linear, jacobian,
+                                                  m_data.scratch_r, m_data.scratch_v,
+                                                  m_data.scratch_m);
+        side.body->calcAccelerationDeltasMultiDof(jacobian, &side.response[k * side.ndof],
+                                                  m_data.scratch_r, m_data.scratch_v);
+      }
     }
   }
 
@@ -151,7 +175,7 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
     const int normal_index = m_multiBodyNormalContactConstraints.size();
     btMultiBodySolverConstraint& normal =
         m_multiBodyNormalContactConstraints.expandNonInitializing();
-    addRow(normal, point, point.m_normalWorldOnB, /*friction=*/false, link_side, static_body, info);
+    addRow(normal, point, point.m_normalWorldOnB, /*friction=*/false, info);
     normal.m_frictionIndex = m_multiBodyFrictionContactConstraints.size();
     // Friction along two fixed tangents of the normal, as Bullet's multibody
     // contacts; the solver clamps the pair to the friction cone.
@@ -162,7 +186,7 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
       btMultiBodySolverConstraint& row =
           m_multiBodyFrictionContactConstraints.expandNonInitializing();
       addRow(row, point, d == 0 ? point.m_lateralFrictionDir1 : point.m_lateralFrictionDir2,
-             /*friction=*/true, link_side, static_body, info);
+             /*friction=*/true, info);
       row.m_frictionIndex = normal_index;
     }
     if (two_directions &&
@@ -172,62 +196,77 @@ void ArticulationSolver::convertLinkContact(btPersistentManifold& manifold, int 
 }
 
 void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoint& point,
-                                const btVector3& direction, bool friction, int link_side,
-                                int static_body, const btContactSolverInfo& info) {
-  const bool link_is_a = link_side == 0;
+                                const btVector3& direction, bool friction,
+                                const btContactSolverInfo& info) {
   row.m_orgConstraint = nullptr;
   row.m_orgDofIndex = -1;
   row.m_originalContactPoint = &point;
   row.m_overrideNumSolverIterations = -1;
-  row.m_solverBodyIdA = link_is_a ? -1 : static_body;
-  row.m_solverBodyIdB = link_is_a ? static_body : -1;
-  row.m_multiBodyA = link_is_a ? body_ : nullptr;
-  row.m_multiBodyB = link_is_a ? nullptr : body_;
-  row.m_linkA = link_is_a ? link_ : -1;
-  row.m_linkB = link_is_a ? -1 : link_;
+  row.m_solverBodyIdA = sides_[0].solver_body;
+  row.m_solverBodyIdB = sides_[1].solver_body;
+  row.m_multiBodyA = sides_[0].body;
+  row.m_multiBodyB = sides_[1].body;
+  row.m_linkA = sides_[0].body ? sides_[0].link : -1;
+  row.m_linkB = sides_[1].body ? sides_[1].link : -1;
 
-  // The link's row: along +direction at its point on side A, along
+  // Each articulation's row: along +direction at its point on side A, along
   // -direction on side B; the basis combination (lever arm x direction,
-  // direction) gives its Jacobian and response.
-  const btVector3 link_direction = link_is_a ? direction : -direction;
-  const btVector3 link_arm =
-      (link_is_a ? point.getPositionWorldOnA() : point.getPositionWorldOnB()) - basis_origin_;
-  const btVector3 moment = link_arm.cross(link_direction);
-  const btScalar weight[6] = {moment.x(),         moment.y(),         moment.z(),
-                              link_direction.x(), link_direction.y(), link_direction.z()};
-  const int block = deltaVelocityBlock(body_, m_data);
-  const int index = m_data.m_jacobians.size();
-  m_data.m_jacobians.resize(index + ndof_);
-  m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof_);
-  btScalar* jacobian = &m_data.m_jacobians[index];
-  btScalar* response = &m_data.m_deltaVelocitiesUnitImpulse[index];
-  // Basis row by basis row over contiguous arrays (the compiler vectorises
-  // these), the same sums in the same order for every entry.
-  for (int i = 0; i < ndof_; ++i) {
-    jacobian[i] = weight[0] * basis_jacobian_[i];
-    response[i] = weight[0] * basis_response_[i];
-  }
-  for (int k = 1; k < 6; ++k) {
-    const btScalar* bj = &basis_jacobian_[k * ndof_];
-    const btScalar* br = &basis_response_[k * ndof_];
-    for (int i = 0; i < ndof_; ++i) {
-      jacobian[i] += weight[k] * bj[i];
-      response[i] += weight[k] * br[i];
+  // direction) gives its Jacobian and, with the basis's responses, its
+  // response. Effective mass (J M^-1 J^T, both sides) and velocity.
+  const btVector3 position[2] = {point.getPositionWorldOnA(), point.getPositionWorldOnB()};
+  btScalar inverse_mass = 0, velocity = 0;
+  for (int s = 0; s < 2; ++s) {
+    ContactSide& side = sides_[s];
+    if (!side.body) continue;
+    const int ndof = side.ndof;
+    const btVector3 link_direction = s == 0 ? direction : -direction;
+    const btVector3 moment = (position[s] - side.origin).cross(link_direction);
+    const btScalar weight[6] = {moment.x(),         moment.y(),         moment.z(),
+                                link_direction.x(), link_direction.y(), link_direction.z()};
+    const int block = deltaVelocityBlock(side.body, m_data);
+    const int index = m_data.m_jacobians.size();
+    m_data.m_jacobians.resize(index + ndof);
+    m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof);
+    btScalar* jacobian = &m_data.m_jacobians[index];
+    btScalar* response = &m_data.m_deltaVelocitiesUnitImpulse[index];
+    // Basis row by basis row over contiguous arrays (the compiler vectorises
+    // these), the same sums in the same order for every entry.
+    const btScalar* basis_jacobian = &side.jacobian[0];
+    const btScalar* basis_response = &side.response[0];
+    for (int i = 0; i < ndof; ++i) jacobian[i] = weight[0] * basis_jacobian[i];
+    for (int k = 1; k < 6; ++k) {
+      const btScalar* bj = &basis_jacobian[k * ndof];
+      for (int i = 0; i < ndof; ++i) jacobian[i] += weight[k] * bj[i];
     }
-  }
-  if (link_is_a) {
-    row.m_deltaVelAindex = block;
-    row.m_jacAindex = index;
-  } else {
-    row.m_deltaVelBindex = block;
-    row.m_jacBindex = index;
+    if (side.basis) {
+      for (int i = 0; i < ndof; ++i) response[i] = weight[0] * basis_response[i];
+      for (int k = 1; k < 6; ++k) {
+        const btScalar* br = &basis_response[k * ndof];
+        for (int i = 0; i < ndof; ++i) response[i] += weight[k] * br[i];
+      }
+      ++basis_rows_;
+    } else {
+      side.inertia->solve(jacobian, response, side.inertia->chainOf(side.link));
+      ++solved_rows_;
+    }
+    if (s == 0) {
+      row.m_deltaVelAindex = block;
+      row.m_jacAindex = index;
+    } else {
+      row.m_deltaVelBindex = block;
+      row.m_jacBindex = index;
+    }
+    const btScalar* qdot = side.body->getVelocityVector();
+    for (int i = 0; i < ndof; ++i) {
+      inverse_mass += jacobian[i] * response[i];
+      velocity += qdot[i] * jacobian[i];
+    }
   }
 
   // Lever arms and normals as the solver's feedback and rigid-body paths
-  // read them: from the link's origin, and from the static body's.
-  const btVector3 static_origin = m_tmpSolverBodyPool[static_body].getWorldTransform().getOrigin();
-  const btVector3 arm_a = point.getPositionWorldOnA() - (link_is_a ? basis_origin_ : static_origin);
-  const btVector3 arm_b = point.getPositionWorldOnB() - (link_is_a ? static_origin : basis_origin_);
+  // read them: from each link's origin, or the static body's.
+  const btVector3 arm_a = position[0] - sides_[0].origin;
+  const btVector3 arm_b = position[1] - sides_[1].origin;
   row.m_relpos1CrossNormal = arm_a.cross(direction);
   row.m_contactNormal1 = direction;
   row.m_relpos2CrossNormal = -arm_b.cross(direction);
@@ -235,17 +274,11 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   row.m_angularComponentA.setZero();
   row.m_angularComponentB.setZero();
 
-  // Effective mass (J M^-1 J^T plus the softness), the velocity error with
-  // restitution and Baumgarte stabilisation, and the impulse bounds.
+  // The velocity error with restitution and Baumgarte stabilisation, and
+  // the impulse bounds.
   const btScalar dt = info.m_timeStep;
   const btScalar cfm = (friction ? info.m_frictionCFM : info.m_globalCfm) * (btScalar(1) / dt);
   const btScalar erp = friction ? info.m_frictionERP : info.m_erp2;
-  btScalar inverse_mass = 0, velocity = 0;
-  const btScalar* qdot = body_->getVelocityVector();
-  for (int i = 0; i < ndof_; ++i) {
-    inverse_mass += jacobian[i] * response[i];
-    velocity += qdot[i] * jacobian[i];
-  }
   const btScalar denominator = inverse_mass + cfm;
   row.m_jacDiagABInv = denominator > SIMD_EPSILON ? info.m_sor / denominator : btScalar(0);
   row.m_friction = point.m_combinedFriction;
@@ -267,7 +300,6 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   row.m_cfm = cfm * row.m_jacDiagABInv;
   row.m_appliedImpulse = 0;
   row.m_appliedPushImpulse = 0;
-  ++basis_rows_;
 }
 
 btScalar ArticulationSolver::rowVelocity(const btMultiBodySolverConstraint& row) {

@@ -36,6 +36,7 @@
 
 namespace simsoccer::engine {
 
+class ArticulationInertia;
 class ArticulationInertias;
 
 // The articulation's block of velocity changes in the solver's data (its
@@ -46,9 +47,12 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
  public:
   explicit ArticulationSolver(bool own) : own_(own) {}
 
-  // Rows built from a link basis since the last reset (for tests and reports).
+  // Contact rows built from a link basis, and articulation contact rows the
+  // engine built and solved one by one, since the last reset (for tests and
+  // reports).
   long basisRows() const { return basis_rows_; }
-  void resetBasisRows() { basis_rows_ = 0; }
+  long solvedRows() const { return solved_rows_; }
+  void resetRowCounts() { basis_rows_ = solved_rows_ = 0; }
   // Responses from these factorised inertias where they support the body
   // (null: Bullet's articulated-body pass for every row).
   void setInertias(ArticulationInertias* inertias) { inertias_ = inertias; }
@@ -83,27 +87,41 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   // The velocity change a row sees (both sides).
   btScalar rowVelocity(const btMultiBodySolverConstraint& row);
 
-  // Whether the manifold takes the basis path; `link_side` 0: body 0 is the
-  // articulation link, 1: body 1 is.
-  bool takesBasisPath(const btPersistentManifold& manifold, int& link_side) const;
-  void convertLinkContact(btPersistentManifold& manifold, int link_side,
-                          const btContactSolverInfo& info);
-  // One row (normal or friction) along `direction` (world, from the static
-  // side to the link as Bullet's contact normal) at the contact point.
+  // Whether the engine builds the manifold's rows (returns its points within
+  // the processing threshold; 0: Bullet builds them). It does for one or two
+  // articulation links (factorised) against each other or something static,
+  // and without the factorisation for a link on static ground at three or
+  // more points; a rigid body, anisotropic, rolling or spinning friction or
+  // per-contact settings go through Bullet. Fills sides_.
+  int ownContact(const btPersistentManifold& manifold);
+  void convertOwnContact(btPersistentManifold& manifold, int points,
+                         const btContactSolverInfo& info);
+  // One row (normal or friction) along `direction` (world, Bullet's contact
+  // normal: from side B to side A) at the contact point.
   void addRow(btMultiBodySolverConstraint& row, btManifoldPoint& point, const btVector3& direction,
-              bool friction, int link_side, int static_body, const btContactSolverInfo& info);
+              bool friction, const btContactSolverInfo& info);
+
+  // One side of a manifold the engine converts.
+  struct ContactSide {
+    btMultiBody* body = nullptr;  // null: a static object
+    int link = -1;
+    int solver_body = -1;  // the static object's solver body
+    // The link's origin (Bullet's lever arms start there) or the static body's.
+    btVector3 origin;
+    const ArticulationInertia* inertia = nullptr;  // null: Bullet's passes for the basis
+    bool basis = false;  // responses as combinations of the basis's (three points or more)
+    int ndof = 0;
+    // The link's basis: 6 Jacobians and (with `basis`) 6 responses, ndof each
+    // (angular x, y, z, then linear x, y, z at the link's origin).
+    btAlignedObjectArray<btScalar> jacobian, response;
+  };
 
   bool own_;
   ArticulationInertias* inertias_ = nullptr;
   long basis_rows_ = 0;
-  // The link's basis this manifold: 6 Jacobians and 6 responses, ndof each
-  // (angular x, y, z, then linear x, y, z at the link's origin).
-  btAlignedObjectArray<btScalar> basis_jacobian_, basis_response_;
-  btVector3 basis_origin_;
-  std::vector<char> applied_;    // per delta-velocity block: added to its articulation
-  btMultiBody* body_ = nullptr;  // the manifold's articulation and link
-  int link_ = 0;
-  int ndof_ = 0;
+  long solved_rows_ = 0;
+  ContactSide sides_[2];
+  std::vector<char> applied_;  // per delta-velocity block: added to its articulation
 };
 
 }  // namespace simsoccer::engine

@@ -919,7 +919,7 @@ void PhysicsWorld::step() {
   // Stage 2: Bullet (collision, dynamics, solve with the servo rows,
   // integrate); exactly one dt.
   const auto dt = static_cast<btScalar>(settings_.dt);
-  for (ArticulationSolver* solver : m.all_solvers) solver->resetBasisRows();
+  for (ArticulationSolver* solver : m.all_solvers) solver->resetRowCounts();
   m.world->stepSimulation(dt, 0, dt);
 
   // Stage 3: the motor torques the solver applied.
@@ -943,6 +943,12 @@ double PhysicsWorld::inverseInertiaMismatch() const {
 long PhysicsWorld::lastStepBasisRows() const {
   long rows = 0;
   for (const ArticulationSolver* solver : impl_->all_solvers) rows += solver->basisRows();
+  return rows;
+}
+
+long PhysicsWorld::lastStepSolvedRows() const {
+  long rows = 0;
+  for (const ArticulationSolver* solver : impl_->all_solvers) rows += solver->solvedRows();
   return rows;
 }
 

@@ -128,6 +128,10 @@ class PhysicsWorld {
   // Contact rows built from a link's spatial basis in the last step (0 with
   // bullet_solver).
   long lastStepBasisRows() const;
+  // Articulation contact rows the engine built and solved one by one in the
+  // last step (from the factorised inertia: robot against robot, a link on
+  // the ground at one or two points; 0 with bullet_solver).
+  long lastStepSolvedRows() const;
   // Checking (tests): every step's factorised joint-space inertia of each
   // articulation against Bullet's articulated-body pass, and its links' basis
   // Jacobians against Bullet's; the largest difference (of a column of M^-1,
