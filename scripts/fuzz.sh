@@ -2,8 +2,11 @@
 # Builds the libFuzzer targets (fuzz/) with clang under ASan and UBSan in build-fuzz/
 # and runs each for SECONDS (default 20; hours when asked: scripts/fuzz.sh 3600).
 # Findings (crash-*, leak-*, timeout-*, oom-* files) are written to build-fuzz/fuzz/.
-# Then the unit tests over the same sanitized libraries (ctest -L unit in build-fuzz/):
-# any ASan, LeakSanitizer or UBSan report fails them.
+# Then the unit tests over the same sanitized libraries (ctest -L unit in build-fuzz/),
+# and the net tests of simsoccer_net_tests (the simulator in the test process, sanitized
+# agent processes, DDS on loopback) but those that run the simsoccer program (NetApps.*,
+# not built here: CI's time) and the cameras' (Mesa's leak, below): any ASan,
+# LeakSanitizer or UBSan report fails them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-20}"
@@ -13,7 +16,7 @@ bash scripts/setup.sh
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DSIMSOCCER_FUZZ=ON \
   -DSIMSOCCER_FUZZ_SECONDS="$SECONDS_EACH" -DSIMSOCCER_FUZZ_SEED="$SEED" > /dev/null
-cmake --build build-fuzz --target fuzzers simsoccer_unit_tests
+cmake --build build-fuzz --target fuzzers simsoccer_unit_tests simsoccer_net_tests
 (cd build-fuzz/fuzz && ctest -L fuzz --output-on-failure -j "$(nproc)")
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L unit -E '^Camera' \
@@ -23,3 +26,5 @@ ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L unit -E '^Camera' \
 # (no frame of ours); memory errors and undefined behaviour still fail them.
 ASAN_OPTIONS="detect_leaks=0" ctest --test-dir build-fuzz -L unit -R '^Camera' \
   --output-on-failure -j "$(nproc)"
+ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L net -R '^Net' \
+  -E '^(NetApps|NetCameras)[.]' --output-on-failure -j "$(nproc)"
