@@ -342,6 +342,71 @@ void ArticulationSolver::applyImpulse(const btMultiBodySolverConstraint& row, bt
        row.m_contactNormal2, row.m_angularComponentB);
 }
 
+void ArticulationSolver::findJointRows() {
+  joint_rows_.resize(static_cast<size_t>(m_multiBodyNonContactConstraints.size()));
+  for (int j = 0; j < m_multiBodyNonContactConstraints.size(); ++j) {
+    const btMultiBodySolverConstraint& row = m_multiBodyNonContactConstraints[j];
+    JointRow& joint = joint_rows_[static_cast<size_t>(j)];
+    joint.sparse = false;
+    if (!row.m_multiBodyA || row.m_multiBodyB != row.m_multiBodyA) continue;
+    const int n = row.m_multiBodyA->getNumDofs() + 6;
+    // At most one entry per side: the coordinate and its value.
+    auto single = [&](int index, int& coordinate, btScalar& value) {
+      const btScalar* jacobian = &m_data.m_jacobians[index];
+      coordinate = 0;
+      value = 0;
+      int entries = 0;
+      for (int i = 0; i < n; ++i)
+        if (jacobian[i] != 0) {
+          coordinate = i;
+          value = jacobian[i];
+          ++entries;
+        }
+      return entries <= 1;
+    };
+    if (!single(row.m_jacAindex, joint.coordinate_a, joint.value_a) ||
+        !single(row.m_jacBindex, joint.coordinate_b, joint.value_b))
+      continue;
+    joint.sparse = true;
+    const btScalar* response_b = &m_data.m_deltaVelocitiesUnitImpulse[row.m_jacBindex];
+    joint.response_b = false;
+    for (int i = 0; i < n; ++i) joint.response_b = joint.response_b || response_b[i] != 0;
+  }
+}
+
+btScalar ArticulationSolver::resolveNonContactRow(int index) {
+  btMultiBodySolverConstraint& row = m_multiBodyNonContactConstraints[index];
+  const JointRow& joint = joint_rows_[static_cast<size_t>(index)];
+  if (!joint.sparse) return resolveRow(row);
+  // A joint row (servo, gear, limit): its velocity from one coordinate per
+  // side, its impulse applied through the responses that are not zero. The
+  // same numbers as the dense sums, whose other terms are all zero.
+  const btScalar* dv_a = &m_data.m_deltaVelocities[row.m_deltaVelAindex];
+  const btScalar* dv_b = &m_data.m_deltaVelocities[row.m_deltaVelBindex];
+  const btScalar velocity =
+      joint.value_a * dv_a[joint.coordinate_a] + joint.value_b * dv_b[joint.coordinate_b];
+  btScalar delta =
+      row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm - velocity * row.m_jacDiagABInv;
+  const btScalar total = btScalar(row.m_appliedImpulse) + delta;
+  btScalar bounded = total;
+  if (total < row.m_lowerLimit)
+    bounded = row.m_lowerLimit;
+  else if (total > row.m_upperLimit)
+    bounded = row.m_upperLimit;
+  if (bounded != total) delta = bounded - btScalar(row.m_appliedImpulse);
+  row.m_appliedImpulse = bounded;
+  const int n = row.m_multiBodyA->getNumDofs() + 6;
+  auto apply = [&](int response_index, int block) {
+    const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response_index];
+    btScalar* dv = &m_data.m_deltaVelocities[block];
+    for (int i = 0; i < n; ++i) dv[i] += r[i] * delta;
+  };
+  apply(row.m_jacAindex, row.m_deltaVelAindex);
+  if (joint.response_b) apply(row.m_jacBindex, row.m_deltaVelBindex);
+  touched(row);
+  return delta / row.m_jacDiagABInv;
+}
+
 btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
   // Projected Gauss-Seidel: the impulse that removes the row's velocity
   // error (softened by its cfm), clamped to its bounds.
@@ -411,8 +476,7 @@ btScalar ArticulationSolver::solveSingleIteration(
   for (int inner = 0; inner < info.m_numNonContactInnerIterations; ++inner) {
     own = 0;
     for (int j = 0; j < num_own; ++j) {
-      const btScalar change =
-          resolveRow(m_multiBodyNonContactConstraints[(iteration & 1) ? j : num_own - 1 - j]);
+      const btScalar change = resolveNonContactRow((iteration & 1) ? j : num_own - 1 - j);
       own = btMax(own, change * change);
     }
   }
@@ -466,6 +530,7 @@ btScalar ArticulationSolver::solveGroupCacheFriendlyIterations(
     btCollisionObject** bodies, int num_bodies, btPersistentManifold** manifolds, int num_manifolds,
     btTypedConstraint** constraints, int num_constraints, const btContactSolverInfo& info,
     btIDebugDraw* debug_draw) {
+  if (lean(info)) findJointRows();
   const btScalar residual = btSequentialImpulseConstraintSolver::solveGroupCacheFriendlyIterations(
       bodies, num_bodies, manifolds, num_manifolds, constraints, num_constraints, info, debug_draw);
   if (!lean(info)) return residual;

@@ -80,6 +80,11 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   }
   // One projected Gauss-Seidel update of a row; returns its velocity change.
   btScalar resolveRow(btMultiBodySolverConstraint& row);
+  // The same for the articulations' own constraint `index`, a joint row
+  // (its Jacobian one coordinate per side) in O(1) plus its responses.
+  btScalar resolveNonContactRow(int index);
+  // Fills joint_rows_ for this group's own constraints.
+  void findJointRows();
   // Two friction rows of one contact, clamped together to the friction cone.
   btScalar resolveFrictionPair(btMultiBodySolverConstraint& a, btMultiBodySolverConstraint& b);
   // The row's impulse change applied to the group's velocity changes.
@@ -121,6 +126,16 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   long basis_rows_ = 0;
   long solved_rows_ = 0;
   ContactSide sides_[2];
+  // Per own constraint row of the group: whether each side's Jacobian is a
+  // single coordinate (servos, gears, limits), which, its value, and whether
+  // side B's response is not zero (a servo's is: its parent side is empty).
+  struct JointRow {
+    bool sparse = false;
+    int coordinate_a = 0, coordinate_b = 0;
+    btScalar value_a = 0, value_b = 0;
+    bool response_b = false;
+  };
+  std::vector<JointRow> joint_rows_;
   std::vector<char> applied_;  // per delta-velocity block: added to its articulation
 };
 
