@@ -33,7 +33,7 @@ bool ArticulationInertia::supports(const btMultiBody& body) {
   return true;
 }
 
-void ArticulationInertia::factor(const btMultiBody& body) {
+bool ArticulationInertia::factor(const btMultiBody& body) {
   const int links = body.getNumLinks();
   n_ = 6 + body.getNumDofs();
   const auto n = static_cast<size_t>(n_);
@@ -131,6 +131,9 @@ void ArticulationInertia::factor(const btMultiBody& body) {
   for (int k = n_ - 1; k >= 0; --k) {
     const double* row_k = &matrix_[static_cast<size_t>(k) * n];
     const double diagonal = row_k[k];
+    // A coordinate that moves no inertia (a massless leaf, a point mass on
+    // its axis): Bullet's pass freezes it; here the factorisation declines.
+    if (!(diagonal > 1e-12)) return false;
     for (int i = parent_[static_cast<size_t>(k)]; i >= 0; i = parent_[static_cast<size_t>(i)]) {
       const double a = row_k[i] / diagonal;
       double* row_i = &matrix_[static_cast<size_t>(i) * n];
@@ -150,6 +153,7 @@ void ArticulationInertia::factor(const btMultiBody& body) {
     }
     row_start_.push_back(static_cast<int>(column_.size()));
   }
+  return true;
 }
 
 void ArticulationInertia::solve(const btScalar* force, btScalar* response, int chain) const {
@@ -225,9 +229,8 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
   Entry& e = entries_[index];
   if (e.step == step_) return e.supported ? &e.inertia : nullptr;
   e.step = step_;
-  e.supported = ArticulationInertia::supports(body);
+  e.supported = ArticulationInertia::supports(body) && e.inertia.factor(body);
   if (!e.supported) return nullptr;
-  e.inertia.factor(body);
   if (check_) {
     const auto n = static_cast<size_t>(e.inertia.size());
     std::vector<btScalar> unit(n, 0), ours(n), bullets(n);
@@ -245,23 +248,32 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
       }
       e.mismatch = std::max({e.mismatch, 0.0, scale > 0 ? difference / scale : difference});
     }
-    std::vector<btScalar> rows(6 * n);
+    std::vector<btScalar> rows(6 * n), responses(6 * n), bullet_response(n);
     btAlignedObjectArray<btMatrix3x3> scratch_m;
     for (int link = -1; link < body.getNumLinks(); ++link) {
       const btVector3 point =
           link < 0 ? body.getBasePos() : body.getLink(link).m_cachedWorldTransform.getOrigin();
       e.inertia.basisJacobians(link, point, rows.data());
+      // The responses as the solver gets them: the six at once, along the
+      // link's path only.
+      e.inertia.solveSix(rows.data(), responses.data(), e.inertia.chainOf(link));
       for (size_t a = 0; a < 6; ++a) {
         btVector3 angular(0, 0, 0), linear(0, 0, 0);
         (a < 3 ? angular : linear)[static_cast<int>(a % 3)] = 1;
         body.fillConstraintJacobianMultiDof(link, point, angular, linear, bullets.data(), scratch_r,
                                             scratch_v, scratch_m);
-        double scale = 0, difference = 0;
-        for (size_t k = 0; k < n; ++k) {
-          scale = std::max(scale, std::abs(double(bullets[k])));
-          difference = std::max(difference, std::abs(double(rows[a * n + k]) - double(bullets[k])));
-        }
-        e.mismatch = std::max(e.mismatch, scale > 0 ? difference / scale : difference);
+        body.calcAccelerationDeltasMultiDof(bullets.data(), bullet_response.data(), scratch_r,
+                                            scratch_v);
+        const auto relative = [&](const btScalar* mine, const btScalar* theirs) {
+          double scale = 0, difference = 0;
+          for (size_t k = 0; k < n; ++k) {
+            scale = std::max(scale, std::abs(double(theirs[k])));
+            difference = std::max(difference, std::abs(double(mine[k]) - double(theirs[k])));
+          }
+          return scale > 0 ? difference / scale : difference;
+        };
+        e.mismatch = std::max({e.mismatch, relative(&rows[a * n], bullets.data()),
+                               relative(&responses[a * n], bullet_response.data())});
       }
     }
   }

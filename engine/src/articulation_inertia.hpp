@@ -38,7 +38,8 @@ class ArticulationInertia {
 
   // Builds and factorises M at the body's configuration: its base pose and
   // its links' cached world transforms (as forward kinematics left them).
-  void factor(const btMultiBody& body);
+  // False where a coordinate moves no inertia (then Bullet's pass is used).
+  bool factor(const btMultiBody& body);
 
   // response = M^-1 force, 6 + dofs entries each. `chain`: a coordinate such
   // that force is zero off the path from it to the root (a row on a link:
@@ -98,10 +99,11 @@ class ArticulationInertias {
   const ArticulationInertia* of(btMultiBody& body);
 
   // Checking (tests): each factorisation's M^-1 against Bullet's
-  // articulated-body pass, column by column, and each link's basis rows
-  // against Bullet's Jacobians; the largest difference relative to its
-  // column's (row's) largest entry, over all factorisations since turned on
-  // (negative: none checked).
+  // articulated-body pass, column by column, and each link's basis rows and
+  // their responses (as the solver solves them) against Bullet's Jacobians
+  // and passes; the largest difference relative to its column's (row's)
+  // largest entry, over all factorisations since turned on (negative: none
+  // checked).
   void check(bool on) { check_ = on; }
   double mismatch() const;
 

@@ -100,8 +100,9 @@ int ArticulationSolver::ownContact(const btPersistentManifold& manifold) {
       factorised = factorised && side.inertia;
       ++links;
     } else {
-      // A static object (the carpet, a goal); a rigid body (the ball) or a
-      // moving object goes through Bullet.
+      // A static (or kinematic) object: the carpet, a goal; it moves nothing
+      // and takes no velocity, as in Bullet's rows. A rigid body (the ball)
+      // goes through Bullet.
       if (btRigidBody::upcast(object[s]) != nullptr || !object[s]->isStaticOrKinematicObject())
         return 0;
       side.body = nullptr;
@@ -214,7 +215,10 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   // direction) gives its Jacobian and, with the basis's responses, its
   // response. Effective mass (J M^-1 J^T, both sides) and velocity.
   const btVector3 position[2] = {point.getPositionWorldOnA(), point.getPositionWorldOnB()};
-  btScalar inverse_mass = 0, velocity = 0;
+  // Per side J M^-1 J^T (summed as Bullet: side A's, then side B's, then
+  // the softness), and the relative velocity in one running sum as Bullet's.
+  btScalar side_inverse_mass[2] = {0, 0}, velocity = 0;
+  bool from_basis = false, solved = false;
   for (int s = 0; s < 2; ++s) {
     ContactSide& side = sides_[s];
     if (!side.body) continue;
@@ -244,10 +248,10 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
         const btScalar* br = &basis_response[k * ndof];
         for (int i = 0; i < ndof; ++i) response[i] += weight[k] * br[i];
       }
-      ++basis_rows_;
+      from_basis = true;
     } else {
       side.inertia->solve(jacobian, response, side.inertia->chainOf(side.link));
-      ++solved_rows_;
+      solved = true;
     }
     if (s == 0) {
       row.m_deltaVelAindex = block;
@@ -258,10 +262,13 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
     }
     const btScalar* qdot = side.body->getVelocityVector();
     for (int i = 0; i < ndof; ++i) {
-      inverse_mass += jacobian[i] * response[i];
+      side_inverse_mass[s] += jacobian[i] * response[i];
       velocity += qdot[i] * jacobian[i];
     }
   }
+  basis_rows_ += from_basis;
+  solved_rows_ += solved;
+  two_articulation_rows_ += sides_[0].body && sides_[1].body;
 
   // Lever arms and normals as the solver's feedback and rigid-body paths
   // read them: from each link's origin, or the static body's.
@@ -279,7 +286,7 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
   const btScalar dt = info.m_timeStep;
   const btScalar cfm = (friction ? info.m_frictionCFM : info.m_globalCfm) * (btScalar(1) / dt);
   const btScalar erp = friction ? info.m_frictionERP : info.m_erp2;
-  const btScalar denominator = inverse_mass + cfm;
+  const btScalar denominator = side_inverse_mass[0] + side_inverse_mass[1] + cfm;
   row.m_jacDiagABInv = denominator > SIMD_EPSILON ? info.m_sor / denominator : btScalar(0);
   row.m_friction = point.m_combinedFriction;
   btScalar velocity_error = -velocity, position_error = 0;

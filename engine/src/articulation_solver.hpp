@@ -1,32 +1,35 @@
-// The engine's multibody constraint solver: Bullet's, with cheaper contact
-// rows for a robot link resting on something static and a leaner iteration
-// loop (engine-internal).
+// The engine's multibody constraint solver: Bullet's, with its own contact
+// rows for robot links and a leaner iteration loop (engine-internal).
 //
 // Rows. Bullet builds every contact row of an articulation with one
 // articulated-body pass (btMultiBody::calcAccelerationDeltasMultiDof,
-// O(links)) for its response and one for its Jacobian: a foot flat on the
-// carpet has four points of three rows each (the normal and two friction
-// directions), twelve passes of each kind, the largest cost of a step with
-// 22 robots. The response to a row is linear in the row: a row along
-// direction d at point p of a link is the combination (d, (p - o) x d) of the
-// six rows of the link's spatial basis at its origin o (three linear, three
-// angular). So for a manifold of three or more points between one
-// articulation link and a static object, this solver computes the basis's
-// six Jacobians and responses once and every row of the manifold as its
-// combination. The rows are otherwise the ones Bullet 3.24 builds (same
+// O(links)) for its response and one for its Jacobian. Here the rows of a
+// manifold between one or two articulation links and/or something static
+// (a foot on the carpet, robot against robot) are built from each link's
+// spatial basis: a row along direction d at point p of a link is the
+// combination (d, (p - o) x d) of the six rows of the basis at the link's
+// origin o (three angular, three linear). The basis's Jacobians come from the
+// articulation's factorised inertia (articulation_inertia.hpp); with three or
+// more points (a foot flat on the carpet: four points, twelve rows) the
+// basis's six responses are solved once and every row's response is their
+// combination, below that each row's response is solved on its own. Without
+// the factorisation (an articulation it does not support), only a link on
+// static ground at three or more points takes this path, its basis from
+// Bullet's passes. The rows are otherwise the ones Bullet 3.24 builds (same
 // fields, order, friction directions, Baumgarte terms, no warm start without
-// SOLVER_USE_ARTICULATED_WARMSTARTING). Everything else (rigid bodies, robot
-// against robot, rolling or anisotropic friction, per-contact stiffness)
-// goes through Bullet's own conversion.
+// SOLVER_USE_ARTICULATED_WARMSTARTING). Rigid bodies (the ball), rolling or
+// anisotropic friction and per-contact stiffness go through Bullet's own
+// conversion.
 //
 // Iterations. Bullet's row update adds each impulse's velocity change twice,
 // to the solver's delta velocities and to the articulation's pending ones,
 // in scalar loops; here each row updates the delta velocities only (in loops
-// the compiler vectorises), and each articulation's total is added once
+// the compiler vectorises), a joint row (one coordinate per side) reads its
+// velocity from that coordinate, and each articulation's total is added once
 // after the last iteration. Same rows, order, bounds and friction cone.
 //
-// Both differ from Bullet's in the last bits only (a test holds a pair of
-// Naos within micrometres of Bullet's own after a second); `own` false
+// Both differ from Bullet's in the last bits only (tests hold pairs of
+// robots within micrometres of Bullet's own after a second); `own` false
 // leaves everything to Bullet, for comparisons.
 #pragma once
 
@@ -47,12 +50,13 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
  public:
   explicit ArticulationSolver(bool own) : own_(own) {}
 
-  // Contact rows built from a link basis, and articulation contact rows the
-  // engine built and solved one by one, since the last reset (for tests and
-  // reports).
+  // Contact rows the engine built since the last reset (for tests and
+  // reports): with their responses from a link's basis, solved one by one,
+  // and between two articulations.
   long basisRows() const { return basis_rows_; }
   long solvedRows() const { return solved_rows_; }
-  void resetRowCounts() { basis_rows_ = solved_rows_ = 0; }
+  long twoArticulationRows() const { return two_articulation_rows_; }
+  void resetRowCounts() { basis_rows_ = solved_rows_ = two_articulation_rows_ = 0; }
   // Responses from these factorised inertias where they support the body
   // (null: Bullet's articulated-body pass for every row).
   void setInertias(ArticulationInertias* inertias) { inertias_ = inertias; }
@@ -125,6 +129,7 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   ArticulationInertias* inertias_ = nullptr;
   long basis_rows_ = 0;
   long solved_rows_ = 0;
+  long two_articulation_rows_ = 0;
   ContactSide sides_[2];
   // Per own constraint row of the group: whether each side's Jacobian is a
   // single coordinate (servos, gears, limits), which, its value, and whether

@@ -940,15 +940,13 @@ double PhysicsWorld::inverseInertiaMismatch() const {
   return impl_->inertias.mismatch();
 }
 
-long PhysicsWorld::lastStepBasisRows() const {
-  long rows = 0;
-  for (const ArticulationSolver* solver : impl_->all_solvers) rows += solver->basisRows();
-  return rows;
-}
-
-long PhysicsWorld::lastStepSolvedRows() const {
-  long rows = 0;
-  for (const ArticulationSolver* solver : impl_->all_solvers) rows += solver->solvedRows();
+PhysicsWorld::ContactRowCounts PhysicsWorld::lastStepContactRows() const {
+  ContactRowCounts rows;
+  for (const ArticulationSolver* solver : impl_->all_solvers) {
+    rows.basis += solver->basisRows();
+    rows.solved += solver->solvedRows();
+    rows.between_articulations += solver->twoArticulationRows();
+  }
   return rows;
 }
 

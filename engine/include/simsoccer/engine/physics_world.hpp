@@ -125,13 +125,14 @@ class PhysicsWorld {
   // Constraint batches the last step's solver formed (solved side by side on
   // the solver threads; 0: Bullet's own loop, for a randomised row order).
   int lastStepSolverBatches() const;
-  // Contact rows built from a link's spatial basis in the last step (0 with
-  // bullet_solver).
-  long lastStepBasisRows() const;
-  // Articulation contact rows the engine built and solved one by one in the
-  // last step (from the factorised inertia: robot against robot, a link on
-  // the ground at one or two points; 0 with bullet_solver).
-  long lastStepSolvedRows() const;
+  // Contact rows the engine built itself in the last step (all 0 with
+  // bullet_solver): their responses from a link's spatial basis (three or
+  // more points), solved one by one from the factorised inertia (fewer
+  // points), and between two articulations (robot against robot, either kind).
+  struct ContactRowCounts {
+    long basis = 0, solved = 0, between_articulations = 0;
+  };
+  ContactRowCounts lastStepContactRows() const;
   // Checking (tests): every step's factorised joint-space inertia of each
   // articulation against Bullet's articulated-body pass, and its links' basis
   // Jacobians against Bullet's; the largest difference (of a column of M^-1,
