@@ -390,18 +390,8 @@ btScalar ArticulationSolver::resolveNonContactRow(int index) {
   // same numbers as the dense sums, whose other terms are all zero.
   const btScalar* dv_a = &m_data.m_deltaVelocities[row.m_deltaVelAindex];
   const btScalar* dv_b = &m_data.m_deltaVelocities[row.m_deltaVelBindex];
-  const btScalar velocity =
-      joint.value_a * dv_a[joint.coordinate_a] + joint.value_b * dv_b[joint.coordinate_b];
-  btScalar delta =
-      row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm - velocity * row.m_jacDiagABInv;
-  const btScalar total = btScalar(row.m_appliedImpulse) + delta;
-  btScalar bounded = total;
-  if (total < row.m_lowerLimit)
-    bounded = row.m_lowerLimit;
-  else if (total > row.m_upperLimit)
-    bounded = row.m_upperLimit;
-  if (bounded != total) delta = bounded - btScalar(row.m_appliedImpulse);
-  row.m_appliedImpulse = bounded;
+  const btScalar delta = clampedUpdate(
+      row, joint.value_a * dv_a[joint.coordinate_a] + joint.value_b * dv_b[joint.coordinate_b]);
   const int n = row.m_multiBodyA->getNumDofs() + 6;
   auto apply = [&](int response_index, int block) {
     const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response_index];
@@ -414,11 +404,11 @@ btScalar ArticulationSolver::resolveNonContactRow(int index) {
   return delta / row.m_jacDiagABInv;
 }
 
-btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
+btScalar ArticulationSolver::clampedUpdate(btMultiBodySolverConstraint& row, btScalar velocity) {
   // Projected Gauss-Seidel: the impulse that removes the row's velocity
   // error (softened by its cfm), clamped to its bounds.
-  btScalar delta = row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm -
-                   rowVelocity(row) * row.m_jacDiagABInv;
+  btScalar delta =
+      row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm - velocity * row.m_jacDiagABInv;
   const btScalar total = btScalar(row.m_appliedImpulse) + delta;
   btScalar bounded = total;
   if (total < row.m_lowerLimit)
@@ -427,6 +417,11 @@ btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
     bounded = row.m_upperLimit;
   if (bounded != total) delta = bounded - btScalar(row.m_appliedImpulse);
   row.m_appliedImpulse = bounded;
+  return delta;
+}
+
+btScalar ArticulationSolver::resolveRow(btMultiBodySolverConstraint& row) {
+  const btScalar delta = clampedUpdate(row, rowVelocity(row));
   applyImpulse(row, delta);
   touched(row);
   return delta / row.m_jacDiagABInv;

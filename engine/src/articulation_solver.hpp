@@ -84,6 +84,9 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   }
   // One projected Gauss-Seidel update of a row; returns its velocity change.
   btScalar resolveRow(btMultiBodySolverConstraint& row);
+  // The row's clamped impulse change given the velocity it sees (its applied
+  // impulse updated).
+  btScalar clampedUpdate(btMultiBodySolverConstraint& row, btScalar velocity);
   // The same for the articulations' own constraint `index`, a joint row
   // (its Jacobian one coordinate per side) in O(1) plus its responses.
   btScalar resolveNonContactRow(int index);

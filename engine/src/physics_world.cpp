@@ -262,6 +262,29 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   }
 };
 
+// A row of an articulation's own constraint on its joints (both sides the
+// articulation, as Bullet's joint motors and gears build theirs): the common
+// fields, the articulation's delta-velocity block for both sides, and room
+// for a Jacobian and a response per side (side A's first).
+btMultiBodySolverConstraint& addJointRow(btMultiBodyConstraintArray& rows,
+                                         btMultiBodyJacobianData& data, btMultiBody* mb, int link_a,
+                                         int link_b, btMultiBodyConstraint* constraint) {
+  const int ndof = mb->getNumDofs() + 6;
+  btMultiBodySolverConstraint& row = rows.expandNonInitializing();
+  row.m_multiBodyA = row.m_multiBodyB = mb;
+  row.m_linkA = link_a;
+  row.m_linkB = link_b;
+  row.m_solverBodyIdA = row.m_solverBodyIdB = data.m_fixedBodyId;
+  row.m_orgConstraint = constraint;
+  row.m_orgDofIndex = 0;
+  row.m_deltaVelAindex = row.m_deltaVelBindex = deltaVelocityBlock(mb, data);
+  row.m_jacAindex = data.m_jacobians.size();
+  row.m_jacBindex = row.m_jacAindex + ndof;
+  data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
+  data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
+  return row;
+}
+
 // One joint servo as a row of Bullet's constraint solver: a joint-velocity
 // row (as Bullet's btMultiBodyJointMotor, whose island and finalize code it
 // reuses) made soft with the servo's compliance gamma, so that the solver
@@ -293,22 +316,8 @@ class ServoConstraint : public btMultiBodyJointMotor {
     if (m_numDofsFinalized != m_jacSizeBoth) finalizeMultiDof();
     btMultiBody* mb = m_bodyA;
     const int ndof = mb->getNumDofs() + 6;
-    btMultiBodySolverConstraint& row = rows.expandNonInitializing();
-    row.m_multiBodyA = mb;
-    row.m_multiBodyB = mb;
-    row.m_linkA = m_linkA;
-    row.m_linkB = m_linkB;
-    row.m_solverBodyIdA = row.m_solverBodyIdB = data.m_fixedBodyId;
-    row.m_orgConstraint = this;
-    row.m_orgDofIndex = 0;
-    // Both sides share the articulation's delta-velocity block.
-    const int block = deltaVelocityBlock(mb, data);
-    row.m_deltaVelAindex = row.m_deltaVelBindex = block;
+    btMultiBodySolverConstraint& row = addJointRow(rows, data, mb, m_linkA, m_linkB, this);
     // Jacobians: 1 at the joint's coordinate (side A), zero (side B).
-    row.m_jacAindex = data.m_jacobians.size();
-    row.m_jacBindex = row.m_jacAindex + ndof;
-    data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
-    data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
     btScalar* jac = &data.m_jacobians[row.m_jacAindex];
     btScalar* response = &data.m_deltaVelocitiesUnitImpulse[row.m_jacAindex];
     const btScalar* own = jacobianA(0);
@@ -388,20 +397,8 @@ class MimicConstraint : public btMultiBodyGearConstraint {
     const int ndof = mb->getNumDofs() + 6;
     const int coordinate_a = 6 + mb->getLink(m_linkA).m_dofOffset;
     const int coordinate_b = 6 + mb->getLink(m_linkB).m_dofOffset;
-    btMultiBodySolverConstraint& row = rows.expandNonInitializing();
-    row.m_multiBodyA = row.m_multiBodyB = mb;
-    row.m_linkA = m_linkA;
-    row.m_linkB = m_linkB;
-    row.m_solverBodyIdA = row.m_solverBodyIdB = data.m_fixedBodyId;
-    row.m_orgConstraint = this;
-    row.m_orgDofIndex = 0;
-    const int block = deltaVelocityBlock(mb, data);
-    row.m_deltaVelAindex = row.m_deltaVelBindex = block;
+    btMultiBodySolverConstraint& row = addJointRow(rows, data, mb, m_linkA, m_linkB, this);
     // Side A: 1 at joint A; side B: the ratio at joint B.
-    row.m_jacAindex = data.m_jacobians.size();
-    row.m_jacBindex = row.m_jacAindex + ndof;
-    data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
-    data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
     btScalar* jac_a = &data.m_jacobians[row.m_jacAindex];
     btScalar* jac_b = jac_a + ndof;
     for (int i = 0; i < 2 * ndof; ++i) jac_a[i] = 0;
