@@ -264,8 +264,9 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
 
 // A row of an articulation's own constraint on its joints (both sides the
 // articulation, as Bullet's joint motors and gears build theirs): the common
-// fields, the articulation's delta-velocity block for both sides, and room
-// for a Jacobian and a response per side (side A's first).
+// fields and the torque axes, the articulation's delta-velocity block for
+// both sides, and room for a Jacobian and a response per side (side A's
+// first); the caller fills those and the bias, softness and bounds.
 btMultiBodySolverConstraint& addJointRow(btMultiBodyConstraintArray& rows,
                                          btMultiBodyJacobianData& data, btMultiBody* mb, int link_a,
                                          int link_b, btMultiBodyConstraint* constraint) {
@@ -282,6 +283,20 @@ btMultiBodySolverConstraint& addJointRow(btMultiBodyConstraintArray& rows,
   row.m_jacBindex = row.m_jacAindex + ndof;
   data.m_jacobians.resize(row.m_jacAindex + 2 * ndof);
   data.m_deltaVelocitiesUnitImpulse.resize(row.m_jacAindex + 2 * ndof);
+  row.m_rhsPenetration = 0;
+  row.m_friction = 0;
+  row.m_appliedImpulse = 0;
+  row.m_appliedPushImpulse = 0;
+  // As Bullet's motor: the impulse acts as a torque about joint A's axis on
+  // its link and as the reaction on the other side.
+  const btVector3 axis = quatRotate(mb->getLink(link_a).m_cachedWorldTransform.getRotation(),
+                                    mb->getLink(link_a).m_axes[0].m_topVec);
+  row.m_contactNormal1.setZero();
+  row.m_contactNormal2.setZero();
+  row.m_relpos1CrossNormal = axis;
+  row.m_relpos2CrossNormal = -axis;
+  row.m_angularComponentA.setZero();
+  row.m_angularComponentB.setZero();
   return row;
 }
 
@@ -343,22 +358,8 @@ class ServoConstraint : public btMultiBodyJointMotor {
     row.m_jacDiagABInv = soft;
     row.m_rhs = (goal - velocity) * soft;
     row.m_cfm = gamma * soft;
-    row.m_rhsPenetration = 0;
     row.m_lowerLimit = static_cast<btScalar>((r.lower - r.feedforward) * h);
     row.m_upperLimit = static_cast<btScalar>((r.upper - r.feedforward) * h);
-    row.m_friction = 0;
-    row.m_appliedImpulse = 0;
-    row.m_appliedPushImpulse = 0;
-    // As Bullet's motor: the impulse acts as a torque about the joint axis on
-    // the child link and its reaction on the parent.
-    const btVector3 axis = quatRotate(mb->getLink(m_linkA).m_cachedWorldTransform.getRotation(),
-                                      mb->getLink(m_linkA).m_axes[0].m_topVec);
-    row.m_contactNormal1.setZero();
-    row.m_contactNormal2.setZero();
-    row.m_relpos1CrossNormal = axis;
-    row.m_relpos2CrossNormal = -axis;
-    row.m_angularComponentA.setZero();
-    row.m_angularComponentB.setZero();
     row_made_ = true;
   }
 
@@ -423,21 +424,9 @@ class MimicConstraint : public btMultiBodyGearConstraint {
     }
     const btScalar positional = -position_error * info.m_erp / info.m_timeStep;
     row.m_rhs = positional * row.m_jacDiagABInv + (btScalar(0) - velocity) * row.m_jacDiagABInv;
-    row.m_rhsPenetration = 0;
     row.m_cfm = 0;
     row.m_lowerLimit = -m_maxAppliedImpulse;
     row.m_upperLimit = m_maxAppliedImpulse;
-    row.m_friction = 0;
-    row.m_appliedImpulse = 0;
-    row.m_appliedPushImpulse = 0;
-    const btVector3 axis = quatRotate(mb->getLink(m_linkA).m_cachedWorldTransform.getRotation(),
-                                      mb->getLink(m_linkA).m_axes[0].m_topVec);
-    row.m_contactNormal1.setZero();
-    row.m_contactNormal2.setZero();
-    row.m_relpos1CrossNormal = axis;
-    row.m_relpos2CrossNormal = -axis;
-    row.m_angularComponentA.setZero();
-    row.m_angularComponentB.setZero();
   }
 
  private:
