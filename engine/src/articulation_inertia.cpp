@@ -33,7 +33,7 @@ bool ArticulationInertia::supports(const btMultiBody& body) {
   return true;
 }
 
-bool ArticulationInertia::factor(const btMultiBody& body) {
+void ArticulationInertia::setUp(const btMultiBody& body) {
   const int links = body.getNumLinks();
   n_ = 6 + body.getNumDofs();
   const auto n = static_cast<size_t>(n_);
@@ -44,32 +44,11 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
   coordinate_body_.resize(n);
   composite_.resize(bodies);
   last_coordinate_.resize(bodies);
+  matrix_.resize(n * n);  // only entries between a coordinate and its ancestors are used
+  inverse_d_.resize(n);
   scratch_.resize(6 * n);
-
-  // Each body alone about the base's centre of mass: mass m, first moment
-  // m c, rotational inertia I_c + m (|c|^2 1 - c c^T).
-  const Eigen::Vector3d origin = toEigen(body.getBasePos());
-  origin_ = origin;
-  {
-    const Eigen::Matrix3d rotation = toEigen(btMatrix3x3(body.getWorldToBaseRot().inverse()));
-    composite_[0] = {double(body.getBaseMass()), Eigen::Vector3d::Zero(),
-                     rotation * toEigen(body.getBaseInertia()).asDiagonal() * rotation.transpose()};
-  }
-  for (int l = 0; l < links; ++l) {
-    const btMultibodyLink& link = body.getLink(l);
-    const Eigen::Matrix3d rotation = toEigen(link.m_cachedWorldTransform.getBasis());
-    const Eigen::Vector3d c = toEigen(link.m_cachedWorldTransform.getOrigin()) - origin;
-    const double m = link.m_mass;
-    const Eigen::Matrix3d inertia =
-        rotation * toEigen(link.m_inertiaLocal).asDiagonal() * rotation.transpose() +
-        m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
-    composite_[static_cast<size_t>(l) + 1] = {m, m * c, inertia};
-  }
-
-  // Motion subspaces about the origin: the base's angular coordinates turn
-  // about it, its linear ones translate; a revolute joint turns about its
-  // axis through its pivot p: (axis, p x axis). The coordinates form a tree:
-  // the base's six a chain, each joint's parent the nearest coordinate of
+  // The coordinates form a tree: the base's six a chain (turning about the
+  // origin, then translating), each joint's parent the nearest coordinate of
   // its parent link or the ones above it.
   for (int a = 0; a < 6; ++a) {
     const auto k = static_cast<size_t>(a);
@@ -89,15 +68,51 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
       continue;
     }
     const auto k = static_cast<size_t>(6 + link.m_dofOffset);
+    parent_[k] = last_coordinate_[above];
+    coordinate_body_[k] = l + 1;
+    last_coordinate_[self] = static_cast<int>(k);
+  }
+  // L's pattern, by rows over each coordinate's ancestors.
+  row_start_.assign(1, 0);
+  column_.clear();
+  for (size_t k = 0; k < n; ++k) {
+    for (int i = parent_[k]; i >= 0; i = parent_[static_cast<size_t>(i)]) column_.push_back(i);
+    row_start_.push_back(static_cast<int>(column_.size()));
+  }
+  entry_.resize(column_.size());
+}
+
+bool ArticulationInertia::factor(const btMultiBody& body) {
+  const int links = body.getNumLinks();
+  const auto n = static_cast<size_t>(n_);
+
+  // Each body alone about the base's centre of mass: mass m, first moment
+  // m c, rotational inertia I_c + m (|c|^2 1 - c c^T); and each revolute
+  // joint's motion about the origin, turning about its axis through its
+  // pivot p: (axis, p x axis).
+  const Eigen::Vector3d origin = toEigen(body.getBasePos());
+  origin_ = origin;
+  {
+    const Eigen::Matrix3d rotation = toEigen(btMatrix3x3(body.getWorldToBaseRot().inverse()));
+    composite_[0] = {double(body.getBaseMass()), Eigen::Vector3d::Zero(),
+                     rotation * toEigen(body.getBaseInertia()).asDiagonal() * rotation.transpose()};
+  }
+  for (int l = 0; l < links; ++l) {
+    const btMultibodyLink& link = body.getLink(l);
     const Eigen::Matrix3d rotation = toEigen(link.m_cachedWorldTransform.getBasis());
+    const Eigen::Vector3d c = toEigen(link.m_cachedWorldTransform.getOrigin()) - origin;
+    const double m = link.m_mass;
+    const Eigen::Matrix3d inertia =
+        rotation * toEigen(link.m_inertiaLocal).asDiagonal() * rotation.transpose() +
+        m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+    composite_[static_cast<size_t>(l) + 1] = {m, m * c, inertia};
+    if (link.m_dofCount == 0) continue;
+    const auto k = static_cast<size_t>(6 + link.m_dofOffset);
     const Eigen::Vector3d axis = rotation * toEigen(link.getAxisTop(0));
     const Eigen::Vector3d pivot = toEigen(link.m_cachedWorldTransform.getOrigin()) -
                                   rotation * toEigen(link.m_dVector) - origin;
-    parent_[k] = last_coordinate_[above];
-    coordinate_body_[k] = l + 1;
     motion_angular_[k] = axis;
     motion_linear_[k] = pivot.cross(axis);
-    last_coordinate_[self] = static_cast<int>(k);
   }
 
   // Composite bodies: each link with everything outboard of it (children
@@ -113,7 +128,6 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
   // M: coordinate k moves its body's composite; the momentum that motion
   // gives it (angular about the origin: I w + h x v; linear: m v + w x h)
   // paired with each coordinate on the way to the root.
-  matrix_.resize(n * n);  // only entries between a coordinate and its ancestors are used
   for (size_t k = 0; k < n; ++k) {
     const Body& c = composite_[static_cast<size_t>(coordinate_body_[k])];
     const Eigen::Vector3d& w = motion_angular_[k];
@@ -141,17 +155,11 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
       matrix_[static_cast<size_t>(k) * n + static_cast<size_t>(i)] = a;
     }
   }
-  inverse_d_.resize(n);
-  row_start_.assign(1, 0);
-  column_.clear();
-  entry_.clear();
+  size_t e = 0;
   for (size_t k = 0; k < n; ++k) {
     inverse_d_[k] = 1.0 / matrix_[k * n + k];
-    for (int i = parent_[k]; i >= 0; i = parent_[static_cast<size_t>(i)]) {
-      column_.push_back(i);
-      entry_.push_back(matrix_[k * n + static_cast<size_t>(i)]);
-    }
-    row_start_.push_back(static_cast<int>(column_.size()));
+    for (int i = parent_[k]; i >= 0; i = parent_[static_cast<size_t>(i)])
+      entry_[e++] = matrix_[k * n + static_cast<size_t>(i)];
   }
   return true;
 }
@@ -227,57 +235,69 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
   const auto index = static_cast<size_t>(body.getUserIndex());
   if (index >= entries_.size()) return nullptr;
   Entry& e = entries_[index];
-  if (e.step == step_) return e.supported ? &e.inertia : nullptr;
+  if (e.step == step_) return e.factored ? &e.inertia : nullptr;
   e.step = step_;
-  e.supported = ArticulationInertia::supports(body) && e.inertia.factor(body);
-  if (!e.supported) return nullptr;
-  if (check_) {
-    const auto n = static_cast<size_t>(e.inertia.size());
-    std::vector<btScalar> unit(n, 0), ours(n), bullets(n);
-    btAlignedObjectArray<btScalar> scratch_r;
-    btAlignedObjectArray<btVector3> scratch_v;
-    for (size_t i = 0; i < n; ++i) {
-      unit[i] = 1;
-      e.inertia.solve(unit.data(), ours.data());
-      body.calcAccelerationDeltasMultiDof(unit.data(), bullets.data(), scratch_r, scratch_v);
-      unit[i] = 0;
-      double scale = 0, difference = 0;
-      for (size_t k = 0; k < n; ++k) {
-        scale = std::max(scale, std::abs(double(bullets[k])));
-        difference = std::max(difference, std::abs(double(ours[k]) - double(bullets[k])));
-      }
-      e.mismatch = std::max({e.mismatch, 0.0, scale > 0 ? difference / scale : difference});
-    }
-    std::vector<btScalar> rows(6 * n), responses(6 * n), bullet_response(n);
-    btAlignedObjectArray<btMatrix3x3> scratch_m;
-    for (int link = -1; link < body.getNumLinks(); ++link) {
-      const btVector3 point =
-          link < 0 ? body.getBasePos() : body.getLink(link).m_cachedWorldTransform.getOrigin();
-      e.inertia.basisJacobians(link, point, rows.data());
-      // The responses as the solver gets them: the six at once, along the
-      // link's path only.
-      e.inertia.solveSix(rows.data(), responses.data(), e.inertia.chainOf(link));
-      for (size_t a = 0; a < 6; ++a) {
-        btVector3 angular(0, 0, 0), linear(0, 0, 0);
-        (a < 3 ? angular : linear)[static_cast<int>(a % 3)] = 1;
-        body.fillConstraintJacobianMultiDof(link, point, angular, linear, bullets.data(), scratch_r,
-                                            scratch_v, scratch_m);
-        body.calcAccelerationDeltasMultiDof(bullets.data(), bullet_response.data(), scratch_r,
-                                            scratch_v);
-        const auto relative = [&](const btScalar* mine, const btScalar* theirs) {
-          double scale = 0, difference = 0;
-          for (size_t k = 0; k < n; ++k) {
-            scale = std::max(scale, std::abs(double(theirs[k])));
-            difference = std::max(difference, std::abs(double(mine[k]) - double(theirs[k])));
-          }
-          return scale > 0 ? difference / scale : difference;
-        };
-        e.mismatch = std::max({e.mismatch, relative(&rows[a * n], bullets.data()),
-                               relative(&responses[a * n], bullet_response.data())});
-      }
+  if (!e.set_up) {  // the model's structure: once
+    e.set_up = true;
+    e.supported = ArticulationInertia::supports(body);
+    if (e.supported) e.inertia.setUp(body);
+  }
+  e.factored = e.supported && e.inertia.factor(body);
+  if (!e.factored) return nullptr;
+  if (check_) e.mismatch = std::max({e.mismatch, 0.0, checkAgainstBullet(body, e.inertia)});
+  return &e.inertia;
+}
+
+namespace {
+
+// The largest difference between two vectors of n entries relative to the
+// second's largest entry.
+double relativeDifference(const btScalar* mine, const btScalar* theirs, size_t n) {
+  double scale = 0, difference = 0;
+  for (size_t k = 0; k < n; ++k) {
+    scale = std::max(scale, std::abs(double(theirs[k])));
+    difference = std::max(difference, std::abs(double(mine[k]) - double(theirs[k])));
+  }
+  return scale > 0 ? difference / scale : difference;
+}
+
+}  // namespace
+
+double ArticulationInertias::checkAgainstBullet(btMultiBody& body,
+                                                const ArticulationInertia& inertia) {
+  const auto n = static_cast<size_t>(inertia.size());
+  std::vector<btScalar> unit(n, 0), ours(n), bullets(n);
+  btAlignedObjectArray<btScalar> scratch_r;
+  btAlignedObjectArray<btVector3> scratch_v;
+  btAlignedObjectArray<btMatrix3x3> scratch_m;
+  double worst = 0;
+  // M^-1, column by column.
+  for (size_t i = 0; i < n; ++i) {
+    unit[i] = 1;
+    inertia.solve(unit.data(), ours.data());
+    body.calcAccelerationDeltasMultiDof(unit.data(), bullets.data(), scratch_r, scratch_v);
+    unit[i] = 0;
+    worst = std::max(worst, relativeDifference(ours.data(), bullets.data(), n));
+  }
+  // Each link's basis rows and their responses as the solver gets them (the
+  // six at once, along the link's path only).
+  std::vector<btScalar> rows(6 * n), responses(6 * n);
+  for (int link = -1; link < body.getNumLinks(); ++link) {
+    const btVector3 point =
+        link < 0 ? body.getBasePos() : body.getLink(link).m_cachedWorldTransform.getOrigin();
+    inertia.basisJacobians(link, point, rows.data());
+    inertia.solveSix(rows.data(), responses.data(), inertia.chainOf(link));
+    for (size_t a = 0; a < 6; ++a) {
+      btVector3 angular(0, 0, 0), linear(0, 0, 0);
+      (a < 3 ? angular : linear)[static_cast<int>(a % 3)] = 1;
+      body.fillConstraintJacobianMultiDof(link, point, angular, linear, bullets.data(), scratch_r,
+                                          scratch_v, scratch_m);
+      body.calcAccelerationDeltasMultiDof(bullets.data(), ours.data(), scratch_r, scratch_v);
+      worst = std::max({worst, relativeDifference(&rows[a * n], bullets.data(), n),
+                        relativeDifference(&responses[a * n], ours.data(), n)});
     }
   }
-  return &e.inertia;
+  return worst;
 }
 
 double ArticulationInertias::mismatch() const {

@@ -36,6 +36,10 @@ class ArticulationInertia {
   // other articulation keeps Bullet's pass.
   static bool supports(const btMultiBody& body);
 
+  // The tree's structure, which the model fixes: the coordinates' parents,
+  // L's pattern, the arrays' sizes. Once per articulation, before factor().
+  void setUp(const btMultiBody& body);
+
   // Builds and factorises M at the body's configuration: its base pose and
   // its links' cached world transforms (as forward kinematics left them).
   // False where a coordinate moves no inertia (then Bullet's pass is used).
@@ -111,9 +115,12 @@ class ArticulationInertias {
   struct Entry {
     ArticulationInertia inertia;
     uint64_t step = 0;
-    bool supported = false;
+    bool set_up = false, supported = false;
+    bool factored = false;  // this step
     double mismatch = -1;
   };
+  // The largest relative difference of one factorisation against Bullet.
+  static double checkAgainstBullet(btMultiBody& body, const ArticulationInertia& inertia);
   std::vector<Entry> entries_;
   uint64_t step_ = 1;
   bool check_ = false;

@@ -36,6 +36,17 @@ btScalar dot(const btScalar* a, const btScalar* b, int n) {
   return (s0 + s1) + (s2 + s3);
 }
 
+// out = sum over k of weight[k] times the basis's row k (ndof entries each):
+// basis row by basis row over contiguous arrays (the compiler vectorises
+// these), the same sums in the same order for every entry.
+void combineBasis(const btScalar weight[6], const btScalar* basis, int ndof, btScalar* out) {
+  for (int i = 0; i < ndof; ++i) out[i] = weight[0] * basis[i];
+  for (int k = 1; k < 6; ++k) {
+    const btScalar* row = &basis[k * ndof];
+    for (int i = 0; i < ndof; ++i) out[i] += weight[k] * row[i];
+  }
+}
+
 void touched(const btMultiBodySolverConstraint& row) {
   if (row.m_multiBodyA) row.m_multiBodyA->setPosUpdated(false);
   if (row.m_multiBodyB) row.m_multiBodyB->setPosUpdated(false);
@@ -233,21 +244,9 @@ void ArticulationSolver::addRow(btMultiBodySolverConstraint& row, btManifoldPoin
     m_data.m_deltaVelocitiesUnitImpulse.resize(index + ndof);
     btScalar* jacobian = &m_data.m_jacobians[index];
     btScalar* response = &m_data.m_deltaVelocitiesUnitImpulse[index];
-    // Basis row by basis row over contiguous arrays (the compiler vectorises
-    // these), the same sums in the same order for every entry.
-    const btScalar* basis_jacobian = &side.jacobian[0];
-    const btScalar* basis_response = &side.response[0];
-    for (int i = 0; i < ndof; ++i) jacobian[i] = weight[0] * basis_jacobian[i];
-    for (int k = 1; k < 6; ++k) {
-      const btScalar* bj = &basis_jacobian[k * ndof];
-      for (int i = 0; i < ndof; ++i) jacobian[i] += weight[k] * bj[i];
-    }
+    combineBasis(weight, &side.jacobian[0], ndof, jacobian);
     if (side.basis) {
-      for (int i = 0; i < ndof; ++i) response[i] = weight[0] * basis_response[i];
-      for (int k = 1; k < 6; ++k) {
-        const btScalar* br = &basis_response[k * ndof];
-        for (int i = 0; i < ndof; ++i) response[i] += weight[k] * br[i];
-      }
+      combineBasis(weight, &side.response[0], ndof, response);
       from_basis = true;
     } else {
       side.inertia->solve(jacobian, response, side.inertia->chainOf(side.link));
