@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # README quick start, command 2: set up, build, run the whole test suite, then build the
-# fuzz targets with clang (ASan, UBSan) and run each for 20 s (ctest -L fuzz in build-fuzz/).
+# fuzz targets with clang (ASan, UBSan) and run each for 20 s with the unit and net tests under
+# the same sanitizers (build-fuzz/), then the multi-threaded parts' tests under
+# ThreadSanitizer (build-tsan/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 bash scripts/fuzz.sh 20
+bash scripts/tsan.sh
