@@ -21,13 +21,15 @@ cmake --build build-fuzz --target fuzzers simsoccer_unit_tests simsoccer_net_tes
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # Left out under the sanitizers: the unit tests that play minutes of a game in physics
 # (15-110 s each there, 60 % of the label's time; the engine's hot loops are ours and
-# instrumented), which CI's 20 minutes cannot hold; the other referee, simulation and
-# servo tests reach the same code.
+# instrumented), which CI's 20 minutes cannot hold; the other referee, simulation,
+# walk and servo tests reach the same code.
 LONG='Referee[.](WholeFirstHalfFromScriptedBallPositions|IllegalPositionInSetOrAutoPlacement'
 LONG+='|GameStuckLocalThenGlobal|LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement'
 LONG+='|FirstHalfWithScriptedBall|RefereedRunsAreBitForBitRepeatable|FallenRobotIsPenalisedAsInactive'
-LONG+='|IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount)'
+LONG+='|IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount|StandingIdleNextToTheBallIsInactive)'
 LONG+='|Joints[.]CurrentRisesWithLoadAndTemperatureWithTime|Simulation[.]AnExternalGameControllerRunsTheGame'
+LONG+='|Simulation[.]PipelinedModeIsDeterministicAndDiffersFromSerial'
+LONG+='|WalkEngine[.]PlannedZmpAgainstTheSupportPolygon'
 ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L unit -E "^(Camera|$LONG)" \
   --output-on-failure -j "$(nproc)"
 # The camera tests without the leak check: Mesa's EGL driver is unloaded at exit and

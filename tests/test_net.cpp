@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -371,6 +372,93 @@ TEST(Net, TheLanConfigurationFindsTheAgentOnANetworkInterface) {
   // The participants announced themselves by multicast on the network
   // interface (with loopback.xml: none, unicast to 127.0.0.1 only).
   EXPECT_GE(announcements.received(), 2);
+}
+
+namespace {
+
+// The kernel's count of datagrams dropped at the IPv4 UDP socket bound to `port`
+// (/proc/net/udp's last column), or -1 if there is none.
+long udpDrops(uint16_t port) {
+  std::ifstream table("/proc/net/udp");
+  std::string line;
+  std::getline(table, line);  // header
+  while (std::getline(table, line)) {
+    std::istringstream fields(line);
+    std::string slot, local, field;
+    fields >> slot >> local;
+    if (std::stoul(local.substr(local.find(':') + 1), nullptr, 16) != port) continue;
+    while (fields >> field) {
+    }
+    return std::stol(field);  // the last field
+  }
+  return -1;
+}
+
+// `count` datagrams from a socket bound to `from` to `to`:`port`.
+void sendDatagrams(in_addr from, in_addr to, uint16_t port, int count) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_addr = from;
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&at), sizeof at), 0);
+  at.sin_addr = to;
+  at.sin_port = htons(port);
+  const char rtps[] = "RTPS not really";
+  for (int i = 0; i < count; ++i)
+    sendto(fd, rtps, sizeof rtps, 0, reinterpret_cast<sockaddr*>(&at), sizeof at);
+  close(fd);
+}
+
+}  // namespace
+
+// Cyclone binds its receive sockets to every address; with loopback.xml a domain's are
+// filtered to datagrams from 127.0.0.0/8 (net/src/dds.cpp). Datagrams sent to them from
+// this machine's network address are dropped by the kernel (its drop count rises by each);
+// datagrams from loopback are not, and a participant on loopback is still matched.
+TEST(Net, TheLoopbackConfigurationHearsNothingFromOtherAddresses) {
+  const auto network_address = test::multicastInterfaceAddress();
+  if (!network_address) GTEST_SKIP() << "no network interface";
+  const uint32_t domain = 161;
+  net::Participant listener(dds(domain));
+  ASSERT_EQ(listener.loopbackOnlyPorts().size(), 2u) << "discovery and data unicast ports";
+  // A configuration that sends on a network interface is left alone.
+  net::DomainConfig on_network = dds(162);
+  on_network.config_file = test::sourceDir() / "configs" / "dds" / "lan.xml";
+  EXPECT_TRUE(net::Participant(on_network).loopbackOnlyPorts().empty());
+
+  in_addr loopback{};
+  loopback.s_addr = htonl(INADDR_LOOPBACK);
+  for (const uint16_t port : listener.loopbackOnlyPorts()) {
+    const long before = udpDrops(port);
+    ASSERT_GE(before, 0) << "no socket on port " << port;
+    sendDatagrams(*network_address, *network_address, port, 10);
+    sendDatagrams(loopback, loopback, port, 10);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_EQ(udpDrops(port) - before, 10) << "port " << port;
+  }
+
+  // A neighbour on loopback (the same RTPS domain: Cyclone's ExternalDomainId) is matched.
+  net::DomainConfig on_loopback = dds(163);
+  on_loopback.external_domain = domain;
+  net::Participant neighbour(on_loopback);
+  dds_qos_t* q = net::makeQos({});
+  const net::Entity reader(net::check(
+      dds_create_reader(listener.get(), listener.topic(simsoccer_msg_SimClock_desc, "Neighbour"), q,
+                        nullptr),
+      "create reader"));
+  const net::Entity writer(net::check(
+      dds_create_writer(neighbour.get(), neighbour.topic(simsoccer_msg_SimClock_desc, "Neighbour"),
+                        q, nullptr),
+      "create writer"));
+  dds_delete_qos(q);
+  dds_subscription_matched_status_t matched{};
+  const auto start = Clock::now();
+  while (matched.current_count == 0 && seconds(start) < 10.0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    net::check(dds_get_subscription_matched_status(reader.get(), &matched), "matched status");
+  }
+  EXPECT_EQ(matched.current_count, 1u) << "the loopback neighbour was not matched";
 }
 
 TEST(Net, GarbageCommandsAreRejectedAndCounted) {

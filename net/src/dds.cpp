@@ -1,6 +1,14 @@
 #include "simsoccer/net/dds.hpp"
 
+#include <linux/filter.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -30,6 +38,81 @@ Entity::~Entity() {
   if (e_ > 0) dds_delete(e_);
 }
 
+namespace {
+
+// The process's IPv4 UDP sockets, by descriptor.
+std::vector<int> udpSockets() {
+  std::vector<int> fds;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", ec)) {
+    char* end = nullptr;
+    const std::string name = entry.path().filename().string();
+    const long fd = std::strtol(name.c_str(), &end, 10);
+    if (*end != '\0') continue;
+    int family = 0, protocol = 0;
+    socklen_t n = sizeof family;
+    if (getsockopt(static_cast<int>(fd), SOL_SOCKET, SO_DOMAIN, &family, &n) != 0) continue;
+    n = sizeof protocol;
+    if (getsockopt(static_cast<int>(fd), SOL_SOCKET, SO_PROTOCOL, &protocol, &n) != 0) continue;
+    if (family == AF_INET && protocol == IPPROTO_UDP) fds.push_back(static_cast<int>(fd));
+  }
+  return fds;
+}
+
+bool isLoopback(in_addr a) {
+  return (ntohl(a.s_addr) >> 24) == 127;
+}
+
+// Cyclone DDS 0.10 binds its receive sockets to 0.0.0.0 whatever interfaces it is configured
+// for, and has no setting to change that (eclipse-cyclonedds/cyclonedds#1923): with
+// configs/dds/loopback.xml, a datagram from the network to its port still reaches it. Its
+// transmit sockets are bound to the interfaces it chose. So when every socket a domain made
+// that is bound to an address is bound to a loopback one (the configuration chose loopback
+// only), a socket filter on the others, in the kernel, drops every datagram whose IPv4 source
+// is not 127.0.0.0/8 before Cyclone reads it. The ports it restricted.
+std::vector<uint16_t> restrictToLoopback(const std::vector<int>& domain_sockets) {
+  std::vector<int> receive;
+  bool loopback_bound = false;
+  for (const int fd : domain_sockets) {
+    sockaddr_in at{};
+    socklen_t n = sizeof at;
+    if (getsockname(fd, reinterpret_cast<sockaddr*>(&at), &n) != 0 || at.sin_family != AF_INET)
+      return {};
+    if (at.sin_addr.s_addr == htonl(INADDR_ANY))
+      receive.push_back(fd);
+    else if (isLoopback(at.sin_addr))
+      loopback_bound = true;
+    else
+      return {};  // it sends on a network interface: it is meant to hear the network
+  }
+  if (!loopback_bound) return {};
+  // Classic BPF: A = the IPv4 header's source address (SKF_NET_OFF: the network header,
+  // whatever the socket type); accept 127/8 whole, drop the rest.
+  sock_filter code[] = {
+      BPF_STMT(BPF_LD | BPF_W | BPF_ABS, static_cast<uint32_t>(SKF_NET_OFF + 12)),
+      BPF_STMT(BPF_ALU | BPF_AND | BPF_K, 0xff000000u),
+      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, 0x7f000000u, 0, 1),
+      BPF_STMT(BPF_RET | BPF_K, 0xffffffffu),
+      BPF_STMT(BPF_RET | BPF_K, 0),
+  };
+  const sock_fprog program{static_cast<unsigned short>(std::size(code)), code};
+  std::vector<uint16_t> ports;
+  for (const int fd : receive) {
+    if (setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0)
+      throw std::runtime_error("DDS: cannot restrict a loopback domain's socket to loopback");
+    sockaddr_in at{};
+    socklen_t n = sizeof at;
+    getsockname(fd, reinterpret_cast<sockaddr*>(&at), &n);
+    ports.push_back(ntohs(at.sin_port));
+  }
+  return ports;
+}
+
+// Domains are made one at a time, so the sockets that appear while one is made are its own.
+std::mutex domain_creation;
+
+}  // namespace
+
 Participant::Participant(const DomainConfig& config) {
   if (!(config.lease >= DomainConfig::kMinLease && config.lease <= DomainConfig::kMaxLease))
     throw std::invalid_argument("DDS lease must be between " +
@@ -46,13 +129,20 @@ Participant::Participant(const DomainConfig& config) {
     }
     // Cyclone reads a list of configurations, later ones adding to earlier ones.
     if (config.external_domain)
-      xml << (xml.tellp() > 0 ? "," : "")
-          << "<CycloneDDS><Domain><Discovery><ExternalDomainId>" << *config.external_domain
-          << "</ExternalDomainId></Discovery></Domain></CycloneDDS>";
+      xml << (xml.tellp() > 0 ? "," : "") << "<CycloneDDS><Domain><Discovery><ExternalDomainId>"
+          << *config.external_domain << "</ExternalDomainId></Discovery></Domain></CycloneDDS>";
+    const std::lock_guard lock(domain_creation);
+    const std::vector<int> before = udpSockets();
     const dds_entity_t d = dds_create_domain(config.domain, xml.str().c_str());
     // A domain this process already created keeps its configuration.
     if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) check(d, "create domain");
-    if (d > 0) domain_ = Entity(d);
+    if (d > 0) {
+      domain_ = Entity(d);
+      std::vector<int> made;
+      for (const int fd : udpSockets())
+        if (std::find(before.begin(), before.end(), fd) == before.end()) made.push_back(fd);
+      loopback_only_ports_ = restrictToLoopback(made);
+    }
   }
   dds_qos_t* q = dds_create_qos();
   dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, static_cast<dds_duration_t>(config.lease * 1e9));

@@ -69,11 +69,17 @@ class Participant {
   explicit Participant(const DomainConfig& config);
   dds_entity_t get() const { return participant_.get(); }
   dds_guid_t guid() const;
+  // The UDP ports of this participant's domain that take datagrams from 127.0.0.0/8 only:
+  // those of its receive sockets when this participant made the domain and the domain's
+  // configuration chose loopback interfaces only (Cyclone binds them to every address and
+  // dds.cpp filters them); empty otherwise.
+  const std::vector<uint16_t>& loopbackOnlyPorts() const { return loopback_only_ports_; }
   // The topic `name` of type `desc`, created once per participant.
   dds_entity_t topic(const dds_topic_descriptor_t& desc, const std::string& name);
 
  private:
   Entity domain_;  // only when this participant created the domain
+  std::vector<uint16_t> loopback_only_ports_;
   Entity participant_;
   std::vector<std::pair<std::string, Entity>> topics_;
 };
