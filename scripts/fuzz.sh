@@ -37,5 +37,6 @@ ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L unit -E "^(Camera|$
 # (no frame of ours); memory errors and undefined behaviour still fail them.
 ASAN_OPTIONS="detect_leaks=0" ctest --test-dir build-fuzz -L unit -R '^Camera' \
   --output-on-failure -j "$(nproc)"
+# Two per core: they wait on agent processes and DDS much of the time.
 ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L net -R '^Net' \
-  -E '^(NetApps|NetCameras)[.]' --output-on-failure -j "$(nproc)"
+  -E '^(NetApps|NetCameras)[.]' --output-on-failure -j "$((2 * $(nproc)))"
