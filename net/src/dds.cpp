@@ -119,6 +119,9 @@ Participant::Participant(const DomainConfig& config) {
                                 engine::formatNumber(DomainConfig::kMinLease) + " and " +
                                 engine::formatNumber(DomainConfig::kMaxLease) + " s, not " +
                                 engine::formatNumber(config.lease));
+  // Also a participant without a configuration of its own may make its domain (Cyclone's
+  // default, or $CYCLONEDDS_URI), with sockets of its own.
+  const std::lock_guard lock(domain_creation);
   if (!config.config_file.empty() || config.external_domain) {
     std::stringstream xml;
     if (!config.config_file.empty()) {
@@ -131,7 +134,6 @@ Participant::Participant(const DomainConfig& config) {
     if (config.external_domain)
       xml << (xml.tellp() > 0 ? "," : "") << "<CycloneDDS><Domain><Discovery><ExternalDomainId>"
           << *config.external_domain << "</ExternalDomainId></Discovery></Domain></CycloneDDS>";
-    const std::lock_guard lock(domain_creation);
     const std::vector<int> before = udpSockets();
     const dds_entity_t d = dds_create_domain(config.domain, xml.str().c_str());
     // A domain this process already created keeps its configuration.
