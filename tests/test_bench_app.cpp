@@ -273,6 +273,9 @@ TEST(ServeApp, CommandLineNumbersAreRangeChecked) {
       {"--agents -1", "--agents must be a whole number from 0 to 10"},
       {"--rules " + rules + " --gc-address 127.0.0.1 --gc-port 70000",
        "--gc-port must be a whole number from 1 to 65535"},
+      // Also where no GameController link uses it.
+      {"--gc-port 70000", "--gc-port must be a whole number from 1 to 65535"},
+      {"--gc-return-port -1", "--gc-return-port must be a whole number from 0 to 65535"},
       {"--seed -1", "--seed: expected a whole number"},
       {"--seed 1e30", "--seed: expected a whole number"},
       {"--seconds -3", "--seconds must be > 0"},

@@ -101,6 +101,10 @@ int serve(int argc, char** argv, int first) {
   if (opt.has("gc-address") && !officials)
     throw UsageError(
         "--gc-address needs --rules or a match config (the referee makes the packets)");
+  // Range-checked whether or not a GameController link below uses them.
+  const auto gc_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
+  const auto gc_return_port =
+      static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
   world::World& w = session ? session->world() : *own_world;
   // GameController team numbers of the scenario's teams 0 and 1.
   std::array<int, 2> team_numbers{1, 2};
@@ -158,8 +162,8 @@ int serve(int argc, char** argv, int first) {
         gcfg.return_bind = booster->bridge->network().hostAddress();
         gcfg.team_message_bind = booster->bridge->network().broadcast();
       }
-      gcfg.control_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
-      gcfg.return_port = static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
+      gcfg.control_port = gc_port;
+      gcfg.return_port = gc_return_port;
       gc_link = std::make_unique<referee::GameControllerLink>(gcfg);
       gc_link->update(officials->game());
       // The programs' team messages count against each team's budget.
