@@ -27,6 +27,11 @@ void countingBulletFree(void* p) {
   std::free(p);
 }
 
+// The replacements below pair malloc with free; GCC cannot see that the free in the
+// replaced operator delete frees what the replaced operator new malloc'ed, and warns.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
 void* operator new(std::size_t size) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
   if (void* p = std::malloc(size ? size : 1)) return p;
