@@ -27,9 +27,8 @@ LONG='Referee[.](WholeFirstHalfFromScriptedBallPositions|IllegalPositionInSetOrA
 LONG+='|GameStuckLocalThenGlobal|LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement'
 LONG+='|FirstHalfWithScriptedBall|RefereedRunsAreBitForBitRepeatable|FallenRobotIsPenalisedAsInactive'
 LONG+='|IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount|StandingIdleNextToTheBallIsInactive)'
-LONG+='|Joints[.]CurrentRisesWithLoadAndTemperatureWithTime|Simulation[.]AnExternalGameControllerRunsTheGame'
-LONG+='|Simulation[.]PipelinedModeIsDeterministicAndDiffersFromSerial'
-LONG+='|WalkEngine[.]PlannedZmpAgainstTheSupportPolygon'
+LONG+='|Simulation[.](AnExternalGameControllerRunsTheGame|PipelinedModeIsDeterministicAndDiffersFromSerial)'
+LONG+='|Joints[.]CurrentRisesWithLoadAndTemperatureWithTime|WalkEngine[.]PlannedZmpAgainstTheSupportPolygon'
 ASAN_OPTIONS="detect_leaks=1" ctest --test-dir build-fuzz -L unit -E "^(Camera|$LONG)" \
   --output-on-failure -j "$(nproc)"
 # The camera tests without the leak check: Mesa's EGL driver is unloaded at exit and

@@ -72,15 +72,17 @@ bool isLoopback(in_addr a) {
 // is not 127.0.0.0/8 before Cyclone reads it. The ports it restricted.
 std::vector<uint16_t> restrictToLoopback(const std::vector<int>& domain_sockets) {
   std::vector<int> receive;
+  std::vector<uint16_t> ports;  // of the receive sockets
   bool loopback_bound = false;
   for (const int fd : domain_sockets) {
     sockaddr_in at{};
     socklen_t n = sizeof at;
     if (getsockname(fd, reinterpret_cast<sockaddr*>(&at), &n) != 0 || at.sin_family != AF_INET)
       return {};
-    if (at.sin_addr.s_addr == htonl(INADDR_ANY))
+    if (at.sin_addr.s_addr == htonl(INADDR_ANY)) {
       receive.push_back(fd);
-    else if (isLoopback(at.sin_addr))
+      ports.push_back(ntohs(at.sin_port));
+    } else if (isLoopback(at.sin_addr))
       loopback_bound = true;
     else
       return {};  // it sends on a network interface: it is meant to hear the network
@@ -96,15 +98,9 @@ std::vector<uint16_t> restrictToLoopback(const std::vector<int>& domain_sockets)
       BPF_STMT(BPF_RET | BPF_K, 0),
   };
   const sock_fprog program{static_cast<unsigned short>(std::size(code)), code};
-  std::vector<uint16_t> ports;
-  for (const int fd : receive) {
+  for (const int fd : receive)
     if (setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0)
       throw std::runtime_error("DDS: cannot restrict a loopback domain's socket to loopback");
-    sockaddr_in at{};
-    socklen_t n = sizeof at;
-    getsockname(fd, reinterpret_cast<sockaddr*>(&at), &n);
-    ports.push_back(ntohs(at.sin_port));
-  }
   return ports;
 }
 
