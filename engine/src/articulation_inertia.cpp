@@ -145,8 +145,9 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
   for (int k = n_ - 1; k >= 0; --k) {
     const double* row_k = &matrix_[static_cast<size_t>(k) * n];
     const double diagonal = row_k[k];
-    // A coordinate that moves no inertia (a massless leaf, a point mass on
-    // its axis): Bullet's pass freezes it; here the factorisation declines.
+    // A coordinate that moves no inertia (a link whose inertia about the
+    // axis is zero: a point mass on its axis): Bullet's pass freezes it; here
+    // the factorisation declines. (A massless link is refused by the model check.)
     if (!(diagonal > 1e-12)) return false;
     for (int i = parent_[static_cast<size_t>(k)]; i >= 0; i = parent_[static_cast<size_t>(i)]) {
       const double a = row_k[i] / diagonal;
@@ -155,11 +156,12 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
       matrix_[static_cast<size_t>(k) * n + static_cast<size_t>(i)] = a;
     }
   }
-  size_t e = 0;
+  // L's entries in the pattern setUp laid out (row k: k's ancestors).
   for (size_t k = 0; k < n; ++k) {
     inverse_d_[k] = 1.0 / matrix_[k * n + k];
-    for (int i = parent_[k]; i >= 0; i = parent_[static_cast<size_t>(i)])
-      entry_[e++] = matrix_[k * n + static_cast<size_t>(i)];
+    for (auto e = static_cast<size_t>(row_start_[k]); e < static_cast<size_t>(row_start_[k + 1]);
+         ++e)
+      entry_[e] = matrix_[k * n + static_cast<size_t>(column_[e])];
   }
   return true;
 }
@@ -244,7 +246,7 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
   }
   e.factored = e.supported && e.inertia.factor(body);
   if (!e.factored) return nullptr;
-  if (check_) e.mismatch = std::max({e.mismatch, 0.0, checkAgainstBullet(body, e.inertia)});
+  if (check_) e.mismatch = std::max(e.mismatch, checkAgainstBullet(body, e.inertia));
   return &e.inertia;
 }
 

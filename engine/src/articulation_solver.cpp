@@ -52,6 +52,11 @@ void touched(const btMultiBodySolverConstraint& row) {
   if (row.m_multiBodyB) row.m_multiBodyB->setPosUpdated(false);
 }
 
+// Gauss-Seidel: the impulse that removes the row's velocity error, softened by its cfm.
+btScalar unclampedDelta(const btMultiBodySolverConstraint& row, btScalar velocity) {
+  return row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm - velocity * row.m_jacDiagABInv;
+}
+
 }  // namespace
 
 int deltaVelocityBlock(btMultiBody* body, btMultiBodyJacobianData& data) {
@@ -404,10 +409,8 @@ btScalar ArticulationSolver::resolveNonContactRow(int index) {
 }
 
 btScalar ArticulationSolver::clampedUpdate(btMultiBodySolverConstraint& row, btScalar velocity) {
-  // Projected Gauss-Seidel: the impulse that removes the row's velocity
-  // error (softened by its cfm), clamped to its bounds.
-  btScalar delta =
-      row.m_rhs - btScalar(row.m_appliedImpulse) * row.m_cfm - velocity * row.m_jacDiagABInv;
+  // Projected Gauss-Seidel: the unclamped update, clamped to the row's bounds.
+  btScalar delta = unclampedDelta(row, velocity);
   const btScalar total = btScalar(row.m_appliedImpulse) + delta;
   btScalar bounded = total;
   if (total < row.m_lowerLimit)
@@ -431,10 +434,8 @@ btScalar ArticulationSolver::resolveFrictionPair(btMultiBodySolverConstraint& a,
   // Both rows' unclamped updates from the same velocities, then the pair
   // scaled back onto the circle of radius mu N (the rows' bounds) along its
   // own direction, as Bullet's implicit friction cone.
-  btScalar delta_a =
-      a.m_rhs - btScalar(a.m_appliedImpulse) * a.m_cfm - rowVelocity(a) * a.m_jacDiagABInv;
-  btScalar delta_b =
-      b.m_rhs - btScalar(b.m_appliedImpulse) * b.m_cfm - rowVelocity(b) * b.m_jacDiagABInv;
+  btScalar delta_a = unclampedDelta(a, rowVelocity(a));
+  btScalar delta_b = unclampedDelta(b, rowVelocity(b));
   btScalar total_a = btScalar(a.m_appliedImpulse) + delta_a;
   btScalar total_b = btScalar(b.m_appliedImpulse) + delta_b;
   if (total_a * total_a + total_b * total_b >= a.m_lowerLimit * b.m_lowerLimit) {
