@@ -18,7 +18,8 @@ generation: the kept motions are means). Environment:
   ASYM=1      every joint searched on its own (default: the left side, mirrored)
   ROLL=1      the motion is a roll onto the front (`ends: front`, no stand at its end),
               scored by how far onto the front it leaves the robot, plus 2 for standing
-              (after the get-up from the front) and up to +0.5 the sooner (-1 at 10 s)
+              (after the get-up from the front) and up to +0.5 the sooner (-1 at 10 s);
+              ROLL=back: a roll onto the back (`ends: back`), likewise
   SQUAT_TAIL=1  every candidate ends in a fixed deep squat and the stand
   ROBOT=NAME  nao_v6_h25 (default) or booster_k1: the robot, its motions folder
               (configs/bench/motion_NAME.yaml) and the joints searched
@@ -102,7 +103,7 @@ SIGMA = float(os.environ.get("SIGMA", "0.25"))  # initial spread of the joint an
 
 def write_yaml(side, frames, path, tail):
     out = [f"motion: get_up_{side}"] + (["interpolation: linear"] if LINEAR else []) + \
-          (["ends: front"] if ROLL else []) + ["frames:"]
+          ([f"ends: {ROLL_TO}"] if ROLL else []) + ["frames:"]
     for f in frames:
         js = {} if "HeadYaw" in f["joints"] else dict(HeadYaw=0.0)
         for j, x in f["joints"].items():
@@ -121,6 +122,7 @@ TAIL = ["  - duration: 1.0", "    pose: stand"]
 # end); scored by how far onto the front it ends, +2 when the front get-up that follows
 # it stands the robot up in time.
 ROLL = bool(os.environ.get("ROLL"))
+ROLL_TO = "back" if os.environ.get("ROLL") == "back" else "front"
 if ROLL:
     TAIL = []
 if os.environ.get("SQUAT_TAIL") and ROBOT == "nao_v6_h25":
@@ -148,10 +150,11 @@ def run(side, motions_dir, seed):
         return 0.0, False
     end = next((i for i in range(start, len(rows)) if rows[i][1] != "getting_up"), len(rows))
     if ROLL:
-        # How far onto the front (the torso's x axis down) the motion leaves it,
-        # over the 0.3 s after it ends.
+        # How far onto the front (the torso's x axis down; onto the back: up) the
+        # motion leaves it, over the 0.3 s after it ends.
         after = rows[end:end + 3] or rows[-1:]
-        score = sum(-r[4] for r in after) / len(after)
+        sign = 1.0 if ROLL_TO == "back" else -1.0
+        score = sum(sign * r[4] for r in after) / len(after)
         success = bool(ok) and float(ok.group(1)) < 8.0
         if ok:  # standing: +2, more the sooner (up to +0.5 at 7 s, -1 at 10 s)
             score += 2.0 + max(-1.0, min(0.5, 0.5 * (8.0 - float(ok.group(1)))))

@@ -682,6 +682,64 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
   }
 }
 
+// The same from the front (the Booster K1's get-up from the front is a roll
+// onto its back, then the rock-up from the back): `ends: back`.
+TEST(MotionController, ARollOntoTheBackIsFollowedByTheGetUpFromTheBack) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const test::TempDir dir("roll_back_motions");
+  for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
+    if (f.is_regular_file()) std::filesystem::copy_file(f.path(), dir / f.path().filename());
+  std::filesystem::remove(dir / "get_up_front.yaml");
+  std::ofstream(dir / "get_up_front.yaml") << "motion: get_up_front\nends: back\nframes:\n  - "
+                                              "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
+  EXPECT_EQ(agents::loadKeyframeMotion(dir / "get_up_front.yaml", model).ends,
+            agents::KeyframeMotion::Ends::Back);
+  for (const bool rolled : {true, false}) {
+    agents::FallDetectorParameters fall;
+    fall.get_up = true;
+    agents::MotionController mc = agents::loadMotionController(model, dir.path(), fall);
+    std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
+    agents::MotionSensors s;
+    s.position = joints;
+    MotionRequest stand;
+    auto run = [&](double seconds) {
+      for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i)
+        mc.update(0.01, s, stand, position, stiffness);
+    };
+    run(0.5);
+    s.accel = Vec3(-9.81, 0, 0);  // on its front: up is -x in the torso frame
+    s.pitch = M_PI / 2;
+    for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
+    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);  // the roll
+    if (rolled) {                                           // now on its back
+      s.accel = Vec3(9.81, 0, 0);
+      s.pitch = -M_PI / 2;
+    }
+    run(0.55);
+    EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
+    EXPECT_EQ(mc.counters().failed_get_ups, rolled ? 0 : 1);
+    run(0.5);
+    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;
+    ASSERT_NE(mc.keyframeMotion(), nullptr);
+    EXPECT_EQ(mc.keyframeMotion()->name, rolled ? "get_up_back" : "get_up_front");
+  }
+}
+
+// A motion file's `ends` is standing, front or back; anything else names the key.
+TEST(MotionController, AnUnknownEndsValueIsRefusedNamingTheKey) {
+  const auto model = robots::loadRobotModel(test::naoH25());
+  const test::TempDir dir("ends_motion");
+  std::ofstream(dir / "m.yaml") << "motion: m\nends: sideways\nframes:\n  - "
+                                   "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
+  try {
+    agents::loadKeyframeMotion(dir / "m.yaml", model);
+    FAIL() << "accepted ends: sideways";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("ends"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("standing, front or back"), std::string::npos) << e.what();
+  }
+}
+
 // A robot picked up in the middle of its get-up (the referee removing an
 // inactive player) or of a dive (the shoot-out's next kick) and put on its
 // feet stops the motion and eases into the stance, instead of playing the rest

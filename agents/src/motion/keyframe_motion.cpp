@@ -36,7 +36,15 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
   m.name = root["motion"].string();
   if (secondChoice(root, "interpolation", "smooth", "linear"))
     m.interpolation = KeyframeMotion::Interpolation::Linear;
-  if (secondChoice(root, "ends", "standing", "front")) m.ends = KeyframeMotion::Ends::Front;
+  if (const auto ends = root.optional("ends")) {
+    const std::string v = ends->string();
+    if (v == "front")
+      m.ends = KeyframeMotion::Ends::Front;
+    else if (v == "back")
+      m.ends = KeyframeMotion::Ends::Back;
+    else if (v != "standing")
+      ends->fail("must be standing, front or back");
+  }
   const auto& joints = model.body->joints;
   std::vector<double> q = model.pose("stand");
   for (const engine::ConfigNode& item : root["frames"].items()) {

@@ -287,9 +287,11 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         if (upright()) {
           ++counters_.get_ups;
           easeIntoStance();
-        } else if (player_.motion()->ends == KeyframeMotion::Ends::Front && gravity_.x() < 0.0) {
-          // Rolled from the back onto the front, as meant: lying, so the fall
-          // detector starts the get-up from the front once it is still.
+        } else if (const KeyframeMotion::Ends ends = player_.motion()->ends;
+                   (ends == KeyframeMotion::Ends::Front && gravity_.x() < 0.0) ||
+                   (ends == KeyframeMotion::Ends::Back && gravity_.x() > 0.0)) {
+          // Rolled onto the side the motion meant: lying, so the fall detector
+          // starts the get-up from that side once it is still.
           enter(MotionState::Lying);
         } else {
           ++counters_.failed_get_ups;

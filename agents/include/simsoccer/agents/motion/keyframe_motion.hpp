@@ -25,14 +25,14 @@ struct KeyframeMotion {
   // sequence of short frames moves without stopping at each).
   enum class Interpolation { Smooth, Linear } interpolation = Interpolation::Smooth;
   // Where the motion leaves the robot: standing (a get-up), or lying on its
-  // front (a roll from the back, after which the get-up from the front runs).
-  enum class Ends { Standing, Front } ends = Ends::Standing;
+  // front or back (a roll, after which the get-up from that side runs).
+  enum class Ends { Standing, Front, Back } ends = Ends::Standing;
   std::vector<Keyframe> frames;
   double duration() const;
 };
 
 // Reads a motion for `model`: interpolation: smooth|linear (default smooth),
-// ends: standing|front (default standing), frames: [{duration,
+// ends: standing|front|back (default standing), frames: [{duration,
 // stiffness, pose: NAME (a pose of the robot model), joints: {Name: rad, ...}}]. A frame starts
 // from the previous frame (the first from the model's `stand` pose) or from its `pose`, then sets
 // its `joints`; mimic joints follow their masters. Throws engine::ConfigError (file, key, reason).
