@@ -173,13 +173,12 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
 }
 
 // The Booster K1's table (configs/bench/motion_booster_k1.yaml): the 0.5 m/s over 5 m,
-// sideways and random walking without a fall, kicks of 4 m with the size 3 ball. Serial
-// periods: the K1's kick was tuned without the pipelined mode's period of delay (with it,
-// 55 % of its kicks reach 4 m; docs/benchmarks.md).
-TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondAndKicksFourMetres) {
+// sideways and random walking without a fall, kicks of 4 m with the size 3 ball, up from its
+// front (a roll, then the rock-up) and from its back.
+TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsUp) {
   const test::BenchRun run = test::runBench(
       SIMSOCCER_BIN,
-      "bench motion --robot booster_k1 --mode serial --random-minutes 1 --get-up-trials 1 "
+      "bench motion --robot booster_k1 --random-minutes 1 --get-up-trials 1 "
       "--sit-trials 1 --striker-trials 1 --penalty-trials 1 --block-trials 1");
   ASSERT_EQ(run.status, 0) << run.out;
   EXPECT_NE(run.out.find("one booster_k1 on an empty field (hsl_m.yaml)"), std::string::npos)
@@ -203,6 +202,8 @@ TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondAndKicksFourMetres) {
   EXPECT_GE(std::stod(rows.at("kick_distance")[3]), 4.0);
   EXPECT_GE(std::stod(rows.at("kick_success")[3]), 0.9);
   EXPECT_EQ(rows.at("kick_distance")[6], "0");
+  EXPECT_EQ(rows.at("get_up_front")[3], "1.000");
+  EXPECT_EQ(rows.at("get_up_back")[3], "1.000");
   // A robot without a motion bench is named.
   int status = 0;
   const std::string out =

@@ -86,8 +86,10 @@ const std::vector<Field<KickParameters>>& kickFields() {
       {"lower_time", &K::lower_time, Range::Positive},
       {"return_time", &K::return_time, Range::Positive},
       {"settle_time", &K::settle_time, Range::NonNegative},
+      {"ready_time", &K::ready_time, Range::NonNegative},
       {"hip_roll_compensation", &K::hip_roll_compensation, Range::Any},
-      {"swing_height", &K::swing_height, Range::Any}};
+      {"swing_height", &K::swing_height, Range::Any},
+      {"swing_out", &K::swing_out, Range::Any}};
   return f;
 }
 

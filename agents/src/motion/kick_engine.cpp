@@ -10,9 +10,9 @@ namespace simsoccer::agents {
 namespace {
 
 // One keyframe: torso shift (fraction of the full shift), the kicking foot
-// forward (m) and up (m), and the time to reach it.
+// forward (m), up (m) and out (fraction of swing_out), and the time to reach it.
 struct Key {
-  double shift, along, up, time;
+  double shift, along, up, out, time;
 };
 
 }  // namespace
@@ -33,17 +33,17 @@ double KickEngine::duration() const {
 }
 
 void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets) {
-  const std::array<Key, 8> keys{{{0, 0, 0, 0},
-                                 {1, 0, 0, p_.shift_time},
-                                 {1, -p_.draw_back, p_.lift, p_.lift_time},
-                                 {1, p_.reach, p_.swing_height, p_.swing_time},
-                                 {1, 0, p_.lift, p_.retract_time},
-                                 {1, 0, 0, p_.lower_time},
-                                 {0, 0, 0, p_.return_time},
-                                 {0, 0, 0, p_.settle_time}}};
+  const std::array<Key, 8> keys{{{0, 0, 0, 0, 0},
+                                 {1, 0, 0, 0, p_.shift_time},
+                                 {1, -p_.draw_back, p_.lift, 1, p_.lift_time},
+                                 {1, p_.reach, p_.swing_height, 1, p_.swing_time},
+                                 {1, 0, p_.lift, 0, p_.retract_time},
+                                 {1, 0, 0, 0, p_.lower_time},
+                                 {0, 0, 0, 0, p_.return_time},
+                                 {0, 0, 0, 0, p_.settle_time}}};
   if (active_) t_ += dt;
   // Where in the keyframes we are.
-  double shift = 0, along = 0, up = 0, t = t_;
+  double shift = 0, along = 0, up = 0, outward = 0, t = t_;
   bool done = true;
   for (size_t k = 1; k < keys.size(); ++k) {
     if (t <= keys[k].time) {
@@ -52,6 +52,7 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
       shift = keys[k - 1].shift + a * (keys[k].shift - keys[k - 1].shift);
       along = keys[k - 1].along + a * (keys[k].along - keys[k - 1].along);
       up = keys[k - 1].up + a * (keys[k].up - keys[k - 1].up);
+      outward = keys[k - 1].out + a * (keys[k].out - keys[k - 1].out);
       done = false;
       break;
     }
@@ -69,7 +70,7 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
     return inv * f;
   };
   const double half = 0.5 * stance_.step_width;
-  const Pose kicking = foot(side * half, along, up);
+  const Pose kicking = foot(side * (half + outward * p_.swing_out), along, up);
   const Pose support = foot(-side * half, 0.0, 0.0);
   const LegSolution s = foot_ == Leg::Left
                             ? kinematics_.inverse(kicking, support, have_last_ ? &last_ : nullptr)

@@ -201,8 +201,9 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
                        measured, dt);
         break;
       }
+      standing_for_ = state_ == MotionState::Stance && !walk_.walking() ? standing_for_ + dt : 0.0;
       if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
-          !walk_.walking()) {
+          !walk_.walking() && standing_for_ >= kick_parameters_.ready_time) {
         kick_.start(request.kick_foot);
         ++counters_.kicks;
         enter(MotionState::Kicking);

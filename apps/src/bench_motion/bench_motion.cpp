@@ -26,12 +26,13 @@ const char* kHelp =
     "                names the robot, field, motions, agent config and targets\n"
     "  --bench FILE  another such file\n"
     "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
-    "[--ball-gap M]:\n"
+    "[--ball-gap M] [--steps-first N]:\n"
     "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
     "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
     "--ankle-roll-gyro, --gyro-smoothing, --forward-scale, --max-forward, --max-turn,\n"
     "--max-turn-accel, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
-    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height).\n"
+    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height,\n"
+    "--kick-swing-out, --kick-ready-time).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --random [--random-minutes M] [--seed N] [--verbose]: the random-commands trial alone.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
@@ -80,7 +81,9 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-lift", &kp.lift},
       {"kick-draw-back", &kp.draw_back},
       {"kick-hip-roll", &kp.hip_roll_compensation},
-      {"kick-swing-height", &kp.swing_height}};
+      {"kick-swing-height", &kp.swing_height},
+      {"kick-swing-out", &kp.swing_out},
+      {"kick-ready-time", &kp.ready_time}};
   std::vector<std::string> valued{"robot",
                                   "bench",
                                   "seconds",
@@ -93,6 +96,7 @@ int benchMotion(int argc, char** argv, int first) {
                                   "foot",
                                   "ball-offset",
                                   "ball-gap",
+                                  "steps-first",
                                   "get-up",
                                   "get-up-trials",
                                   "sit-trials",
@@ -174,7 +178,8 @@ int benchMotion(int argc, char** argv, int first) {
   if (opt.flag("kick")) {  // one kick, for tuning
     const motion::KickResult r =
         motion::kickTrial(c, opt.number("foot", 1) == 0 ? agents::Leg::Left : agents::Leg::Right,
-                          opt.number("ball-offset", 0), 1, opt.number("ball-gap", 0.015));
+                          opt.number("ball-offset", 0), 1, opt.number("ball-gap", 0.015),
+                          static_cast<int>(opt.number("steps-first", 0)));
     std::printf("ball %.3f m at %.1f deg, fell %d\n", r.distance, r.direction * 180 / M_PI, r.fell);
     return 0;
   }

@@ -50,7 +50,7 @@ double toe(const robots::RobotModel& model, int foot_link) {
 }  // namespace
 
 KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
-                     double gap) {
+                     double gap, int steps_first) {
   world::Scenario s = emptyField(c);
   s.seed = seed;
   TrialWorld t(s, c);
@@ -60,6 +60,25 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
   agents::KickEngine engine(model, c.walk, c.kick);
   std::vector<double> targets = model.pose("stand");
   settleIntoStance(t, walk, targets);
+  if (steps_first > 0) {
+    // Stepping on the spot, then stopping: the kick starts from the sway the last steps leave.
+    const double dt = t.dt();
+    walk.setVelocity(0.0, 0.0, 0.0);
+    t.driver.setControl([&](const world::World& world, std::span<float> p, std::span<float> k) {
+      const auto& fr = world.sensorFrame(0);
+      walk.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), fr.angles[2],
+                  targets);
+      bodyTargetsToCommand(model, targets, 1.0, p, k);
+      return true;
+    });
+    const int periods = static_cast<int>(std::lround(steps_first * c.walk.step_period / dt));
+    for (int i = 0; i < periods; ++i) t.period();
+    walk.stop();
+    for (int i = 0; i < static_cast<int>(std::lround(3.0 / dt)) && walk.walking(); ++i) t.period();
+    // Then standing for the kick's ready_time, as the motion controller does.
+    for (int i = 0; i < static_cast<int>(std::lround(c.kick.ready_time / dt)); ++i) t.period();
+    t.driver.setControl({});
+  }
   const int foot_link = engine.kinematics().footLink(foot);
   const Vec3 f = w.linkPose(0, foot_link).translation();
   engine::RigidBodyState b;

@@ -127,8 +127,10 @@ struct KickResult {
   double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)
   bool fell = false;
 };
+// steps_first: steps on the spot before the kick, which starts as soon as the walk has
+// stopped (as the motion controller kicks in play), instead of from a settled stance.
 KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
-                     double gap = 0.015);
+                     double gap = 0.015, int steps_first = 0);
 
 struct GetUpResult {
   bool success = false;
