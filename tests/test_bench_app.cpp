@@ -194,7 +194,9 @@ TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsU
   ASSERT_EQ(rows.size(), 13u);
   EXPECT_EQ(rows.at("walk_forward")[2], "0.500");
   EXPECT_GE(std::stod(rows.at("walk_forward")[3]), 0.49);
-  EXPECT_GE(std::stod(rows.at("walk_sideways")[3]), 0.15);
+  // Sideways steps are at most 8 cm, every other step (gait.yaml's max_side): 0.14 m/s for the
+  // 0.15 commanded.
+  EXPECT_GE(std::stod(rows.at("walk_sideways")[3]), 0.13);
   for (const char* t : {"walk_forward", "walk_sideways", "turn", "random_commands"})
     EXPECT_EQ(rows.at(t)[6], "0") << t;
   EXPECT_LT(std::stod(rows.at("walk_forward")[5]), 10.0);

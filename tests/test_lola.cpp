@@ -146,9 +146,10 @@ TEST(LolaEndpoint, PartialSplitAndDoubleMapsAreMerged) {
   EXPECT_EQ(rig.finish(), 0);
   EXPECT_NEAR(rig.headYaw(), -0.5, 0.03);
   const lola::RobotLolaStats s = rig.endpoint.stats(0);
-  // A full map first, then a Position map and an LED map per cycle; the last
-  // cycle's LED map comes after its answer (in lockstep the next period takes it).
-  EXPECT_EQ(s.maps, 198u);
+  // A full map first, then a Position map and an LED map per cycle. The last cycle's LED map
+  // comes after its answer: whether a period reads it before the client is seen to exit
+  // depends on the machine's load (under ctest -j 4 on 2 cores it often does).
+  EXPECT_TRUE(s.maps == 198u || s.maps == 199u) << s.maps;
   EXPECT_EQ(s.bad_maps, 0u);
   EXPECT_EQ(rig.endpoint.actuators(0).chest[0], 1.0f);  // the second map's red
 }

@@ -54,6 +54,24 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
       t.driver.setControl(walkControl);
       continue;
     }
+    if (falls) {
+      // Random walking: near the field's lines the robot is put back in the middle (facing as
+      // it was; not a fall), so that it never walks into a goal or off the carpet: what this
+      // trial counts is the walk's own falls.
+      const engine::Pose p = w.torsoPose(0);
+      const double margin = 1.0;  // m, inside the lines
+      if (std::abs(p.translation().x()) > w.field().halfLength() - margin ||
+          std::abs(p.translation().y()) > w.field().halfWidth() - margin) {
+        if (c.verbose)
+          std::fprintf(stderr, "back to the middle at %.2f s from %.2f %.2f\n",
+                       static_cast<double>(i) * dt, p.translation().x(), p.translation().y());
+        w.placeRobot(0, 0.0, 0.0, std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
+        engine = agents::WalkEngine(model, c.walk);
+        settleIntoStance(t, engine, targets);
+        t.driver.setControl(walkControl);
+        continue;
+      }
+    }
     if (c.verbose && i % 5 == 0) {  // a trace every 0.05 s, for tuning
       const engine::Pose torso = w.torsoPose(0);
       const Vec3 p = torso.translation();
