@@ -637,20 +637,26 @@ TEST(MotionController, TheFallDetectorGoesSoftWhileFallingAndStaysDownWithoutGet
   EXPECT_EQ(mc.counters().get_ups, 0);
 }
 
-// A motion that `ends: front` (the roll that starts the get-up from the back)
-// leaves the robot lying on its front on purpose: no failed get-up, and the
-// get-up from the front follows once it lies still. One that leaves it on its
-// back failed.
-TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
+// A roll: a get-up whose motion `ends: front` (the Nao's roll that starts its get-up from the
+// back) or `ends: back` (the Booster K1's roll that starts its get-up from the front) leaves
+// the robot lying on that side on purpose: no failed get-up, and the get-up from that side
+// follows once it lies still. One that leaves it where it started failed.
+namespace {
+void expectTheRollIsFollowedByTheOtherGetUp(bool from_back) {
   const auto model = robots::loadRobotModel(test::naoH25());
-  const test::TempDir dir("roll_motions");
+  const test::TempDir dir(from_back ? "roll_front_motions" : "roll_back_motions");
   for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
     if (f.is_regular_file()) std::filesystem::copy_file(f.path(), dir / f.path().filename());
-  std::filesystem::remove(dir / "get_up_back.yaml");
-  std::ofstream(dir / "get_up_back.yaml") << "motion: get_up_back\nends: front\nframes:\n  - "
-                                             "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
-  EXPECT_EQ(agents::loadKeyframeMotion(dir / "get_up_back.yaml", model).ends,
-            agents::KeyframeMotion::Ends::Front);
+  const std::string roll = from_back ? "get_up_back" : "get_up_front";
+  const std::string other = from_back ? "get_up_front" : "get_up_back";
+  std::filesystem::remove(dir / (roll + ".yaml"));
+  std::ofstream(dir / (roll + ".yaml"))
+      << "motion: " << roll << "\nends: " << (from_back ? "front" : "back")
+      << "\nframes:\n  - {duration: 0.5, joints: {LKneePitch: 1.0}}\n";
+  EXPECT_EQ(agents::loadKeyframeMotion(dir / (roll + ".yaml"), model).ends,
+            from_back ? agents::KeyframeMotion::Ends::Front : agents::KeyframeMotion::Ends::Back);
+  // Up is +x in the torso frame lying on the back, -x on the front.
+  const double start_up = from_back ? 9.81 : -9.81;
   for (const bool rolled : {true, false}) {
     agents::FallDetectorParameters fall;
     fall.get_up = true;
@@ -664,13 +670,13 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
         mc.update(0.01, s, stand, position, stiffness);
     };
     run(0.5);
-    s.accel = Vec3(9.81, 0, 0);  // on its back: up is +x in the torso frame
-    s.pitch = -M_PI / 2;
+    s.accel = Vec3(start_up, 0, 0);
+    s.pitch = from_back ? -M_PI / 2 : M_PI / 2;
     for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
     ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);  // the roll
-    if (rolled) {                                           // now on its front
-      s.accel = Vec3(-9.81, 0, 0);
-      s.pitch = M_PI / 2;
+    if (rolled) {                                           // now on the other side
+      s.accel = Vec3(-start_up, 0, 0);
+      s.pitch = -s.pitch;
     }
     run(0.55);
     EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
@@ -678,51 +684,17 @@ TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
     run(0.5);
     ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;
     ASSERT_NE(mc.keyframeMotion(), nullptr);
-    EXPECT_EQ(mc.keyframeMotion()->name, rolled ? "get_up_front" : "get_up_back");
+    EXPECT_EQ(mc.keyframeMotion()->name, rolled ? other : roll);
   }
 }
+}  // namespace
 
-// The same from the front (the Booster K1's get-up from the front is a roll
-// onto its back, then the rock-up from the back): `ends: back`.
+TEST(MotionController, ARollOntoTheFrontIsFollowedByTheGetUpFromTheFront) {
+  expectTheRollIsFollowedByTheOtherGetUp(true);
+}
+
 TEST(MotionController, ARollOntoTheBackIsFollowedByTheGetUpFromTheBack) {
-  const auto model = robots::loadRobotModel(test::naoH25());
-  const test::TempDir dir("roll_back_motions");
-  for (const auto& f : std::filesystem::directory_iterator(test::sourceDir() / "configs/motions"))
-    if (f.is_regular_file()) std::filesystem::copy_file(f.path(), dir / f.path().filename());
-  std::filesystem::remove(dir / "get_up_front.yaml");
-  std::ofstream(dir / "get_up_front.yaml") << "motion: get_up_front\nends: back\nframes:\n  - "
-                                              "{duration: 0.5, joints: {LKneePitch: 1.0}}\n";
-  EXPECT_EQ(agents::loadKeyframeMotion(dir / "get_up_front.yaml", model).ends,
-            agents::KeyframeMotion::Ends::Back);
-  for (const bool rolled : {true, false}) {
-    agents::FallDetectorParameters fall;
-    fall.get_up = true;
-    agents::MotionController mc = agents::loadMotionController(model, dir.path(), fall);
-    std::vector<float> joints(25, 0.0f), position(25), stiffness(25);
-    agents::MotionSensors s;
-    s.position = joints;
-    MotionRequest stand;
-    auto run = [&](double seconds) {
-      for (int i = 0; i < static_cast<int>(seconds / 0.01); ++i)
-        mc.update(0.01, s, stand, position, stiffness);
-    };
-    run(0.5);
-    s.accel = Vec3(-9.81, 0, 0);  // on its front: up is -x in the torso frame
-    s.pitch = M_PI / 2;
-    for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) run(0.01);
-    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);  // the roll
-    if (rolled) {                                           // now on its back
-      s.accel = Vec3(9.81, 0, 0);
-      s.pitch = -M_PI / 2;
-    }
-    run(0.55);
-    EXPECT_EQ(mc.state(), agents::MotionState::Lying) << rolled;
-    EXPECT_EQ(mc.counters().failed_get_ups, rolled ? 0 : 1);
-    run(0.5);
-    ASSERT_EQ(mc.state(), agents::MotionState::GettingUp) << rolled;
-    ASSERT_NE(mc.keyframeMotion(), nullptr);
-    EXPECT_EQ(mc.keyframeMotion()->name, rolled ? "get_up_back" : "get_up_front");
-  }
+  expectTheRollIsFollowedByTheOtherGetUp(false);
 }
 
 // A motion file's `ends` is standing, front or back; anything else names the key.
