@@ -176,10 +176,10 @@ TEST(BenchMotionApp, WalksForwardSidewaysAndTurnsWithoutFalling) {
 // sideways and random walking without a fall, kicks of 4 m with the size 3 ball, up from its
 // front (a roll, then the rock-up) and from its back.
 TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsUp) {
-  const test::BenchRun run = test::runBench(
-      SIMSOCCER_BIN,
-      "bench motion --robot booster_k1 --random-minutes 1 --get-up-trials 1 "
-      "--sit-trials 1 --striker-trials 1 --penalty-trials 1 --block-trials 1");
+  const test::BenchRun run =
+      test::runBench(SIMSOCCER_BIN,
+                     "bench motion --robot booster_k1 --random-minutes 1 --get-up-trials 1 "
+                     "--sit-trials 1 --striker-trials 1 --penalty-trials 1 --block-trials 1");
   ASSERT_EQ(run.status, 0) << run.out;
   EXPECT_NE(run.out.find("one booster_k1 on an empty field (hsl_m.yaml)"), std::string::npos)
       << run.out;

@@ -151,7 +151,7 @@ class MotionController {
   std::vector<double> targets_, ease_from_;
   std::vector<int> leg_joints_;  // body joint indices of both legs
   double state_time_ = 0.0, still_for_ = 0.0, tilt_ = 0.0;
-  double standing_for_ = 0.0;  // s in the stance with the walk stopped (a kick's ready_time)
+  double standing_for_ = 0.0;        // s in the stance with the walk stopped (a kick's ready_time)
   Vec3 gravity_ = Vec3(0, 0, 9.81);  // low-passed accelerometer
   double stiffness_ = 1.0;
   int head_yaw_ = -1, head_pitch_ = -1;  // body joint indices
