@@ -15,9 +15,10 @@ lines) after every generation. Environment:
   SIGMA=S      initial spread, a share of each parameter's start value (default 0.15)
   MODE=M       the control period, serial or pipelined (default: the bench's default), or
                both: every kick in each (the agents' kick must hold in either)
-  OFFSETS=N    ball offsets per foot, evenly from -2 to +2 cm (default 5)
+  OFFSETS=N    ball offsets per foot, evenly from -2 to +2 cm (default 5, at least 2)
   STEPS=A,B    every kick also after A, B steps on the spot (--steps-first: the kick starts from
-               the sway of the last steps, as in play; default: from a settled stance only)
+               the sway of the last steps, as in play; default: from a settled stance only);
+               with STEPS the kick's ready_time is searched too
   SIM=PATH     the simsoccer binary (default build/apps/simsoccer)
 Needs python3-yaml; runs two kicks at a time."""
 import concurrent.futures as cf
@@ -38,19 +39,25 @@ SIGMA = float(os.environ.get("SIGMA", "0.15"))
 MODES = {"both": ["serial", "pipelined"], None: [None]}.get(os.environ.get("MODE"),
                                                            [os.environ.get("MODE")])
 _BENCH = yaml.safe_load(open(os.path.join(ROOT, "configs/bench/motion_%s.yaml" % ROBOT)))
-_GAIT = yaml.safe_load(open(os.path.normpath(os.path.join(ROOT, "configs/bench", _BENCH["motions"],
-                                                          "gait.yaml"))))
+_GAIT_FILE = os.path.normpath(os.path.join(ROOT, "configs/bench", _BENCH["motions"], "gait.yaml"))
+# A robot without a gait.yaml (the Nao) has the code's defaults.
+_KICK = ((yaml.safe_load(open(_GAIT_FILE)) or {}).get("kick", {})
+         if os.path.exists(_GAIT_FILE) else {})
 # The searched parameters: gait.yaml key, bench motion option, lower and upper bound.
 PARAMS = [("shift", "--kick-shift", 0.02, 0.15), ("lift", "--kick-lift", 0.05, 0.25),
           ("draw_back", "--kick-draw-back", 0.0, 0.2), ("reach", "--kick-reach", 0.05, 0.3),
           ("swing_time", "--kick-swing", 0.05, 0.25),
           ("swing_height", "--kick-swing-height", 0.02, 0.15),
           ("hip_roll_compensation", "--kick-hip-roll", 0.0, 0.3),
-          ("swing_out", "--kick-swing-out", -0.04, 0.04),
-          ("ready_time", "--kick-ready-time", 0.0, 1.0)]
+          ("swing_out", "--kick-swing-out", -0.04, 0.04)]
+STEPS = [int(x) for x in os.environ.get("STEPS", "").split(",") if x]
+if STEPS:  # the wait before a kick after walking only matters after steps
+    PARAMS.append(("ready_time", "--kick-ready-time", 0.0, 1.0))
 # Where gait.yaml leaves a parameter out, the code's default (agents/motion/kick_engine.hpp).
-DEFAULTS = {"hip_roll_compensation": 0.07, "swing_out": 0.0, "ready_time": 0.0}
-START = [float(_GAIT["kick"].get(k, DEFAULTS.get(k))) for k, _, _, _ in PARAMS]
+DEFAULTS = {"shift": 0.052, "lift": 0.105, "draw_back": 0.08, "reach": 0.10, "swing_time": 0.05,
+            "swing_height": 0.02, "hip_roll_compensation": 0.07, "swing_out": 0.0,
+            "ready_time": 0.0}
+START = [float(_KICK.get(k, DEFAULTS[k])) for k, _, _, _ in PARAMS]
 RESULT = re.compile(r"ball (\S+) m at (\S+) deg, fell (\d)")
 
 
@@ -79,9 +86,8 @@ def main():
     gens = int(sys.argv[2]) if len(sys.argv) > 2 else 12
     pop = int(sys.argv[3]) if len(sys.argv) > 3 else 16
     os.makedirs(outdir, exist_ok=True)
-    n = int(os.environ.get("OFFSETS", "5"))
-    steps = [0] + [int(x) for x in os.environ.get("STEPS", "").split(",") if x]
-    kicks = [(foot, -0.02 + 0.04 * k / (n - 1), mode, st) for mode in MODES for st in steps
+    n = max(2, int(os.environ.get("OFFSETS", "5")))
+    kicks = [(foot, -0.02 + 0.04 * k / (n - 1), mode, st) for mode in MODES for st in [0] + STEPS
              for foot in (0, 1) for k in range(n)]
     mean = list(START)
     # A share of each start value; swing_out and ready_time (near 0) on the scale of their range.

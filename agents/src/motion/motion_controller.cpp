@@ -110,6 +110,7 @@ void MotionController::enter(MotionState s) {
   state_ = s;
   state_time_ = 0.0;
   still_for_ = 0.0;
+  standing_for_ = 0.0;
 }
 
 void MotionController::startKeyframes(MotionState s, const KeyframeMotion& motion,
@@ -203,7 +204,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       standing_for_ = state_ == MotionState::Stance && !walk_.walking() ? standing_for_ + dt : 0.0;
       if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
-          !walk_.walking() && standing_for_ >= kick_parameters_.ready_time) {
+          !walk_.walking() && standing_for_ >= kick_parameters_.ready_time - 1e-9) {
         kick_.start(request.kick_foot);
         ++counters_.kicks;
         enter(MotionState::Kicking);

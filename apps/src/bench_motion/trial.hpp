@@ -127,8 +127,10 @@ struct KickResult {
   double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)
   bool fell = false;
 };
-// steps_first: steps on the spot before the kick, which starts as soon as the walk has
-// stopped (as the motion controller kicks in play), instead of from a settled stance.
+// steps_first: steps on the spot before the kick, which starts once the walk has stopped and
+// the robot has stood for the kick's ready_time (as the motion controller kicks in play),
+// instead of from a settled stance. The ball is placed along the field's x axis, the robot's
+// heading at the start: steps on the spot may turn it a little.
 KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset, uint64_t seed,
                      double gap = 0.015, int steps_first = 0);
 

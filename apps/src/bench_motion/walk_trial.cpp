@@ -17,6 +17,13 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   std::vector<double> targets = model.pose("stand");
   const double dt = t.dt();
   settleIntoStance(t, engine, targets);
+  if (falls) {
+    // Random walking: the ball in a corner, outside where the robot walks (below).
+    engine::RigidBodyState ball;
+    ball.pose.translation() = Vec3(w.field().halfLength() - 0.3, w.field().halfWidth() - 0.3,
+                                   w.field().ball.radius);
+    w.setBallState(ball);
+  }
   const engine::Pose start = w.torsoPose(0);
   const Eigen::Vector3d first = schedule(0.0);
   const double vx = first.x(), vy = first.y();
