@@ -20,8 +20,8 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   if (falls) {
     // Random walking: the ball in a corner, outside where the robot walks (below).
     engine::RigidBodyState ball;
-    ball.pose.translation() = Vec3(w.field().halfLength() - 0.3, w.field().halfWidth() - 0.3,
-                                   w.field().ball.radius);
+    ball.pose.translation() =
+        Vec3(w.field().halfLength() - 0.3, w.field().halfWidth() - 0.3, w.field().ball.radius);
     w.setBallState(ball);
   }
   const engine::Pose start = w.torsoPose(0);
