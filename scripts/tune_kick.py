@@ -36,8 +36,8 @@ SIM = os.environ.get("SIM", os.path.join(ROOT, "build/apps/simsoccer"))
 ROBOT = os.environ.get("ROBOT", "booster_k1")
 TARGET = float(os.environ.get("TARGET", "4.0"))
 SIGMA = float(os.environ.get("SIGMA", "0.15"))
-MODES = {"both": ["serial", "pipelined"], None: [None]}.get(os.environ.get("MODE"),
-                                                           [os.environ.get("MODE")])
+MODE = os.environ.get("MODE")  # None: the bench's default
+MODES = ["serial", "pipelined"] if MODE == "both" else [MODE]
 _BENCH = yaml.safe_load(open(os.path.join(ROOT, "configs/bench/motion_%s.yaml" % ROBOT)))
 _GAIT_FILE = os.path.normpath(os.path.join(ROOT, "configs/bench", _BENCH["motions"], "gait.yaml"))
 # A robot without a gait.yaml (the Nao) has the code's defaults.

@@ -1,6 +1,8 @@
 #include "simsoccer/agents/motion/keyframe_motion.hpp"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 #include "simsoccer/engine/config.hpp"
 #include "smoothstep.hpp"
@@ -9,15 +11,21 @@ namespace simsoccer::agents {
 
 namespace {
 
-// An optional `key: first|second` (default first): true for second; any other
-// value is an error naming the key.
-bool secondChoice(const engine::ConfigNode& root, const std::string& key, const std::string& first,
-                  const std::string& second) {
+// An optional `key: one of choices` (default the first): the index of the value; any
+// other value is an error naming the key and the choices.
+size_t choice(const engine::ConfigNode& root, const std::string& key,
+              const std::vector<std::string>& choices) {
   const auto node = root.optional(key);
-  if (!node) return false;
+  if (!node) return 0;
   const std::string v = node->string();
-  if (v != first && v != second) node->fail("must be " + first + " or " + second);
-  return v == second;
+  const auto it = std::find(choices.begin(), choices.end(), v);
+  if (it == choices.end()) {
+    std::string list;
+    for (size_t i = 0; i < choices.size(); ++i)
+      list += (i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + choices[i];
+    node->fail("must be " + list);
+  }
+  return static_cast<size_t>(it - choices.begin());
 }
 
 }  // namespace
@@ -34,17 +42,10 @@ KeyframeMotion loadKeyframeMotion(const std::filesystem::path& file,
   root.allowOnly({"motion", "interpolation", "ends", "frames"});
   KeyframeMotion m;
   m.name = root["motion"].string();
-  if (secondChoice(root, "interpolation", "smooth", "linear"))
-    m.interpolation = KeyframeMotion::Interpolation::Linear;
-  if (const auto ends = root.optional("ends")) {
-    const std::string v = ends->string();
-    if (v == "front")
-      m.ends = KeyframeMotion::Ends::Front;
-    else if (v == "back")
-      m.ends = KeyframeMotion::Ends::Back;
-    else if (v != "standing")
-      ends->fail("must be standing, front or back");
-  }
+  // In the enums' order.
+  m.interpolation = static_cast<KeyframeMotion::Interpolation>(
+      choice(root, "interpolation", {"smooth", "linear"}));
+  m.ends = static_cast<KeyframeMotion::Ends>(choice(root, "ends", {"standing", "front", "back"}));
   const auto& joints = model.body->joints;
   std::vector<double> q = model.pose("stand");
   for (const engine::ConfigNode& item : root["frames"].items()) {

@@ -39,6 +39,15 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
     return true;
   };
   t.driver.setControl(walkControl);
+  // Puts the robot on its feet at (x, y), facing as it does now, and eases it into the walk's
+  // stance as at the start (the trial's clock stands still meanwhile).
+  const auto restartAt = [&](double x, double y) {
+    const engine::Pose p = w.torsoPose(0);
+    w.placeRobot(0, x, y, std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
+    engine = agents::WalkEngine(model, c.walk);
+    settleIntoStance(t, engine, targets);
+    t.driver.setControl(walkControl);
+  };
   for (i = 0; i < periods; ++i) {
     t.period();
     if (!w.isStanding(0)) {
@@ -53,29 +62,22 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
         std::fprintf(stderr, "fall at %.2f s, command %.2f %.2f %.2f (before: %.2f %.2f %.2f)\n",
                      r.fell_at, now.x(), now.y(), now.z(), before.x(), before.y(), before.z());
       }
-      const engine::Pose p = w.torsoPose(0);
-      w.placeRobot(0, p.translation().x(), p.translation().y(),
-                   std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
-      engine = agents::WalkEngine(model, c.walk);
-      settleIntoStance(t, engine, targets);  // as at the start, then on
-      t.driver.setControl(walkControl);
+      const Vec3 p = w.torsoPose(0).translation();
+      restartAt(p.x(), p.y());
       continue;
     }
     if (falls) {
       // Random walking: near the field's lines the robot is put back in the middle (facing as
       // it was; not a fall), so that it never walks into a goal or off the carpet: what this
       // trial counts is the walk's own falls.
-      const engine::Pose p = w.torsoPose(0);
+      const Vec3 p = w.torsoPose(0).translation();
       const double margin = 1.0;  // m, inside the lines
-      if (std::abs(p.translation().x()) > w.field().halfLength() - margin ||
-          std::abs(p.translation().y()) > w.field().halfWidth() - margin) {
+      if (std::abs(p.x()) > w.field().halfLength() - margin ||
+          std::abs(p.y()) > w.field().halfWidth() - margin) {
         if (c.verbose)
           std::fprintf(stderr, "back to the middle at %.2f s from %.2f %.2f\n",
-                       static_cast<double>(i) * dt, p.translation().x(), p.translation().y());
-        w.placeRobot(0, 0.0, 0.0, std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
-        engine = agents::WalkEngine(model, c.walk);
-        settleIntoStance(t, engine, targets);
-        t.driver.setControl(walkControl);
+                       static_cast<double>(i) * dt, p.x(), p.y());
+        restartAt(0.0, 0.0);
         continue;
       }
     }
