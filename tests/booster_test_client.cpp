@@ -110,6 +110,10 @@ int main(int argc, char** argv) {
   int periods = 300;
   double walk = 0.0;       // --walk V: walk with Booster's locomotion API at V m/s instead
   int custom_between = 0;  // with --walk: N LowStates in CUSTOM between two walks
+  // --kick shoot|visual: in SOCCER mode, Shoot once, or run the visual kick (aimed at
+  // --kick-dir rad, robot frame, through rt/kick_ball) for --periods LowStates.
+  std::string kick;
+  double kick_dir = 0.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--domain")
@@ -122,6 +126,10 @@ int main(int argc, char** argv) {
       walk = std::stod(argv[i + 1]);
     else if (a == "--custom-between")
       custom_between = std::stoi(argv[i + 1]);
+    else if (a == "--kick")
+      kick = argv[i + 1];
+    else if (a == "--kick-dir")
+      kick_dir = std::stod(argv[i + 1]);
   }
   if (!config.empty()) {
     std::ifstream f(config);
@@ -187,6 +195,42 @@ int main(int argc, char** argv) {
   const json mode = rpc.api(2017, json::object());
   expect("get_mode_first", mode, 0);
   if (json::parse(mode.at("body").get<std::string>()).at("mode") != 1) ok = false;
+  if (!kick.empty()) {
+    // As team code that kicks with Booster's soccer mode (HULKs, NUbots): SOCCER, then Shoot,
+    // or VisualKick started with its direction on rt/kick_ball (reliable, as ROS 2 publishers
+    // are), left running, then stopped.
+    expect("soccer", rpc.api(2000, {{"mode", 4}}), 0);
+    for (int k = 0; k < 100; ++k) nextState(0.05);  // standing still first
+    expect("visual_kick_malformed", rpc.api(2038, {{"start", "yes"}}), 400);
+    if (kick == "shoot") {
+      // Looking down at the ball first (Shoot takes the foot on the side the robot saw it).
+      expect("head_down", rpc.api(2004, {{"pitch", 0.8}, {"yaw", 0.0}}), 0);
+      for (int k = 0; k < 50; ++k) nextState(0.05);
+      expect("shoot", rpc.api(2024, json::object()), 0);
+      for (int k = 0; k < periods; ++k)
+        if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+    } else {
+      const dds_entity_t target = endpoint(false, &brain_msg_dds__Kick__desc, "rt/kick_ball", true, 1);
+      expect("visual_kick", rpc.api(2038, {{"start", true}, {"version", 1}}), 0);
+      expect("shoot_while_visual_kick", rpc.api(2024, json::object()), 502);
+      for (int k = 0; k < periods; ++k) {
+        if (k < 300 && k % 100 == 0) {  // three times, as team code repeats its target
+          std::string frame = "base_link";
+          brain_msg_dds__Kick_ m{};
+          m.header.frame_id = frame.data();
+          m.dir = kick_dir;
+          m.power = 6.0;
+          if (dds_write(target, &m) < 0) fail("write Kick");
+        }
+        if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
+      }
+      expect("visual_kick_stop", rpc.api(2038, {{"start", false}, {"version", 1}}), 0);
+    }
+    const json soccer = rpc.api(2017, json::object());
+    expect("get_mode_soccer", soccer, 0);
+    if (json::parse(soccer.at("body").get<std::string>()).at("mode") != 4) ok = false;
+    return finish();
+  }
   if (walk != 0.0) {
     // As team code that uses Booster's walk: walking mode, the head turned, Move repeated at
     // about 50 Hz (every 2 LowStates of a 10 ms period) for `periods` LowStates, then a stop.

@@ -81,12 +81,14 @@ struct ServedK1 {
   world::World w;
   sim::Simulation simulation;
   booster::Endpoint endpoint;
-  ServedK1(const booster::BoosterRobot& robot, bool lockstep)
-      : w(k1Scenario()),
+  ServedK1(const booster::BoosterRobot& robot, bool lockstep,
+           const world::Scenario& scenario = k1Scenario(), sim::Mode mode = sim::Mode::Serial)
+      : w(scenario),
         simulation(w,
                    [&] {
                      sim::SimulationConfig c;
                      c.lockstep = lockstep;
+                     c.mode = mode;
                      return c;
                    }()),
         endpoint(w, [&] {
@@ -200,6 +202,80 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   EXPECT_TRUE(w.isStanding(0));
   const int head = w.robot(0).model->body->jointIndex("HeadYaw");
   EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.3, 0.05);
+}
+
+// A K1 on the HSL M-Field (its size 3 ball) at the centre facing +x, with the simulation's
+// perception (ideal: what its cameras' frustums hold) for its locomotion service's kicks.
+world::Scenario k1KickScenario() {
+  world::Scenario s = k1Scenario();
+  s.field_file = test::sourceDir() / "fields/hsl_m.yaml";
+  s.robots[0].x = 0.0;
+  s.robots[0].y = 0.0;
+  s.perception.enabled = true;
+  return s;
+}
+
+// Team code that kicks through Booster's soccer mode (HULKs, NUbots): VisualKick started, its
+// direction on rt/kick_ball; simsoccer's K1 walks to the ball its perception sees, lines up
+// behind it on that line and kicks it, with the walk's own kick.
+TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
+  booster::BoosterRobot robot = served(0, 175);
+  robot.motions = test::sourceDir() / "configs/motions/booster_k1";
+  // Pipelined, as simsoccer serve runs (the K1's kick is tuned for its one period of delay).
+  ServedK1 k1(robot, /*lockstep=*/false, k1KickScenario(), sim::kDefaultMode);
+  auto& [w, simulation, endpoint] = k1;
+  // The ball 1.5 m ahead and 0.6 m to the left; kicked along the field's +x (dir 0 from the
+  // robot's heading then): the K1 has to walk round to behind it first.
+  test::putBallOnCarpet(w, 1.5, 0.6);
+  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "175", "--dds-config",
+                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
+                        "1400", "--kick", "visual", "--kick-dir", "0"});
+  ASSERT_TRUE(client.process.started());
+  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
+  const json r = client.result();
+  std::printf("client: %s\n", r.dump().c_str());
+  ASSERT_EQ(status, 0) << r.dump();
+  const engine::Vec3 ball = w.ballState().pose.translation();
+  const auto s = endpoint.stats(0);
+  std::printf("ball at (%.2f, %.2f) after %.1f s; kicks %llu, targets %llu\n", ball.x(), ball.y(),
+              w.time(), (unsigned long long)s.kicks, (unsigned long long)s.kick_targets);
+  EXPECT_EQ(s.kick_targets, 3u);
+  EXPECT_EQ(s.kick_targets_refused, 0u);
+  EXPECT_GE(s.kicks, 1u);
+  EXPECT_EQ(s.requests_malformed, 1u);  // {"start": "yes"}
+  EXPECT_EQ(s.requests_refused, 1u);    // Shoot while the visual kick runs: 502
+  // Kicked on along +x, not sideways: at least 2 m on from where it lay.
+  EXPECT_GT(ball.x(), 3.5);
+  EXPECT_LT(std::abs(ball.y() - 0.6), 0.4 * (ball.x() - 1.5));
+  EXPECT_TRUE(w.isStanding(0));
+}
+
+// Shoot: one kick where the robot stands, with the foot on the ball's side.
+TEST(BoosterEndpoint, ShootKicksTheBallInFrontOfTheK1) {
+  booster::BoosterRobot robot = served(0, 176);
+  robot.motions = test::sourceDir() / "configs/motions/booster_k1";
+  // Pipelined, as simsoccer serve runs (the K1's kick is tuned for its one period of delay).
+  ServedK1 k1(robot, /*lockstep=*/false, k1KickScenario(), sim::kDefaultMode);
+  auto& [w, simulation, endpoint] = k1;
+  // In front of the left foot, where the walk's kick meets it (configs/motions/booster_k1/
+  // kick_approach.yaml: 0.25 m ahead, 0.095 m to the side).
+  test::putBallOnCarpet(w, 0.25, 0.095);
+  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "176", "--dds-config",
+                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
+                        "500", "--kick", "shoot"});
+  ASSERT_TRUE(client.process.started());
+  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
+  const json r = client.result();
+  std::printf("client: %s\n", r.dump().c_str());
+  ASSERT_EQ(status, 0) << r.dump();
+  const engine::Vec3 ball = w.ballState().pose.translation();
+  const auto s = endpoint.stats(0);
+  std::printf("ball at (%.2f, %.2f) after %.1f s; kicks %llu\n", ball.x(), ball.y(), w.time(),
+              (unsigned long long)s.kicks);
+  EXPECT_EQ(s.kicks, 1u);
+  EXPECT_GT(ball.x(), 3.0);
+  EXPECT_LT(std::abs(ball.y()), 0.3 * ball.x());
+  EXPECT_TRUE(w.isStanding(0));
 }
 
 // Two robots cannot share a domain (the SDK's topics carry no robot id), and

@@ -77,9 +77,10 @@ TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
 TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
   LocoService s(RobotMode::Prepare, /*walk=*/true);
   EXPECT_FALSE(s.walking());
-  // Move and GetUp outside walking and soccer: refused, nothing changes.
-  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", 0.0}, {"vyaw", 0.0}}).status, kStatusServerRefused);
-  EXPECT_EQ(call(s, 2008, json::object()).status, kStatusServerRefused);
+  // Move and GetUp outside walking and soccer: not from this state, nothing changes.
+  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", 0.0}, {"vyaw", 0.0}}).status,
+            kStatusStateTransitionFailed);
+  EXPECT_EQ(call(s, 2008, json::object()).status, kStatusStateTransitionFailed);
   EXPECT_EQ(s.velocity().vx, 0.0);
   EXPECT_EQ(call(s, 2000, {{"mode", 2}}).status, kStatusSuccess);
   EXPECT_TRUE(s.walking());
@@ -96,12 +97,66 @@ TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
   EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", "fast"}, {"vyaw", 0.0}}).status, kStatusBadRequest);
   EXPECT_EQ(call(s, 2001, {{"vx", 1e9}, {"vy", 0.0}, {"vyaw", 0.0}}).status, kStatusBadRequest);
   EXPECT_DOUBLE_EQ(s.velocity().vx, 0.3);
-  // Kicks are not served yet; LieDown neither.
+  // Without a kick approach no kicks; LieDown is not served.
   EXPECT_EQ(call(s, 2038, {{"start", true}}).status, kStatusServerRefused);
+  EXPECT_EQ(call(s, 2024, json::object()).status, kStatusServerRefused);
   EXPECT_EQ(call(s, 2007, json::object()).status, kStatusServerRefused);
   // Back to prepare: standing, the velocity forgotten; walking again starts from rest.
   EXPECT_EQ(call(s, 2000, {{"mode", 1}}).status, kStatusSuccess);
   EXPECT_FALSE(s.walking());
   EXPECT_EQ(call(s, 2000, {{"mode", 2}}).status, kStatusSuccess);
   EXPECT_EQ(s.velocity().vx, 0.0);
+}
+
+// A robot with a walk and a kick approach (the K1): Shoot and VisualKick in Walking and
+// Soccer with the robot on its feet; the visual kick runs until stopped, the mode left or a
+// fall; malformed kicks named.
+TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
+  LocoService s(RobotMode::Prepare, /*walk=*/true, /*kicks=*/true);
+  EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status,
+            kStatusStateTransitionFailed);
+  EXPECT_FALSE(s.takeShoot());
+  EXPECT_FALSE(s.visualKick());
+  // Stopping is always allowed.
+  EXPECT_EQ(call(s, 2038, {{"start", false}, {"version", 0}}).status, kStatusSuccess);
+  EXPECT_EQ(call(s, 2000, {{"mode", 4}}).status, kStatusSuccess);
+  // Shoot: one kick, the walk's velocity forgotten.
+  EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", 0.0}, {"vyaw", 0.0}}).status, kStatusSuccess);
+  EXPECT_EQ(call(s, 2024, json::object()).status, kStatusSuccess);
+  EXPECT_TRUE(s.takeShoot());
+  EXPECT_FALSE(s.takeShoot());
+  EXPECT_EQ(s.velocity().vx, 0.0);
+  // VisualKick: the body as the SDK writes it ({"start", "version"}; version 1 is V2).
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 1}}).status, kStatusSuccess);
+  EXPECT_TRUE(s.visualKick());
+  EXPECT_EQ(s.visualKickVersion(), 1);
+  EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
+  EXPECT_FALSE(s.takeShoot());
+  // Down: it ends, and kicks wait until the robot is up.
+  s.setDown(true);
+  EXPECT_FALSE(s.visualKick());
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status,
+            kStatusStateTransitionFailed);
+  EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
+  s.setDown(false);
+  EXPECT_EQ(call(s, 2038, {{"start", true}}).status, kStatusSuccess);  // version: V1
+  EXPECT_EQ(s.visualKickVersion(), 0);
+  // Soccer to walking keeps it; prepare ends it.
+  EXPECT_EQ(call(s, 2000, {{"mode", 2}}).status, kStatusSuccess);
+  EXPECT_TRUE(s.visualKick());
+  EXPECT_EQ(call(s, 2000, {{"mode", 1}}).status, kStatusSuccess);
+  EXPECT_FALSE(s.visualKick());
+  // Malformed: 400, nothing changes.
+  call(s, 2000, {{"mode", 4}});
+  const uint64_t malformed = s.malformed();
+  for (const json& body : {json{{"start", "yes"}}, json{{"version", 1}},
+                           json{{"start", true}, {"version", 2}},
+                           json{{"start", true}, {"version", "V2"}}}) {
+    const RpcAnswer a = call(s, 2038, body);
+    EXPECT_EQ(a.status, kStatusBadRequest) << body.dump();
+    EXPECT_NE(a.body.find("VisualKick"), std::string::npos) << a.body;
+  }
+  EXPECT_EQ(s.malformed(), malformed + 4);
+  EXPECT_FALSE(s.visualKick());
 }

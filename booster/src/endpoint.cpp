@@ -16,6 +16,7 @@
 #include <string>
 
 #include "booster_sdk.h"
+#include "simsoccer/agents/behaviour/kick_approach.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/net/dds.hpp"
 
@@ -30,6 +31,7 @@ using RpcReq = booster_msgs_msg_dds__RpcReqMsg_;
 using RpcResp = booster_msgs_msg_dds__RpcRespMsg_;
 using Image = sensor_msgs_msg_dds__Image_;
 using CompressedImage = sensor_msgs_msg_dds__CompressedImage_;
+using KickTarget = brain_msg_dds__Kick_;
 
 namespace {
 net::QosSpec qos(bool reliable, int depth, bool transient_local = false) {
@@ -50,6 +52,7 @@ struct Endpoint::Robot {
   net::Reader<RpcReq> requests;
   net::Writer<RpcResp> answers;
   net::Writer<FallDown> fall;
+  net::Reader<KickTarget> kick_targets;
   LocoService loco;
   RobotBoosterStats stats;
   // Camera images (attachCameras), written from the camera conversion thread.
@@ -76,6 +79,21 @@ struct Endpoint::Robot {
   // loaded with the endpoint and restarted from the measured joints on each entry.
   std::unique_ptr<agents::MotionController> motion;
   bool was_walking = false;
+  // The walk's targets for this period (computed when the state is observed).
+  std::array<float, world::kActuators> walk_position{}, walk_stiffness{};
+  bool walk_ready = false;
+  // Shoot and VisualKick: the kick approach (the motions folder's
+  // kick_approach.yaml), the ball as the robot's perception saw it last, the
+  // latest rt/kick_ball direction (rad, robot frame when the heading was
+  // target_yaw, at simulation time target_at).
+  std::unique_ptr<agents::KickApproach> approach;
+  agents::BallSighting ball;
+  bool was_visual_kick = false;
+  bool shooting = false;
+  agents::Leg shoot_foot = agents::Leg::Right;
+  double shoot_until = -1.0;
+  std::optional<double> target_dir;
+  double target_yaw = 0.0, target_at = -1e9;
 
   // LowState buffers (the sample points at them) and the last joint speeds.
   std::vector<MotorState> motors;
@@ -84,7 +102,7 @@ struct Endpoint::Robot {
   int fall_state = -1;
   double fall_sent_at = -1e9;
 
-  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds, bool walk)
+  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds, bool walk, bool kicks)
       : config(c),
         actuators(n),
         participant(dds),
@@ -100,7 +118,9 @@ struct Endpoint::Robot {
                 qos(true, 10, true)),
         fall(participant, booster_interface_msg_dds__FallDownState__desc, "rt/fall_down",
              qos(true, 1)),
-        loco(c.initial_mode, walk),
+        // Best effort, as Booster's own readers of it: matches every writer.
+        kick_targets(participant, brain_msg_dds__Kick__desc, "rt/kick_ball", qos(false, 4)),
+        loco(c.initial_mode, walk, kicks),
         pending_pool(kMaxPending, Command{std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n)}),
@@ -133,12 +153,14 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     const robots::RobotModel& model = *world.robot(b.robot).model;
     const std::vector<double>& stand = model.pose("stand");  // throws if the model has none
     const bool walk = !b.motions.empty();
+    const std::filesystem::path approach = b.motions / "kick_approach.yaml";
+    const bool kicks = walk && std::filesystem::exists(approach);
     net::DomainConfig dds;
     dds.domain = b.domain;
     dds.config_file = config_.dds_config;
     std::unique_ptr<Robot> r;
     if (b.network_namespace.empty()) {
-      r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk);
+      r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk, kicks);
     } else {
       // Cyclone opens the domain's sockets and starts its threads when the
       // domain is made: made on a thread inside the namespace, they stay
@@ -156,7 +178,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
           if (rc != 0)
             throw std::runtime_error("Booster endpoint: cannot enter network namespace " +
                                      b.network_namespace + " (needs CAP_SYS_ADMIN)");
-          r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk);
+          r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk, kicks);
         } catch (...) {
           failed = std::current_exception();
         }
@@ -169,6 +191,8 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     if (walk)
       r->motion = std::make_unique<agents::MotionController>(
           agents::loadMotionController(model, b.motions));
+    if (kicks)
+      r->approach = std::make_unique<agents::KickApproach>(agents::loadKickApproach(approach));
     robots_.push_back(std::move(r));
   }
   // Lockstep waits on every robot's commands at once.
@@ -245,6 +269,7 @@ RobotBoosterStats Endpoint::stats(std::size_t i) const {
   s.requests = r.loco.requests();
   s.requests_refused = r.loco.refused();
   s.requests_malformed = r.loco.malformed();
+  if (r.motion) s.kicks = static_cast<uint64_t>(r.motion->counters().kicks);
   return s;
 }
 
@@ -289,8 +314,15 @@ void takeCommands(auto& r) {
 void Endpoint::observe(const sim::Observation& o) {
   const world::World& w = *o.world;
   const double period = w.scenario().physics.control_period;
+  time_ = o.time;
   for (auto& rp : robots_) {
     Robot& r = *rp;
+    // The ball as the robot's cameras saw it (the simulation's perception):
+    // what its visual kick goes for.
+    if (o.perception) {
+      const world::PerceivedObject& b = o.perception->perception(r.config.robot).ball;
+      r.ball = agents::BallSighting{b.x, b.y, b.last_seen < 0.0 ? -1.0 : o.time - b.last_seen};
+    }
     // Lockstep: what came after the last period's wait answers a state that
     // is gone; it must not answer the new one (the robot would run a period
     // behind for good).
@@ -341,7 +373,73 @@ void Endpoint::observe(const sim::Observation& o) {
       r.fall_state = fallen;
       r.fall_sent_at = o.time;
     }
+    // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
+    r.walk_ready = false;
+    if (r.loco.walking())
+      walkTargets(r, f);
+    else
+      r.was_walking = r.was_visual_kick = false;
   }
+}
+
+void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame) {
+  // Walking and Soccer: simsoccer's walk at Move's velocity, the head
+  // where RotateHead turned it; from standing still it eases into the
+  // walk's stance (and after a fall it gets up). Computed from the frame
+  // the client gets, so that the walk's commands act when a client's would
+  // (pipelined: a period later).
+  if (!r.was_walking) {
+    r.motion->restart();
+    ++r.stats.walk_starts;
+  }
+  r.was_walking = true;
+  const double yaw = frame.angles[2];
+  agents::MotionRequest request;
+  const bool visual = r.approach && r.loco.visualKick();
+  if (visual) {
+    // The visual kick: to the ball the robot sees, kicked the way
+    // rt/kick_ball says (a direction sent with the start holds).
+    if (!r.was_visual_kick) {
+      r.approach->start(time_, yaw);
+      if (r.target_dir && time_ - r.target_at < 1.0) r.approach->aimAt(*r.target_dir, r.target_yaw);
+    }
+    request = r.approach->update(time_, r.ball, yaw, r.motion->state());
+  } else {
+    if (r.loco.takeShoot()) {
+      // Shoot: one kick where it stands, with the foot on the side of a
+      // ball it saw near in the last second (else the right).
+      r.shooting = true;
+      r.shoot_until = time_ + 3.0;
+      const bool near =
+          r.ball.age >= 0.0 && r.ball.age < 1.0 && std::hypot(r.ball.x, r.ball.y) < 1.0;
+      r.shoot_foot = near && r.ball.y >= 0.0 ? agents::Leg::Left : agents::Leg::Right;
+    }
+    // Asked for until the motion layer kicks (it stops the walk first).
+    if (r.motion->state() == agents::MotionState::Kicking || time_ > r.shoot_until)
+      r.shooting = false;
+    const WalkVelocity& v = r.loco.velocity();
+    if (r.shooting) {
+      request.kind = agents::MotionRequest::Kind::Kick;
+      request.kick_foot = r.shoot_foot;
+    } else if (v.vx != 0.0 || v.vy != 0.0 || v.vyaw != 0.0) {
+      request.kind = agents::MotionRequest::Kind::Walk;
+      request.forward = v.vx;
+      request.left = v.vy;
+      request.turn = v.vyaw;
+    }
+    if (const auto& head = r.loco.headTarget()) {
+      request.head_yaw = head->yaw;
+      request.head_pitch = head->pitch;
+    }
+  }
+  r.was_visual_kick = visual;
+  r.motion->update(world_.scenario().physics.control_period, agents::motionSensors(frame), request,
+                   r.walk_position, r.walk_stiffness);
+  r.walk_ready = true;
+  // Kicks need the robot on its feet (the walk's fall detector tells).
+  const agents::MotionState m = r.motion->state();
+  r.loco.setDown(m == agents::MotionState::Falling || m == agents::MotionState::Lying ||
+                 m == agents::MotionState::GettingUp);
 }
 
 void Endpoint::answerRequests(Robot& r) {
@@ -358,10 +456,27 @@ void Endpoint::answerRequests(Robot& r) {
 }
 
 
+void Endpoint::takeKickTargets(Robot& r) {
+  const double yaw = world_.sensorFrame(r.config.robot).angles[2];
+  r.kick_targets.take([&](const KickTarget& k, const dds_sample_info_t&) {
+    ++r.stats.kick_targets;
+    if (!std::isfinite(k.dir)) {
+      ++r.stats.kick_targets_refused;
+      return;
+    }
+    r.target_dir = k.dir;
+    r.target_yaw = yaw;
+    r.target_at = time_;
+    if (r.approach && r.was_visual_kick && r.loco.visualKick()) r.approach->aimAt(k.dir, yaw);
+  });
+}
+
 void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandSlot> slots) {
   for (auto& rp : robots_) {
-    answerRequests(*rp);
-    takeCommands(*rp);
+    Robot& r = *rp;
+    answerRequests(r);
+    takeKickTargets(r);
+    takeCommands(r);
   }
   const auto awaited = [&](const Robot& r) {
     return config_.lockstep && r.loco.mode() == RobotMode::Custom && r.ever_commanded &&
@@ -383,8 +498,6 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
   for (auto& rp : robots_) {
     Robot& r = *rp;
     sim::CommandSlot& slot = slots[r.config.robot];
-    // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
-    if (!r.loco.walking()) r.was_walking = false;
     if (r.loco.mode() != RobotMode::Custom) {
       r.stats.ignored += r.pending;
       r.pending = 0;
@@ -428,33 +541,11 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
 std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGate& gate) const {
   const robots::RobotModel& model = *world_.robot(r.config.robot).model;
   const size_t n = r.actuators;
-  const bool walking = r.loco.walking();
-  if (walking) {
-    // Walking and Soccer: simsoccer's walk at Move's velocity, the head
-    // where RotateHead turned it; from standing still it eases into the
-    // walk's stance (and after a fall it gets up).
-    if (!r.was_walking) {
-      r.motion->restart();
-      ++r.stats.walk_starts;
-    }
-    r.was_walking = true;
-    const WalkVelocity& v = r.loco.velocity();
-    agents::MotionRequest request;
-    request.kind = v.vx == 0.0 && v.vy == 0.0 && v.vyaw == 0.0 ? agents::MotionRequest::Kind::Stand
-                                                               : agents::MotionRequest::Kind::Walk;
-    request.forward = v.vx;
-    request.left = v.vy;
-    request.turn = v.vyaw;
-    if (const auto& head = r.loco.headTarget()) {
-      request.head_yaw = head->yaw;
-      request.head_pitch = head->pitch;
-    }
-    std::array<float, world::kActuators> position{}, stiffness{};
-    r.motion->update(world_.scenario().physics.control_period,
-                     agents::motionSensors(world_.sensorFrame(r.config.robot)), request, position,
-                     stiffness);
-    return gate.check(r.config.robot, std::span<const float>(position),
-                      std::span<const float>(stiffness));
+  if (r.loco.walking()) {
+    // Walking and Soccer: the walk's targets for this period (walkTargets).
+    if (!r.walk_ready) return std::nullopt;
+    return gate.check(r.config.robot, std::span<const float>(r.walk_position),
+                      std::span<const float>(r.walk_stiffness));
   }
   if (r.loco.mode() == RobotMode::Prepare) {
     // Standing: the stand pose on the robot's own servos, the head where

@@ -50,6 +50,11 @@ RpcAnswer error(int64_t status, const std::string& why) {
 
 }  // namespace
 
+void LocoService::setDown(bool down) {
+  down_ = down;
+  if (down) visual_kick_ = shoot_ = false;
+}
+
 RpcAnswer LocoService::handle(std::string_view header_text, std::string_view body_text) {
   ++requests_;
   const std::optional<json> header = parseObject(header_text);
@@ -77,8 +82,28 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
   };
   const auto walkingOnly = [&](const char* what) {
     ++refused_;
-    a = error(kStatusServerRefused, std::string(what) + ": the robot is in " + modeName(mode_) +
-                                        " mode, not walking or soccer");
+    a = error(kStatusStateTransitionFailed, std::string(what) + ": the robot is in " +
+                                                modeName(mode_) + " mode, not walking or soccer");
+  };
+  // A kick's preconditions; false (and the answer made) if one is not met.
+  const auto canKick = [&](const char* what) {
+    if (!kicks_) {
+      ++refused_;
+      a = error(kStatusServerRefused,
+                std::string(what) + " is not available in simsoccer for this robot (" +
+                    (walk_ ? "it has no kick approach" : "it has no walk") + ")");
+      return false;
+    }
+    if (!walking()) {
+      walkingOnly(what);
+      return false;
+    }
+    if (down_) {
+      ++refused_;
+      a = error(kStatusStateTransitionFailed, std::string(what) + ": the robot is down");
+      return false;
+    }
+    return true;
   };
   if (!body) {
     bad("the body is not a JSON object");
@@ -96,7 +121,10 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
             const bool was_walking = walking();
             mode_ = mode;
             if (mode_ == RobotMode::Damping || mode_ == RobotMode::Custom) head_.reset();
-            if (!(was_walking && walking())) velocity_ = WalkVelocity{};
+            if (!(was_walking && walking())) {
+              velocity_ = WalkVelocity{};
+              visual_kick_ = shoot_ = false;
+            }
           }
         }
         break;
@@ -141,9 +169,36 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
         unavailable("Lying down");
         break;
       case LocoApi::Shoot:
-      case LocoApi::VisualKick:
-        unavailable("Kicking");
+        if (canKick("Shoot")) {
+          if (visual_kick_) {
+            ++refused_;
+            a = error(kStatusStateTransitionFailed, "Shoot: the visual kick runs (stop it first)");
+          } else {
+            shoot_ = true;
+            velocity_ = WalkVelocity{};  // it stands after the kick until the next Move
+          }
+        }
         break;
+      case LocoApi::VisualKick: {
+        if (!kicks_) {
+          canKick("VisualKick");  // answers 501
+          break;
+        }
+        const auto start = body->find("start");
+        const std::optional<double> version =
+            body->contains("version") ? number(*body, "version") : std::optional<double>(0.0);
+        if (start == body->end() || !start->is_boolean() || !version ||
+            (*version != 0.0 && *version != 1.0)) {
+          bad("VisualKick: \"start\" must be true or false and \"version\" 0 (V1) or 1 (V2)");
+        } else if (!start->get<bool>()) {
+          visual_kick_ = false;  // stopping is always allowed
+        } else if (canKick("VisualKick")) {
+          visual_kick_ = true;
+          shoot_ = false;
+          visual_kick_version_ = static_cast<int>(*version);
+        }
+        break;
+      }
       case LocoApi::SwitchGait:
         unavailable("SwitchGait");
         break;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "simsoccer/agents/behaviour/kick_approach.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/protocol/gamecontroller.hpp"
 
@@ -441,24 +442,12 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
   }
   // Line up: the ball in front of a foot, the body along the aim. Fine
   // control on the robot-frame sighting (what the robot sees directly).
-  const Vec2 b = ball_robot_;
-  if (std::abs(b.y) > 0.02 || kick_foot_ == Leg::Right)
-    kick_foot_ = b.y >= 0 ? Leg::Left : Leg::Right;
-  const double foot_y = kick_foot_ == Leg::Left ? config_.kick_ball_y : -config_.kick_ball_y;
-  const double ex = b.x - config_.kick_ball_x, ey = b.y - foot_y;
-  const double ea = wrap(aim - self_.yaw);
-  MotionRequest r;
-  if (std::abs(ex) < config_.kick_tolerance_x && std::abs(ey) < config_.kick_tolerance_y &&
-      std::abs(ea) < config_.kick_tolerance_angle) {
-    r.kind = MotionRequest::Kind::Kick;
-    r.kick_foot = kick_foot_;
+  MotionRequest r = lineUpForKick(config_, ball_robot_.x, ball_robot_.y, wrap(aim - self_.yaw),
+                                  penalty ? 0.1 : 0.15, kick_foot_);
+  if (r.kind == MotionRequest::Kind::Kick) {
     kick_commit_until_ = now_ + 1.5;
     return r;
   }
-  r.kind = MotionRequest::Kind::Walk;
-  r.forward = std::clamp(0.9 * ex, -0.06, penalty ? 0.1 : 0.15);
-  r.left = std::clamp(0.9 * ey, -0.06, 0.06);
-  r.turn = std::clamp(1.0 * ea, -0.4, 0.4);
   target_ = {ball_.x, ball_.y, aim};
   return r;
 }
@@ -652,9 +641,7 @@ void SoccerBehaviour::head(MotionRequest& r, const MotionRequest& planned, const
     // camera sees far, the bottom one near the feet); where it was last
     // known, if the head was turned away from it for a while.
     const Vec2 b = seen ? ball_robot_ : toRobot(ball_);
-    const double d = std::hypot(b.x, b.y);
-    r.head_yaw = std::atan2(b.y, b.x);
-    r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
+    lookAt(b.x, b.y, r);
   } else {
     // Scan: side to side, 4 s a sweep, nearly to the yaw limits (±2.09 rad):
     // with the cameras' width that covers all but the back 65° without

@@ -219,8 +219,10 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       }
       if (request.kind == MotionRequest::Kind::Walk)
         walk_.setVelocity(request.forward, request.left, request.turn);
-      else  // stand, or stop before a kick; before sitting down, come to rest
-        walk_.stop(request.kind == MotionRequest::Kind::Sit);
+      else  // stand; before a kick or sitting down, come to rest (the sway must not keep
+            // the heading hold stepping: a K1 lined up at the ball stepped on for good)
+        walk_.stop(request.kind == MotionRequest::Kind::Sit ||
+                   request.kind == MotionRequest::Kind::Kick);
       walk_.update(dt, sensors.gyro, sensors.yaw, targets_);
       state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
       break;

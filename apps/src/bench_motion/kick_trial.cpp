@@ -73,7 +73,7 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
     });
     const int periods = static_cast<int>(std::lround(steps_first * c.walk.step_period / dt));
     for (int i = 0; i < periods; ++i) t.period();
-    walk.stop();
+    walk.stop(/*settle=*/true);  // as the motion controller stops before a kick
     for (int i = 0; i < static_cast<int>(std::lround(3.0 / dt)) && walk.walking(); ++i) t.period();
     // Then standing for the kick's ready_time, as the motion controller does.
     for (int i = 0; i < static_cast<int>(std::lround(c.kick.ready_time / dt)); ++i) t.period();

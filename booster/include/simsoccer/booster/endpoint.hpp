@@ -16,6 +16,9 @@
 //                         C++ SDK's volatile and the Rust SDK's
 //                         transient-local readers both match)
 //   rt/fall_down          FallDownState_ out, on change and once a second
+//   rt/kick_ball          brain Kick_ in: the visual kick's direction (its
+//                         "dir"; the ball is the one the robot's own
+//                         perception sees)
 //   rt/StereoNetNode/rectified_image   the head camera's images as ROS 2's
 //                         sensor_msgs Image_ (YUYV: "yuv422_yuy2") or, with
 //                         JPEG cameras, CompressedImage_ on .../compressed,
@@ -52,7 +55,10 @@ struct BoosterRobot {
   uint32_t namespace_domain = 0;
   // The robot's motions folder (keyframes and gait.yaml, e.g.
   // configs/motions/booster_k1): simsoccer's walk for the locomotion
-  // service's Walking and Soccer modes. Empty: those modes answer 501.
+  // service's Walking and Soccer modes. Empty: those modes answer 501. With
+  // a kick_approach.yaml there (agents::loadKickApproach), Shoot and
+  // VisualKick are served too (the visual kick needs the scenario's
+  // perception on: without it the robot sees no ball and searches).
   std::filesystem::path motions;
 };
 
@@ -84,6 +90,9 @@ struct RobotBoosterStats {
   uint64_t images = 0;            // camera images published
   uint64_t walk_starts = 0;       // times simsoccer's walk (re)started: each entry into WALKING
                                   // or SOCCER from another mode
+  uint64_t kicks = 0;             // kicks the walk made (Shoot, the visual kick)
+  uint64_t kick_targets = 0;      // rt/kick_ball samples received
+  uint64_t kick_targets_refused = 0;  // of them with a direction that is not a number
 };
 
 class Endpoint : public sim::CommandSource {
@@ -114,14 +123,19 @@ class Endpoint : public sim::CommandSource {
  private:
   struct Robot;
   void answerRequests(Robot& r);
+  // rt/kick_ball: the visual kick's direction.
+  void takeKickTargets(Robot& r);
   void publishImage(const world::CameraImage& image);
+  // Walking and Soccer: the walk's targets from the frame just observed.
+  void walkTargets(Robot& r, const world::SensorFrame& frame);
   // The command of robot r's mode outside CUSTOM (prepare: stand; damping;
-  // walking and soccer: the walk).
+  // walking and soccer: the walk's targets).
   std::optional<sim::RobotCommand> modeCommand(Robot& r, sim::CommandGate& gate) const;
   const world::World& world_;
   EndpointConfig config_;
   std::vector<std::unique_ptr<Robot>> robots_;
   int32_t waitset_ = 0;  // a DDS waitset on every robot's commands (lockstep)
+  double time_ = 0.0;    // the simulation time of the last observation
 };
 
 }  // namespace simsoccer::booster

@@ -1,7 +1,7 @@
 // The Booster SDK's locomotion service (rt/LocoApiTopicReq and ...Resp) as
 // far as simsoccer answers it for one robot: its mode machine, head turns,
-// and an answer to every request, in the SDK's RPC conventions (JSON header
-// {"api_id", "expect_response"} and body; answers {"status"} and a body).
+// kicks, and an answer to every request, in the SDK's RPC conventions (JSON
+// header {"api_id", "expect_response"} and body; answers {"status"} and a body).
 //
 // Modes (RobotMode): Damping (joints limp but damped), Prepare (standing,
 // holding the stand pose: the robot's own position servos), Custom (the
@@ -11,14 +11,22 @@
 // where the robot has one). Move sets the walk's velocity in Walking and
 // Soccer; RotateHead turns the head in Prepare, Walking and Soccer; GetUp
 // answers 0 there (the walk's fall detector gets the robot up once it lies
-// still). Kicks, LieDown and the other motion calls are refused with status
-// 501 (server refused). Malformed requests get 400; unknown api ids 400.
+// still). Where the robot also has a kick approach, Shoot kicks once where
+// the robot stands and VisualKick {"start", "version"} starts and stops the
+// visual kick (the robot goes to the ball it sees and kicks it the way
+// rt/kick_ball says, again and again until stopped), both in Walking and
+// Soccer with the robot on its feet. As the SDK's status codes say: a call the
+// robot has no motion for (LieDown, SwitchGait, ...) answers 501 (server
+// refused), one its state does not allow (Move in Prepare, a kick while it
+// lies) 502 (state transition failed); malformed requests and unknown api
+// ids 400.
 #pragma once
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace simsoccer::booster {
 
@@ -30,6 +38,7 @@ const char* modeName(RobotMode m);
 inline constexpr int64_t kStatusSuccess = 0;
 inline constexpr int64_t kStatusBadRequest = 400;
 inline constexpr int64_t kStatusServerRefused = 501;
+inline constexpr int64_t kStatusStateTransitionFailed = 502;
 
 // LocoApiId values answered (b1_loco_api.hpp).
 enum class LocoApi : int {
@@ -64,9 +73,11 @@ struct WalkVelocity {
 
 class LocoService {
  public:
-  // `walk`: the robot has simsoccer's walk (Walking and Soccer are served).
-  explicit LocoService(RobotMode initial = RobotMode::Prepare, bool walk = false)
-      : mode_(initial), walk_(walk) {}
+  // `walk`: the robot has simsoccer's walk (Walking and Soccer are served);
+  // `kicks`: and a kick approach (Shoot and VisualKick are served).
+  explicit LocoService(RobotMode initial = RobotMode::Prepare, bool walk = false,
+                       bool kicks = false)
+      : mode_(initial), walk_(walk), kicks_(walk && kicks) {}
 
   // One request: its header and body as the client sent them (any bytes).
   RpcAnswer handle(std::string_view header, std::string_view body);
@@ -78,14 +89,26 @@ class LocoService {
   bool walking() const { return mode_ == RobotMode::Walking || mode_ == RobotMode::Soccer; }
   // The velocity of the last Move (zero on entering Walking or Soccer).
   const WalkVelocity& velocity() const { return velocity_; }
+  // The visual kick runs (VisualKick started it; stopping it, leaving
+  // Walking and Soccer, or the robot falling ends it) and its version (0:
+  // V1, 1: V2, "stronger" on the robot; simsoccer's K1 has one kick).
+  bool visualKick() const { return visual_kick_; }
+  int visualKickVersion() const { return visual_kick_version_; }
+  // True once for each Shoot taken.
+  bool takeShoot() { return std::exchange(shoot_, false); }
+  // Whether the robot is down (falling, lying, getting up): kicks answer 502
+  // and a running visual kick ends.
+  void setDown(bool down);
 
   uint64_t requests() const { return requests_; }
-  uint64_t refused() const { return refused_; }      // 501: not available in simsoccer
+  uint64_t refused() const { return refused_; }      // 501 and 502
   uint64_t malformed() const { return malformed_; }  // 400
 
  private:
   RobotMode mode_;
-  bool walk_ = false;
+  bool walk_ = false, kicks_ = false;
+  bool down_ = false, visual_kick_ = false, shoot_ = false;
+  int visual_kick_version_ = 0;
   std::optional<HeadTarget> head_;
   WalkVelocity velocity_;
   uint64_t requests_ = 0, refused_ = 0, malformed_ = 0;

@@ -74,7 +74,7 @@ class WalkEngine {
   void setVelocity(double forward, double left, double turn);
   // Finishes the step under way, then stands with the feet together once
   // the heading hold has nothing left to correct. `settle` (coming to rest
-  // for good, to sit down): heading errors under stop_heading_tolerance are
+  // to kick or to sit down): heading errors under stop_heading_tolerance are
   // left alone, so the yaw's sway cannot keep it stepping.
   void stop(bool settle = false);
   bool walking() const { return walking_; }
