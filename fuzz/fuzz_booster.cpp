@@ -41,17 +41,23 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       // Header, then body, split where the second byte says.
       const std::string_view all(reinterpret_cast<const char*>(body), n);
       const size_t split = n == 0 ? 0 : data[1] % (n + 1);
-      booster::LocoService service;
-      for (int k = 0; k < 2; ++k) {  // twice: the second sees the first's mode
+      // Bit 1 of the first byte: a robot with simsoccer's walk and kicks (the K1), which
+      // starts walking.
+      const bool walk = data[0] & 2;
+      booster::LocoService service(
+          walk ? booster::RobotMode::Soccer : booster::RobotMode::Prepare, walk, walk);
+      for (int k = 0; k < 3; ++k) {  // thrice: later ones see the earlier ones' state
+        if (k == 2) service.setDown(data[1] & 1);
         const booster::RpcAnswer a = service.handle(all.substr(0, split), all.substr(split));
-        // Only the SDK's codes; a JSON body; never a mode simsoccer cannot run.
+        // Only the SDK's codes; a JSON body; never a mode or a kick simsoccer cannot run.
         if (a.status != booster::kStatusSuccess && a.status != booster::kStatusBadRequest &&
-            a.status != booster::kStatusServerRefused)
+            a.status != booster::kStatusServerRefused &&
+            a.status != booster::kStatusStateTransitionFailed)
           std::abort();
         if (!a.body.empty() && !nlohmann::json::accept(a.body)) std::abort();
-        if (service.mode() == booster::RobotMode::Walking ||
-            service.mode() == booster::RobotMode::Soccer)
+        if (!walk && (service.walking() || service.visualKick() || service.takeShoot()))
           std::abort();
+        if (service.visualKick() && !service.walking()) std::abort();
       }
     } else {
       // Five arrays of equal length (the second byte shortens the last).

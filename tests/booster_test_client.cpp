@@ -7,6 +7,8 @@
 //   then answers every LowState with a SERIAL LowCmd that holds the posture
 //   it found and turns the head yaw to 0.4 rad, with three bad commands in
 //   between (21 entries, PARALLEL, a NaN), then GetMode (custom).
+// With --walk it walks the robot with Move instead; with --kick shoot|visual
+// it kicks through SOCCER mode (Shoot, or VisualKick with rt/kick_ball).
 // Prints one JSON line of what it saw; exit status 0 if every answer was as
 // the SDK expects.
 #include <dds/dds.h>
