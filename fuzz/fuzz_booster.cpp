@@ -44,8 +44,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       // Bit 1 of the first byte: a robot with simsoccer's walk and kicks (the K1), which
       // starts walking.
       const bool walk = data[0] & 2;
-      booster::LocoService service(
-          walk ? booster::RobotMode::Soccer : booster::RobotMode::Prepare, walk, walk);
+      booster::LocoService service(walk ? booster::RobotMode::Soccer : booster::RobotMode::Prepare,
+                                   {walk, walk, walk});
       for (int k = 0; k < 3; ++k) {  // thrice: later ones see the earlier ones' state
         if (k == 2) service.setDown(data[1] & 1);
         const booster::RpcAnswer a = service.handle(all.substr(0, split), all.substr(split));

@@ -116,6 +116,7 @@ int main(int argc, char** argv) {
   // --kick-dir rad, robot frame, through rt/kick_ball) for --periods LowStates.
   std::string kick;
   double kick_dir = 0.0;
+  int scale = 1;  // --scale N: the waits between calls N times as many LowStates (2 ms periods: 5)
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--domain")
@@ -132,6 +133,8 @@ int main(int argc, char** argv) {
       kick = argv[i + 1];
     else if (a == "--kick-dir")
       kick_dir = std::stod(argv[i + 1]);
+    else if (a == "--scale")
+      scale = std::stoi(argv[i + 1]);
   }
   if (!config.empty()) {
     std::ifstream f(config);
@@ -202,12 +205,12 @@ int main(int argc, char** argv) {
     // or VisualKick started with its direction on rt/kick_ball (reliable, as ROS 2 publishers
     // are), left running, then stopped.
     expect("soccer", rpc.api(2000, {{"mode", 4}}), 0);
-    for (int k = 0; k < 100; ++k) nextState(0.05);  // standing still first
+    for (int k = 0; k < 100 * scale; ++k) nextState(0.05);  // standing still first
     expect("visual_kick_malformed", rpc.api(2038, {{"start", "yes"}}), 400);
     if (kick == "shoot") {
       // Looking down at the ball first (Shoot takes the foot on the side the robot saw it).
       expect("head_down", rpc.api(2004, {{"pitch", 0.8}, {"yaw", 0.0}}), 0);
-      for (int k = 0; k < 50; ++k) nextState(0.05);
+      for (int k = 0; k < 50 * scale; ++k) nextState(0.05);
       expect("shoot", rpc.api(2024, json::object()), 0);
       for (int k = 0; k < periods; ++k)
         if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));

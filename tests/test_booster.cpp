@@ -108,13 +108,13 @@ struct ServedK1 {
 // the locomotion API commands no joints, and unpaced the walk would last as
 // many simulated seconds as the machine is fast). Returns the client's exit status.
 int runUntilTheClientEnds(sim::Simulation& simulation, const booster::Endpoint& endpoint,
-                          ClientProcess& client, bool pace = false) {
+                          ClientProcess& client, bool pace = false, int pace_ms = 5) {
   int status = -1;
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while ((status = client.process.exitStatus(0)) < 0 && std::chrono::steady_clock::now() < end) {
     simulation.period();
     if (pace || endpoint.stats(0).applied == 0)
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      std::this_thread::sleep_for(std::chrono::milliseconds(pace_ms));
   }
   return status;
 }
@@ -221,7 +221,7 @@ world::Scenario k1KickScenario() {
 TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   booster::BoosterRobot robot = served(0, 175);
   robot.motions = test::sourceDir() / "configs/motions/booster_k1";
-  // Pipelined, as simsoccer serve runs (the K1's kick is tuned for its one period of delay).
+  // Pipelined, as simsoccer serve runs.
   ServedK1 k1(robot, /*lockstep=*/false, k1KickScenario(), sim::kDefaultMode);
   auto& [w, simulation, endpoint] = k1;
   // The ball 1.5 m ahead and 0.6 m to the left; kicked along the field's +x (dir 0 from the
@@ -250,21 +250,25 @@ TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   EXPECT_TRUE(w.isStanding(0));
 }
 
-// Shoot: one kick where the robot stands, with the foot on the ball's side.
+// Shoot: one kick where the robot stands, with the foot on the ball's side. At the K1's 2 ms
+// control period (configs/scenarios/k1_3v3.yaml) and serial periods: the walk still runs every
+// 10 ms, its targets acting 10 ms later, as the kick was tuned (at 2 ms with 2 ms of delay, or
+// serial at 10 ms, the K1 fell after every kick).
 TEST(BoosterEndpoint, ShootKicksTheBallInFrontOfTheK1) {
   booster::BoosterRobot robot = served(0, 176);
   robot.motions = test::sourceDir() / "configs/motions/booster_k1";
-  // Pipelined, as simsoccer serve runs (the K1's kick is tuned for its one period of delay).
-  ServedK1 k1(robot, /*lockstep=*/false, k1KickScenario(), sim::kDefaultMode);
+  world::Scenario scenario = k1KickScenario();
+  scenario.physics.dt = scenario.physics.control_period = 0.002;
+  ServedK1 k1(robot, /*lockstep=*/false, scenario, sim::Mode::Serial);
   auto& [w, simulation, endpoint] = k1;
   // In front of the left foot, where the walk's kick meets it (configs/motions/booster_k1/
   // kick_approach.yaml: 0.25 m ahead, 0.095 m to the side).
   test::putBallOnCarpet(w, 0.25, 0.095);
   ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "176", "--dds-config",
                         (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "500", "--kick", "shoot"});
+                        "2500", "--kick", "shoot", "--scale", "5"});
   ASSERT_TRUE(client.process.started());
-  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
+  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true, 1);
   const json r = client.result();
   std::printf("client: %s\n", r.dump().c_str());
   ASSERT_EQ(status, 0) << r.dump();

@@ -75,7 +75,7 @@ TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
 // A robot with simsoccer's walk (the K1): Walking and Soccer are served, Move sets the walk's
 // velocity there and only there, the head turns, GetUp is the walk's own fall recovery.
 TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
-  LocoService s(RobotMode::Prepare, /*walk=*/true);
+  LocoService s(RobotMode::Prepare, {.walk = true});
   EXPECT_FALSE(s.walking());
   // Move and GetUp outside walking and soccer: not from this state, nothing changes.
   EXPECT_EQ(call(s, 2001, {{"vx", 0.3}, {"vy", 0.0}, {"vyaw", 0.0}}).status,
@@ -112,7 +112,7 @@ TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
 // Soccer with the robot on its feet; the visual kick runs until stopped, the mode left or a
 // fall; malformed kicks named.
 TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
-  LocoService s(RobotMode::Prepare, /*walk=*/true, /*kicks=*/true);
+  LocoService s(RobotMode::Prepare, {.walk = true, .kicks = true, .vision = true});
   EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
   EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status,
             kStatusStateTransitionFailed);
@@ -159,4 +159,11 @@ TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
   }
   EXPECT_EQ(s.malformed(), malformed + 4);
   EXPECT_FALSE(s.visualKick());
+  // Without the simulation's perception the robot would see no ball: no visual kick; Shoot
+  // needs none.
+  LocoService blind(RobotMode::Soccer, {.walk = true, .kicks = true});
+  const RpcAnswer a = call(blind, 2038, {{"start", true}, {"version", 1}});
+  EXPECT_EQ(a.status, kStatusServerRefused);
+  EXPECT_NE(a.body.find("perception"), std::string::npos) << a.body;
+  EXPECT_EQ(call(blind, 2024, json::object()).status, kStatusSuccess);
 }

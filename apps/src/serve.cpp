@@ -218,7 +218,9 @@ int serve(int argc, char** argv, int first) {
     if (gc_link->returnsRejected() > 0)
       std::printf("last rejected return packet: %s\n", gc_link->lastReturnError().c_str());
   }
-  std::printf("final state hash %016llx\n", static_cast<unsigned long long>(w.stateHash()));
+  const engine::Vec3 ball = w.ballState().pose.translation();
+  std::printf("final state hash %016llx, the ball at (%.2f, %.2f) m\n",
+              static_cast<unsigned long long>(w.stateHash()), ball.x(), ball.y());
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <exception>
 #include <thread>
 #include <nlohmann/json.hpp>
@@ -79,9 +80,12 @@ struct Endpoint::Robot {
   // loaded with the endpoint and restarted from the measured joints on each entry.
   std::unique_ptr<agents::MotionController> motion;
   bool was_walking = false;
-  // The walk's targets for this period (computed when the state is observed).
-  std::array<float, world::kActuators> walk_position{}, walk_stiffness{};
-  bool walk_ready = false;
+  // The walk's targets, each with the period it acts from (walkTargets), oldest first.
+  struct WalkTargets {
+    uint64_t acts_at = 0;
+    std::array<float, world::kActuators> position{}, stiffness{};
+  };
+  std::deque<WalkTargets> walk_targets;
   // Shoot and VisualKick: the kick approach (the motions folder's
   // kick_approach.yaml), the ball as the robot's perception saw it last, the
   // latest rt/kick_ball direction (rad, robot frame when the heading was
@@ -102,7 +106,7 @@ struct Endpoint::Robot {
   int fall_state = -1;
   double fall_sent_at = -1e9;
 
-  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds, bool walk, bool kicks)
+  Robot(const BoosterRobot& c, size_t n, const net::DomainConfig& dds, LocoCapabilities can)
       : config(c),
         actuators(n),
         participant(dds),
@@ -120,7 +124,7 @@ struct Endpoint::Robot {
              qos(true, 1)),
         // Best effort, as Booster's own readers of it: matches every writer.
         kick_targets(participant, brain_msg_dds__Kick__desc, "rt/kick_ball", qos(false, 4)),
-        loco(c.initial_mode, walk, kicks),
+        loco(c.initial_mode, can),
         pending_pool(kMaxPending, Command{std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n), std::vector<float>(n),
                                           std::vector<float>(n)}),
@@ -135,6 +139,9 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     : world_(world), config_(std::move(config)) {
   if (!(config_.answer_timeout > 0.0 && config_.answer_timeout <= 60.0))
     throw std::invalid_argument("Booster endpoint: answer timeout must be in (0, 60] s");
+  const double period = world.scenario().physics.control_period;
+  walk_periods_ = static_cast<uint64_t>(std::max(1L, std::lround(kWalkPeriod / period)));
+  walk_dt_ = static_cast<double>(walk_periods_) * period;
   std::set<world::RobotId> robots;
   std::set<uint32_t> domains;
   for (const BoosterRobot& b : config_.robots) {
@@ -154,13 +161,14 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     const std::vector<double>& stand = model.pose("stand");  // throws if the model has none
     const bool walk = !b.motions.empty();
     const std::filesystem::path approach = b.motions / "kick_approach.yaml";
-    const bool kicks = walk && std::filesystem::exists(approach);
+    const LocoCapabilities can{walk, walk && std::filesystem::exists(approach),
+                               world.scenario().perception.enabled};
     net::DomainConfig dds;
     dds.domain = b.domain;
     dds.config_file = config_.dds_config;
     std::unique_ptr<Robot> r;
     if (b.network_namespace.empty()) {
-      r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk, kicks);
+      r = std::make_unique<Robot>(b, model.actuators.size(), dds, can);
     } else {
       // Cyclone opens the domain's sockets and starts its threads when the
       // domain is made: made on a thread inside the namespace, they stay
@@ -178,7 +186,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
           if (rc != 0)
             throw std::runtime_error("Booster endpoint: cannot enter network namespace " +
                                      b.network_namespace + " (needs CAP_SYS_ADMIN)");
-          r = std::make_unique<Robot>(b, model.actuators.size(), dds, walk, kicks);
+          r = std::make_unique<Robot>(b, model.actuators.size(), dds, can);
         } catch (...) {
           failed = std::current_exception();
         }
@@ -191,7 +199,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
     if (walk)
       r->motion = std::make_unique<agents::MotionController>(
           agents::loadMotionController(model, b.motions));
-    if (kicks)
+    if (can.kicks)
       r->approach = std::make_unique<agents::KickApproach>(agents::loadKickApproach(approach));
     robots_.push_back(std::move(r));
   }
@@ -373,21 +381,26 @@ void Endpoint::observe(const sim::Observation& o) {
       r.fall_state = fallen;
       r.fall_sent_at = o.time;
     }
-    // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
-    r.walk_ready = false;
-    if (r.loco.walking())
-      walkTargets(r, f);
-    else
-      r.was_walking = r.was_visual_kick = false;
+    // The walk runs at its own period, on the state of its period's start.
+    if (r.loco.walking()) {
+      if (o.tick % walk_periods_ == 0) walkTargets(r, f, o.tick + walk_periods_);
+    } else {
+      // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
+      r.was_walking = r.was_visual_kick = r.shooting = false;
+      r.walk_targets.clear();
+    }
+    acts_at_ = o.tick + static_cast<uint64_t>(std::max(0, o.actuation_delay));
   }
 }
 
-void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame) {
+void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t acts_at) {
   // Walking and Soccer: simsoccer's walk at Move's velocity, the head
   // where RotateHead turned it; from standing still it eases into the
-  // walk's stance (and after a fall it gets up). Computed from the frame
-  // the client gets, so that the walk's commands act when a client's would
-  // (pipelined: a period later).
+  // walk's stance (and after a fall it gets up). Every kWalkPeriod on the
+  // state of that moment, its targets acting one walk period later: the
+  // built-in agents' timing in matches, which the K1's walk and kick were
+  // tuned with (without the delay, or at 2 ms periods with 2 ms of it, the K1
+  // fell after its kicks).
   if (!r.was_walking) {
     r.motion->restart();
     ++r.stats.walk_starts;
@@ -399,6 +412,7 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame) {
   if (visual) {
     // The visual kick: to the ball the robot sees, kicked the way
     // rt/kick_ball says (a direction sent with the start holds).
+    r.shooting = false;
     if (!r.was_visual_kick) {
       r.approach->start(time_, yaw);
       if (r.target_dir && time_ - r.target_at < 1.0) r.approach->aimAt(*r.target_dir, r.target_yaw);
@@ -433,9 +447,9 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame) {
     }
   }
   r.was_visual_kick = visual;
-  r.motion->update(world_.scenario().physics.control_period, agents::motionSensors(frame), request,
-                   r.walk_position, r.walk_stiffness);
-  r.walk_ready = true;
+  Robot::WalkTargets& t = r.walk_targets.emplace_back();
+  t.acts_at = acts_at;
+  r.motion->update(walk_dt_, agents::motionSensors(frame), request, t.position, t.stiffness);
   // Kicks need the robot on its feet (the walk's fall detector tells).
   const agents::MotionState m = r.motion->state();
   r.loco.setDown(m == agents::MotionState::Falling || m == agents::MotionState::Lying ||
@@ -542,10 +556,13 @@ std::optional<sim::RobotCommand> Endpoint::modeCommand(Robot& r, sim::CommandGat
   const robots::RobotModel& model = *world_.robot(r.config.robot).model;
   const size_t n = r.actuators;
   if (r.loco.walking()) {
-    // Walking and Soccer: the walk's targets for this period (walkTargets).
-    if (!r.walk_ready) return std::nullopt;
-    return gate.check(r.config.robot, std::span<const float>(r.walk_position),
-                      std::span<const float>(r.walk_stiffness));
+    // Walking and Soccer: the walk's latest targets due by the period this command acts in
+    // (none yet: the robot holds its last command).
+    auto& q = r.walk_targets;
+    while (q.size() > 1 && q[1].acts_at <= acts_at_) q.pop_front();
+    if (q.empty() || q.front().acts_at > acts_at_) return std::nullopt;
+    return gate.check(r.config.robot, std::span<const float>(q.front().position),
+                      std::span<const float>(q.front().stiffness));
   }
   if (r.loco.mode() == RobotMode::Prepare) {
     // Standing: the stand pose on the robot's own servos, the head where

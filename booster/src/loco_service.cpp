@@ -192,6 +192,10 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
           bad("VisualKick: \"start\" must be true or false and \"version\" 0 (V1) or 1 (V2)");
         } else if (!start->get<bool>()) {
           visual_kick_ = false;  // stopping is always allowed
+        } else if (!vision_) {
+          ++refused_;
+          a = error(kStatusServerRefused,
+                    "VisualKick: the robot sees nothing (the scenario's perception is off)");
         } else if (canKick("VisualKick")) {
           visual_kick_ = true;
           shoot_ = false;

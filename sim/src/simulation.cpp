@@ -102,6 +102,7 @@ void Simulation::observe(uint64_t tick) {
   o.time = world_.time();
   o.world = &world_;
   o.perception = perception_.get();
+  o.actuation_delay = config_.mode == Mode::Pipelined ? 1 : 0;
   if (game_) {
     o.game = &*game_;
     o.left_team = officials_->leftTeam();

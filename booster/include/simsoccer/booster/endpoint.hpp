@@ -95,6 +95,13 @@ struct RobotBoosterStats {
   uint64_t kick_targets_refused = 0;  // of them with a direction that is not a number
 };
 
+// The period (s) simsoccer's walk runs at for the locomotion service: the
+// matches' control period, which the built-in agents' walk and kick were
+// tuned at. At shorter control periods (a K1's 2 ms) it runs every few of
+// them; its targets always act one walk period after the state they were
+// computed from, as the agents' do in matches.
+inline constexpr double kWalkPeriod = 0.010;
+
 class Endpoint : public sim::CommandSource {
  public:
   // Joins every robot's domain. Throws std::invalid_argument for a robot
@@ -126,8 +133,9 @@ class Endpoint : public sim::CommandSource {
   // rt/kick_ball: the visual kick's direction.
   void takeKickTargets(Robot& r);
   void publishImage(const world::CameraImage& image);
-  // Walking and Soccer: the walk's targets from the frame just observed.
-  void walkTargets(Robot& r, const world::SensorFrame& frame);
+  // Walking and Soccer: the walk's targets from the frame just observed,
+  // acting from period `acts_at`.
+  void walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t acts_at);
   // The command of robot r's mode outside CUSTOM (prepare: stand; damping;
   // walking and soccer: the walk's targets).
   std::optional<sim::RobotCommand> modeCommand(Robot& r, sim::CommandGate& gate) const;
@@ -136,6 +144,10 @@ class Endpoint : public sim::CommandSource {
   std::vector<std::unique_ptr<Robot>> robots_;
   int32_t waitset_ = 0;  // a DDS waitset on every robot's commands (lockstep)
   double time_ = 0.0;    // the simulation time of the last observation
+  uint64_t acts_at_ = 0;  // the period the commands collected next act in
+  // The walk's period: kWalkPeriod in whole control periods (at least one).
+  uint64_t walk_periods_ = 1;
+  double walk_dt_ = 0.01;
 };
 
 }  // namespace simsoccer::booster

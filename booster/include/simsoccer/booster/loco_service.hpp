@@ -14,8 +14,8 @@
 // still). Where the robot also has a kick approach, Shoot kicks once where
 // the robot stands and VisualKick {"start", "version"} starts and stops the
 // visual kick (the robot goes to the ball it sees and kicks it the way
-// rt/kick_ball says, again and again until stopped), both in Walking and
-// Soccer with the robot on its feet. As the SDK's status codes say: a call the
+// rt/kick_ball says, again and again until stopped; it needs the
+// simulation's perception), both in Walking and Soccer with the robot on its feet. As the SDK's status codes say: a call the
 // robot has no motion for (LieDown, SwitchGait, ...) answers 501 (server
 // refused), one its state does not allow (Move in Prepare, a kick while it
 // lies) 502 (state transition failed); malformed requests and unknown api
@@ -71,13 +71,17 @@ struct WalkVelocity {
   double vx = 0.0, vy = 0.0, vyaw = 0.0;
 };
 
+// What simsoccer can do for a robot through the service.
+struct LocoCapabilities {
+  bool walk = false;    // simsoccer's walk: Walking and Soccer are served
+  bool kicks = false;   // and a kick approach: Shoot and VisualKick (with walk)
+  bool vision = false;  // the simulation's perception, which the visual kick needs
+};
+
 class LocoService {
  public:
-  // `walk`: the robot has simsoccer's walk (Walking and Soccer are served);
-  // `kicks`: and a kick approach (Shoot and VisualKick are served).
-  explicit LocoService(RobotMode initial = RobotMode::Prepare, bool walk = false,
-                       bool kicks = false)
-      : mode_(initial), walk_(walk), kicks_(walk && kicks) {}
+  explicit LocoService(RobotMode initial = RobotMode::Prepare, LocoCapabilities can = {})
+      : mode_(initial), walk_(can.walk), kicks_(can.walk && can.kicks), vision_(can.vision) {}
 
   // One request: its header and body as the client sent them (any bytes).
   RpcAnswer handle(std::string_view header, std::string_view body);
@@ -106,7 +110,7 @@ class LocoService {
 
  private:
   RobotMode mode_;
-  bool walk_ = false, kicks_ = false;
+  bool walk_ = false, kicks_ = false, vision_ = false;
   bool down_ = false, visual_kick_ = false, shoot_ = false;
   int visual_kick_version_ = 0;
   std::optional<HeadTarget> head_;

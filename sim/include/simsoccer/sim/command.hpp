@@ -106,6 +106,8 @@ struct Observation {
   const world::PerceptionSystem* perception = nullptr;  // null: perception off
   const referee::ControlData* game = nullptr;           // null: no referee
   int left_team = 0;                                    // the team game->teams[0] describes
+  // Periods after this one that the answers collected for it act in: 0 serial, 1 pipelined.
+  int actuation_delay = 0;
 };
 
 class CommandSource {
