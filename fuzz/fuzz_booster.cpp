@@ -47,7 +47,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       booster::LocoService service(walk ? booster::RobotMode::Soccer : booster::RobotMode::Prepare,
                                    {walk, walk, walk});
       for (int k = 0; k < 3; ++k) {  // thrice: later ones see the earlier ones' state
-        if (k == 2) service.setDown(data[1] & 1);
+        if (k == 2) {
+          service.setDown(data[0] & 4);
+          if ((data[0] & 4) && service.visualKick()) std::abort();  // a fall ends it
+        }
         const booster::RpcAnswer a = service.handle(all.substr(0, split), all.substr(split));
         // Only the SDK's codes; a JSON body; never a mode or a kick simsoccer cannot run.
         if (a.status != booster::kStatusSuccess && a.status != booster::kStatusBadRequest &&

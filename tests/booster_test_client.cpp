@@ -112,8 +112,9 @@ int main(int argc, char** argv) {
   int periods = 300;
   double walk = 0.0;       // --walk V: walk with Booster's locomotion API at V m/s instead
   int custom_between = 0;  // with --walk: N LowStates in CUSTOM between two walks
-  // --kick shoot|visual: in SOCCER mode, Shoot once, or run the visual kick (aimed at
-  // --kick-dir rad, robot frame, through rt/kick_ball) for --periods LowStates.
+  // --kick shoot|visual: in SOCCER mode, Shoot once, or run the visual kick for --periods
+  // LowStates, aimed through rt/kick_ball at --kick-dir (rad from the heading the robot had at
+  // the start, which the IMU's yaw tells: the robot frame's dir is that minus the yaw now).
   std::string kick;
   double kick_dir = 0.0;
   int scale = 1;  // --scale N: the waits between calls N times as many LowStates (2 ms periods: 5)
@@ -155,7 +156,7 @@ int main(int argc, char** argv) {
   json out;
   // The latest LowState (waits up to 10 s for a new one).
   std::vector<booster_interface_msg_dds__MotorState_> motors;
-  float acc_z = 0;
+  float acc_z = 0, yaw = 0;
   size_t parallel = 0;
   auto nextState = [&](double seconds) {
     const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -171,6 +172,7 @@ int main(int argc, char** argv) {
                         s->motor_state_serial._buffer + s->motor_state_serial._length);
           parallel = s->motor_state_parallel._length;
           acc_z = s->imu_state.acc[2];
+          yaw = s->imu_state.rpy[2];
           got = true;
         }
         dds_return_loan(state, samples, 1);
@@ -216,6 +218,15 @@ int main(int argc, char** argv) {
         if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
     } else {
       const dds_entity_t target = endpoint(false, &brain_msg_dds__Kick__desc, "rt/kick_ball", true, 1);
+      // A sample written before the writer matches the robot's reader goes nowhere.
+      for (auto end = Clock::now() + std::chrono::seconds(5);;) {
+        dds_publication_matched_status_t st{};
+        dds_get_publication_matched_status(target, &st);
+        if (st.current_count > 0) break;
+        if (Clock::now() > end) fail("rt/kick_ball: no reader within 5 s");
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      const float start_yaw = yaw;
       expect("visual_kick", rpc.api(2038, {{"start", true}, {"version", 1}}), 0);
       expect("shoot_while_visual_kick", rpc.api(2024, json::object()), 502);
       for (int k = 0; k < periods; ++k) {
@@ -223,7 +234,7 @@ int main(int argc, char** argv) {
           std::string frame = "base_link";
           brain_msg_dds__Kick_ m{};
           m.header.frame_id = frame.data();
-          m.dir = kick_dir;
+          m.dir = kick_dir - (yaw - start_yaw);
           m.power = 6.0;
           if (dds_write(target, &m) < 0) fail("write Kick");
         }

@@ -224,12 +224,12 @@ TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   // Pipelined, as simsoccer serve runs.
   ServedK1 k1(robot, /*lockstep=*/false, k1KickScenario(), sim::kDefaultMode);
   auto& [w, simulation, endpoint] = k1;
-  // The ball 1.5 m ahead and 0.6 m to the left; kicked along the field's +x (dir 0 from the
-  // robot's heading then): the K1 has to walk round to behind it first.
-  test::putBallOnCarpet(w, 1.5, 0.6);
+  // The ball 1.5 m ahead, to be kicked 0.7 rad to the left of the robot's heading at the start
+  // (the field's +x): the K1 walks round to behind it on that line first.
+  test::putBallOnCarpet(w, 1.5, 0.0);
   ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "175", "--dds-config",
                         (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "1400", "--kick", "visual", "--kick-dir", "0"});
+                        "1100", "--kick", "visual", "--kick-dir", "0.7"});
   ASSERT_TRUE(client.process.started());
   const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
   const json r = client.result();
@@ -237,17 +237,25 @@ TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   ASSERT_EQ(status, 0) << r.dump();
   const engine::Vec3 ball = w.ballState().pose.translation();
   const auto s = endpoint.stats(0);
-  std::printf("ball at (%.2f, %.2f) after %.1f s; kicks %llu, targets %llu\n", ball.x(), ball.y(),
-              w.time(), (unsigned long long)s.kicks, (unsigned long long)s.kick_targets);
+  std::printf("ball at (%.2f, %.2f) after %.1f s; kicks %llu, targets %llu, falls %llu, get-ups %llu\n",
+              ball.x(), ball.y(), w.time(), (unsigned long long)s.kicks,
+              (unsigned long long)s.kick_targets, (unsigned long long)s.falls,
+              (unsigned long long)s.get_ups);
   EXPECT_EQ(s.kick_targets, 3u);
   EXPECT_EQ(s.kick_targets_refused, 0u);
   EXPECT_GE(s.kicks, 1u);
   EXPECT_EQ(s.requests_malformed, 1u);  // {"start": "yes"}
   EXPECT_EQ(s.requests_refused, 1u);    // Shoot while the visual kick runs: 502
-  // Kicked on along +x, not sideways: at least 2 m on from where it lay.
-  EXPECT_GT(ball.x(), 3.5);
-  EXPECT_LT(std::abs(ball.y() - 0.6), 0.4 * (ball.x() - 1.5));
-  EXPECT_TRUE(w.isStanding(0));
+  // Kicked at least 2 m on, 0.7 rad off +x within the line-up's 0.15 rad and the spread of the
+  // K1's kicks after walking (its support foot turns during the kick: 0.1-0.26 rad seen).
+  const double travelled = std::hypot(ball.x() - 1.5, ball.y());
+  const double direction = std::atan2(ball.y(), ball.x() - 1.5);
+  std::printf("travelled %.2f m at %.2f rad\n", travelled, direction);
+  EXPECT_GT(travelled, 2.0);
+  EXPECT_NEAR(direction, 0.7, 0.35);
+  // The K1 falls after some of its kicks from walking (docs/agents.md): here at most once, after
+  // the kick (the walk then gets it up).
+  EXPECT_LE(s.falls, 1u);
 }
 
 // Shoot: one kick where the robot stands, with the foot on the ball's side. At the K1's 2 ms

@@ -45,7 +45,7 @@ TEST(BoosterLoco, HeadTurnsInPrepareMode) {
   EXPECT_DOUBLE_EQ(s.headTarget()->yaw, -0.5);
   call(s, 2000, {{"mode", 3}});
   EXPECT_FALSE(s.headTarget());  // custom: the client commands the head itself
-  EXPECT_EQ(call(s, 2004, {{"pitch", 0.2}, {"yaw", 0.1}}).status, kStatusServerRefused);
+  EXPECT_EQ(call(s, 2004, {{"pitch", 0.2}, {"yaw", 0.1}}).status, kStatusStateTransitionFailed);
 }
 
 TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
@@ -147,9 +147,10 @@ TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
   EXPECT_TRUE(s.visualKick());
   EXPECT_EQ(call(s, 2000, {{"mode", 1}}).status, kStatusSuccess);
   EXPECT_FALSE(s.visualKick());
-  // Malformed: 400, nothing changes.
+  // Malformed: 400, nothing changes (the running visual kick, its version).
   call(s, 2000, {{"mode", 4}});
-  const uint64_t malformed = s.malformed();
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 1}}).status, kStatusSuccess);
+  const uint64_t malformed = s.malformed(), starts = s.visualKickStarts();
   for (const json& body : {json{{"start", "yes"}}, json{{"version", 1}},
                            json{{"start", true}, {"version", 2}},
                            json{{"start", true}, {"version", "V2"}}}) {
@@ -158,7 +159,13 @@ TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
     EXPECT_NE(a.body.find("VisualKick"), std::string::npos) << a.body;
   }
   EXPECT_EQ(s.malformed(), malformed + 4);
-  EXPECT_FALSE(s.visualKick());
+  EXPECT_TRUE(s.visualKick());
+  EXPECT_EQ(s.visualKickVersion(), 1);
+  EXPECT_EQ(s.visualKickStarts(), starts);
+  // A stop and a start: a new start (the approach starts over).
+  call(s, 2038, {{"start", false}});
+  call(s, 2038, {{"start", true}});
+  EXPECT_EQ(s.visualKickStarts(), starts + 1);
   // Without the simulation's perception the robot would see no ball: no visual kick; Shoot
   // needs none.
   LocoService blind(RobotMode::Soccer, {.walk = true, .kicks = true});

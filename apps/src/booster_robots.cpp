@@ -134,13 +134,14 @@ void printBoosterStats(const BoosterRobots& robots) {
     std::printf(
         "  Booster %s (domain %u): mode %s, %llu states, %llu commands (%llu applied, %llu "
         "ignored, %llu refused, %llu missed), %llu requests (%llu refused, %llu malformed), "
-        "%llu kicks, %llu kick targets, %llu images\n",
+        "%llu kicks, %llu kick targets, %llu falls, %llu get-ups, %llu images\n",
         robots.names[i].c_str(), b.domain, booster::modeName(s.mode),
         (unsigned long long)s.states_sent, (unsigned long long)s.commands,
         (unsigned long long)s.applied, (unsigned long long)s.ignored, (unsigned long long)s.refused,
         (unsigned long long)s.missed, (unsigned long long)s.requests,
         (unsigned long long)s.requests_refused, (unsigned long long)s.requests_malformed,
         (unsigned long long)s.kicks, (unsigned long long)s.kick_targets,
+        (unsigned long long)s.falls, (unsigned long long)s.get_ups,
         (unsigned long long)s.images);
   }
 }

@@ -12,6 +12,7 @@
 #include <exception>
 #include <thread>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -93,7 +94,9 @@ struct Endpoint::Robot {
   std::unique_ptr<agents::KickApproach> approach;
   agents::BallSighting ball;
   bool was_visual_kick = false;
+  uint64_t visual_kick_start = 0;  // the service's start the kick approach runs for
   bool shooting = false;
+  int kicks_before_shot = 0;  // the walk's kicks when the Shoot was taken
   agents::Leg shoot_foot = agents::Leg::Right;
   double shoot_until = -1.0;
   std::optional<double> target_dir;
@@ -277,7 +280,12 @@ RobotBoosterStats Endpoint::stats(std::size_t i) const {
   s.requests = r.loco.requests();
   s.requests_refused = r.loco.refused();
   s.requests_malformed = r.loco.malformed();
-  if (r.motion) s.kicks = static_cast<uint64_t>(r.motion->counters().kicks);
+  if (r.motion) {
+    const agents::MotionCounters& c = r.motion->counters();
+    s.kicks = static_cast<uint64_t>(c.kicks);
+    s.falls = static_cast<uint64_t>(c.falls);
+    s.get_ups = static_cast<uint64_t>(c.get_ups);
+  }
   return s;
 }
 
@@ -413,7 +421,8 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
     // The visual kick: to the ball the robot sees, kicked the way
     // rt/kick_ball says (a direction sent with the start holds).
     r.shooting = false;
-    if (!r.was_visual_kick) {
+    if (!r.was_visual_kick || r.visual_kick_start != r.loco.visualKickStarts()) {
+      r.visual_kick_start = r.loco.visualKickStarts();
       r.approach->start(time_, yaw);
       if (r.target_dir && time_ - r.target_at < 1.0) r.approach->aimAt(*r.target_dir, r.target_yaw);
     }
@@ -423,13 +432,15 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
       // Shoot: one kick where it stands, with the foot on the side of a
       // ball it saw near in the last second (else the right).
       r.shooting = true;
+      r.kicks_before_shot = r.motion->counters().kicks;
       r.shoot_until = time_ + 3.0;
       const bool near =
           r.ball.age >= 0.0 && r.ball.age < 1.0 && std::hypot(r.ball.x, r.ball.y) < 1.0;
       r.shoot_foot = near && r.ball.y >= 0.0 ? agents::Leg::Left : agents::Leg::Right;
     }
-    // Asked for until the motion layer kicks (it stops the walk first).
-    if (r.motion->state() == agents::MotionState::Kicking || time_ > r.shoot_until)
+    // Asked for until the motion layer kicks (it stops the walk first), 3 s at most (it may be
+    // getting up: the shot is dropped).
+    if (r.motion->counters().kicks > r.kicks_before_shot || time_ > r.shoot_until)
       r.shooting = false;
     const WalkVelocity& v = r.loco.velocity();
     if (r.shooting) {
@@ -474,14 +485,16 @@ void Endpoint::takeKickTargets(Robot& r) {
   const double yaw = world_.sensorFrame(r.config.robot).angles[2];
   r.kick_targets.take([&](const KickTarget& k, const dds_sample_info_t&) {
     ++r.stats.kick_targets;
-    if (!std::isfinite(k.dir)) {
+    if (!std::isfinite(k.dir) || std::abs(k.dir) > 2 * std::numbers::pi) {  // not an angle
       ++r.stats.kick_targets_refused;
       return;
     }
     r.target_dir = k.dir;
     r.target_yaw = yaw;
     r.target_at = time_;
-    if (r.approach && r.was_visual_kick && r.loco.visualKick()) r.approach->aimAt(k.dir, yaw);
+    if (r.approach && r.was_visual_kick && r.loco.visualKick() &&
+        r.visual_kick_start == r.loco.visualKickStarts())
+      r.approach->aimAt(k.dir, yaw);
   });
 }
 

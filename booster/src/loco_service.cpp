@@ -124,6 +124,7 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
             if (!(was_walking && walking())) {
               velocity_ = WalkVelocity{};
               visual_kick_ = shoot_ = false;
+              down_ = false;  // the walk tells again from its first period
             }
           }
         }
@@ -136,11 +137,14 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
         const std::optional<double> pitch = number(*body, "pitch"), yaw = number(*body, "yaw");
         if (!pitch || !yaw)
           bad("RotateHead: \"pitch\" and \"yaw\" must be numbers (rad)");
-        else if (mode_ != RobotMode::Prepare && !walking())
-          a = error(kStatusServerRefused,
-                    "RotateHead: simsoccer turns the head in prepare, walking and soccer mode");
-        else
+        else if (mode_ != RobotMode::Prepare && !walking()) {
+          ++refused_;
+          a = error(kStatusStateTransitionFailed,
+                    std::string("RotateHead: the robot is in ") + modeName(mode_) +
+                        " mode; simsoccer turns the head in prepare, walking and soccer mode");
+        } else {
           head_ = HeadTarget{*pitch, *yaw};
+        }
         break;
       }
       case LocoApi::Move: {
@@ -187,9 +191,10 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
         const auto start = body->find("start");
         const std::optional<double> version =
             body->contains("version") ? number(*body, "version") : std::optional<double>(0.0);
-        if (start == body->end() || !start->is_boolean() || !version ||
-            (*version != 0.0 && *version != 1.0)) {
-          bad("VisualKick: \"start\" must be true or false and \"version\" 0 (V1) or 1 (V2)");
+        if (start == body->end() || !start->is_boolean()) {
+          bad("VisualKick: \"start\" must be true or false");
+        } else if (!version || (*version != 0.0 && *version != 1.0)) {
+          bad("VisualKick: \"version\" must be 0 (V1) or 1 (V2)");
         } else if (!start->get<bool>()) {
           visual_kick_ = false;  // stopping is always allowed
         } else if (!vision_) {
@@ -198,6 +203,7 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
                     "VisualKick: the robot sees nothing (the scenario's perception is off)");
         } else if (canKick("VisualKick")) {
           visual_kick_ = true;
+          ++visual_kick_starts_;
           shoot_ = false;
           visual_kick_version_ = static_cast<int>(*version);
         }
@@ -209,7 +215,11 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
       case LocoApi::GetStatus:
       case LocoApi::RotateHeadWithTime:
         ++refused_;
-        a = error(kStatusServerRefused, "not available in simsoccer");
+        a = error(kStatusServerRefused,
+                  std::string(static_cast<LocoApi>(static_cast<int>(*api)) == LocoApi::GetStatus
+                                  ? "GetStatus"
+                                  : "RotateHeadWithTime") +
+                      " is not available in simsoccer");
         break;
       default:
         bad("unknown api_id " + std::to_string(static_cast<long long>(*api)));

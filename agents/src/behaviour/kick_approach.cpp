@@ -11,11 +11,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double wrap(double a) {
-  while (a > kPi) a -= 2 * kPi;
-  while (a < -kPi) a += 2 * kPi;
-  return a;
-}
+double wrap(double a) { return std::remainder(a, 2 * kPi); }
 
 }  // namespace
 

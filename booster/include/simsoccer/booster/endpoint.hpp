@@ -58,7 +58,7 @@ struct BoosterRobot {
   // service's Walking and Soccer modes. Empty: those modes answer 501. With
   // a kick_approach.yaml there (agents::loadKickApproach), Shoot and
   // VisualKick are served too (the visual kick needs the scenario's
-  // perception on: without it the robot sees no ball and searches).
+  // perception on: without it VisualKick answers 501).
   std::filesystem::path motions;
 };
 
@@ -91,15 +91,17 @@ struct RobotBoosterStats {
   uint64_t walk_starts = 0;       // times simsoccer's walk (re)started: each entry into WALKING
                                   // or SOCCER from another mode
   uint64_t kicks = 0;             // kicks the walk made (Shoot, the visual kick)
+  uint64_t falls = 0, get_ups = 0;  // the walk's fall detector's: falls, get-ups that stood
   uint64_t kick_targets = 0;      // rt/kick_ball samples received
   uint64_t kick_targets_refused = 0;  // of them with a direction that is not a number
 };
 
 // The period (s) simsoccer's walk runs at for the locomotion service: the
 // matches' control period, which the built-in agents' walk and kick were
-// tuned at. At shorter control periods (a K1's 2 ms) it runs every few of
-// them; its targets always act one walk period after the state they were
-// computed from, as the agents' do in matches.
+// tuned at, rounded to whole control periods (at least one: a K1's 2 ms
+// period runs it every fifth, 3 ms every third, i.e. 9 ms; 20 ms every one).
+// Its targets act one walk period after the state they were computed from,
+// as the agents' do in matches.
 inline constexpr double kWalkPeriod = 0.010;
 
 class Endpoint : public sim::CommandSource {

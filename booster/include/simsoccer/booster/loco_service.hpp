@@ -17,8 +17,8 @@
 // rt/kick_ball says, again and again until stopped; it needs the
 // simulation's perception), both in Walking and Soccer with the robot on its feet. As the SDK's status codes say: a call the
 // robot has no motion for (LieDown, SwitchGait, ...) answers 501 (server
-// refused), one its state does not allow (Move in Prepare, a kick while it
-// lies) 502 (state transition failed); malformed requests and unknown api
+// refused), one its state does not allow (Move in Prepare, RotateHead in
+// Custom, a kick while it lies) 502 (state transition failed); malformed requests and unknown api
 // ids 400.
 #pragma once
 
@@ -97,6 +97,8 @@ class LocoService {
   // Walking and Soccer, or the robot falling ends it) and its version (0:
   // V1, 1: V2, "stronger" on the robot; simsoccer's K1 has one kick).
   bool visualKick() const { return visual_kick_; }
+  // VisualKick starts so far (a stop and a start between two looks is a new start).
+  uint64_t visualKickStarts() const { return visual_kick_starts_; }
   int visualKickVersion() const { return visual_kick_version_; }
   // True once for each Shoot taken.
   bool takeShoot() { return std::exchange(shoot_, false); }
@@ -113,6 +115,7 @@ class LocoService {
   bool walk_ = false, kicks_ = false, vision_ = false;
   bool down_ = false, visual_kick_ = false, shoot_ = false;
   int visual_kick_version_ = 0;
+  uint64_t visual_kick_starts_ = 0;
   std::optional<HeadTarget> head_;
   WalkVelocity velocity_;
   uint64_t requests_ = 0, refused_ = 0, malformed_ = 0;
