@@ -202,25 +202,10 @@ int serve(int argc, char** argv, int first) {
   printCameraStats(simulation);
   printCounters(w, server);
   if (booster) printBoosterStats(*booster);
-  for (const match::LolaResult& l :
-       lola_robots ? lola_robots->results() : std::vector<match::LolaResult>{})
-    std::printf(
-        "  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
-        l.player.team_number, l.player.player, (unsigned long long)l.stats.sessions,
-        (unsigned long long)l.stats.maps, (unsigned long long)l.stats.missed,
-        (unsigned long long)l.stats.bad_maps, (unsigned long long)l.stats.refused);
+  if (lola_robots) printLolaResults(lola_robots->results());
   if (officials) printGame(officials->game());
-  if (gc_link) {
-    std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",
-                (unsigned long long)gc_link->packetsSent(),
-                (unsigned long long)gc_link->returnsAccepted(),
-                (unsigned long long)gc_link->returnsRejected());
-    if (gc_link->returnsRejected() > 0)
-      std::printf("last rejected return packet: %s\n", gc_link->lastReturnError().c_str());
-  }
-  const engine::Vec3 ball = w.ballState().pose.translation();
-  std::printf("final state hash %016llx, the ball at (%.2f, %.2f) m\n",
-              static_cast<unsigned long long>(w.stateHash()), ball.x(), ball.y());
+  if (gc_link) printGameControllerLink(*gc_link);
+  printFinalState(w);
   return 0;
 }
 

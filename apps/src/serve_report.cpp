@@ -37,4 +37,27 @@ void printCameraStats(const sim::Simulation& simulation) {
   }
 }
 
+void printLolaResults(const std::vector<match::LolaResult>& results) {
+  for (const match::LolaResult& l : results)
+    std::printf(
+        "  LoLA %d:%d: %llu sessions, %llu maps, %llu missed, %llu bad maps, %llu refused\n",
+        l.player.team_number, l.player.player, (unsigned long long)l.stats.sessions,
+        (unsigned long long)l.stats.maps, (unsigned long long)l.stats.missed,
+        (unsigned long long)l.stats.bad_maps, (unsigned long long)l.stats.refused);
+}
+
+void printGameControllerLink(const referee::GameControllerLink& link) {
+  std::printf("GameController packets sent %llu; return packets accepted %llu, rejected %llu\n",
+              (unsigned long long)link.packetsSent(), (unsigned long long)link.returnsAccepted(),
+              (unsigned long long)link.returnsRejected());
+  if (link.returnsRejected() > 0)
+    std::printf("last rejected return packet: %s\n", link.lastReturnError().c_str());
+}
+
+void printFinalState(const world::World& w) {
+  const engine::Vec3 ball = w.ballState().pose.translation();
+  std::printf("final state hash %016llx, the ball at (%.2f, %.2f) m\n",
+              static_cast<unsigned long long>(w.stateHash()), ball.x(), ball.y());
+}
+
 }  // namespace simsoccer::apps
