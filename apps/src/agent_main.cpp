@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "agent_help.hpp"
 #include "agent_modes.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
@@ -23,50 +24,6 @@
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/robots/robot_model.hpp"
-
-namespace {
-
-const char* kHelp =
-    "usage: simsoccer-agent --team T --player P [--domain D] [--dds-config FILE] [--lease S]\n"
-    "                       [--robot FILE] [--role ROLE [--config FILE] [--field FILE]\n"
-    "                        [--team-number N] [--seed N] [--no-get-up] [--verbose]]\n"
-    "                       [--mode nod|walk|garbage|stall] [--stall-after N]\n"
-    "                       [--vx V] [--vy V] [--turn W] [--ticks N] [--claim-timeout S]\n"
-    "                       [--if-owned wait|refuse] [--game-state-wait S]\n"
-    "\n"
-    "Claims robot (T, P) of the simulator on DDS domain D and answers every sensor frame.\n"
-    "  --dds-config FILE\n"
-    "                   Cyclone DDS configuration (default configs/dds/loopback.xml;\n"
-    "                   configs/dds/lan.xml when the simulator runs on another machine)\n"
-    "  --lease S        s the simulator waits after this process went silent (crashed)\n"
-    "                   before it frees the robot (default 5; shorter costs more traffic)\n"
-    "  --role ROLE      play soccer: auto (the GameState's goalkeeper keeps goal, the field\n"
-    "                   players share striker / supporter / defender by distance to the ball\n"
-    "                   over team messages), striker, supporter, defender, goalkeeper,\n"
-    "                   penalty-kicker or penalty-goalkeeper. Needs perception on in the\n"
-    "                   scenario; obeys the GameState (team number --team-number, default T+1).\n"
-    "                   --config: the behaviour (default configs/agents/soccer.yaml); --field:\n"
-    "                   the field (default fields/spl.yaml). --robot: the robot model (default\n"
-    "                   robots/nao_v6_h25.yaml; its motions and gait from configs/motions/NAME/\n"
-    "                   where there is one, e.g. booster_k1). After a fall the robot gets up\n"
-    "                   (from the back: rolls onto its front first); --no-get-up: it stays\n"
-    "                   down, soft (--get-up, the default, is accepted)\n"
-    "Without --role, --mode (default nod): the stand pose and a nodding head (0.2 rad at 0.5 Hz).\n"
-    "  --mode walk      eases into the walk's stance for 1 s, then walks at --vx, --vy (m/s)\n"
-    "                   and --turn (rad/s) with the walk engine (default 0.2 m/s forward)\n"
-    "  --mode garbage   also sends an invalid command before each valid one (NaN, wrong\n"
-    "                   sizes, stale and future ticks, stiffness out of range)\n"
-    "  --mode stall     answers --stall-after ticks, then keeps running without answering\n"
-    "  --ticks N        exit after answering N frames (default: run until the simulator is gone)\n"
-    "  --game-state-wait S  with --role: wait up to S s (default 0) for the referee's GameState\n"
-    "                   before claiming the robot (the match starts its agents so)\n"
-    "A robot owned by another agent is waited for (its owner may have crashed: the simulator\n"
-    "frees the robot when that agent's lease runs out) for up to --claim-timeout (default 10 s);\n"
-    "with --if-owned refuse (the default is wait) it gives up as soon as the simulator refuses "
-    "it.\n"
-    "Exit status: 0 done, 3 the robot was not granted in time, 4 the simulator went away.\n";
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace simsoccer;
@@ -92,7 +49,7 @@ int main(int argc, char** argv) {
                              "seed",
                              "game-state-wait",
                              "if-owned"});
-    if (opt.help(kHelp)) return 0;
+    if (opt.help(simsoccer::apps::kAgentHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
       throw apps::UsageError("--team and --player are required");

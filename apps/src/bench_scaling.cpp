@@ -12,6 +12,7 @@
 
 #include "bench_motion/trial.hpp"
 #include "cli.hpp"
+#include "help_texts.hpp"
 #include "scaling_plot.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/net/sim_server.hpp"
@@ -24,29 +25,6 @@ namespace {
 
 // Agent processes and what they cost, from the match runner library.
 using namespace simsoccer::match;
-
-const char* kHelp =
-    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--robot R] [--seconds S] "
-    "[--cameras]\n"
-    "                               [--modes serial,pipelined] [--threads N] [--csv FILE]\n"
-    "                               [--png FILE] [--domain D]\n"
-    "\n"
-    "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
-    "3D-league-sized field beyond; --robot booster_k1: K1s on the HSL M-Field with their agent\n"
-    "config, from configs/bench/motion_R.yaml), perception on, the automatic referee (simleague\n"
-    "rule book), and N simsoccer-agent processes (--role auto: walking, kicking, team messages) "
-    "over\n"
-    "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
-    "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
-    "the answers to this period's frames) and pipelined (with the answers to the last\n"
-    "period's, while the agents compute the next: physics and agents overlap). --threads N:\n"
-    "the physics' solver threads (default: one per core, up to 4).\n"
-    "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
-    "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
-    "real-time factor and the time per control period split into physics, sensors,\n"
-    "messaging (perception and frames out, commands in), referee and rendering; writes the\n"
-    "CSV and a plot (default scaling.png): real-time factor and frames per second against\n"
-    "robots, log scale, beside USARSim's published 110, 55, 30, 10 fps for 1-4 Naos.\n";
 
 using Clock = std::chrono::steady_clock;
 
@@ -171,7 +149,7 @@ Row runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uin
 int benchScaling(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "cameras"},
                     {"robots", "seconds", "csv", "png", "domain", "modes", "threads", "robot"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBenchScalingHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
   for (int n : counts)

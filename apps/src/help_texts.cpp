@@ -104,12 +104,36 @@ const char* const kServeHelp =
     "--booster all|T:P,... (GameController team number:player, --teams): these robots (Booster\n"
     "K1s: configs/scenarios/k1_3v3.yaml) are served to Booster SDK clients, each on its own\n"
     "DDS domain from --booster-domain D (default 0) up: rt/low_state every control period,\n"
-    "rt/joint_ctrl obeyed in CUSTOM mode, the locomotion RPC's modes (docs/booster.md). The\n"
+    "rt/joint_ctrl obeyed in CUSTOM mode, the locomotion RPC's modes, Move, Shoot and\n"
+    "VisualKick with simsoccer's walk and kick (docs/booster.md). The\n"
     "run is paced to the wall clock; --booster-lockstep instead waits, each period, for the\n"
     "LowCmd of every robot in CUSTOM mode whose client commands (up to --timeout s).\n"
     "--booster-netns (root): each robot in a network namespace of its own, as domain 0 there\n"
     "(unmodified team code joins domain 0), on a field network (10.78.T.P; GameController\n"
     "packets to 10.78.255.255 with --rules or a match config); `simsoccer booster-run --robot\n"
     "T:P -- PROGRAM` runs a team's program in it.\n";
+
+const char* const kBenchScalingHelp =
+    "usage: simsoccer bench scaling [--robots 1,2,4,8,11,22] [--robot R] [--seconds S] "
+    "[--cameras]\n"
+    "                               [--modes serial,pipelined] [--threads N] [--csv FILE]\n"
+    "                               [--png FILE] [--domain D]\n"
+    "\n"
+    "Per N: N Naos in two teams at their kick-off places (SPL field up to 14 robots, the\n"
+    "3D-league-sized field beyond; --robot booster_k1: K1s on the HSL M-Field with their agent\n"
+    "config, from configs/bench/motion_R.yaml), perception on, the automatic referee (simleague\n"
+    "rule book), and N simsoccer-agent processes (--role auto: walking, kicking, team messages) "
+    "over\n"
+    "loopback DDS in lockstep, for S simulated seconds (default 20) from the kick-off's Ready,\n"
+    "once per period mode in --modes (default serial,pipelined): serial (the world steps with\n"
+    "the answers to this period's frames) and pipelined (with the answers to the last\n"
+    "period's, while the agents compute the next: physics and agents overlap). --threads N:\n"
+    "the physics' solver threads (default: one per core, up to 4).\n"
+    "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
+    "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
+    "real-time factor and the time per control period split into physics, sensors,\n"
+    "messaging (perception and frames out, commands in), referee and rendering; writes the\n"
+    "CSV and a plot (default scaling.png): real-time factor and frames per second against\n"
+    "robots, log scale, beside USARSim's published 110, 55, 30, 10 fps for 1-4 Naos.\n";
 
 }  // namespace simsoccer::apps
