@@ -217,7 +217,8 @@ int main(int argc, char** argv) {
       for (int k = 0; k < periods; ++k)
         if (!nextState(5.0)) fail("LowStates stopped after " + std::to_string(k));
     } else {
-      const dds_entity_t target = endpoint(false, &brain_msg_dds__Kick__desc, "rt/kick_ball", true, 1);
+      const dds_entity_t target =
+          endpoint(false, &brain_msg_dds__Kick__desc, "rt/kick_ball", true, 1);
       // A sample written before the writer matches the robot's reader goes nowhere.
       for (auto end = Clock::now() + std::chrono::seconds(5);;) {
         dds_publication_matched_status_t st{};

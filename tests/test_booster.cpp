@@ -237,10 +237,10 @@ TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   ASSERT_EQ(status, 0) << r.dump();
   const engine::Vec3 ball = w.ballState().pose.translation();
   const auto s = endpoint.stats(0);
-  std::printf("ball at (%.2f, %.2f) after %.1f s; kicks %llu, targets %llu, falls %llu, get-ups %llu\n",
-              ball.x(), ball.y(), w.time(), (unsigned long long)s.kicks,
-              (unsigned long long)s.kick_targets, (unsigned long long)s.falls,
-              (unsigned long long)s.get_ups);
+  std::printf(
+      "ball at (%.2f, %.2f) after %.1f s; kicks %llu, targets %llu, falls %llu, get-ups %llu\n",
+      ball.x(), ball.y(), w.time(), (unsigned long long)s.kicks, (unsigned long long)s.kick_targets,
+      (unsigned long long)s.falls, (unsigned long long)s.get_ups);
   EXPECT_EQ(s.kick_targets, 3u);
   EXPECT_EQ(s.kick_targets_refused, 0u);
   EXPECT_GE(s.kicks, 1u);

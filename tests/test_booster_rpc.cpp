@@ -114,8 +114,7 @@ TEST(BoosterLoco, WithAWalkMoveDrivesItInWalkingAndSoccerMode) {
 TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
   LocoService s(RobotMode::Prepare, {.walk = true, .kicks = true, .vision = true});
   EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
-  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status,
-            kStatusStateTransitionFailed);
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status, kStatusStateTransitionFailed);
   EXPECT_FALSE(s.takeShoot());
   EXPECT_FALSE(s.visualKick());
   // Stopping is always allowed.
@@ -136,8 +135,7 @@ TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
   // Down: it ends, and kicks wait until the robot is up.
   s.setDown(true);
   EXPECT_FALSE(s.visualKick());
-  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status,
-            kStatusStateTransitionFailed);
+  EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 0}}).status, kStatusStateTransitionFailed);
   EXPECT_EQ(call(s, 2024, json::object()).status, kStatusStateTransitionFailed);
   s.setDown(false);
   EXPECT_EQ(call(s, 2038, {{"start", true}}).status, kStatusSuccess);  // version: V1
@@ -151,9 +149,9 @@ TEST(BoosterLoco, KicksInWalkingAndSoccerModeOnItsFeet) {
   call(s, 2000, {{"mode", 4}});
   EXPECT_EQ(call(s, 2038, {{"start", true}, {"version", 1}}).status, kStatusSuccess);
   const uint64_t malformed = s.malformed(), starts = s.visualKickStarts();
-  for (const json& body : {json{{"start", "yes"}}, json{{"version", 1}},
-                           json{{"start", true}, {"version", 2}},
-                           json{{"start", true}, {"version", "V2"}}}) {
+  for (const json& body :
+       {json{{"start", "yes"}}, json{{"version", 1}}, json{{"start", true}, {"version", 2}},
+        json{{"start", true}, {"version", "V2"}}}) {
     const RpcAnswer a = call(s, 2038, body);
     EXPECT_EQ(a.status, kStatusBadRequest) << body.dump();
     EXPECT_NE(a.body.find("VisualKick"), std::string::npos) << a.body;

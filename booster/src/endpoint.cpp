@@ -10,12 +10,12 @@
 #include <cmath>
 #include <deque>
 #include <exception>
-#include <thread>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "booster_sdk.h"
 #include "simsoccer/agents/behaviour/kick_approach.hpp"
@@ -75,7 +75,7 @@ struct Endpoint::Robot {
   // no longer waited for until it answers again.
   int missed_in_row = 0;
   bool unresponsive = false;
-  dds_entity_t command_condition = 0;  // data on rt/joint_ctrl (owned by the reader)
+  dds_entity_t command_condition = 0;          // data on rt/joint_ctrl (owned by the reader)
   const std::vector<double>* stand = nullptr;  // the model's stand pose
   // Walking and Soccer: simsoccer's walk (the built-in agents' motion layer),
   // loaded with the endpoint and restarted from the measured joints on each entry.
@@ -113,8 +113,7 @@ struct Endpoint::Robot {
       : config(c),
         actuators(n),
         participant(dds),
-        state(participant, booster_interface_msg_dds__LowState__desc, "rt/low_state",
-              qos(true, 5)),
+        state(participant, booster_interface_msg_dds__LowState__desc, "rt/low_state", qos(true, 5)),
         // Best effort matches both reliable and best-effort writers; 16 deep so
         // that every command of a period is seen (the last good one drives).
         commands(participant, booster_interface_msg_dds__LowCmd__desc, "rt/joint_ctrl",
@@ -128,9 +127,9 @@ struct Endpoint::Robot {
         // Best effort, as Booster's own readers of it: matches every writer.
         kick_targets(participant, brain_msg_dds__Kick__desc, "rt/kick_ball", qos(false, 4)),
         loco(c.initial_mode, can),
-        pending_pool(kMaxPending, Command{std::vector<float>(n), std::vector<float>(n),
-                                          std::vector<float>(n), std::vector<float>(n),
-                                          std::vector<float>(n)}),
+        pending_pool(kMaxPending,
+                     Command{std::vector<float>(n), std::vector<float>(n), std::vector<float>(n),
+                             std::vector<float>(n), std::vector<float>(n)}),
         motors(n),
         last_dq(n) {
     command_condition = dds_create_readcondition(commands.get(), DDS_ANY_STATE);
@@ -182,8 +181,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
         try {
           const std::string path = "/run/netns/" + b.network_namespace;
           const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-          if (fd < 0)
-            throw std::invalid_argument("Booster endpoint: no network namespace " + path);
+          if (fd < 0) throw std::invalid_argument("Booster endpoint: no network namespace " + path);
           const int rc = ::setns(fd, CLONE_NEWNET);
           ::close(fd);
           if (rc != 0)
@@ -480,7 +478,6 @@ void Endpoint::answerRequests(Robot& r) {
   });
 }
 
-
 void Endpoint::takeKickTargets(Robot& r) {
   const double yaw = world_.sensorFrame(r.config.robot).angles[2];
   r.kick_targets.take([&](const KickTarget& k, const dds_sample_info_t&) {
@@ -515,7 +512,8 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
     for (;;) {
       bool waiting = false;
       for (auto& rp : robots_) waiting = waiting || awaited(*rp);
-      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - Clock::now());
       if (!waiting || left.count() <= 0) break;
       dds_waitset_wait(waitset_, nullptr, 0, static_cast<dds_duration_t>(left.count()));
       for (auto& rp : robots_) takeCommands(*rp);

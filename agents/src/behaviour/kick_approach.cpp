@@ -11,14 +11,15 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double wrap(double a) { return std::remainder(a, 2 * kPi); }
+double wrap(double a) {
+  return std::remainder(a, 2 * kPi);
+}
 
 }  // namespace
 
 MotionRequest lineUpForKick(const BehaviourConfig& c, double ball_x, double ball_y, double aim,
                             double max_forward, Leg& foot) {
-  if (std::abs(ball_y) > 0.02 || foot == Leg::Right)
-    foot = ball_y >= 0 ? Leg::Left : Leg::Right;
+  if (std::abs(ball_y) > 0.02 || foot == Leg::Right) foot = ball_y >= 0 ? Leg::Left : Leg::Right;
   const double foot_y = foot == Leg::Left ? c.kick_ball_y : -c.kick_ball_y;
   const double ex = ball_x - c.kick_ball_x, ey = ball_y - foot_y;
   MotionRequest r;
@@ -43,8 +44,8 @@ void lookAt(double x, double y, MotionRequest& r) {
 
 BehaviourConfig loadKickApproach(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly({"max_forward", "max_side", "max_turn", "kick_ball", "kick_tolerance",
-                  "approach_distance"});
+  root.allowOnly(
+      {"max_forward", "max_side", "max_turn", "kick_ball", "kick_tolerance", "approach_distance"});
   BehaviourConfig c;
   c.max_forward = root.number("max_forward", c.max_forward);
   c.max_side = root.number("max_side", c.max_side);
@@ -75,7 +76,9 @@ void KickApproach::start(double time, double yaw) {
   kicking_ = false;
 }
 
-void KickApproach::aimAt(double direction, double yaw) { aim_yaw_ = wrap(yaw + direction); }
+void KickApproach::aimAt(double direction, double yaw) {
+  aim_yaw_ = wrap(yaw + direction);
+}
 
 MotionRequest KickApproach::update(double time, const BallSighting& ball, double yaw,
                                    MotionState motion) {

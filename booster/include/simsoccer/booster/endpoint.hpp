@@ -70,7 +70,7 @@ struct EndpointConfig {
   // LowState; real time: whatever has arrived is taken.
   bool lockstep = false;
   double answer_timeout = 0.5;
-  int unresponsive_after = 3;  // misses in a row before a client is no longer waited for
+  int unresponsive_after = 3;       // misses in a row before a client is no longer waited for
   double fall_down_interval = 1.0;  // s of simulation between unchanged fall_down samples
   // The ROS 2 topic (DDS name) of the robot's first camera; Booster's vision
   // stack publishes its rectified head-camera image here.
@@ -79,21 +79,21 @@ struct EndpointConfig {
 
 struct RobotBoosterStats {
   RobotMode mode = RobotMode::Prepare;  // the locomotion service's, when asked
-  uint64_t states_sent = 0;       // LowState_ samples
-  uint64_t commands = 0;          // LowCmd_ samples received
-  uint64_t applied = 0;           // periods a LowCmd drove the robot (CUSTOM)
-  uint64_t ignored = 0;           // well-formed LowCmds outside CUSTOM mode
-  uint64_t refused = 0;           // LowCmds refused (size, PARALLEL; NaN, range: the gate)
-  uint64_t missed = 0;            // lockstep periods without a LowCmd in time
-  uint64_t late = 0;              // lockstep: LowCmds that came after their period (dropped)
+  uint64_t states_sent = 0;             // LowState_ samples
+  uint64_t commands = 0;                // LowCmd_ samples received
+  uint64_t applied = 0;                 // periods a LowCmd drove the robot (CUSTOM)
+  uint64_t ignored = 0;                 // well-formed LowCmds outside CUSTOM mode
+  uint64_t refused = 0;                 // LowCmds refused (size, PARALLEL; NaN, range: the gate)
+  uint64_t missed = 0;                  // lockstep periods without a LowCmd in time
+  uint64_t late = 0;                    // lockstep: LowCmds that came after their period (dropped)
   uint64_t requests = 0, requests_refused = 0, requests_malformed = 0;
-  uint64_t images = 0;            // camera images published
-  uint64_t walk_starts = 0;       // times simsoccer's walk (re)started: each entry into WALKING
-                                  // or SOCCER from another mode
-  uint64_t kicks = 0;             // kicks the walk made (Shoot, the visual kick)
-  uint64_t falls = 0, get_ups = 0;  // the walk's fall detector's: falls, get-ups that stood
-  uint64_t kick_targets = 0;      // rt/kick_ball samples received
-  uint64_t kick_targets_refused = 0;  // of them with a direction that is not a number
+  uint64_t images = 0;                // camera images published
+  uint64_t walk_starts = 0;           // times simsoccer's walk (re)started: each entry into WALKING
+                                      // or SOCCER from another mode
+  uint64_t kicks = 0;                 // kicks the walk made (Shoot, the visual kick)
+  uint64_t falls = 0, get_ups = 0;    // the walk's fall detector's: falls, get-ups that stood
+  uint64_t kick_targets = 0;          // rt/kick_ball samples received
+  uint64_t kick_targets_refused = 0;  // of them with a dir that is not an angle (NaN, beyond 2π)
 };
 
 // The period (s) simsoccer's walk runs at for the locomotion service: the
@@ -144,8 +144,8 @@ class Endpoint : public sim::CommandSource {
   const world::World& world_;
   EndpointConfig config_;
   std::vector<std::unique_ptr<Robot>> robots_;
-  int32_t waitset_ = 0;  // a DDS waitset on every robot's commands (lockstep)
-  double time_ = 0.0;    // the simulation time of the last observation
+  int32_t waitset_ = 0;   // a DDS waitset on every robot's commands (lockstep)
+  double time_ = 0.0;     // the simulation time of the last observation
   uint64_t acts_at_ = 0;  // the period the commands collected next act in
   // The walk's period: kWalkPeriod in whole control periods (at least one).
   uint64_t walk_periods_ = 1;

@@ -15,11 +15,10 @@
 // the robot stands and VisualKick {"start", "version"} starts and stops the
 // visual kick (the robot goes to the ball it sees and kicks it the way
 // rt/kick_ball says, again and again until stopped; it needs the
-// simulation's perception), both in Walking and Soccer with the robot on its feet. As the SDK's status codes say: a call the
-// robot has no motion for (LieDown, SwitchGait, ...) answers 501 (server
-// refused), one its state does not allow (Move in Prepare, RotateHead in
-// Custom, a kick while it lies) 502 (state transition failed); malformed requests and unknown api
-// ids 400.
+// simulation's perception), both in Walking and Soccer with the robot on its feet. As the SDK's
+// status codes say: a call the robot has no motion for (LieDown, SwitchGait, ...) answers 501
+// (server refused), one its state does not allow (Move in Prepare, RotateHead in Custom, a kick
+// while it lies) 502 (state transition failed); malformed requests and unknown api ids 400.
 #pragma once
 
 #include <cstdint>

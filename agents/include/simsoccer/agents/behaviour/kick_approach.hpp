@@ -17,8 +17,8 @@ namespace simsoccer::agents {
 // answers a Kick with it once the ball lies in front of it within the
 // config's tolerances, else a small walk step towards that (forward at most
 // `max_forward` m/s).
-MotionRequest lineUpForKick(const BehaviourConfig& config, double ball_x, double ball_y,
-                            double aim, double max_forward, Leg& foot);
+MotionRequest lineUpForKick(const BehaviourConfig& config, double ball_x, double ball_y, double aim,
+                            double max_forward, Leg& foot);
 
 // The head turned to a ball at (x, y) (robot frame, m), pitched by its
 // distance (near: down at the feet).
