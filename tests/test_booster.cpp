@@ -119,6 +119,24 @@ int runUntilTheClientEnds(sim::Simulation& simulation, const booster::Endpoint& 
   return status;
 }
 
+// The test client on robot 0's domain with the project's loopback DDS configuration and
+// `args`, paced (`pace_ms` per period) until it ends; its one-line result, its exit status
+// in `status`.
+json runPacedClient(ServedK1& k1, std::vector<std::string> args, int& status, int pace_ms = 5) {
+  args.insert(args.begin(), {SIMSOCCER_BOOSTER_CLIENT, "--domain",
+                             std::to_string(k1.endpoint.config().robots[0].domain), "--dds-config",
+                             (test::sourceDir() / "configs/dds/loopback.xml").string()});
+  ClientProcess client(std::move(args));
+  if (!client.process.started()) {
+    status = -1;
+    return json();
+  }
+  status = runUntilTheClientEnds(k1.simulation, k1.endpoint, client, /*pace=*/true, pace_ms);
+  const json r = client.result();
+  std::printf("client: %s\n", r.dump().c_str());
+  return r;
+}
+
 }  // namespace
 
 TEST(BoosterEndpoint, AnSdkClientDrivesAK1InCustomMode) {
@@ -172,13 +190,9 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   ServedK1 k1(robot, /*lockstep=*/false);
   auto& [w, simulation, endpoint] = k1;
   const engine::Vec3 start = w.torsoPose(0).translation();
-  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "174", "--dds-config",
-                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "400", "--walk", "0.3", "--custom-between", "100"});
-  ASSERT_TRUE(client.process.started());
-  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
-  const json r = client.result();
-  std::printf("client: %s\n", r.dump().c_str());
+  int status = -1;
+  const json r =
+      runPacedClient(k1, {"--periods", "400", "--walk", "0.3", "--custom-between", "100"}, status);
   ASSERT_EQ(status, 0) << r.dump();
   const engine::Pose torso = w.torsoPose(0);
   const engine::Vec3 moved = torso.translation() - start;
@@ -227,13 +241,9 @@ TEST(BoosterEndpoint, TheVisualKickGoesToTheBallAndKicksItTheWayAsked) {
   // The ball 1.5 m ahead, to be kicked 0.7 rad to the left of the robot's heading at the start
   // (the field's +x): the K1 walks round to behind it on that line first.
   test::putBallOnCarpet(w, 1.5, 0.0);
-  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "175", "--dds-config",
-                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "1100", "--kick", "visual", "--kick-dir", "0.7"});
-  ASSERT_TRUE(client.process.started());
-  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true);
-  const json r = client.result();
-  std::printf("client: %s\n", r.dump().c_str());
+  int status = -1;
+  const json r =
+      runPacedClient(k1, {"--periods", "1100", "--kick", "visual", "--kick-dir", "0.7"}, status);
   ASSERT_EQ(status, 0) << r.dump();
   const engine::Vec3 ball = w.ballState().pose.translation();
   const auto s = endpoint.stats(0);
@@ -272,13 +282,9 @@ TEST(BoosterEndpoint, ShootKicksTheBallInFrontOfTheK1) {
   // In front of the left foot, where the walk's kick meets it (configs/motions/booster_k1/
   // kick_approach.yaml: 0.25 m ahead, 0.095 m to the side).
   test::putBallOnCarpet(w, 0.25, 0.095);
-  ClientProcess client({SIMSOCCER_BOOSTER_CLIENT, "--domain", "176", "--dds-config",
-                        (test::sourceDir() / "configs/dds/loopback.xml").string(), "--periods",
-                        "2500", "--kick", "shoot", "--scale", "5"});
-  ASSERT_TRUE(client.process.started());
-  const int status = runUntilTheClientEnds(simulation, endpoint, client, /*pace=*/true, 1);
-  const json r = client.result();
-  std::printf("client: %s\n", r.dump().c_str());
+  int status = -1;
+  const json r =
+      runPacedClient(k1, {"--periods", "2500", "--kick", "shoot", "--scale", "5"}, status, 1);
   ASSERT_EQ(status, 0) << r.dump();
   const engine::Vec3 ball = w.ballState().pose.translation();
   const auto s = endpoint.stats(0);

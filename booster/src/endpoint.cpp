@@ -332,8 +332,8 @@ void Endpoint::observe(const sim::Observation& o) {
   for (auto& rp : robots_) {
     Robot& r = *rp;
     // The ball as the robot's cameras saw it (the simulation's perception):
-    // what its visual kick goes for.
-    if (o.perception) {
+    // what its kicks go for.
+    if (o.perception && r.approach) {
       const world::PerceivedObject& b = o.perception->perception(r.config.robot).ball;
       r.ball = agents::BallSighting{b.x, b.y, b.last_seen < 0.0 ? -1.0 : o.time - b.last_seen};
     }

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "simsoccer/engine/config.hpp"
-
 namespace simsoccer::agents {
 namespace {
 
@@ -42,38 +40,10 @@ void lookAt(double x, double y, MotionRequest& r) {
   r.head_pitch = std::clamp(std::atan2(0.45, std::max(d, 0.1)) - 0.35, -0.4, 0.45);
 }
 
-BehaviourConfig loadKickApproach(const std::filesystem::path& file) {
-  const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
-  root.allowOnly(
-      {"max_forward", "max_side", "max_turn", "kick_ball", "kick_tolerance", "approach_distance"});
-  BehaviourConfig c;
-  c.max_forward = root.number("max_forward", c.max_forward);
-  c.max_side = root.number("max_side", c.max_side);
-  c.max_turn = root.number("max_turn", c.max_turn);
-  c.approach_distance = root.number("approach_distance", c.approach_distance);
-  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance"})
-    if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
-  if (auto n = root.optional("kick_ball")) {
-    const auto v = n->numbers(2);
-    if (!(v[0] > 0)) n->fail("the ball must lie ahead of the torso (x > 0)");
-    c.kick_ball_x = v[0];
-    c.kick_ball_y = std::abs(v[1]);
-  }
-  if (auto n = root.optional("kick_tolerance")) {
-    const auto v = n->numbers(3);
-    if (!(v[0] > 0 && v[1] > 0 && v[2] > 0)) n->fail("tolerances must be > 0");
-    c.kick_tolerance_x = v[0];
-    c.kick_tolerance_y = v[1];
-    c.kick_tolerance_angle = v[2];
-  }
-  return c;
-}
-
 void KickApproach::start(double time, double yaw) {
   aim_yaw_ = yaw;
   started_ = time;
   commit_until_ = -1.0;
-  kicking_ = false;
 }
 
 void KickApproach::aimAt(double direction, double yaw) {
@@ -84,10 +54,7 @@ MotionRequest KickApproach::update(double time, const BallSighting& ball, double
                                    MotionState motion) {
   const bool down = motion == MotionState::Falling || motion == MotionState::Lying ||
                     motion == MotionState::GettingUp || motion == MotionState::Diving;
-  const bool kicking = motion == MotionState::Kicking;
-  if (kicking && !kicking_) ++kicks_;
-  kicking_ = kicking;
-  if (kicking || down) commit_until_ = -1.0;
+  if (motion == MotionState::Kicking || down) commit_until_ = -1.0;
   const double aim = wrap(aim_yaw_ - yaw);  // robot frame
   const bool seen = ball.age >= 0.0 && ball.age < 1.0;
   MotionRequest r;

@@ -42,6 +42,31 @@ int get16u(const std::vector<uint8_t>& b, size_t i) {
   return static_cast<uint16_t>(b[i] | (b[i + 1] << 8));
 }
 
+// The keys of the walk up to a kick and its line-up (a behaviour config's, and a kick
+// approach file's whole): the speeds, the ball's place for a kick, the tolerances, the
+// approach distance; each checked.
+void readKickApproach(const engine::ConfigNode& root, BehaviourConfig& c) {
+  c.max_forward = root.number("max_forward", c.max_forward);
+  c.max_side = root.number("max_side", c.max_side);
+  c.max_turn = root.number("max_turn", c.max_turn);
+  c.approach_distance = root.number("approach_distance", c.approach_distance);
+  for (const char* k : {"max_forward", "max_side", "max_turn", "approach_distance"})
+    if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
+  if (auto n = root.optional("kick_ball")) {
+    const auto v = n->numbers(2);
+    if (!(v[0] > 0)) n->fail("the ball must lie ahead of the torso (x > 0)");
+    c.kick_ball_x = v[0];
+    c.kick_ball_y = std::abs(v[1]);
+  }
+  if (auto n = root.optional("kick_tolerance")) {
+    const auto v = n->numbers(3);
+    if (!(v[0] > 0 && v[1] > 0 && v[2] > 0)) n->fail("tolerances must be > 0");
+    c.kick_tolerance_x = v[0];
+    c.kick_tolerance_y = v[1];
+    c.kick_tolerance_angle = v[2];
+  }
+}
+
 }  // namespace
 
 const char* roleName(Role r) {
@@ -105,21 +130,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   };
   for (const auto& item : root["ready_positions"].items()) c.ready_positions.push_back(pose(item));
   if (auto n = root.optional("kick_off_position")) c.kick_off_position = pose(*n);
-  c.max_forward = root.number("max_forward", c.max_forward);
-  c.max_side = root.number("max_side", c.max_side);
-  c.max_turn = root.number("max_turn", c.max_turn);
-  if (auto n = root.optional("kick_ball")) {
-    const auto v = n->numbers(2);
-    c.kick_ball_x = v[0];
-    c.kick_ball_y = v[1];
-  }
-  if (auto n = root.optional("kick_tolerance")) {
-    const auto v = n->numbers(3);
-    c.kick_tolerance_x = v[0];
-    c.kick_tolerance_y = v[1];
-    c.kick_tolerance_angle = v[2];
-  }
-  c.approach_distance = root.number("approach_distance", c.approach_distance);
+  readKickApproach(root, c);
   c.ball_lost_time = root.number("ball_lost_time", c.ball_lost_time);
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
   c.ball_velocity_window = root.number("ball_velocity_window", c.ball_velocity_window);
@@ -137,8 +148,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.avoid_far = root.number("avoid_far", c.avoid_far);
   c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
   for (const char* k :
-       {"max_forward", "max_side", "max_turn", "approach_distance", "message_interval",
-        "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
+       {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
     if (root.has(k) && !(root[k].number() > 0)) root[k].fail("must be > 0");
   // Three sightings at the least at 100 Hz over half the window.
@@ -149,6 +159,15 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
         .fail("avoid_far must be greater than avoid_near");
   for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
+  return c;
+}
+
+BehaviourConfig loadKickApproach(const std::filesystem::path& file) {
+  const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
+  root.allowOnly(
+      {"max_forward", "max_side", "max_turn", "kick_ball", "kick_tolerance", "approach_distance"});
+  BehaviourConfig c;
+  readKickApproach(root, c);
   return c;
 }
 

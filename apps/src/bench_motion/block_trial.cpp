@@ -29,8 +29,7 @@ BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout) {
   s.ball_position = {line + 2.5, 0.0, -1.0};
   TrialWorld t(s, c);
   world::World& w = t.world;
-  t.addAgents({shootout ? agents::Role::PenaltyGoalkeeper : agents::Role::Goalkeeper},
-                         seed);
+  t.addAgents({shootout ? agents::Role::PenaltyGoalkeeper : agents::Role::Goalkeeper}, seed);
   const double dt = w.scenario().physics.control_period;
   for (int i = 0; i < 200; ++i) {  // 2 s to settle into the stance
     t.period();

@@ -65,10 +65,7 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
     const double dt = t.dt();
     walk.setVelocity(0.0, 0.0, 0.0);
     t.driver.setControl([&](const world::World& world, std::span<float> p, std::span<float> k) {
-      const auto& fr = world.sensorFrame(0);
-      walk.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), fr.angles[2],
-                  targets);
-      bodyTargetsToCommand(model, targets, 1.0, p, k);
+      walkPeriod(world, walk, dt, targets, p, k);
       return true;
     });
     const int periods = static_cast<int>(std::lround(steps_first * c.walk.step_period / dt));

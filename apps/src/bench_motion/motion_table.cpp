@@ -1,5 +1,7 @@
 // The table of `simsoccer bench motion`: every trial, seeded, against its
 // target.
+#include "motion_table.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,7 +9,6 @@
 #include <random>
 
 #include "cli.hpp"
-#include "motion_table.hpp"
 
 namespace simsoccer::apps::motion {
 
@@ -33,20 +34,23 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
   };
   {
     const double v = b.walk_forward, seconds = std::ceil(5.0 / v) + 2.0;  // 5 m and more
-    const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(v, 0, 0); }, seconds);
+    const WalkResult r = walkTrial(
+        quiet, [&](double) { return Eigen::Vector3d(v, 0, 0); }, seconds);
     row("walk_forward", v, r.speed, "m/s", 100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9),
         r.fell, seconds);
   }
   {
     const double v = b.walk_sideways, seconds = 10.0;
-    const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(0, v, 0); }, seconds);
+    const WalkResult r = walkTrial(
+        quiet, [&](double) { return Eigen::Vector3d(0, v, 0); }, seconds);
     row("walk_sideways", v, r.speed, "m/s",
         100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9), r.fell, seconds);
   }
   {
     // Less than a turn, so the angle is unambiguous.
     const double w = b.turn, seconds = std::min(5.0, 5.0 / w);
-    const WalkResult r = walkTrial(quiet, [&](double) { return Eigen::Vector3d(0, 0, w); }, seconds);
+    const WalkResult r = walkTrial(
+        quiet, [&](double) { return Eigen::Vector3d(0, 0, w); }, seconds);
     double turned = r.turned;
     if (turned < 0) turned += 2 * M_PI;
     row("turn", w * 180 / M_PI, turned / seconds * 180 / M_PI, "deg/s",
@@ -125,7 +129,8 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
     const int trials = static_cast<int>(opt.number("penalty-trials", 50));
     std::array<int, 4> count{};
     for (int i = 0; i < trials; ++i)
-      ++count[static_cast<size_t>(penaltyTrial(quiet, seed + 500 + static_cast<uint64_t>(i), 30.0))];
+      ++count[static_cast<size_t>(
+          penaltyTrial(quiet, seed + 500 + static_cast<uint64_t>(i), 30.0))];
     std::fprintf(stderr, "  penalties:");
     for (size_t k = 0; k < count.size(); ++k)
       std::fprintf(stderr, " %d %s", count[k], penaltyOutcomeName(static_cast<PenaltyOutcome>(k)));

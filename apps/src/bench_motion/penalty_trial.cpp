@@ -39,7 +39,8 @@ PenaltyOutcome penaltyTrial(const TrialContext& c, uint64_t seed, double limit) 
     t.period();
     if (c.verbose && i % 100 == 0)
       std::fprintf(stderr, "t %5.1f kicker %s | keeper %s\n", i * dt,
-                   t.agents->behaviour(0).status().c_str(), t.agents->behaviour(1).status().c_str());
+                   t.agents->behaviour(0).status().c_str(),
+                   t.agents->behaviour(1).status().c_str());
     const auto ball = w.ballState();
     if (goalScored(w) == 1) return PenaltyOutcome::Goal;
     const Vec3 b = ball.pose.translation();

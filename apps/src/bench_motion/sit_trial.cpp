@@ -17,8 +17,7 @@ SitResult sitTrial(const TrialContext& c, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   w.placeRobot(0, -3.0 + 0.5 * u(rng), 0.5 * u(rng), M_PI * u(rng));
-  agents::MotionController motion =
-      agents::loadMotionController(*w.robot(0).model, c.motions_dir);
+  agents::MotionController motion = agents::loadMotionController(*w.robot(0).model, c.motions_dir);
   const double dt = t.dt();
   agents::MotionRequest request;
   request.kind = agents::MotionRequest::Kind::Walk;

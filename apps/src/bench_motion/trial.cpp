@@ -87,8 +87,8 @@ TrialWorld::TrialWorld(const world::Scenario& scenario, const TrialContext& cont
 
 void TrialWorld::addAgents(std::vector<agents::Role> roles, uint64_t seed) {
   agents = std::make_unique<match::InProcessAgents>(
-      world, match::InProcessSetup{std::move(roles), seed, true,
-                                   context_.bench.agents, context_.motions_dir});
+      world, match::InProcessSetup{std::move(roles), seed, true, context_.bench.agents,
+                                   context_.motions_dir});
   simulation.addSource(*agents);
 }
 
@@ -110,6 +110,14 @@ void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<dou
   }
 }
 
+void walkPeriod(const world::World& world, agents::WalkEngine& engine, double dt,
+                std::vector<double>& targets, std::span<float> position,
+                std::span<float> stiffness) {
+  const auto& f = world.sensorFrame(0);
+  engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
+  bodyTargetsToCommand(*world.robot(0).model, targets, 1.0, position, stiffness);
+}
+
 void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<double>& targets) {
   const auto& model = *t.world.robot(0).model;
   const std::vector<double>& stand = model.pose("stand");
@@ -122,7 +130,6 @@ void settleIntoStance(TrialWorld& t, agents::WalkEngine& engine, std::vector<dou
   for (i = 0; i < 100; ++i) t.period();
   t.driver.setControl({});  // its captures end here
 }
-
 
 int goalScored(const world::World& w) {
   return referee::ballInGoal(w.field(), w.ballState().pose.translation());

@@ -1,6 +1,6 @@
 // bench motion's trials: one robot (or a striker and a keeper) on an empty
-// field (a Nao on the SPL field, a K1 on the HSL M-Field), driven through the same period pipeline as a match (the gate, the
-// quantisation and the mode's actuation timing), one file per trial.
+// field (a Nao on the SPL field, a K1 on the HSL M-Field), driven through the same period pipeline
+// as a match (the gate, the quantisation and the mode's actuation timing), one file per trial.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,7 +32,7 @@ struct MotionBench {
   std::string robot;  // the robot's name (its model's)
   std::filesystem::path robot_model, field, motions, agents;
   double walk_forward = 0.25, walk_sideways = 0.1, turn = 0.8;  // m/s, m/s, rad/s
-  double kick_distance = 3.0;                                    // m, a successful kick
+  double kick_distance = 3.0;                                   // m, a successful kick
   // The random walk's commands: [lowest, highest] forward, sideways (m/s), turn (rad/s).
   std::array<double, 2> random_forward{-0.1, 0.3}, random_sideways{-0.1, 0.1},
       random_turn{-0.8, 0.8};
@@ -97,6 +97,12 @@ struct TrialWorld {
 void bodyTargetsToCommand(const robots::RobotModel& model, const std::vector<double>& targets,
                           double stiffness, std::span<float> position,
                           std::span<float> stiffness_out);
+
+// One control period of the walk on robot 0: updated from its sensor frame (gyro, IMU yaw),
+// its targets (body joint order) written as the command at full stiffness.
+void walkPeriod(const world::World& world, agents::WalkEngine& engine, double dt,
+                std::vector<double>& targets, std::span<float> position,
+                std::span<float> stiffness);
 
 // Robot 0 for 1 s from the stand pose into the walk's stance (eased in,
 // then held); `targets` (body joint order) end in the stance.

@@ -33,9 +33,7 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   const auto walkControl = [&](const world::World& world, std::span<float> p, std::span<float> k) {
     const Eigen::Vector3d v = schedule(static_cast<double>(i) * dt);
     engine.setVelocity(v.x(), v.y(), v.z());
-    const auto& f = world.sensorFrame(0);
-    engine.update(dt, Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[2], targets);
-    bodyTargetsToCommand(model, targets, 1.0, p, k);
+    walkPeriod(world, engine, dt, targets, p, k);
     return true;
   };
   t.driver.setControl(walkControl);

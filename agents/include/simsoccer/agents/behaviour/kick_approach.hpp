@@ -5,8 +5,6 @@
 // through that API (booster/, docs/booster.md).
 #pragma once
 
-#include <filesystem>
-
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 
 namespace simsoccer::agents {
@@ -23,12 +21,6 @@ MotionRequest lineUpForKick(const BehaviourConfig& config, double ball_x, double
 // The head turned to a ball at (x, y) (robot frame, m), pitched by its
 // distance (near: down at the feet).
 void lookAt(double x, double y, MotionRequest& request);
-
-// A kick approach's parameters from a file with some of a behaviour config's
-// keys (configs/agents/*.yaml): max_forward, max_side, max_turn, kick_ball,
-// kick_tolerance, approach_distance; the others keep their defaults. Throws
-// engine::ConfigError (file, key, reason).
-BehaviourConfig loadKickApproach(const std::filesystem::path& file);
 
 // Where the robot last saw the ball (its perception), robot frame.
 struct BallSighting {
@@ -54,17 +46,12 @@ class KickApproach {
   // layer's state; the request, head included.
   MotionRequest update(double time, const BallSighting& ball, double yaw, MotionState motion);
 
-  double aim() const { return aim_yaw_; }  // rad, IMU heading frame
-  int kicks() const { return kicks_; }     // kicks started since constructed
-
  private:
   BehaviourConfig config_;
   double aim_yaw_ = 0.0;
   double started_ = 0.0;
   double commit_until_ = -1.0;  // a kick decided is asked for until the motion layer kicks
   Leg foot_ = Leg::Right;
-  bool kicking_ = false;
-  int kicks_ = 0;
   double last_side_ = 1.0;  // which way the ball was seen last (+1 left)
 };
 

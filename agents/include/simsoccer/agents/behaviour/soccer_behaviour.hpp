@@ -97,6 +97,10 @@ struct BehaviourConfig {
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
+// A kick approach's (agents/behaviour/kick_approach.hpp) from a file with only these keys of a
+// behaviour config: max_forward, max_side, max_turn, kick_ball, kick_tolerance,
+// approach_distance (read and checked as there); the others keep their defaults.
+BehaviourConfig loadKickApproach(const std::filesystem::path& file);
 
 // What one robot tells its teammates (field frame), in 20 bytes.
 struct TeamMessageData {
