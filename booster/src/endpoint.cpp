@@ -93,8 +93,7 @@ struct Endpoint::Robot {
   // target_yaw, at simulation time target_at).
   std::unique_ptr<agents::KickApproach> approach;
   agents::BallSighting ball;
-  bool was_visual_kick = false;
-  uint64_t visual_kick_start = 0;  // the service's start the kick approach runs for
+  uint64_t visual_kick_start = 0;  // the service's VisualKick start the kick approach runs for
   bool shooting = false;
   int kicks_before_shot = 0;  // the walk's kicks when the Shoot was taken
   agents::Leg shoot_foot = agents::Leg::Right;
@@ -392,7 +391,7 @@ void Endpoint::observe(const sim::Observation& o) {
       if (o.tick % walk_periods_ == 0) walkTargets(r, f, o.tick + walk_periods_);
     } else {
       // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
-      r.was_walking = r.was_visual_kick = r.shooting = false;
+      r.was_walking = r.shooting = false;
       r.walk_targets.clear();
     }
     acts_at_ = o.tick + static_cast<uint64_t>(std::max(0, o.actuation_delay));
@@ -419,7 +418,7 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
     // The visual kick: to the ball the robot sees, kicked the way
     // rt/kick_ball says (a direction sent with the start holds).
     r.shooting = false;
-    if (!r.was_visual_kick || r.visual_kick_start != r.loco.visualKickStarts()) {
+    if (r.visual_kick_start != r.loco.visualKickStarts()) {
       r.visual_kick_start = r.loco.visualKickStarts();
       r.approach->start(time_, yaw);
       if (r.target_dir && time_ - r.target_at < 1.0) r.approach->aimAt(*r.target_dir, r.target_yaw);
@@ -455,7 +454,6 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
       request.head_pitch = head->pitch;
     }
   }
-  r.was_visual_kick = visual;
   Robot::WalkTargets& t = r.walk_targets.emplace_back();
   t.acts_at = acts_at;
   r.motion->update(walk_dt_, agents::motionSensors(frame), request, t.position, t.stiffness);
@@ -489,8 +487,7 @@ void Endpoint::takeKickTargets(Robot& r) {
     r.target_dir = k.dir;
     r.target_yaw = yaw;
     r.target_at = time_;
-    if (r.approach && r.was_visual_kick && r.loco.visualKick() &&
-        r.visual_kick_start == r.loco.visualKickStarts())
+    if (r.approach && r.loco.visualKick() && r.visual_kick_start == r.loco.visualKickStarts())
       r.approach->aimAt(k.dir, yaw);
   });
 }
