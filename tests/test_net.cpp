@@ -884,7 +884,7 @@ TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
   EXPECT_EQ(server.stats(0).missed, 0u);
 }
 
-TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
+TEST(NetPerception, EveryFrameCarriesTheRobotsPerceptionOfItsPeriod) {
   const uint32_t domain = 116;
   world::Scenario s = teams(1);
   s.robots[0].x = -2.0;
@@ -900,20 +900,43 @@ TEST(NetPerception, TheRobotsPerceptionArrivesEveryPeriod) {
   server.poll(0.5);  // the viewer's reader matches
   int received = 0;
   agents::PerceptionIn p;
+  simsoccer_msg_SensorFrame frame{};
   for (int i = 0; i < 50; ++i) {
     simulation.period();
+    const uint64_t tick = w.controlTick() - 1;
     const auto start = Clock::now();
-    while (!viewer.perception(p) && seconds(start) < 1.0)
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    if (p.tick == w.controlTick() - 1) ++received;
+    while ((frame.tick != tick || !viewer.receive(frame, 0.05)) && seconds(start) < 1.0) {
+    }
+    if (frame.tick == tick && agents::perceptionFromFrame(frame, p) && p.tick == tick) ++received;
   }
-  std::printf("perception received for %d of 50 periods; ball at (%.3f, %.3f), in view %d\n",
-              received, p.ball.x, p.ball.y, p.ball.in_view);
+  std::printf("perception in %d of 50 frames; ball at (%.3f, %.3f), in view %d, %zu robots\n",
+              received, p.ball.x, p.ball.y, p.ball.in_view, p.robots.size());
   EXPECT_GE(received, 45);
   EXPECT_TRUE(p.ball.in_view);
   EXPECT_NEAR(p.ball.x, 1.0, 0.05);
   EXPECT_NEAR(p.ball.y, 0.0, 0.05);
   EXPECT_NEAR(p.self_pose[0], -2.0, 0.05);
+  EXPECT_EQ(p.robots.size(), 1u);  // the other team's robot, seen or not
+}
+
+TEST(NetPerception, WithPerceptionOffAFrameCarriesNone) {
+  const uint32_t domain = 120;
+  world::Scenario s = teams(1);
+  world::World w(s);
+  sim::Simulation simulation(w);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
+  agents::AgentClient viewer(dds(domain), 0, 1);
+  server.poll(0.5);  // the viewer's reader matches
+  simsoccer_msg_SensorFrame frame{};
+  bool got = false;
+  for (int i = 0; i < 20 && !got; ++i) {
+    simulation.period();
+    got = viewer.receive(frame, 0.2);
+  }
+  ASSERT_TRUE(got);
+  agents::PerceptionIn p;
+  EXPECT_FALSE(agents::perceptionFromFrame(frame, p));
+  EXPECT_EQ(frame.perception.robots._length, 0u);
 }
 
 TEST(NetKick, AStrikerAgentKicksTheBallTwoMetres) {

@@ -21,7 +21,6 @@ struct AgentClient::Impl {
   net::Reader<simsoccer_msg_SensorFrame> frames;
   net::Reader<simsoccer_msg_RobotStatus> status;
   net::Reader<simsoccer_msg_GameState> game;
-  net::Reader<simsoccer_msg_Perception> perception;
   net::Reader<simsoccer_msg_TeamMessage> team_deliver;
   net::Entity waitset, frame_condition;
   std::unique_ptr<net::Reader<simsoccer_msg_CameraImage>> images;  // after subscribeImages()
@@ -82,8 +81,6 @@ struct AgentClient::Impl {
         // then (one instance: the topic has no key) does not push the
         // simulator's out before they are taken (a flood still can).
         game(participant, simsoccer_msg_GameState_desc, "simsoccer_GameState", {true, 16, true, ""}),
-        perception(participant, simsoccer_msg_Perception_desc, "simsoccer_Perception",
-                   {true, 1, false, net::robotPartitionName(team, player)}),
         team_deliver(participant, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
                      {true, 16, false, net::robotPartitionName(team, player)}) {
     waitset = net::Entity(net::check(dds_create_waitset(participant.get()), "create waitset"));
@@ -406,28 +403,22 @@ PerceivedIn fromMessage(const simsoccer_msg_PerceivedObject& m) {
 }
 }  // namespace
 
-PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m) {
-  PerceptionIn out;
-  out.tick = m.tick;
-  out.sim_time = m.sim_time;
+void perceptionFromMessage(const simsoccer_msg_Perception& m, uint64_t tick, double sim_time,
+                           PerceptionIn& out) {
+  out.tick = tick;
+  out.sim_time = sim_time;
   out.ball = fromMessage(m.ball);
   for (size_t k = 0; k < 4; ++k) out.posts[k] = fromMessage(m.posts[k]);
+  out.robots.clear();  // its capacity is kept: no allocation per period
   for (uint32_t i = 0; i < m.robots._length; ++i)
     out.robots.push_back(fromMessage(m.robots._buffer[i]));
   for (size_t k = 0; k < 3; ++k) out.self_pose[k] = m.self_pose[k];
-  return out;
 }
 
-bool AgentClient::perception(PerceptionIn& out) {
-  bool got = false;
-  impl_->perception.take([&](const simsoccer_msg_Perception& m, const dds_sample_info_t& info) {
-    if (m.team != team_ || m.player != player_ || (got && m.tick < out.tick) ||
-        !fromSimulator(impl_->perception.get(), info))
-      return;
-    out = perceptionFromMessage(m);
-    got = true;
-  });
-  return got;
+bool perceptionFromFrame(const simsoccer_msg_SensorFrame& f, PerceptionIn& out) {
+  if (!f.perception.present) return false;
+  perceptionFromMessage(f.perception, f.tick, f.sim_time, out);
+  return true;
 }
 
 }  // namespace simsoccer::agents

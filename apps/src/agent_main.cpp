@@ -149,26 +149,21 @@ int main(int argc, char** argv) {
     };
     last_frame_ns = now_ns();
     agents::PerceptionIn seen;
-    bool have_seen = false;
     client.onFrame([&](const simsoccer_msg_SensorFrame& frame) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;
       if (max_ticks >= 0 && answered >= max_ticks) return;
       if (soccer) {
-        // The soccer agent: this tick's perception (published before the
-        // frame), the game, teammates' messages, then behaviour and motion.
+        // The soccer agent: this tick's perception (in the frame), the
+        // game, teammates' messages, then behaviour and motion.
         const double dt = last_time > 0 ? frame.sim_time - last_time : 0.01;
         last_time = frame.sim_time;
-        agents::PerceptionIn p;
-        if (client.perception(p)) {
-          seen = std::move(p);
-          have_seen = true;
-        }
+        const bool have_seen = agents::perceptionFromFrame(frame, seen);
         const bool have_game = client.gameState(game);
         for (const auto& m : client.receiveTeamMessages()) soccer->receive(m, frame.sim_time);
         if (auto out =
                 soccer->step(frame.sim_time, dt > 0 ? dt : 0.01, agents::motionSensors(frame),
-                             have_seen && seen.tick == frame.tick ? &seen : nullptr,
+                             have_seen ? &seen : nullptr,
                              have_game ? &game : nullptr, position, stiffness))
           client.sendTeamMessage(*out);
         if (verbose && frame.tick % 100 == 0)

@@ -54,10 +54,9 @@ void InProcessAgents::observe(const sim::Observation& o) {
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
     // The perception as an agent gets it: through the DDS message's conversion.
     simsoccer_msg_Perception msg{};
-    net::toMessage(perception->perception(r), world_.robot(r).team, world_.robot(r).number, msg,
-                   scratch_);
-    const PerceptionIn seen = perceptionFromMessage(msg);
-    if (auto out = agents_[r]->step(o.time, dt, motionSensors(world_.sensorFrame(r)), &seen,
+    net::toMessage(perception->perception(r), msg, scratch_);
+    perceptionFromMessage(msg, o.tick, o.time, seen_);
+    if (auto out = agents_[r]->step(o.time, dt, motionSensors(world_.sensorFrame(r)), &seen_,
                                     o.game ? &game : nullptr, position_[r], stiffness_[r])) {
       TeamMessageIn m;
       m.from_player = world_.robot(r).number;

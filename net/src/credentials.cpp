@@ -205,8 +205,8 @@ std::string permissions(const CredentialsOptions& o, const std::string& id) {
     rules = "<publish>" +
             topicList({"simsoccer_JoinRequest", "simsoccer_JointCommand", "simsoccer_TeamMessageSend"}) +
             robots + "</publish><subscribe>" +
-            topicList({"simsoccer_SensorFrame", "simsoccer_RobotStatus", "simsoccer_Perception",
-                       "simsoccer_CameraImage", "simsoccer_TeamMessageDeliver"}) +
+            topicList({"simsoccer_SensorFrame", "simsoccer_RobotStatus", "simsoccer_CameraImage",
+                       "simsoccer_TeamMessageDeliver"}) +
             robots + "</subscribe><subscribe>" +
             topicList({"simsoccer_GameState", "simsoccer_SimClock"}) + "</subscribe>";
   }

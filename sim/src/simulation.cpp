@@ -94,8 +94,7 @@ void Simulation::flushCameras() {
 }
 
 void Simulation::observe(uint64_t tick) {
-  // Perception first: a driver that answers as soon as its frame arrives
-  // finds this tick's perception already there.
+  // Perception first: the sources send it with this tick's frames.
   if (perception_) perception_->update(world_);
   Observation o;
   o.tick = tick;

@@ -127,12 +127,9 @@ simsoccer_msg_PerceivedObject toMessage(const world::PerceivedObject& o) {
 }
 }  // namespace
 
-void toMessage(const world::Perception& p, int team, int player, simsoccer_msg_Perception& m,
+void toMessage(const world::Perception& p, simsoccer_msg_Perception& m,
                std::vector<simsoccer_msg_PerceivedObject>& scratch) {
-  m.team = static_cast<uint8_t>(team);
-  m.player = static_cast<uint8_t>(player);
-  m.tick = p.tick;
-  m.sim_time = p.time;
+  m.present = 1;
   m.ball = toMessage(p.ball);
   for (size_t k = 0; k < 4; ++k) m.posts[k] = toMessage(p.posts[k]);
   scratch.clear();
@@ -155,18 +152,13 @@ struct SimServer::Impl {
   // agent before, which threw away all but its own: at 22 robots 484 status
   // samples a second; 11 v 11, 4,840 team message samples.)
   struct RobotWriters {
-    RobotWriters(Participant& p, const std::string& partition, bool with_perception,
-                 bool with_images)
+    RobotWriters(Participant& p, const std::string& partition, bool with_images)
         : frame(p, simsoccer_msg_SensorFrame_desc, "simsoccer_SensorFrame",
                 QosSpec{true, 1, false, partition}),
           status(p, simsoccer_msg_RobotStatus_desc, "simsoccer_RobotStatus",
                  QosSpec{true, 1, true, partition}),
           team_deliver(p, simsoccer_msg_TeamMessage_desc, "simsoccer_TeamMessageDeliver",
                        QosSpec{true, 16, false, partition}) {
-      if (with_perception)
-        perception = std::make_unique<Writer<simsoccer_msg_Perception>>(
-            p, simsoccer_msg_Perception_desc, "simsoccer_Perception",
-            QosSpec{true, 1, false, partition});
       if (with_images)
         images = std::make_unique<Writer<simsoccer_msg_CameraImage>>(
             p, simsoccer_msg_CameraImage_desc, "simsoccer_CameraImage",
@@ -175,8 +167,7 @@ struct SimServer::Impl {
     Writer<simsoccer_msg_SensorFrame> frame;
     Writer<simsoccer_msg_RobotStatus> status;
     Writer<simsoccer_msg_TeamMessage> team_deliver;                // messages to this robot
-    std::unique_ptr<Writer<simsoccer_msg_Perception>> perception;  // perception on
-    std::unique_ptr<Writer<simsoccer_msg_CameraImage>> images;     // cameras on (both)
+    std::unique_ptr<Writer<simsoccer_msg_CameraImage>> images;  // cameras on (both)
   };
   std::vector<std::unique_ptr<RobotWriters>> robot_writers;  // world order
   std::vector<simsoccer_msg_PerceivedObject> perceived_scratch;
@@ -267,7 +258,7 @@ SimServer::SimServer(sim::Simulation& sim, const ServerConfig& config)
     robots_.push_back(slot);
     impl_->robot_writers.push_back(std::make_unique<Impl::RobotWriters>(
         impl_->participant, robotPartitionName(info.team, info.number),
-        sim.perception() != nullptr, world.scenario().cameras.enabled));
+        world.scenario().cameras.enabled));
     publishStatus(r);
   }
   sim.addSource(*this);
@@ -545,7 +536,7 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                       std::chrono::duration<double>(timeout_seconds));
   // Owned, and every path between the simulator and the agents matched:
-  // a frame, perception or team message sent before its reader is matched is
+  // a frame or team message sent before its reader is matched is
   // lost, and an agent that misses the first ones plays another game (the
   // same seed would no longer give the same match under load).
   const auto writer_matched = [](dds_entity_t writer, uint32_t n) {
@@ -567,8 +558,6 @@ bool SimServer::waitForOwners(size_t count, double timeout_seconds) {
       if (!writer_matched(impl_->robot_writers[r]->frame.get(), 1) ||
           !writer_matched(impl_->robot_writers[r]->team_deliver.get(), 1))
         return false;
-      const auto& perception = impl_->robot_writers[r]->perception;
-      if (perception && !writer_matched(perception->get(), 1)) return false;
     }
     return owned >= count && reader_matched(impl_->commands.get(), owned) &&
            reader_matched(impl_->team_send.get(), owned);
@@ -591,23 +580,17 @@ void SimServer::observe(const sim::Observation& o) {
     }
     published_tick_ = tick;
   }
-  // The game state first (when it changed), then perception, then the frames
-  // for this tick (the state the commands will answer): an agent that
-  // answers in its frame callback finds this tick's perception and game
-  // state already there (one writer, in order, on loopback). (A frame
+  // The game state first (when it changed), then the frames for this tick
+  // (the state the commands will answer), each with the robot's perception:
+  // one sample per robot and period, so an agent wakes once. (A frame
   // carries the tick and time of the period it closed: this one's.)
   if (o.game) publishGameState(*o.game, o.left_team);
-  if (o.perception) {
-    simsoccer_msg_Perception m{};
-    for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-      toMessage(o.perception->perception(r), robots_[r].team, robots_[r].player, m,
-                impl_->perceived_scratch);
-      impl_->robot_writers[r]->perception->write(m);
-    }
-  }
+  simsoccer_msg_SensorFrame& m = impl_->frame_msg;
   for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
-    toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, impl_->frame_msg);
-    impl_->robot_writers[r]->frame.write(impl_->frame_msg);
+    toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, m);
+    if (o.perception)
+      toMessage(o.perception->perception(r), m.perception, impl_->perceived_scratch);
+    impl_->robot_writers[r]->frame.write(m);
   }
   simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
   impl_->clock.write(clock);

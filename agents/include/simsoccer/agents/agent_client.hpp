@@ -54,8 +54,13 @@ struct PerceptionIn {
   std::array<float, 3> self_pose{};  // x, y, yaw in the field frame
 };
 
-// The Perception message as the agent side keeps it.
-PerceptionIn perceptionFromMessage(const simsoccer_msg_Perception& m);
+// A frame's perception as the agent side keeps it (`out.robots` keeps its
+// capacity); the tick and time are the frame's.
+void perceptionFromMessage(const simsoccer_msg_Perception& m, uint64_t tick, double sim_time,
+                           PerceptionIn& out);
+// The perception a SensorFrame carries; false when it carries none (the
+// scenario turns perception off).
+bool perceptionFromFrame(const simsoccer_msg_SensorFrame& f, PerceptionIn& out);
 
 // Which participant is the simulator: the one whose RobotStatus granted this
 // agent its robot (with a robot key: whose status also proved it holds that
@@ -114,10 +119,6 @@ class AgentClient {
   // this robot's teammates.
   void sendTeamMessage(std::span<const uint8_t> data);
   std::vector<TeamMessageIn> receiveTeamMessages();
-
-  // Takes the newest Perception of this robot that arrived since the last
-  // call; false if none did (the scenario must turn perception on).
-  bool perception(PerceptionIn& out);
 
   // Subscribes to this robot's camera images (the scenario must turn cameras
   // on; nothing is sent to an agent that does not subscribe).

@@ -49,6 +49,7 @@ class InProcessAgents : public sim::CommandSource {
   std::vector<std::unique_ptr<agents::SoccerAgent>> agents_;
   std::vector<std::pair<int, agents::TeamMessageIn>> outbox_;  // (team, message)
   std::vector<simsoccer_msg_PerceivedObject> scratch_;
+  agents::PerceptionIn seen_;  // one robot's, as its agent gets it (reused)
   // Per robot, the answer computed in observe.
   std::vector<std::vector<float>> position_, stiffness_;
 };

@@ -1,13 +1,13 @@
 // The DDS transport of the simulation: a command source of the period
-// pipeline (sim::Simulation) that publishes every robot's SensorFrame (and
-// its perception, camera images, status, team messages) and takes the
+// pipeline (sim::Simulation) that publishes every robot's SensorFrame (with
+// its perception), camera images, status and team messages, and takes the
 // agents' JointCommands, keeps robot ownership, and relays team messages on
 // simulated time. Lockstep: collect waits for every owned robot's answer to
 // the tick it published (up to the timeout); real time: the latest answer.
 // Perception and cameras belong to the simulation; this only sends them.
 //
 // Topics (names, QoS, rates and sizes: docs/protocol.md):
-//   simsoccer_SensorFrame   sim -> agent, partition robot_<team>_<player>
+//   simsoccer_SensorFrame   sim -> agent, partition robot_<team>_<player> (with perception)
 //   simsoccer_JointCommand  agent -> sim
 //   simsoccer_JoinRequest   agent -> sim
 //   simsoccer_RobotStatus   sim -> agent, partition robot_<team>_<player>
@@ -17,7 +17,6 @@
 //   simsoccer_TeamMessageDeliver sim -> agent, partition robot_<team>_<to>
 //   simsoccer_WorldTruth    sim -> monitors (optional)
 //   simsoccer_CameraImage   sim -> agent, partition robot_<team>_<player> (cameras on)
-//   simsoccer_Perception    sim -> agent, partition robot_<team>_<player> (perception on)
 #pragma once
 
 #include <array>
@@ -149,8 +148,9 @@ class SimServer : public sim::CommandSource {
 // The referee's GameController packet as the DDS GameState message.
 void toMessage(const referee::ControlData& d, uint64_t tick, simsoccer_msg_GameState& m);
 
-// A robot's perception as the wire message (`m.robots` points into `scratch`).
-void toMessage(const world::Perception& p, int team, int player, simsoccer_msg_Perception& m,
+// A robot's perception as its SensorFrame carries it (`m.robots` points into
+// `scratch`; the tick and time are the frame's).
+void toMessage(const world::Perception& p, simsoccer_msg_Perception& m,
                std::vector<simsoccer_msg_PerceivedObject>& scratch);
 
 // A camera image as the wire message (`m.data` points into `image.data`).
