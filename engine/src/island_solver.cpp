@@ -113,7 +113,7 @@ void appendIsland(T** sorted, int n, int island, btAlignedObjectArray<T*>& out) 
 
 ParallelIslandSolver::ParallelIslandSolver(
     int threads, const std::function<std::unique_ptr<btMultiBodyConstraintSolver>()>& make_solver)
-    : threads_(threads) {
+    : active_(threads), threads_(threads) {
   for (int i = 0; i < threads; ++i) solvers_.push_back(make_solver());
   shares_.resize(static_cast<size_t>(threads));
   load_.resize(shares_.size());
@@ -201,13 +201,14 @@ void ParallelIslandSolver::solve(btIDebugDraw* debug_draw, btDispatcher* dispatc
   });
   std::fill(load_.begin(), load_.end(), 0L);
   for (auto& share : shares_) share.clear();
+  const auto active_load_end = load_.begin() + active_;
   for (const size_t i : order_) {
     const auto t =
-        static_cast<size_t>(std::min_element(load_.begin(), load_.end()) - load_.begin());
+        static_cast<size_t>(std::min_element(load_.begin(), active_load_end) - load_.begin());
     shares_[t].push_back(i);
     load_[t] += batches_[i].cost;
   }
-  if (batch_count_ < 2)
+  if (batch_count_ < 2 || active_ == 1)
     job_(0);
   else
     threads_.run(job_);

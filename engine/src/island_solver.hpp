@@ -18,6 +18,7 @@
 #include <BulletCollision/CollisionDispatch/btSimulationIslandManager.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -85,6 +86,10 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   void solve(btIDebugDraw* debug_draw, btDispatcher* dispatcher,
              const Prologue* prologue = nullptr);
   int threadCount() const { return threads_.count(); }
+  // Solves on the first `n` threads only (1 .. threadCount(); the others
+  // idle): the same result for any number.
+  void setActiveThreads(int n) { active_ = std::clamp(n, 1, threadCount()); }
+  int activeThreads() const { return active_; }
   void clear() { batch_count_ = 0; }  // a step solved without it
   int batchCount() const { return static_cast<int>(batch_count_); }
 
@@ -107,6 +112,7 @@ class ParallelIslandSolver : public btSimulationIslandManager::IslandCallback {
   std::vector<size_t> order_;                // batches, largest first
   std::vector<long> load_;                   // per thread: the cost of its batches
   std::function<void(int)> job_;             // thread t solves shares_[t]
+  int active_ = 1;                           // threads given batches
   WorkerThreads threads_;                    // last: stopped before the rest goes
   btTypedConstraint** constraints_ = nullptr;
   int num_constraints_ = 0;

@@ -1012,6 +1012,14 @@ RigidBodyState PhysicsWorld::rigidBodyState(BodyId b) const {
           fromBt(body->getAngularVelocity())};
 }
 
+void PhysicsWorld::setActiveSolverThreads(int n) {
+  if (impl_->islands) impl_->islands->setActiveThreads(n);
+}
+
+int PhysicsWorld::activeSolverThreads() const {
+  return impl_->islands ? impl_->islands->activeThreads() : 1;
+}
+
 ContactCount PhysicsWorld::contactCount() const {
   btDispatcher* d = impl_->dispatcher.get();
   ContactCount c;

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <thread>
 
+#include "simsoccer/sim/cores.hpp"
+
 extern char** environ;
 
 namespace simsoccer::match {
@@ -29,7 +31,10 @@ ChildProcess::ChildProcess(std::vector<std::string> args, std::vector<std::strin
   }
   for (auto& e : environment) envp.push_back(e.data());
   envp.push_back(nullptr);
-  if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
+  // During a pipelined run, off the CPU the periods run on (sim/cores.hpp).
+  sim::CoreClaim::spawnOnOtherCpus([&] {
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
+  });
 }
 
 ChildProcess::~ChildProcess() {

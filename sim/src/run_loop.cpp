@@ -1,6 +1,9 @@
 #include "simsoccer/sim/run_loop.hpp"
 
+#include "simsoccer/sim/cores.hpp"
+
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -21,6 +24,13 @@ RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
                        std::chrono::duration<double>(static_cast<double>(i) * period / speed_));
   };
   RunStats stats;
+  // Pipelined, the world steps while the agents compute: on a CPU of its own.
+  // Its solver then uses that one CPU (the same result with any number of threads).
+  std::optional<CoreClaim> claim;
+  if (sim_.mode() == Mode::Pipelined && sim_.config().own_core) claim.emplace();
+  engine::PhysicsWorld& physics = sim_.world().physics();
+  const int solver_threads = physics.activeSolverThreads();
+  if (claim && claim->held()) physics.setActiveSolverThreads(1);
   for (long i = 0; max_periods < 0 || i < max_periods; ++i) {
     if (stop()) break;
     if (pacing_ == Pacing::RealTime) {
@@ -30,9 +40,12 @@ RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
         std::this_thread::sleep_until(due(i));
     }
     sim_.period();
+    // The threads the first period started (cameras, the frame sender) off the claimed CPU.
+    if (claim && i == 0) claim->placeOtherThreads();
     ++stats.periods;
     if (after_period) after_period();
   }
+  physics.setActiveSolverThreads(solver_threads);
   // Paced: the run ends when its last period's simulated time is due.
   if (pacing_ == Pacing::RealTime) std::this_thread::sleep_until(due(stats.periods));
   stats.wall_s = std::chrono::duration<double>(Clock::now() - start).count();

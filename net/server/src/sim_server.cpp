@@ -6,6 +6,7 @@
 #include <cstring>
 #include <deque>
 #include <random>
+#include <thread>
 #include <tuple>
 
 #include "simsoccer/world/match_log.hpp"
@@ -170,7 +171,6 @@ struct SimServer::Impl {
     std::unique_ptr<Writer<simsoccer_msg_CameraImage>> images;  // cameras on (both)
   };
   std::vector<std::unique_ptr<RobotWriters>> robot_writers;  // world order
-  std::vector<simsoccer_msg_PerceivedObject> perceived_scratch;
   Writer<simsoccer_msg_SimClock> clock;
   Writer<simsoccer_msg_GameState> game;
   std::unique_ptr<Writer<simsoccer_msg_WorldTruth>> truth;
@@ -199,7 +199,55 @@ struct SimServer::Impl {
   simsoccer_msg_GameState game_state{};
   double game_state_published_at = -1e9;
   bool game_state_set = false;  // a referee has set one (then it repeats at 2 Hz)
-  simsoccer_msg_SensorFrame frame_msg{};
+  // This period's frames (perception in them, `perceived` holding each
+  // one's sightings) and clock, written by writeFrames.
+  std::vector<simsoccer_msg_SensorFrame> frames_out;
+  std::vector<std::vector<simsoccer_msg_PerceivedObject>> perceived;
+  simsoccer_msg_SimClock clock_out{};
+  // Pipelined periods: the frames go out on this thread while the world
+  // steps (each write runs the loopback receive path of its agent's process:
+  // about 20 us). Started with the first such period.
+  std::thread sender;
+  std::mutex send_mutex;
+  std::condition_variable send_cv;
+  bool send_due = false, send_stop = false;
+
+  void writeFrames() {
+    for (size_t r = 0; r < frames_out.size(); ++r) robot_writers[r]->frame.write(frames_out[r]);
+    clock.write(clock_out);
+  }
+  void sendLoop() {
+    std::unique_lock lock(send_mutex);
+    for (;;) {
+      send_cv.wait(lock, [&] { return send_due || send_stop; });
+      if (!send_due) return;  // stopped, nothing left to write
+      lock.unlock();
+      writeFrames();
+      lock.lock();
+      send_due = false;
+      send_cv.notify_all();
+    }
+  }
+  // Waits until the frames handed to the sender are written.
+  void framesOut() {
+    std::unique_lock lock(send_mutex);
+    send_cv.wait(lock, [&] { return !send_due; });
+  }
+  void sendInBackground() {
+    if (!sender.joinable()) sender = std::thread([this] { sendLoop(); });
+    std::lock_guard lock(send_mutex);
+    send_due = true;
+    send_cv.notify_all();
+  }
+  ~Impl() {
+    if (!sender.joinable()) return;
+    {
+      std::lock_guard lock(send_mutex);
+      send_stop = true;  // after the frames due, if any
+    }
+    send_cv.notify_all();
+    sender.join();
+  }
 
   explicit Impl(const ServerConfig& c, uint64_t seed)
       : participant(c.dds),
@@ -585,15 +633,23 @@ void SimServer::observe(const sim::Observation& o) {
   // one sample per robot and period, so an agent wakes once. (A frame
   // carries the tick and time of the period it closed: this one's.)
   if (o.game) publishGameState(*o.game, o.left_team);
-  simsoccer_msg_SensorFrame& m = impl_->frame_msg;
-  for (world::RobotId r = 0; r < world_.robotCount(); ++r) {
+  impl_->framesOut();  // the last period's are out: their messages are reused
+  const size_t n = world_.robotCount();
+  impl_->frames_out.resize(n);
+  impl_->perceived.resize(n);
+  for (world::RobotId r = 0; r < n; ++r) {
+    simsoccer_msg_SensorFrame& m = impl_->frames_out[r];
     toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, m);
     if (o.perception)
-      toMessage(o.perception->perception(r), m.perception, impl_->perceived_scratch);
-    impl_->robot_writers[r]->frame.write(m);
+      toMessage(o.perception->perception(r), m.perception, impl_->perceived[r]);
   }
-  simsoccer_msg_SimClock clock{tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
-  impl_->clock.write(clock);
+  impl_->clock_out = {tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
+  // When the step does not wait for the answers (pipelined), it need not
+  // wait for the frames to go out either.
+  if (o.actuation_delay > 0)
+    impl_->sendInBackground();
+  else
+    impl_->writeFrames();
   if (impl_->game_state_set && world_.time() - impl_->game_state_published_at >= 0.5 - 1e-9)
     setGameState(impl_->game_state);
   if (impl_->truth) publishTruth(tick);

@@ -85,6 +85,11 @@ class PhysicsWorld {
   PhysicsWorld& operator=(const PhysicsWorld&) = delete;
 
   const PhysicsSettings& settings() const { return settings_; }
+  // The solver threads given work, 1 .. settings().solver_threads (all at
+  // first); the result is the same for any number. A pipelined run whose
+  // periods have one CPU of their own uses one (sim/cores.hpp).
+  void setActiveSolverThreads(int n);
+  int activeSolverThreads() const;
 
   // --- building --------------------------------------------------------------
   // Infinite ground plane z = 0.

@@ -51,6 +51,9 @@ struct SimulationConfig {
   // time: captures are dropped (and counted) instead.
   bool lockstep = true;
   double position_margin = 0.5;  // rad beyond a joint's limits before a target is refused
+  // Pipelined: RunLoop runs the periods on a CPU of their own, the other
+  // threads and the agent processes on the rest (sim/cores.hpp).
+  bool own_core = true;
   // Spectator camera images (on the conversion thread); robots' images go
   // to the image sinks of the sources.
   std::function<void(const world::CameraImage&)> spectator_sink;
