@@ -886,7 +886,7 @@ TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
 
 TEST(NetPerception, EveryFrameCarriesTheRobotsPerceptionOfItsPeriod) {
   const uint32_t domain = 116;
-  world::Scenario s = teams(1);
+  world::Scenario s = teams(2);
   s.robots[0].x = -2.0;
   s.robots[0].y = 1.5;
   s.ball_position = {-1.0, 1.5, -1.0};  // 1 m ahead
@@ -905,9 +905,9 @@ TEST(NetPerception, EveryFrameCarriesTheRobotsPerceptionOfItsPeriod) {
     simulation.period();
     const uint64_t tick = w.controlTick() - 1;
     const auto start = Clock::now();
-    while ((frame.tick != tick || !viewer.receive(frame, 0.05)) && seconds(start) < 1.0) {
-    }
-    if (frame.tick == tick && agents::perceptionFromFrame(frame, p) && p.tick == tick) ++received;
+    bool got = false;
+    while (!got && seconds(start) < 1.0) got = viewer.receive(frame, 0.05) && frame.tick == tick;
+    if (got && agents::perceptionFromFrame(frame, p) && p.tick == tick) ++received;
   }
   std::printf("perception in %d of 50 frames; ball at (%.3f, %.3f), in view %d, %zu robots\n",
               received, p.ball.x, p.ball.y, p.ball.in_view, p.robots.size());
@@ -916,7 +916,9 @@ TEST(NetPerception, EveryFrameCarriesTheRobotsPerceptionOfItsPeriod) {
   EXPECT_NEAR(p.ball.x, 1.0, 0.05);
   EXPECT_NEAR(p.ball.y, 0.0, 0.05);
   EXPECT_NEAR(p.self_pose[0], -2.0, 0.05);
-  EXPECT_EQ(p.robots.size(), 1u);  // the other team's robot, seen or not
+  ASSERT_EQ(p.robots.size(), 1u);  // the other robot, seen or not
+  EXPECT_EQ(p.robots[0].kind, 2);
+  EXPECT_EQ(p.robots[0].team, 1);
 }
 
 TEST(NetPerception, WithPerceptionOffAFrameCarriesNone) {

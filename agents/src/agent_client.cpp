@@ -29,6 +29,8 @@ struct AgentClient::Impl {
   // it, so the simulator relays them by when they were sent, not by when they
   // arrived (which varies with the machine's load).
   std::atomic<uint64_t> frame_tick{0};
+  // The sightings of the frame receive() returned last (its perception's robots point here).
+  std::vector<simsoccer_msg_PerceivedObject> received_robots;
   dds_guid_t me{};  // this agent's participant
   // The simulator once known, and which writers are its (checked once per
   // writer): the DDS receive thread and the agent's thread both ask.
@@ -230,6 +232,13 @@ bool AgentClient::receive(simsoccer_msg_SensorFrame& frame, double timeout_secon
       if (f.team == team_ && f.player == player_ && (!got || f.tick > frame.tick) &&
           fromSimulator(impl_->frames.get(), info)) {
         frame = f;
+        // The sample's memory goes back to DDS after the take: the sightings
+        // are kept here, until the next receive.
+        const auto& seen = f.perception.robots;
+        impl_->received_robots.assign(seen._buffer, seen._buffer + seen._length);
+        frame.perception.robots._buffer = impl_->received_robots.data();
+        frame.perception.robots._maximum = seen._length;
+        frame.perception.robots._release = false;
         got = true;
       }
     });

@@ -97,12 +97,14 @@ class AgentClient {
   // Samples ignored because another participant than the simulator wrote them.
   uint64_t foreignSamples() const;
 
-  // Waits for this robot's next SensorFrame; false on timeout.
+  // Waits for this robot's next SensorFrame; false on timeout. Its
+  // perception's sightings are held by the client until the next call.
   bool receive(simsoccer_msg_SensorFrame& frame, double timeout_seconds);
   // Alternative to receive(): `handler` is called for every new frame of
   // this robot right in the DDS receive thread (no thread hop: the fastest
   // lockstep round trip). It answers with send(); the caller's thread must
   // not call send() or receive() meanwhile. Pass an empty handler to stop.
+  // The frame (its perception's sightings) is valid during the call only.
   using FrameHandler = std::function<void(const simsoccer_msg_SensorFrame&)>;
   void onFrame(FrameHandler handler);
   // Answers the frame of `tick`: 25 positions (rad) and stiffnesses, actuator order.
