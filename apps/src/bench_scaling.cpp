@@ -16,7 +16,7 @@
 namespace simsoccer::apps {
 
 int benchScaling(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "cameras"},
+  const Options opt(argc, argv, first, {"help", "cameras", "shared-cores"},
                     {"robots", "seconds", "csv", "png", "domain", "modes", "threads", "robot"});
   if (opt.help(kBenchScalingHelp)) return 0;
   opt.noPositional();
@@ -26,6 +26,7 @@ int benchScaling(int argc, char** argv, int first) {
   const double seconds = opt.positive("seconds", 20.0);
   if (!(seconds > 0)) throw UsageError("--seconds must be > 0");
   const bool cameras = opt.flag("cameras");
+  const bool own_core = !opt.flag("shared-cores");
   const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
   std::vector<sim::Mode> modes;
   {
@@ -63,18 +64,20 @@ int benchScaling(int argc, char** argv, int first) {
   std::fflush(stdout);
   Table table;
   table.header = {"robots",     "mode",         "steps_per_s", "fps",       "rtf",    "physics_ms",
-                  "sensors_ms", "messaging_ms", "referee_ms",  "render_ms", "missed", "cpu_ms"};
+                  "sensors_ms", "messaging_ms", "referee_ms",  "render_ms", "missed", "cpu_ms",
+                  "period_cpu"};
   std::vector<ScalingRow> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {
-      const ScalingRow r = runRow(n, seconds, cameras, mode, threads, domain, robot);
+      const ScalingRow r = runRow(n, seconds, cameras, mode, threads, domain, robot, own_core);
       rows.push_back(r);
       if (mode == modes.back()) plotted.push_back(r);
       table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),
                             fmt(r.fps, 0), fmt(r.rtf, 2), fmt(r.physics_ms, 2),
                             fmt(r.sensors_ms, 2), fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
                             fmt(r.render_ms, 2), std::to_string(r.missed),
-                            r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a"});
+                            r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a",
+                            r.period_cpu >= 0 ? std::to_string(r.period_cpu) : "-"});
       std::fprintf(stderr, "  %d robots, %s done\n", n, sim::modeName(mode));
     }
   }
@@ -86,8 +89,9 @@ int benchScaling(int argc, char** argv, int first) {
       "step), referee, render (cameras); "
       "missed: lockstep periods an agent did not answer in time; cpu_ms: CPU time of the "
       "simulator and all agent processes per period (against cores x wall ms per period: how "
-      "full the machine was). USARSim (published): 1 Nao "
-      "110 fps, 2: 55, 3: 30, 4: 10.",
+      "full the machine was); period_cpu: the CPU a pipelined row's periods had to themselves "
+      "(its solver on that one; the agents and the other threads on the rest; -: none). "
+      "USARSim (published): 1 Nao 110 fps, 2: 55, 3: 30, 4: 10.",
       opt.get("csv", ""));
   std::vector<ScalingPoint> points;
   for (const ScalingRow& r : plotted) points.push_back({r.robots, r.fps, r.rtf});

@@ -54,11 +54,12 @@ world::Scenario scalingScenario(int n, bool cameras, int threads, const ScalingR
 }
 
 ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uint32_t domain,
-                  const ScalingRobot& robot) {
+                  const ScalingRobot& robot, bool own_core) {
   world::Scenario s = scalingScenario(n, cameras, threads, robot);
   world::World w(s);
   sim::SimulationConfig simc;
   simc.mode = mode;
+  simc.own_core = own_core;
   sim::Simulation simulation(w, simc);
   net::ServerConfig sc;
   sc.dds.domain = domain;
@@ -116,6 +117,7 @@ ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threa
   row.render_ms = t.camera_s * per;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;
   if (cpu0 >= 0 && cpu1 >= 0) row.cpu_ms = (cpu1 - cpu0) * per;
+  row.period_cpu = run.period_cpu;
   for (auto& a : agents) a->stop();
   return row;
 }

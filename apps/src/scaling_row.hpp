@@ -19,6 +19,7 @@ struct ScalingRow {
   double physics_ms = 0, sensors_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
   uint64_t missed = 0;
   double cpu_ms = -1;  // CPU time of the simulator and all agents per period (-1: unknown)
+  int period_cpu = -1;  // the CPU the periods had to themselves (-1: none; sim/cores.hpp)
 };
 
 // The robot: a Nao on the SPL field (the 3D-league-sized field beyond 14 robots) with the
@@ -30,8 +31,9 @@ struct ScalingRobot {
 
 // N robots in two teams at their kick-off places, perception on.
 world::Scenario scalingScenario(int n, bool cameras, int threads, const ScalingRobot& robot);
-// Runs `seconds` simulated with N agent processes on DDS domain `domain`.
+// Runs `seconds` simulated with N agent processes on DDS domain `domain`;
+// `own_core`: a pipelined row's periods on a CPU of their own.
 ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threads, uint32_t domain,
-                  const ScalingRobot& robot);
+                  const ScalingRobot& robot, bool own_core = true);
 
 }  // namespace simsoccer::apps

@@ -17,20 +17,26 @@ RunLoop::RunLoop(Simulation& sim, Pacing pacing, double speed)
 RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
                       const std::function<void()>& after_period) {
   using Clock = std::chrono::steady_clock;
+  RunStats stats;
+  // Pipelined, the world steps while the agents compute: on a CPU of its own.
+  // Its solver then uses that one CPU (the same result with any number of threads).
+  std::optional<CoreClaim> claim;
+  if (sim_.mode() == Mode::Pipelined && sim_.config().own_core) claim.emplace();
+  struct SolverThreads {  // as they were after the run, also when a period throws
+    engine::PhysicsWorld& physics;
+    const int before = physics.activeSolverThreads();
+    ~SolverThreads() { physics.setActiveSolverThreads(before); }
+  } solver{sim_.world().physics()};
+  if (claim && claim->held()) {
+    solver.physics.setActiveSolverThreads(1);
+    stats.period_cpu = claim->cpu();
+  }
   const double period = sim_.world().scenario().physics.control_period;
   const auto start = Clock::now();
   const auto due = [&](long i) {
     return start + std::chrono::duration_cast<Clock::duration>(
                        std::chrono::duration<double>(static_cast<double>(i) * period / speed_));
   };
-  RunStats stats;
-  // Pipelined, the world steps while the agents compute: on a CPU of its own.
-  // Its solver then uses that one CPU (the same result with any number of threads).
-  std::optional<CoreClaim> claim;
-  if (sim_.mode() == Mode::Pipelined && sim_.config().own_core) claim.emplace();
-  engine::PhysicsWorld& physics = sim_.world().physics();
-  const int solver_threads = physics.activeSolverThreads();
-  if (claim && claim->held()) physics.setActiveSolverThreads(1);
   for (long i = 0; max_periods < 0 || i < max_periods; ++i) {
     if (stop()) break;
     if (pacing_ == Pacing::RealTime) {
@@ -45,7 +51,6 @@ RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
     ++stats.periods;
     if (after_period) after_period();
   }
-  physics.setActiveSolverThreads(solver_threads);
   // Paced: the run ends when its last period's simulated time is due.
   if (pacing_ == Pacing::RealTime) std::this_thread::sleep_until(due(stats.periods));
   stats.wall_s = std::chrono::duration<double>(Clock::now() - start).count();

@@ -16,6 +16,7 @@ struct RunStats {
   long periods = 0;
   long late = 0;        // real time: periods that started late (the simulation fell behind)
   double wall_s = 0.0;  // wall time of the run
+  int period_cpu = -1;  // pipelined: the CPU the periods had to themselves (-1: none; cores.hpp)
 };
 
 class RunLoop {
