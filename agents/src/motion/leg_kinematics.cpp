@@ -171,9 +171,10 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
         Jacobian j(12, static_cast<int>(cols.size()));
         for (size_t k = 0; k < cols.size(); ++k) j.col(static_cast<int>(k)) = jac.col(cols[k]);
         const double damping = 1e-9 + 1e-3 * e.squaredNorm();
-        Square normal = j.transpose() * j;
+        // Coefficient products: at 12 x 11 a general product's packing costs more.
+        Square normal = j.transpose().lazyProduct(j);
         normal.diagonal().array() += damping;
-        const Vector d = normal.ldlt().solve(j.transpose() * e);
+        const Vector d = normal.ldlt().solve(j.transpose().lazyProduct(e));
         bool changed = false;
         for (size_t k = 0; k < cols.size(); ++k) {
           const auto [side, i] = unknown[static_cast<size_t>(cols[k])];
@@ -193,7 +194,10 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
         }
       }
       const double step = Eigen::Map<const Eigen::Matrix<double, 12, 1>>(dq.data()).norm();
-      if (step < 1e-13) break;
+      // Done when a step moves the joints less than a nanoradian: commands
+      // are quantised to 1e-4 rad (a yaw the shared hinge cannot serve keeps
+      // a residual, so the error alone would not end the iterations).
+      if (step < 1e-9) break;
       const double scale = step > 0.3 ? 0.3 / step : 1.0;  // no wild jumps far from the goal
       for (int side = 0; side < 2; ++side) {
         const Chain& c = legs_[static_cast<size_t>(side)];
