@@ -67,6 +67,7 @@ class ChildProcess {
     }
   }
   bool running() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
   bool started() const { return pid_ > 0 || exit_status_ >= 0; }
 
  private:

@@ -3,6 +3,7 @@
 // CPU across processes (lock files), everything as it was afterwards; and
 // RunLoop using it. Real threads, a real child process, real affinity masks.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,9 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
-
-#include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <future>
 #include <string>
@@ -50,26 +49,18 @@ class CoreClaimTest : public ::testing::Test {
   void SetUp() override {
     all_ = cpusOf(0);
     if (all_.size() < 2) GTEST_SKIP() << "this process may use " << all_.size() << " CPU";
-    const char* before = std::getenv("XDG_RUNTIME_DIR");
-    if (before) saved_ = before;
-    had_ = before != nullptr;
     dir_ = std::filesystem::temp_directory_path() /
            ("simsoccer_cores_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
-    ::setenv("XDG_RUNTIME_DIR", dir_.c_str(), 1);
   }
   void TearDown() override {
-    if (had_)
-      ::setenv("XDG_RUNTIME_DIR", saved_.c_str(), 1);
-    else
-      ::unsetenv("XDG_RUNTIME_DIR");
     std::error_code ec;
     std::filesystem::remove_all(dir_, ec);
   }
   // Holds the lock file of `cpu` as another run would (-1: already held).
   int lockAsAnotherRun(int cpu) {
-    const std::string path = (dir_ / ("simsoccer-cpu" + std::to_string(cpu) + ".lock")).string();
+    const std::string path = sim::CoreClaim::lockFile(dir_, cpu).string();
     const int fd = ::open(path.c_str(), O_RDONLY | O_CREAT | O_CLOEXEC, 0666);
     if (fd < 0) return -1;
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
@@ -81,12 +72,10 @@ class CoreClaimTest : public ::testing::Test {
 
   std::vector<int> all_;
   std::filesystem::path dir_;
-  std::string saved_;
-  bool had_ = false;
 };
 
 TEST_F(CoreClaimTest, TheClaimingThreadGetsACpuOfItsOwnAndEverythingElseTheRest) {
-  // A thread and a child process started before the claim.
+  // A thread and a child process started before the claim, the thread pinned more narrowly.
   std::promise<void> release;
   std::promise<pid_t> tid_of;
   std::thread helper([&] {
@@ -94,6 +83,10 @@ TEST_F(CoreClaimTest, TheClaimingThreadGetsACpuOfItsOwnAndEverythingElseTheRest)
     release.get_future().wait();
   });
   const pid_t helper_tid = tid_of.get_future().get();
+  cpu_set_t first;
+  CPU_ZERO(&first);
+  CPU_SET(all_.front(), &first);
+  ASSERT_EQ(sched_setaffinity(helper_tid, sizeof first, &first), 0);
   const auto spawnSleep = [] {
     pid_t pid = -1;
     char sleep_path[] = "/bin/sleep", seconds[] = "30";
@@ -104,7 +97,7 @@ TEST_F(CoreClaimTest, TheClaimingThreadGetsACpuOfItsOwnAndEverythingElseTheRest)
   const pid_t child_before = spawnSleep();
   pid_t child_during = -1;
   {
-    sim::CoreClaim claim;
+    sim::CoreClaim claim(dir_);
     ASSERT_TRUE(claim.held());
     EXPECT_EQ(claim.cpu(), all_.back());  // the highest, no other run holding one
     const std::vector<int> others = without(all_, claim.cpu());
@@ -118,13 +111,15 @@ TEST_F(CoreClaimTest, TheClaimingThreadGetsACpuOfItsOwnAndEverythingElseTheRest)
     EXPECT_EQ(cpusOf(0), std::vector<int>{claim.cpu()});
     // Another run cannot take the same CPU; a second claim in this process takes none.
     EXPECT_EQ(lockAsAnotherRun(claim.cpu()), -1);
-    const sim::CoreClaim nested;
+    const sim::CoreClaim nested(dir_);
     EXPECT_FALSE(nested.held());
   }
-  // All as before, and the CPU free again.
+  // All as before (the helper on its one CPU again; the child started during the claim on
+  // every CPU), and the CPU free again.
   EXPECT_EQ(cpusOf(0), all_);
-  EXPECT_EQ(cpusOf(helper_tid), all_);
+  EXPECT_EQ(cpusOf(helper_tid), std::vector<int>{all_.front()});
   EXPECT_EQ(cpusOf(child_before), all_);
+  EXPECT_EQ(cpusOf(child_during), all_);
   const int fd = lockAsAnotherRun(all_.back());
   EXPECT_GE(fd, 0);
   if (fd >= 0) ::close(fd);
@@ -136,34 +131,44 @@ TEST_F(CoreClaimTest, TheClaimingThreadGetsACpuOfItsOwnAndEverythingElseTheRest)
   helper.join();
 }
 
-TEST_F(CoreClaimTest, ARunFindingItsCpuTakenClaimsAnotherAndWithNoneFreeClaimsNothing) {
+TEST_F(CoreClaimTest, ARunKeepsOffTheCpusOtherRunsHoldAndNeedsTwoFree) {
+  // Other runs hold the highest k CPUs: this one claims the highest free one and keeps the
+  // rest of the free ones for its other threads, while at least two are free.
   std::vector<int> held;
-  for (size_t k = 0; k + 1 < all_.size(); ++k) {
-    const int cpu = all_[all_.size() - 1 - k];
-    const int fd = lockAsAnotherRun(cpu);
-    ASSERT_GE(fd, 0);
-    held.push_back(fd);
-    const sim::CoreClaim claim;  // the highest CPU no one holds
-    ASSERT_TRUE(claim.held());
-    EXPECT_EQ(claim.cpu(), all_[all_.size() - 2 - k]);
-    EXPECT_EQ(claim.otherCpus(), without(all_, claim.cpu()));
-  }
-  held.push_back(lockAsAnotherRun(all_.front()));
-  ASSERT_GE(held.back(), 0);
-  {
-    const sim::CoreClaim claim;  // every CPU held by another run
-    EXPECT_FALSE(claim.held());
-    EXPECT_EQ(cpusOf(0), all_);  // placement left to the scheduler
+  for (size_t k = 0; k < all_.size(); ++k) {
+    const std::vector<int> free(all_.begin(), all_.end() - static_cast<long>(k));
+    {
+      const sim::CoreClaim claim(dir_);
+      if (free.size() >= 2) {
+        ASSERT_TRUE(claim.held()) << k << " held by others";
+        EXPECT_EQ(claim.cpu(), free.back());
+        EXPECT_EQ(claim.otherCpus(), without(free, free.back()));
+        EXPECT_EQ(cpusOf(0), std::vector<int>{free.back()});
+      } else {
+        EXPECT_FALSE(claim.held());  // one CPU free: nothing left for the rest
+        EXPECT_EQ(cpusOf(0), all_);  // placement left to the scheduler
+      }
+    }
+    EXPECT_EQ(cpusOf(0), all_);
+    held.push_back(lockAsAnotherRun(all_[all_.size() - 1 - k]));
+    ASSERT_GE(held.back(), 0);
   }
   for (const int fd : held) ::close(fd);
 }
 
-// Records the CPUs the period thread may use in each observe stage.
-class AffinityProbe : public sim::CommandSource {
+// Records, in each observe stage, the CPUs the period thread may use and the solver
+// threads given work.
+class PeriodProbe : public sim::CommandSource {
  public:
-  void observe(const sim::Observation&) override { seen.push_back(cpusOf(0)); }
+  void observe(const sim::Observation& o) override {
+    cpus.push_back(cpusOf(0));
+    solver_threads.push_back(o.world->physics().activeSolverThreads());
+    batches = std::max(batches, o.world->physics().lastStepSolverBatches());
+  }
   void collect(uint64_t, sim::CommandGate&, std::span<sim::CommandSlot>) override {}
-  std::vector<std::vector<int>> seen;
+  std::vector<std::vector<int>> cpus;
+  std::vector<int> solver_threads;
+  int batches = 0;
 };
 
 TEST_F(CoreClaimTest, APipelinedRunStepsOnItsOwnCpuWithOneSolverThreadAndTheSameResult) {
@@ -175,12 +180,19 @@ TEST_F(CoreClaimTest, APipelinedRunStepsOnItsOwnCpuWithOneSolverThreadAndTheSame
     c.mode = mode;
     c.own_core = own_core;
     sim::Simulation simulation(w, c);
-    AffinityProbe probe;
+    PeriodProbe probe;
     simulation.addSource(probe);
-    sim::RunLoop(simulation, sim::Pacing::Lockstep).run(50);
-    const bool claimed = mode == sim::Mode::Pipelined && own_core;
-    for (const auto& cpus : probe.seen)
-      EXPECT_EQ(cpus, claimed ? std::vector<int>{all_.back()} : all_);
+    const sim::RunStats run = sim::RunLoop(simulation, sim::Pacing::Lockstep).run(50);
+    // The claim uses the default lock folder, shared with the runs of tests beside this
+    // one: it may find none free.
+    if (mode == sim::Mode::Serial || !own_core) {
+      EXPECT_EQ(run.period_cpu, -1);
+    }
+    const bool claimed = run.period_cpu >= 0;
+    for (const auto& cpus : probe.cpus)
+      EXPECT_EQ(cpus, claimed ? std::vector<int>{run.period_cpu} : all_);
+    for (const int n : probe.solver_threads) EXPECT_EQ(n, claimed ? 1 : 2);
+    EXPECT_GE(probe.batches, 2);  // so two solver threads have work to share
     // Afterwards the thread and the solver as they were.
     EXPECT_EQ(cpusOf(0), all_);
     EXPECT_EQ(w.physics().activeSolverThreads(), 2);

@@ -3,6 +3,8 @@
 // HipYawPitch, the Booster K1's independent legs in another joint order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <tuple>
@@ -96,6 +98,56 @@ TEST(LegKinematics, UnreachableTargetsStayWithinLimits) {
     EXPECT_LE(s.left[i], k.upper(Leg::Left, i));
   }
   EXPECT_NEAR(s.left[3], 0.0, 0.1);  // the knee as straight as it goes
+}
+
+TEST(LegKinematics, FromTheLastSolutionAsCloseAsFromScratchAlongAPathAndAfterAStall) {
+  // A turning walk's feet: yaws apart (the Nao's one HipYawPitch cannot serve both), each
+  // pose solved from the last solution, as the walk does, and from scratch (other knee
+  // bends tried): the same errors. A last solution that stalled on an unreachable target
+  // still tries other knee bends.
+  for (const auto& file : {test::naoH25(), test::boosterK1()}) {
+    const robots::RobotModel model = robots::loadRobotModel(file);
+    const agents::LegKinematics k(model);
+    agents::LegSolution last;
+    bool have_last = false;
+    double worst_gap = 0;
+    for (int i = 0; i < 200; ++i) {
+      const double phase = 0.05 * i;
+      LegAngles l{}, r{};
+      l[static_cast<size_t>(k.index(agents::LegJoint::Knee))] = 0.9 + 0.3 * std::sin(phase);
+      l[static_cast<size_t>(k.index(agents::LegJoint::HipPitch))] = -0.45 - 0.1 * std::sin(phase);
+      l[static_cast<size_t>(k.index(agents::LegJoint::AnklePitch))] = -0.45;
+      r = l;
+      r[static_cast<size_t>(k.index(agents::LegJoint::Knee))] = 0.9 - 0.3 * std::sin(phase);
+      agents::Pose fl = k.forward(Leg::Left, l), fr = k.forward(Leg::Right, r);
+      fr.rotate(Eigen::AngleAxisd(0.15 * std::cos(phase), Vec3::UnitZ()));  // turning
+      const agents::LegSolution warm = k.inverse(fl, fr, have_last ? &last : nullptr);
+      const agents::LegSolution cold = k.inverse(fl, fr);
+      EXPECT_LT(warm.position_error, 1e-3);
+      worst_gap = std::max({worst_gap, warm.position_error - cold.position_error,
+                            warm.orientation_error - cold.orientation_error});
+      last = warm;
+      have_last = true;
+    }
+    std::printf("%s: from the last solution at most %.1e worse than from scratch\n",
+                model.name.c_str(), worst_gap);
+    EXPECT_LT(worst_gap, 1e-6);
+    // Stalled: a target below a straight leg, then a reachable one from that solution.
+    agents::Pose far = agents::Pose::Identity();
+    far.translation() = Vec3(0.0, 0.05, -0.6);
+    agents::Pose far_right = far;
+    far_right.translation().y() = -0.05;
+    const agents::LegSolution stalled = k.inverse(far, far_right);
+    EXPECT_GT(stalled.position_error, 0.01);
+    LegAngles bent{};
+    bent[static_cast<size_t>(k.index(agents::LegJoint::Knee))] = 1.2;
+    bent[static_cast<size_t>(k.index(agents::LegJoint::HipPitch))] = -0.6;
+    bent[static_cast<size_t>(k.index(agents::LegJoint::AnklePitch))] = -0.6;
+    const agents::LegSolution back =
+        k.inverse(k.forward(Leg::Left, bent), k.forward(Leg::Right, bent), &stalled);
+    EXPECT_LT(back.position_error, 1e-4);
+    EXPECT_LT(back.orientation_error, 1e-3);
+  }
 }
 
 TEST(LegKinematics, TheBoosterK1sLegsInItsOwnJointOrderAndIndependent) {

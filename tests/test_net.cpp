@@ -1,6 +1,7 @@
 // Agents over DDS, end to end: the simulator's server in this process, real
 // simsoccer-agent processes, real Cyclone DDS on loopback.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -23,6 +24,7 @@
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "simsoccer/sim/run_loop.hpp"
 #include "test_support.hpp"
 
 extern char** environ;
@@ -882,6 +884,41 @@ TEST(NetMotion, AnAgentProcessWalksItsRobotOneMetre) {
   EXPECT_GT(d.x(), 1.0);
   EXPECT_LT(std::abs(d.y()), 0.15);
   EXPECT_EQ(server.stats(0).missed, 0u);
+}
+
+TEST(NetPipelined, TheFramesGoOutWhileTheWorldStepsAndEveryAnswerActsAPeriodLater) {
+  // Pipelined lockstep through the run loop: a sender thread writes the frames while the
+  // world steps, and the periods run on a CPU of their own with the agents on the others
+  // (when a CPU is free: other tests' runs may hold them). Every answer is taken, none
+  // missed. (ThreadSanitizer runs this: the sender thread and the command listener.)
+  const uint32_t domain = 128;
+  world::World w(teams(2));
+  sim::SimulationConfig c;
+  c.mode = sim::Mode::Pipelined;
+  sim::Simulation simulation(w, c);
+  net::SimServer server(simulation, serverConfig(domain, 2.0));
+  AgentProcess a(domain, 0, 1), b(domain, 1, 1);
+  ASSERT_TRUE(server.waitForOwners(2, 20.0));
+  std::vector<int> agent_cpus;
+  const sim::RunStats run = sim::RunLoop(simulation, sim::Pacing::Lockstep).run(200, [&] {
+    if (w.controlTick() == 100) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      if (sched_getaffinity(a.pid(), sizeof set, &set) == 0)
+        for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+          if (CPU_ISSET(cpu, &set)) agent_cpus.push_back(cpu);
+    }
+  });
+  for (world::RobotId r = 0; r < 2; ++r) {
+    EXPECT_EQ(server.stats(r).missed, 0u);
+    // The answer to the last tick waits for the next period.
+    EXPECT_EQ(simulation.commandStats(r).accepted, 199u);
+  }
+  if (run.period_cpu >= 0) {
+    EXPECT_FALSE(agent_cpus.empty());
+    for (const int cpu : agent_cpus) EXPECT_NE(cpu, run.period_cpu);
+  }
+  std::printf("periods on CPU %d; agent on %zu CPU(s)\n", run.period_cpu, agent_cpus.size());
 }
 
 TEST(NetPerception, EveryFrameCarriesTheRobotsPerceptionOfItsPeriod) {

@@ -5,10 +5,10 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include <atomic>
+#include <algorithm>
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <string>
 
@@ -16,8 +16,10 @@ namespace simsoccer::sim {
 
 namespace {
 
-// The claim in force in this process (one at a time: a nested one claims nothing).
-std::atomic<const CoreClaim*> g_active{nullptr};
+// The claim in force in this process (one at a time: a second claims
+// nothing), read by spawnOnOtherCpus.
+std::mutex g_mutex;
+const CoreClaim* g_active = nullptr;
 
 std::vector<int> cpusOf(long tid) {
   cpu_set_t set;
@@ -30,6 +32,7 @@ std::vector<int> cpusOf(long tid) {
 }
 
 void setCpus(long tid, const std::vector<int>& cpus) {
+  if (cpus.empty()) return;
   cpu_set_t set;
   CPU_ZERO(&set);
   for (int c : cpus) CPU_SET(c, &set);
@@ -37,25 +40,31 @@ void setCpus(long tid, const std::vector<int>& cpus) {
   (void)sched_setaffinity(static_cast<pid_t>(tid), sizeof set, &set);
 }
 
-// Every thread of this process but `skip`.
-template <class F>
-void forOtherThreads(long skip, F&& f) {
+// The thread ids in a /proc task folder. Threads and processes come and go
+// while it is read: nothing here throws.
+std::vector<long> tasksIn(const std::filesystem::path& folder) {
+  std::vector<long> tids;
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task", ec)) {
-    const long tid = std::strtol(entry.path().filename().c_str(), nullptr, 10);
-    if (tid > 0 && tid != skip) f(tid);
+  std::filesystem::directory_iterator it(folder, ec);
+  for (const std::filesystem::directory_iterator end; !ec && it != end; it.increment(ec)) {
+    const long tid = std::strtol(it->path().filename().c_str(), nullptr, 10);
+    if (tid > 0) tids.push_back(tid);
   }
+  return tids;
 }
 
-// Every thread of this process's children (the agents it started).
-template <class F>
-void forChildThreads(F&& f) {
+// Every thread of this process but `skip`, and every thread of its child
+// processes (the agents it started).
+std::vector<long> otherThreads(long skip) {
+  std::vector<long> tids = tasksIn("/proc/self/task");
+  std::erase(tids, skip);
   const std::string me = std::to_string(::getpid());
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc", ec)) {
-    const std::string name = entry.path().filename();
+  std::filesystem::directory_iterator it("/proc", ec);
+  for (const std::filesystem::directory_iterator end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename();
     if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream stat(entry.path() / "stat");
+    std::ifstream stat(it->path() / "stat");
     std::string line;
     if (!std::getline(stat, line)) continue;
     // pid (comm) state ppid ...: the name may hold spaces and parentheses.
@@ -65,72 +74,120 @@ void forChildThreads(F&& f) {
     std::string state, ppid;
     rest >> state >> ppid;
     if (ppid != me) continue;
-    for (const auto& task : std::filesystem::directory_iterator(entry.path() / "task", ec)) {
-      const long tid = std::strtol(task.path().filename().c_str(), nullptr, 10);
-      if (tid > 0) f(tid);
-    }
+    const std::vector<long> child = tasksIn(it->path() / "task");
+    tids.insert(tids.end(), child.begin(), child.end());
   }
-}
-
-std::filesystem::path lockFile(int cpu) {
-  const char* dir = std::getenv("XDG_RUNTIME_DIR");
-  const std::filesystem::path base = dir && *dir ? dir : std::filesystem::temp_directory_path();
-  return base / ("simsoccer-cpu" + std::to_string(cpu) + ".lock");
+  return tids;
 }
 
 }  // namespace
 
-CoreClaim::CoreClaim() {
+std::filesystem::path CoreClaim::defaultLockFolder() {
+  const char* dir = std::getenv("XDG_RUNTIME_DIR");
+  if (dir && *dir) return dir;
+  std::error_code ec;
+  const std::filesystem::path tmp = std::filesystem::temp_directory_path(ec);
+  return ec ? std::filesystem::path("/tmp") : tmp;
+}
+
+std::filesystem::path CoreClaim::lockFile(const std::filesystem::path& folder, int cpu) {
+  return folder / ("simsoccer-cpu" + std::to_string(cpu) + ".lock");
+}
+
+CoreClaim::CoreClaim(const std::filesystem::path& lock_folder) {
+  std::lock_guard lock(g_mutex);
+  if (g_active) return;
   all_ = cpusOf(0);
   if (all_.size() < 2) return;
-  const CoreClaim* none = nullptr;
-  if (!g_active.compare_exchange_strong(none, this)) return;
-  for (auto c = all_.rbegin(); c != all_.rend() && cpu_ < 0; ++c) {
-    const int fd = ::open(lockFile(*c).c_str(), O_RDONLY | O_CREAT | O_CLOEXEC, 0666);
+  const std::filesystem::path folder = lock_folder.empty() ? defaultLockFolder() : lock_folder;
+  // The highest CPU no other run holds is ours; the others no run holds are
+  // for the rest (a CPU another run holds is its period's).
+  for (auto c = all_.rbegin(); c != all_.rend(); ++c) {
+    const int fd = ::open(lockFile(folder, *c).c_str(), O_RDONLY | O_CREAT | O_CLOEXEC, 0666);
     if (fd < 0) continue;
-    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) {
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd);
+      continue;
+    }
+    if (cpu_ < 0) {
       cpu_ = *c;
       lock_fd_ = fd;
     } else {
-      ::close(fd);
+      others_.push_back(*c);
+      ::close(fd);  // releases the probe's lock
     }
   }
-  if (cpu_ < 0) {
-    g_active = nullptr;
+  if (others_.empty()) {  // nothing left for the rest: leave placement to the scheduler
+    if (lock_fd_ >= 0) ::close(lock_fd_);
+    lock_fd_ = -1;
+    cpu_ = -1;
     return;
   }
-  for (int c : all_)
-    if (c != cpu_) others_.push_back(c);
+  std::sort(others_.begin(), others_.end());
   owner_tid_ = static_cast<long>(::gettid());
-  setCpus(owner_tid_, {cpu_});
-  placeOtherThreads();
+  try {
+    saved_.emplace_back(owner_tid_, cpusOf(owner_tid_));
+    setCpus(owner_tid_, {cpu_});
+    placeThreads(true);
+  } catch (...) {  // out of memory reading /proc: no claim rather than a half-placed one
+    restoreAll();
+    ::close(lock_fd_);
+    lock_fd_ = cpu_ = -1;
+    others_.clear();
+    return;
+  }
+  g_active = this;
 }
 
 CoreClaim::~CoreClaim() {
+  std::lock_guard lock(g_mutex);
   if (cpu_ < 0) return;
-  setCpus(owner_tid_, all_);
-  forOtherThreads(owner_tid_, [&](long tid) { setCpus(tid, all_); });
-  forChildThreads([&](long tid) { setCpus(tid, all_); });
-  ::close(lock_fd_);  // releases the lock
   g_active = nullptr;
+  try {
+    restoreAll();
+  } catch (...) {  // out of memory reading /proc: the threads keep their places
+  }
+  ::close(lock_fd_);  // releases the lock
 }
 
-void CoreClaim::placeOtherThreads() const {
+void CoreClaim::restoreAll() {
+  // Each thread as it was before the claim; those started during it on every CPU.
+  const auto restore = [&](long tid) {
+    const auto known =
+        std::find_if(saved_.begin(), saved_.end(), [&](const auto& s) { return s.first == tid; });
+    setCpus(tid, known != saved_.end() ? known->second : all_);
+  };
+  restore(owner_tid_);
+  for (const long tid : otherThreads(owner_tid_)) restore(tid);
+}
+
+void CoreClaim::placeOtherThreads() {
+  std::lock_guard lock(g_mutex);
   if (cpu_ < 0) return;
-  forOtherThreads(owner_tid_, [&](long tid) { setCpus(tid, others_); });
-  forChildThreads([&](long tid) { setCpus(tid, others_); });
+  placeThreads(false);
+}
+
+void CoreClaim::placeThreads(bool at_claim) {
+  for (const long tid : otherThreads(owner_tid_)) {
+    // A thread found later was started during the claim (its mask inherited): not saved.
+    if (at_claim) saved_.emplace_back(tid, cpusOf(tid));
+    setCpus(tid, others_);
+  }
 }
 
 void CoreClaim::spawnOnOtherCpus(const std::function<void()>& spawn) {
-  const CoreClaim* claim = g_active;
-  if (!claim || !claim->held()) {
+  std::lock_guard lock(g_mutex);
+  if (!g_active) {
     spawn();
     return;
   }
-  const std::vector<int> before = cpusOf(0);
-  setCpus(0, claim->others_);
+  // A child inherits the mask of the thread that starts it.
+  struct Mask {
+    std::vector<int> before = cpusOf(0);
+    ~Mask() { setCpus(0, before); }
+  } mask;
+  setCpus(0, g_active->others_);
   spawn();
-  setCpus(0, before);
 }
 
 }  // namespace simsoccer::sim

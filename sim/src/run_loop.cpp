@@ -1,11 +1,11 @@
 #include "simsoccer/sim/run_loop.hpp"
 
-#include "simsoccer/sim/cores.hpp"
-
 #include <chrono>
 #include <optional>
 #include <stdexcept>
 #include <thread>
+
+#include "simsoccer/sim/cores.hpp"
 
 namespace simsoccer::sim {
 
@@ -22,7 +22,7 @@ RunStats RunLoop::run(const std::function<bool()>& stop, long max_periods,
   // Its solver then uses that one CPU (the same result with any number of threads).
   std::optional<CoreClaim> claim;
   if (sim_.mode() == Mode::Pipelined && sim_.config().own_core) claim.emplace();
-  struct SolverThreads {  // as they were after the run, also when a period throws
+  struct SolverThreads {  // restored after the run, also when a period throws
     engine::PhysicsWorld& physics;
     const int before = physics.activeSolverThreads();
     ~SolverThreads() { physics.setActiveSolverThreads(before); }

@@ -10,9 +10,11 @@ namespace simsoccer::agents {
 
 namespace {
 
-// From the last solution, a foot this far from its target (m) means the
-// solve stalled: other knee bends are tried.
+// From the last solution, a foot this far from its target (m), or tilted
+// this far from it (rad, roll and pitch), means the solve stalled: other
+// knee bends are tried.
 constexpr double kStalledPosition = 1e-3;
+constexpr double kStalledTilt = 1e-2;
 
 // Orientation error as a rotation vector: the rotation taking `current` to `target`.
 Vec3 rotationError(const Eigen::Matrix3d& target, const Eigen::Matrix3d& current) {
@@ -59,14 +61,16 @@ LegKinematics::LegKinematics(const robots::RobotModel& model) {
   for (int i = 0; i < 6; ++i) {
     const AxisKind k = axisKind(legs_[0].axis[static_cast<size_t>(i)]);
     if (axisKind(legs_[1].axis[static_cast<size_t>(i)]) != k)
-      fail("legs: " + body.joints[static_cast<size_t>(legs_[0].joint[static_cast<size_t>(i)])].name +
-           " and " + body.joints[static_cast<size_t>(legs_[1].joint[static_cast<size_t>(i)])].name +
-           " turn about different axes");
+      fail(
+          "legs: " + body.joints[static_cast<size_t>(legs_[0].joint[static_cast<size_t>(i)])].name +
+          " and " + body.joints[static_cast<size_t>(legs_[1].joint[static_cast<size_t>(i)])].name +
+          " turn about different axes");
     (k == AxisKind::Pitch ? pitch : k == AxisKind::Roll ? roll : yaw).push_back(i);
   }
   if (pitch.size() != 3 || roll.size() != 2 || yaw.size() != 1 || pitch[2] != 4 || roll[1] != 5)
-    fail("legs: a leg must have three pitch joints (hip, knee, ankle), two roll joints (hip, "
-         "ankle) and a hip yaw, the ankle's pitch and roll last");
+    fail(
+        "legs: a leg must have three pitch joints (hip, knee, ankle), two roll joints (hip, "
+        "ankle) and a hip yaw, the ankle's pitch and roll last");
   part_ = {yaw[0], roll[0], pitch[0], pitch[1], pitch[2], roll[1]};
   // Joints of the right leg that follow the left one's (one motor).
   for (size_t i = 0; i < 6; ++i) {
@@ -130,7 +134,9 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
   const auto gain = [&](int side, int i) {
     return side == 1 && shared_[static_cast<size_t>(i)] ? mimic_[static_cast<size_t>(i)] : 1.0;
   };
-  auto run = [&](std::array<LegAngles, 2> q, double& pe, double& oe) {
+  // pe, oe: the larger position (m) and orientation (rad) error of the two
+  // feet; tilt: the larger roll and pitch error, in the target foot's frame.
+  auto run = [&](std::array<LegAngles, 2> q, double& pe, double& oe, double& tilt) {
     std::array<Vec3, 2> pos_err{}, rot_err{};
     for (int iter = 0; iter < 80; ++iter) {
       Jacobian jac = Jacobian::Zero(12, n);
@@ -208,13 +214,15 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
             continue;
           }
           v = std::clamp(v + scale * dq[static_cast<size_t>(column[static_cast<size_t>(side)][i])],
-                         c.lower[i],
-                         c.upper[i]);
+                         c.lower[i], c.upper[i]);
         }
       }
     }
     pe = std::max(pos_err[0].norm(), pos_err[1].norm());
     oe = std::max(rot_err[0].norm(), rot_err[1].norm());
+    tilt = 0;
+    for (int side = 0; side < 2; ++side)
+      tilt = std::max(tilt, (targets[side]->linear().transpose() * rot_err[side]).head<2>().norm());
     return q;
   };
   // Starts: the legs bent at the knee by `knee` (rad), the feet flat.
@@ -232,18 +240,20 @@ LegSolution LegKinematics::inverse(const Pose& left_foot, const Pose& right_foot
   };
   const std::array<LegAngles, 2> q0 =
       share({start ? start->left : bent(0.9), start ? start->right : bent(0.9)});
-  double pe = 0, oe = 0;
-  std::array<LegAngles, 2> best = run(q0, pe, oe);
+  double pe = 0, oe = 0, tilt = 0;
+  std::array<LegAngles, 2> best = run(q0, pe, oe, tilt);
   double best_cost = pe + w * oe;
-  // From the last solution, restarts only when its branch lost the feet's
-  // positions (a leg stalled at a limit): an orientation a shared hinge
-  // cannot serve is no better from other knee bends (in the Nao's walk
-  // they gained under 1e-14 and cost four times the solve).
-  const bool stalled = start ? pe > kStalledPosition : best_cost >= 1e-8;
+  // With a shared hinge, from the last solution, restarts only when its
+  // branch lost a foot's position or flatness (a leg stalled at a limit): a
+  // yaw the shared hinge cannot serve is no better from other knee bends (in
+  // the Nao's walk they gained under 1e-14 and cost four times the solve).
+  const bool shares_a_hinge = std::find(shared_.begin(), shared_.end(), true) != shared_.end();
+  const bool stalled =
+      start && shares_a_hinge ? pe > kStalledPosition || tilt > kStalledTilt : best_cost >= 1e-8;
   for (double knee : {0.6, 1.4, 0.2, 2.0}) {
     if (!stalled || best_cost < 1e-8) break;
-    double p2 = 0, o2 = 0;
-    const auto r = run(share({bent(knee), bent(knee)}), p2, o2);
+    double p2 = 0, o2 = 0, t2 = 0;
+    const auto r = run(share({bent(knee), bent(knee)}), p2, o2, t2);
     if (p2 + w * o2 < best_cost) {
       best = r;
       best_cost = p2 + w * o2;

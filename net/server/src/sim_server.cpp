@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <exception>
 #include <random>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 #include "simsoccer/world/match_log.hpp"
 
@@ -167,7 +169,7 @@ struct SimServer::Impl {
     }
     Writer<simsoccer_msg_SensorFrame> frame;
     Writer<simsoccer_msg_RobotStatus> status;
-    Writer<simsoccer_msg_TeamMessage> team_deliver;                // messages to this robot
+    Writer<simsoccer_msg_TeamMessage> team_deliver;             // messages to this robot
     std::unique_ptr<Writer<simsoccer_msg_CameraImage>> images;  // cameras on (both)
   };
   std::vector<std::unique_ptr<RobotWriters>> robot_writers;  // world order
@@ -211,6 +213,7 @@ struct SimServer::Impl {
   std::mutex send_mutex;
   std::condition_variable send_cv;
   bool send_due = false, send_stop = false;
+  std::exception_ptr send_error;  // a write that failed on the sender, rethrown by framesOut
 
   void writeFrames() {
     for (size_t r = 0; r < frames_out.size(); ++r) robot_writers[r]->frame.write(frames_out[r]);
@@ -222,16 +225,24 @@ struct SimServer::Impl {
       send_cv.wait(lock, [&] { return send_due || send_stop; });
       if (!send_due) return;  // stopped, nothing left to write
       lock.unlock();
-      writeFrames();
+      std::exception_ptr error;
+      try {
+        writeFrames();
+      } catch (...) {
+        error = std::current_exception();
+      }
       lock.lock();
+      if (error && !send_error) send_error = error;
       send_due = false;
       send_cv.notify_all();
     }
   }
-  // Waits until the frames handed to the sender are written.
+  // Waits until the frames handed to the sender are written; a write that
+  // failed there fails here.
   void framesOut() {
     std::unique_lock lock(send_mutex);
     send_cv.wait(lock, [&] { return !send_due; });
+    if (send_error) std::rethrow_exception(std::exchange(send_error, nullptr));
   }
   void sendInBackground() {
     if (!sender.joinable()) sender = std::thread([this] { sendLoop(); });
@@ -496,9 +507,10 @@ void SimServer::handleCommands() {
       return;
     }
     // The one check every command goes through (counted there when refused).
-    const auto checked = sim_.gate().check(
-        static_cast<world::RobotId>(ri), std::span<const float>(c.position._buffer, c.position._length),
-        std::span<const float>(c.stiffness._buffer, c.stiffness._length));
+    const auto checked =
+        sim_.gate().check(static_cast<world::RobotId>(ri),
+                          std::span<const float>(c.position._buffer, c.position._length),
+                          std::span<const float>(c.stiffness._buffer, c.stiffness._length));
     if (!checked) return;
     s.command = *checked;
     s.has_command = true;
@@ -632,16 +644,15 @@ void SimServer::observe(const sim::Observation& o) {
   // (the state the commands will answer), each with the robot's perception:
   // one sample per robot and period, so an agent wakes once. (A frame
   // carries the tick and time of the period it closed: this one's.)
+  impl_->framesOut();  // the last period's are out (before this period's game state)
   if (o.game) publishGameState(*o.game, o.left_team);
-  impl_->framesOut();  // the last period's are out: their messages are reused
   const size_t n = world_.robotCount();
   impl_->frames_out.resize(n);
   impl_->perceived.resize(n);
   for (world::RobotId r = 0; r < n; ++r) {
     simsoccer_msg_SensorFrame& m = impl_->frames_out[r];
     toMessage(world_.sensorFrame(r), robots_[r].team, robots_[r].player, m);
-    if (o.perception)
-      toMessage(o.perception->perception(r), m.perception, impl_->perceived[r]);
+    if (o.perception) toMessage(o.perception->perception(r), m.perception, impl_->perceived[r]);
   }
   impl_->clock_out = {tick, world_.time(), static_cast<uint8_t>(config_.lockstep)};
   // When the step does not wait for the answers (pipelined), it need not

@@ -176,8 +176,8 @@ bool publisherParticipant(dds_entity_t reader, dds_instance_handle_t publication
 // Whether a writer is still matched with (alive for) this reader.
 bool publicationMatched(dds_entity_t reader, dds_instance_handle_t publication);
 
-// The DDS partition of one robot's own topics: its SensorFrames, status,
-// team messages to it, perception and camera images; and its agent's
+// The DDS partition of one robot's own topics: its SensorFrames (with its
+// perception), status, team messages to it and camera images; and its agent's
 // claims, commands and team messages (so that DDS Security's permissions can
 // say which robots a team's agents may write for).
 inline std::string robotPartitionName(int team, int player) {

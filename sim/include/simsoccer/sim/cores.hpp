@@ -5,29 +5,34 @@
 // commands, so the two share the machine's cores. Left to the scheduler, a
 // woken agent, a DDS thread or the frame sender often lands on the stepping
 // thread's core and stalls the step (2 cores, 22 agent processes: the
-// physics' 1.05 ms per period grew to 1.3 ms). A CoreClaim puts the calling
-// thread on a CPU of its own and every other thread of this process, and of
-// the processes it started (the agents), on the rest; a process it starts
-// during the claim goes there too (spawnOnOtherCpus).
+// physics' 1.0 ms per period grew to 1.3-1.4 ms). A CoreClaim puts the
+// calling thread on a CPU of its own and every other thread of this process,
+// and of the processes it started (the agents), on the other CPUs; a process
+// it starts during the claim goes there too (spawnOnOtherCpus).
 //
-// Runs side by side (tests, several matches) each claim a different CPU: a
-// lock file per CPU (flock, released when the process ends). A run that
-// finds none free, or a process allowed fewer than two CPUs, claims nothing
-// and leaves placement to the scheduler. Placement changes when threads run,
-// never what they compute.
+// Runs side by side (tests, several matches) never share a claimed CPU: a
+// lock file per CPU (flock, released when the process ends), and a run keeps
+// its other threads off the CPUs other runs hold. A run that finds no CPU
+// free for itself and one more for the rest, or a process allowed fewer than
+// two CPUs, claims nothing and leaves placement to the scheduler. Placement
+// changes when threads run, never what they compute.
 #pragma once
 
+#include <filesystem>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace simsoccer::sim {
 
 class CoreClaim {
  public:
-  // Claims the highest free CPU of this process's affinity set, keeping at
-  // least one for the rest.
-  CoreClaim();
-  // The masks as they were before the claim; the lock released.
+  // Claims the highest CPU of this process's affinity set that no run holds
+  // (lock files `simsoccer-cpu<N>.lock` in `lock_folder`; empty:
+  // defaultLockFolder()), keeping the other free ones for the rest.
+  explicit CoreClaim(const std::filesystem::path& lock_folder = {});
+  // Every thread as it was before the claim (those started during it on
+  // every CPU the claiming thread had); the lock released.
   ~CoreClaim();
   CoreClaim(const CoreClaim&) = delete;
   CoreClaim& operator=(const CoreClaim&) = delete;
@@ -35,20 +40,29 @@ class CoreClaim {
   bool held() const { return cpu_ >= 0; }
   int cpu() const { return cpu_; }  // -1: none claimed
   const std::vector<int>& otherCpus() const { return others_; }
-  // Puts every other thread of this process and every thread of its child
-  // processes on the other CPUs: at the claim, and again for those started
-  // since (a thread the claiming thread starts inherits its CPU).
-  void placeOtherThreads() const;
+  // Puts the threads started since the claim (a thread the claiming thread
+  // starts inherits its CPU) and those of processes started since on the
+  // other CPUs (RunLoop: after the first period, which starts the cameras'
+  // and the frame sender's threads).
+  void placeOtherThreads();
 
   // Runs `spawn` with the calling thread on the other CPUs of the claim in
   // force, if any, so that a process it starts inherits them.
   static void spawnOnOtherCpus(const std::function<void()>& spawn);
 
+  // $XDG_RUNTIME_DIR, else the temporary folder.
+  static std::filesystem::path defaultLockFolder();
+  static std::filesystem::path lockFile(const std::filesystem::path& folder, int cpu);
+
  private:
+  void placeThreads(bool at_claim);
+  void restoreAll();
+
   int cpu_ = -1;
   int lock_fd_ = -1;
   long owner_tid_ = 0;
   std::vector<int> all_, others_;
+  std::vector<std::pair<long, std::vector<int>>> saved_;  // thread id, CPUs before the claim
 };
 
 }  // namespace simsoccer::sim
