@@ -2,7 +2,7 @@
 # ThreadSanitizer over the multi-threaded parts (scripts/test.sh runs it; CI too): the solver
 # threads (any thread count, the same hash), the camera system's render and conversion
 # threads, the real-time run loop, and lockstep over DDS with agent processes (the server's
-# command listener runs in Cyclone's receive thread). Builds build-tsan/ (gcc,
+# command listener runs in Cyclone's receive thread; pipelined, its frame sender thread). Builds build-tsan/ (gcc,
 # -fsanitize=thread): the libraries, the agent program and one test program of those tests
 # (tests/CMakeLists.txt); any data race fails the test.
 set -euo pipefail
@@ -15,4 +15,4 @@ cmake --build build-tsan --target simsoccer_thread_tests
 # suppressed by library in scripts/tsan.supp; our own threads' hand-offs are checked.
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/scripts/tsan.supp"
 ctest --test-dir build-tsan --output-on-failure -j "$(nproc)" \
-  -R '^(Determinism\.AnyNumberOfSolverThreads|CameraSystem\.|RunLoop\.|Net\.LockstepIsDeterministic)'
+  -R '^(Determinism\.AnyNumberOfSolverThreads|CameraSystem\.|RunLoop\.|Net\.LockstepIsDeterministic|NetPipelined\.)'
