@@ -207,8 +207,8 @@ struct SimServer::Impl {
   std::vector<std::vector<simsoccer_msg_PerceivedObject>> perceived;
   simsoccer_msg_SimClock clock_out{};
   // Pipelined periods: the frames go out on this thread while the world
-  // steps (each write runs the loopback receive path of its agent's process:
-  // about 20 us). Started with the first such period.
+  // steps (each write also runs the loopback path into its agent's socket
+  // and wakes it: 8 us of CPU or more). Started with the first such period.
   std::thread sender;
   std::mutex send_mutex;
   std::condition_variable send_cv;
