@@ -139,6 +139,10 @@ TEST(LegKinematics, FromTheLastSolutionAsCloseAsFromScratchAlongAPathAndAfterASt
     far_right.translation().y() = -0.05;
     const agents::LegSolution stalled = k.inverse(far, far_right);
     EXPECT_GT(stalled.position_error, 0.01);
+    // From a bent solution the unreachable target stalls too: other knee bends are tried, and
+    // the result is as close as from scratch.
+    const agents::LegSolution from_bent = k.inverse(far, far_right, &last);
+    EXPECT_NEAR(from_bent.position_error, stalled.position_error, 1e-6);
     LegAngles bent{};
     bent[static_cast<size_t>(k.index(agents::LegJoint::Knee))] = 1.2;
     bent[static_cast<size_t>(k.index(agents::LegJoint::HipPitch))] = -0.6;

@@ -328,6 +328,7 @@ void Endpoint::observe(const sim::Observation& o) {
   const world::World& w = *o.world;
   const double period = w.scenario().physics.control_period;
   time_ = o.time;
+  acts_at_ = o.tick + static_cast<uint64_t>(std::max(0, o.actuation_delay));
   for (auto& rp : robots_) {
     Robot& r = *rp;
     // The ball as the robot's cameras saw it (the simulation's perception):
@@ -394,7 +395,6 @@ void Endpoint::observe(const sim::Observation& o) {
       r.was_walking = r.shooting = false;
       r.walk_targets.clear();
     }
-    acts_at_ = o.tick + static_cast<uint64_t>(std::max(0, o.actuation_delay));
   }
 }
 

@@ -117,10 +117,13 @@ CoreClaim::CoreClaim(const std::filesystem::path& lock_folder) {
       ::close(fd);  // releases the probe's lock
     }
   }
-  if (others_.empty()) {  // nothing left for the rest: leave placement to the scheduler
+  const auto claimNothing = [&] {
     if (lock_fd_ >= 0) ::close(lock_fd_);
-    lock_fd_ = -1;
-    cpu_ = -1;
+    lock_fd_ = cpu_ = -1;
+    others_.clear();
+  };
+  if (others_.empty()) {  // nothing left for the rest: leave placement to the scheduler
+    claimNothing();
     return;
   }
   std::sort(others_.begin(), others_.end());
@@ -131,9 +134,7 @@ CoreClaim::CoreClaim(const std::filesystem::path& lock_folder) {
     placeThreads(true);
   } catch (...) {  // out of memory reading /proc: no claim rather than a half-placed one
     restoreAll();
-    ::close(lock_fd_);
-    lock_fd_ = cpu_ = -1;
-    others_.clear();
+    claimNothing();
     return;
   }
   g_active = this;
