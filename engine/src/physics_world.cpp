@@ -169,6 +169,12 @@ class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
   void integrateTransforms(btScalar dt) override {
     timed(&StageTimes::integrate_s, [&] { btMultiBodyDynamicsWorld::integrateTransforms(dt); });
   }
+  // Bullet's multibody prediction integrates every robot a step ahead only to set its links'
+  // interpolation transforms, which continuous collision of rigid bodies alone reads (the
+  // links are discrete): the rigid bodies' prediction is kept, the robots' skipped.
+  void predictUnconstraintMotion(btScalar dt) override {
+    btDiscreteDynamicsWorld::predictUnconstraintMotion(dt);
+  }
 
  private:
   // Per solver thread: Bullet's scratch arrays for the forward dynamics.
