@@ -14,6 +14,13 @@ using net::QosSpec;
 using Clock = std::chrono::steady_clock;
 
 struct AgentClient::Impl {
+  // Samples that reached the game state and team message readers (counted by their listeners,
+  // declared before them: they outlive the readers), and the counts when the agent last took
+  // from each: a reader nothing reached is not asked, each period (asking costs DDS locks).
+  std::atomic<uint64_t> game_arrivals{1}, team_arrivals{1};
+  uint64_t game_taken = 0;  // trust_mutex held
+  uint64_t team_taken = 0;  // team_mutex held
+  std::mutex team_mutex;
   net::Participant participant;
   net::Writer<simsoccer_msg_JoinRequest> join;
   net::Writer<simsoccer_msg_JointCommand> command;
@@ -89,7 +96,24 @@ struct AgentClient::Impl {
     frame_condition = net::Entity(
         net::check(dds_create_readcondition(frames.get(), DDS_ANY_STATE), "read condition"));
     net::check(dds_waitset_attach(waitset.get(), frame_condition.get(), 0), "attach");
+    countArrivals(game.get(), game_arrivals);
+    countArrivals(team_deliver.get(), team_arrivals);
     me = participant.guid();
+  }
+  static void countArrivals(dds_entity_t reader, std::atomic<uint64_t>& count) {
+    dds_listener_t* l = dds_create_listener(&count);
+    dds_lset_data_available(l, [](dds_entity_t, void* arg) {
+      static_cast<std::atomic<uint64_t>*>(arg)->fetch_add(1, std::memory_order_release);
+    });
+    net::check(dds_set_listener(reader, l), "set arrival listener");
+    dds_delete_listener(l);
+  }
+  // Whether samples reached a reader since the last call that said so.
+  static bool arrivedSince(const std::atomic<uint64_t>& count, uint64_t& taken) {
+    const uint64_t now = count.load(std::memory_order_acquire);
+    if (now == taken) return false;
+    taken = now;
+    return true;
   }
 };
 
@@ -135,7 +159,8 @@ uint64_t AgentClient::foreignSamples() const {
 
 void AgentClient::onFrameData(dds_entity_t reader, void* self) {
   auto* client = static_cast<AgentClient*>(self);
-  client->impl_->frames.take([&](const simsoccer_msg_SensorFrame& f, const dds_sample_info_t& info) {
+  client->impl_->frames.takeReusing([&](const simsoccer_msg_SensorFrame& f,
+                                        const dds_sample_info_t& info) {
     if (f.team == client->team_ && f.player == client->player_ && client->handler_ &&
         client->fromSimulator(reader, info)) {
       client->impl_->frame_tick = f.tick;
@@ -280,7 +305,8 @@ bool AgentClient::gameState(simsoccer_msg_GameState& out) {
   const dds_entity_t reader = impl_->game.get();
   std::lock_guard lock(impl_->trust_mutex);
   auto& games = impl_->games;
-  impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t& info) {
+  if (Impl::arrivedSince(impl_->game_arrivals, impl_->game_taken))
+    impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t& info) {
     dds_guid_t from;
     if (!impl_->writerParticipant(reader, info.publication_handle, from)) return;
     if (impl_->simulator && !net::sameGuid(from, *impl_->simulator)) {
@@ -342,6 +368,8 @@ void AgentClient::sendTeamMessage(std::span<const uint8_t> data) {
 
 std::vector<TeamMessageIn> AgentClient::receiveTeamMessages() {
   std::vector<TeamMessageIn> out;
+  std::lock_guard lock(impl_->team_mutex);
+  if (!Impl::arrivedSince(impl_->team_arrivals, impl_->team_taken)) return out;
   impl_->team_deliver.take([&](const simsoccer_msg_TeamMessage& m, const dds_sample_info_t& info) {
     if (m.team != team_ || m.to_player != player_ ||
         !fromSimulator(impl_->team_deliver.get(), info))
