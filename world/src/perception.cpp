@@ -81,14 +81,16 @@ bool PerceptionSystem::blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3
 void PerceptionSystem::observe(const World& world, const Viewpoint& from, const Vec3& point,
                                double range, PerceivedObject& object, RobotId skip) {
   object.in_view = false;
+  const Vec3 rel = from.to_robot * point;
+  const double distance = std::hypot(rel.x(), rel.y());
+  // Out of range before the frustums: the same answer, and most of a crowded field's
+  // robots cost no projection.
+  if (settings_.realistic && distance > range) return;
   int camera = -1;
   for (int c = 0; c < static_cast<int>(from.camera_count) && camera < 0; ++c)
     if (inFrustum(from.cameras[static_cast<size_t>(c)], point)) camera = c;
   if (camera < 0) return;
-  const Vec3 rel = from.frame.inverse() * point;
-  const double distance = std::hypot(rel.x(), rel.y());
   if (settings_.realistic) {
-    if (distance > range) return;
     const Vec3 eye = from.cameras[static_cast<size_t>(camera)].pose.translation();
     if (blockedByRobot(from.robot, skip, eye, point)) return;
     if (uniform() < settings_.miss_base + settings_.miss_per_metre * distance) return;
@@ -116,7 +118,8 @@ void PerceptionSystem::update(const World& world) {
     p.tick = tick;
     p.time = world.time();
     // The robot's frame and camera views, once for all the objects it looks at.
-    Viewpoint from{r, robotFrame(world, r), {}};
+    Viewpoint from{r, robotFrame(world, r), {}, {}};
+    from.to_robot = from.frame.inverse();
     const robots::RobotModel& model = *world.robot(r).model;
     from.camera_count = std::min(model.cameraCount(), from.cameras.size());
     for (size_t c = 0; c < from.camera_count; ++c)

@@ -484,7 +484,8 @@ void SimServer::handleCommands() {
   const bool lockstep = config_.lockstep;
   // Lockstep: the tick just published; real time: the newest published.
   const uint64_t tick = lockstep ? expected_tick_ : published_tick_;
-  impl_->commands.take([&](const simsoccer_msg_JointCommand& c, const dds_sample_info_t& info) {
+  impl_->commands.takeReusing([&](const simsoccer_msg_JointCommand& c,
+                                  const dds_sample_info_t& info) {
     const int ri = robotIndex(c.team, c.player);
     if (ri < 0) return;
     RobotSlot& s = robots_[static_cast<size_t>(ri)];
