@@ -134,7 +134,7 @@ const char* const kBenchScalingHelp =
     "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
     "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
     "real-time factor and the time per control period split into physics, sensors,\n"
-    "messaging (perception and frames out, commands in; pipelined: the frames go out on a\n"
+    "perception, messaging (frames out, commands in; pipelined: the frames go out on a\n"
     "sender thread while the world steps), referee and rendering; writes the\n"
     "CSV and a plot (default scaling.png): real-time factor and frames per second against\n"
     "robots, log scale, beside USARSim's published 110, 55, 30, 10 fps for 1-4 Naos.\n";

@@ -112,7 +112,8 @@ ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threa
   row.sensors_ms = (st.sonar_s + st.other_s) * per;
   // The step stage is the whole world step; the sensors' part is taken out.
   row.physics_ms = t.step_s * per - row.sensors_ms;
-  row.messaging_ms = (t.observe_s + t.collect_s + t.apply_s) * per;
+  row.perception_ms = t.perception_s * per;
+  row.messaging_ms = (t.observe_s - t.perception_s + t.collect_s + t.apply_s) * per;
   row.referee_ms = t.officials_s * per;
   row.render_ms = t.camera_s * per;
   for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;

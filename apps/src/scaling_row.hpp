@@ -16,7 +16,8 @@ struct ScalingRow {
   int robots = 0;
   sim::Mode mode = sim::Mode::Serial;
   double steps_per_s = 0, fps = 0, rtf = 0;
-  double physics_ms = 0, sensors_ms = 0, messaging_ms = 0, referee_ms = 0, render_ms = 0;
+  double physics_ms = 0, sensors_ms = 0, perception_ms = 0, messaging_ms = 0, referee_ms = 0,
+         render_ms = 0;
   uint64_t missed = 0;
   double cpu_ms = -1;  // CPU time of the simulator and all agents per period (-1: unknown)
   int period_cpu = -1;  // the CPU the periods had to themselves (-1: none; sim/cores.hpp)

@@ -95,7 +95,11 @@ void Simulation::flushCameras() {
 
 void Simulation::observe(uint64_t tick) {
   // Perception first: the sources send it with this tick's frames.
-  if (perception_) perception_->update(world_);
+  if (perception_) {
+    const auto t0 = Clock::now();
+    perception_->update(world_);
+    profile_.perception_s += seconds(t0, Clock::now());
+  }
   Observation o;
   o.tick = tick;
   o.time = world_.time();

@@ -63,6 +63,7 @@ struct SimulationConfig {
 // every program and benchmark).
 struct Profile {
   double observe_s = 0.0;    // perception and sending the state
+  double perception_s = 0.0;  // of observe_s: the perception
   double collect_s = 0.0;    // waiting for and taking the answers
   double apply_s = 0.0;      // setting the checked commands
   double step_s = 0.0;       // physics and sensors
