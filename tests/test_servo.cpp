@@ -334,6 +334,32 @@ TEST(Servo, SharedHipMotorMovesBothHipsMirrored) {
   EXPECT_THROW(w.setJointTarget(0, right, 0.1, 1.0), std::invalid_argument);
 }
 
+TEST(Servo, ReadJointsAgreesWithTheReadingsPerJoint) {
+  // The whole-robot read the sensors use gives exactly what one call per joint gives, for
+  // servoed and passive joints alike, and refuses a span of the wrong length.
+  world::World w(test::scenario(1));
+  const auto& phys = w.physics();
+  const auto body = w.robot(0).body;
+  const size_t n = w.robot(0).model->body->joints.size();
+  w.setPoseTarget(0, "stand", 0.6);
+  for (int i = 0; i < 30; ++i) w.step();
+  std::vector<double> q(n), qd(n), tau(n), target(n), stiffness(n);
+  phys.readJoints(body, q, qd, tau, target, stiffness);
+  for (size_t j = 0; j < n; ++j) {
+    const int ji = static_cast<int>(j);
+    EXPECT_EQ(q[j], phys.jointPosition(body, ji));
+    EXPECT_EQ(qd[j], phys.jointVelocity(body, ji));
+    EXPECT_EQ(tau[j], phys.jointMotorTorque(body, ji));
+    EXPECT_EQ(target[j], phys.jointTarget(body, ji));
+    EXPECT_EQ(stiffness[j], phys.jointStiffness(body, ji));
+  }
+  std::vector<double> only_velocity(n, -1.0);
+  phys.readJoints(body, {}, only_velocity, {}, {}, {});
+  EXPECT_EQ(only_velocity, qd);
+  std::vector<double> short_span(n - 1);
+  EXPECT_THROW(phys.readJoints(body, short_span, {}, {}, {}, {}), std::invalid_argument);
+}
+
 TEST(Servo, LinkPosesAreCurrentAfterEachStep) {
   // Every link's pose agrees with forward kinematics from the current root
   // pose and joint angles, step after step, while the robot moves.

@@ -1012,6 +1012,28 @@ double PhysicsWorld::jointTarget(ArticulationId a, int joint) const {
   return s >= 0 ? impl_->servos.target(static_cast<size_t>(s)) : 0.0;
 }
 
+void PhysicsWorld::readJoints(ArticulationId a, std::span<double> position,
+                              std::span<double> velocity, std::span<double> motor_torque,
+                              std::span<double> target, std::span<double> stiffness) const {
+  const Articulation& art = impl_->articulations.at(a);
+  const size_t n = art.model->joints.size();
+  for (const std::span<double>* out : {&position, &velocity, &motor_torque, &target, &stiffness})
+    if (!out->empty() && out->size() != n)
+      throw std::invalid_argument("readJoints: " + std::to_string(out->size()) +
+                                  " entries for " + std::to_string(n) + " joints");
+  const JointServoBatch& servos = impl_->servos;
+  for (size_t j = 0; j < n; ++j) {
+    const int link = static_cast<int>(j);
+    if (!position.empty()) position[j] = art.body->getJointPos(link);
+    if (!velocity.empty()) velocity[j] = art.body->getJointVel(link);
+    const int s = art.servo[j];
+    const auto si = static_cast<size_t>(s);
+    if (!motor_torque.empty()) motor_torque[j] = s >= 0 ? servos.motorTorque(si) : 0.0;
+    if (!target.empty()) target[j] = s >= 0 ? servos.target(si) : 0.0;
+    if (!stiffness.empty()) stiffness[j] = s >= 0 ? servos.stiffness(si) : 0.0;
+  }
+}
+
 RigidBodyState PhysicsWorld::rigidBodyState(BodyId b) const {
   const btRigidBody* body = impl_->bodies.at(b).get();
   return {fromBt(body->getWorldTransform()), fromBt(body->getLinearVelocity()),

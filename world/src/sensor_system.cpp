@@ -279,13 +279,18 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     const Pose torso = physics.linkPose(r.body, 0);
     r.gyro_sum += torso.linear().transpose() * physics.rootAngularVelocity(r.body);
     const auto& model = *r.model;
+    const size_t joints = model.body->joints.size();
+    joint_velocity_.resize(joints);
+    joint_motor_torque_.resize(joints);
+    physics.readJoints(r.body, {}, joint_velocity_, joint_motor_torque_, {}, {});
     for (size_t a = 0; a < model.actuators.size(); ++a) {
       const auto& act = model.actuators[a];
       if (act.kind != robots::Actuator::Kind::Joint) continue;
-      const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+      const auto j = static_cast<size_t>(act.index);
+      const auto& joint = model.body->joints[j];
       const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
-      const double qd = std::abs(physics.jointVelocity(r.body, act.index));
-      const double current = std::abs(physics.jointMotorTorque(r.body, act.index)) /
+      const double qd = std::abs(joint_velocity_[j]);
+      const double current = std::abs(joint_motor_torque_[j]) /
                                  (motor.torque_constant * motor.gear_ratio) +
                              motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
       r.current_sum[a] += current;
@@ -310,17 +315,23 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
 
     // Joints and hands.
     const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+    const size_t joints = model.body->joints.size();
+    joint_position_.resize(joints);
+    joint_target_.resize(joints);
+    joint_stiffness_.resize(joints);
+    physics.readJoints(r.body, joint_position_, {}, {}, joint_target_, joint_stiffness_);
     for (size_t a = 0; a < model.actuators.size(); ++a) {
       const auto& act = model.actuators[a];
       if (act.kind == robots::Actuator::Kind::Joint) {
-        const auto& joint = model.body->joints[static_cast<size_t>(act.index)];
+        const auto j = static_cast<size_t>(act.index);
+        const auto& joint = model.body->joints[j];
         const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
-        const double q = physics.jointPosition(r.body, act.index);
+        const double q = joint_position_[j];
         f.position[a] = static_cast<float>(std::round(q / resolution) * resolution);
         f.velocity[a] = static_cast<float>((q - r.last_position[a]) / period);
         r.last_position[a] = q;
-        f.target[a] = static_cast<float>(physics.jointTarget(r.body, act.index));
-        f.stiffness[a] = static_cast<float>(physics.jointStiffness(r.body, act.index));
+        f.target[a] = static_cast<float>(joint_target_[j]);
+        f.stiffness[a] = static_cast<float>(joint_stiffness_[j]);
         f.current[a] = static_cast<float>(r.current_sum[a] / n);
         // Winding temperature: copper losses heat it, the housing cools it.
         const double power = motor.resistance * r.current_sq_sum[a] / n;

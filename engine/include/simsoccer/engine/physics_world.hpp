@@ -160,6 +160,11 @@ class PhysicsWorld {
   double jointMotorTorque(ArticulationId a, int joint) const;
   double jointStiffness(ArticulationId a, int joint) const;
   double jointTarget(ArticulationId a, int joint) const;
+  // The same of every joint at once, in joint order: each span empty (not read) or one entry
+  // per joint. The sensors read the whole robot every step; one call instead of one per joint.
+  void readJoints(ArticulationId a, std::span<double> position, std::span<double> velocity,
+                  std::span<double> motor_torque, std::span<double> target,
+                  std::span<double> stiffness) const;
   RigidBodyState rigidBodyState(BodyId b) const;
   // Contact points in the contact manifolds after the last step.
   ContactCount contactCount() const;

@@ -121,6 +121,9 @@ class SensorSystem {
   std::vector<engine::Shape> static_shapes_;  // goals, field frame
   std::vector<int32_t> static_owner_;         // their broadphase group
   std::vector<SensorFrame> frames_;
+  // One robot's joints as read from the physics (joint order), reused robot after robot.
+  std::vector<double> joint_position_, joint_velocity_, joint_motor_torque_, joint_target_,
+      joint_stiffness_;
   size_t rays_per_sonar_ = 0;
   int steps_in_period_ = 0;
 
