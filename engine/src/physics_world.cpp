@@ -106,6 +106,51 @@ struct SameRobotFilter : btOverlapFilterCallback {
   }
 };
 
+// Bullet's near callback without the narrowphase of a robot link clearly above the ground
+// plane. The plane's bounding box is infinite, so every link of every robot pairs with it
+// every step, and Bullet tests each of the link's shapes against it, mostly to find nothing:
+// most of a robot is far above the carpet. A link whose bounding box (its shapes' margins
+// included) is higher above the plane than any of the pair's contact breaking thresholds can
+// have no point with it, and Bullet's refresh would drop every point its manifolds still
+// hold; so the manifolds are emptied and nothing else runs. Only a pair processed before is
+// skipped: its manifolds were made at its first step, in Bullet's order (which decides the
+// solver's row order), so the state is the same bit for bit.
+void groundCullingNearCallback(btBroadphasePair& pair, btCollisionDispatcher& dispatcher,
+                               const btDispatcherInfo& info) {
+  if (pair.m_algorithm) {
+    auto* a = static_cast<btCollisionObject*>(pair.m_pProxy0->m_clientObject);
+    auto* b = static_cast<btCollisionObject*>(pair.m_pProxy1->m_clientObject);
+    const auto ground = [](const btCollisionObject* o) {
+      if (o->getCollisionShape()->getShapeType() != STATIC_PLANE_PROXYTYPE) return false;
+      const auto* plane = static_cast<const btStaticPlaneShape*>(o->getCollisionShape());
+      return plane->getPlaneNormal() == btVector3(0, 0, 1) &&
+             o->getWorldTransform().getBasis() == btMatrix3x3::getIdentity();
+    };
+    btCollisionObject* plane = ground(a) ? a : ground(b) ? b : nullptr;
+    btCollisionObject* link = plane == a ? b : a;
+    if (plane && btMultiBodyLinkCollider::upcast(link) && dispatcher.needsCollision(a, b)) {
+      btVector3 low, high;
+      link->getCollisionShape()->getAabb(link->getWorldTransform(), low, high);
+      const btScalar height =
+          low.z() - (static_cast<const btStaticPlaneShape*>(plane->getCollisionShape())
+                         ->getPlaneConstant() +
+                     plane->getWorldTransform().getOrigin().z());
+      thread_local btManifoldArray manifolds;
+      manifolds.resize(0);
+      pair.m_algorithm->getAllContactManifolds(manifolds);
+      bool clear = manifolds.size() > 0;
+      for (int i = 0; i < manifolds.size() && clear; ++i)
+        clear = height > manifolds[i]->getContactBreakingThreshold() + btScalar(1e-3);
+      if (clear) {
+        for (int i = 0; i < manifolds.size(); ++i)
+          if (manifolds[i]->getNumContacts() > 0) manifolds[i]->clearManifold();
+        return;
+      }
+    }
+  }
+  btCollisionDispatcher::defaultNearCallback(pair, dispatcher, info);
+}
+
 // btMultiBodyDynamicsWorld with wall-clock timers around Bullet's own stages.
 class TimedMultiBodyWorld : public btMultiBodyDynamicsWorld {
  public:
@@ -577,6 +622,7 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   // Several contact points for a box resting on the ground plane (feet).
   m.config->setPlaneConvexMultipointIterations(3, 3);
   m.dispatcher = std::make_unique<btCollisionDispatcher>(m.config.get());
+  if (settings.cull_ground_pairs) m.dispatcher->setNearCallback(&groundCullingNearCallback);
   m.broadphase = std::make_unique<btDbvtBroadphase>();
   m.solver = std::make_unique<ArticulationSolver>(!settings.bullet_solver);
   m.world = std::make_unique<TimedMultiBodyWorld>(m.dispatcher.get(), m.broadphase.get(),

@@ -106,7 +106,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
 
   const ConfigNode ph = root["physics"];
   ph.allowOnly({"dt", "control_period", "solver_iterations", "friction_directions", "bullet_solver",
-                "gravity", "threads"});
+                "cull_ground_pairs", "gravity", "threads"});
   s.physics.dt = ph["dt"].positive();
   s.physics.control_period = ph["control_period"].positive();
   s.physics.solver_iterations = ph.integer("solver_iterations", s.physics.solver_iterations);
@@ -115,6 +115,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
   if (s.physics.friction_directions != 1 && s.physics.friction_directions != 2)
     ph.failKey("friction_directions", "must be 1 or 2");
   s.physics.bullet_solver = ph.boolean("bullet_solver", s.physics.bullet_solver);
+  s.physics.cull_ground_pairs = ph.boolean("cull_ground_pairs", s.physics.cull_ground_pairs);
   s.physics.gravity = ph.number("gravity", s.physics.gravity);
   if (const auto threads = ph.optional("threads")) {
     const std::string text = threads->raw().IsScalar() ? threads->raw().Scalar() : "";

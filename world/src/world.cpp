@@ -50,6 +50,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   settings.solver_iterations = pc.solver_iterations;
   settings.friction_directions = pc.friction_directions;
   settings.bullet_solver = pc.bullet_solver;
+  settings.cull_ground_pairs = pc.cull_ground_pairs;
   settings.gravity = Vec3(0, 0, pc.gravity);
   settings.solver_threads = solverThreads(pc);
   physics_ = std::make_unique<engine::PhysicsWorld>(settings);

@@ -38,6 +38,9 @@ struct PhysicsSettings {
   // iterations, and with one thread Bullet's own island loop (for
   // comparisons). The two agree up to rounding.
   bool bullet_solver = false;
+  // true: no narrowphase between the ground plane and a robot link clearly above it (the
+  // same state bit for bit, less collision time); false: Bullet's for every link (to compare).
+  bool cull_ground_pairs = true;
   Vec3 gravity{0.0, 0.0, -9.81};
 };
 

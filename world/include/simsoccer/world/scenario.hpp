@@ -34,6 +34,9 @@ struct PhysicsConfig {
   // comparisons; false (the default): the engine's (engine/src/
   // articulation_solver.hpp), the same physics up to rounding, faster.
   bool bullet_solver = false;
+  // true (the default): robot links clearly above the ground skip Bullet's narrowphase with
+  // it (the same state bit for bit); false: Bullet's for every link, for comparisons.
+  bool cull_ground_pairs = true;
   double gravity = -9.81;  // m/s^2 along z
   // Threads that solve the constraint batches (groups of robots and what
   // touches them) side by side; 0 (`auto`, the default): see solverThreads().
