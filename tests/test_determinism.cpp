@@ -92,7 +92,8 @@ TEST(Determinism, CullingTheGroundPairsChangesNothing) {
   // Links far above the carpet skip Bullet's narrowphase with it: the same state as Bullet's
   // own narrowphase for every link, while robots swing their limbs hard enough to fall (links
   // coming down to the carpet and leaving it again).
-  EXPECT_EQ(run(23, 0.6, 1200, 1, nullptr, false, true), run(23, 0.6, 1200, 1, nullptr, false, false));
+  EXPECT_EQ(run(23, 0.6, 1200, 1, nullptr, false, true),
+            run(23, 0.6, 1200, 1, nullptr, false, false));
 }
 
 TEST(Determinism, DifferentSeedGivesDifferentHash) {

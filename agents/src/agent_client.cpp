@@ -307,28 +307,28 @@ bool AgentClient::gameState(simsoccer_msg_GameState& out) {
   auto& games = impl_->games;
   if (Impl::arrivedSince(impl_->game_arrivals, impl_->game_taken))
     impl_->game.take([&](const simsoccer_msg_GameState& g, const dds_sample_info_t& info) {
-    dds_guid_t from;
-    if (!impl_->writerParticipant(reader, info.publication_handle, from)) return;
-    if (impl_->simulator && !net::sameGuid(from, *impl_->simulator)) {
-      ++impl_->foreign;  // somebody else's game
-      return;
-    }
-    size_t k = 0;
-    while (k < games.size() && !net::sameGuid(games[k].participant, from)) ++k;
-    if (k == games.size()) {
-      if (games.size() < 8) {
-        games.push_back({from, {}, 0});
-      } else {  // the one heard from longest ago makes room
-        k = 0;
-        for (size_t i = 1; i < games.size(); ++i)
-          if (games[i].received < games[k].received) k = i;
-        games[k].participant = from;
+      dds_guid_t from;
+      if (!impl_->writerParticipant(reader, info.publication_handle, from)) return;
+      if (impl_->simulator && !net::sameGuid(from, *impl_->simulator)) {
+        ++impl_->foreign;  // somebody else's game
+        return;
       }
-    }
-    games[k].state = g;
-    games[k].received = ++impl_->games_received;
-    impl_->newest_game = k;
-  });
+      size_t k = 0;
+      while (k < games.size() && !net::sameGuid(games[k].participant, from)) ++k;
+      if (k == games.size()) {
+        if (games.size() < 8) {
+          games.push_back({from, {}, 0});
+        } else {  // the one heard from longest ago makes room
+          k = 0;
+          for (size_t i = 1; i < games.size(); ++i)
+            if (games[i].received < games[k].received) k = i;
+          games[k].participant = from;
+        }
+      }
+      games[k].state = g;
+      games[k].received = ++impl_->games_received;
+      impl_->newest_game = k;
+    });
   // Once the simulator is known, only its game; before, the newest of any.
   if (impl_->simulator) {
     for (const auto& gf : games)

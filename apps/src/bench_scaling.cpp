@@ -63,9 +63,9 @@ int benchScaling(int argc, char** argv, int first) {
       robot_name.c_str(), cameras ? ", cameras" : "", seconds);
   std::fflush(stdout);
   Table table;
-  table.header = {"robots",     "mode",         "steps_per_s", "fps",       "rtf",    "physics_ms",
-                  "sensors_ms", "perception_ms", "messaging_ms", "referee_ms", "render_ms",
-                  "missed", "cpu_ms", "period_cpu"};
+  table.header = {"robots",     "mode",       "steps_per_s",   "fps",          "rtf",
+                  "physics_ms", "sensors_ms", "perception_ms", "messaging_ms", "referee_ms",
+                  "render_ms",  "missed",     "cpu_ms",        "period_cpu"};
   std::vector<ScalingRow> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {
@@ -74,9 +74,8 @@ int benchScaling(int argc, char** argv, int first) {
       if (mode == modes.back()) plotted.push_back(r);
       table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),
                             fmt(r.fps, 0), fmt(r.rtf, 2), fmt(r.physics_ms, 2),
-                            fmt(r.sensors_ms, 2), fmt(r.perception_ms, 3),
-                            fmt(r.messaging_ms, 2), fmt(r.referee_ms, 3),
-                            fmt(r.render_ms, 2), std::to_string(r.missed),
+                            fmt(r.sensors_ms, 2), fmt(r.perception_ms, 3), fmt(r.messaging_ms, 2),
+                            fmt(r.referee_ms, 3), fmt(r.render_ms, 2), std::to_string(r.missed),
                             r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a",
                             r.period_cpu >= 0 ? std::to_string(r.period_cpu) : "-"});
       std::fprintf(stderr, "  %d robots, %s done\n", n, sim::modeName(mode));

@@ -132,9 +132,9 @@ void groundCullingNearCallback(btBroadphasePair& pair, btCollisionDispatcher& di
       btVector3 low, high;
       link->getCollisionShape()->getAabb(link->getWorldTransform(), low, high);
       const btScalar height =
-          low.z() - (static_cast<const btStaticPlaneShape*>(plane->getCollisionShape())
-                         ->getPlaneConstant() +
-                     plane->getWorldTransform().getOrigin().z());
+          low.z() -
+          (static_cast<const btStaticPlaneShape*>(plane->getCollisionShape())->getPlaneConstant() +
+           plane->getWorldTransform().getOrigin().z());
       thread_local btManifoldArray manifolds;
       manifolds.resize(0);
       pair.m_algorithm->getAllContactManifolds(manifolds);
@@ -1065,8 +1065,8 @@ void PhysicsWorld::readJoints(ArticulationId a, std::span<double> position,
   const size_t n = art.model->joints.size();
   for (const std::span<double>* out : {&position, &velocity, &motor_torque, &target, &stiffness})
     if (!out->empty() && out->size() != n)
-      throw std::invalid_argument("readJoints: " + std::to_string(out->size()) +
-                                  " entries for " + std::to_string(n) + " joints");
+      throw std::invalid_argument("readJoints: " + std::to_string(out->size()) + " entries for " +
+                                  std::to_string(n) + " joints");
   const JointServoBatch& servos = impl_->servos;
   for (size_t j = 0; j < n; ++j) {
     const int link = static_cast<int>(j);

@@ -290,9 +290,9 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
       const auto& joint = model.body->joints[j];
       const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
       const double qd = std::abs(joint_velocity_[j]);
-      const double current = std::abs(joint_motor_torque_[j]) /
-                                 (motor.torque_constant * motor.gear_ratio) +
-                             motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
+      const double current =
+          std::abs(joint_motor_torque_[j]) / (motor.torque_constant * motor.gear_ratio) +
+          motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
       r.current_sum[a] += current;
       r.current_sq_sum[a] += current * current;
     }

@@ -56,8 +56,8 @@ class PerceptionSystem {
   // One robot's view of the world this period: its frame and its cameras.
   struct Viewpoint {
     RobotId robot;
-    engine::Pose frame;     // robot frame in the field
-    engine::Pose to_robot;  // its inverse: field to robot frame
+    engine::Pose frame;                         // robot frame in the field
+    engine::Pose to_robot;                      // its inverse: field to robot frame
     std::array<engine::RenderView, 2> cameras;  // the robot's first two cameras
     size_t camera_count = 0;
   };
