@@ -147,20 +147,7 @@ class Reader {
     constexpr int kBatch = 64;
     void* samples[kBatch];
     dds_sample_info_t infos[kBatch];
-    int total = 0;
-    for (;;) {
-      samples[0] = nullptr;
-      const dds_return_t n = dds_take(reader_.get(), samples, infos, kBatch, kBatch);
-      if (n <= 0) break;
-      for (int i = 0; i < n; ++i)
-        if (infos[i].valid_data) {
-          f(*static_cast<const T*>(samples[i]), infos[i]);
-          ++total;
-        }
-      dds_return_loan(reader_.get(), samples, n);
-      if (n < kBatch) break;
-    }
-    return total;
+    return takeBatches(samples, infos, kBatch, /*loaned=*/true, f);
   }
   // As take, but DDS deserialises into samples this reader keeps instead of loaning its own:
   // their sequences' buffers serve the next take too, so a reader taking a sample every
@@ -172,22 +159,30 @@ class Reader {
     void* samples[kBatch];
     for (int i = 0; i < kBatch; ++i) samples[i] = &kept_->samples[i];
     dds_sample_info_t infos[kBatch];
+    return takeBatches(samples, infos, kBatch, /*loaned=*/false, f);
+  }
+  dds_entity_t get() const { return reader_.get(); }
+
+ private:
+  // Takes batch after batch into `samples` (loaned: DDS's, returned after each batch; else
+  // the caller's) until fewer than a batch come, calling f for the valid ones.
+  template <class F>
+  int takeBatches(void** samples, dds_sample_info_t* infos, int batch, bool loaned, F& f) {
     int total = 0;
     for (;;) {
-      const dds_return_t n = dds_take(reader_.get(), samples, infos, kBatch, kBatch);
+      if (loaned) samples[0] = nullptr;
+      const dds_return_t n = dds_take(reader_.get(), samples, infos, batch, batch);
       if (n <= 0) break;
       for (int i = 0; i < n; ++i)
         if (infos[i].valid_data) {
           f(*static_cast<const T*>(samples[i]), infos[i]);
           ++total;
         }
-      if (n < kBatch) break;
+      if (loaned) dds_return_loan(reader_.get(), samples, n);
+      if (n < batch) break;
     }
     return total;
   }
-  dds_entity_t get() const { return reader_.get(); }
-
- private:
   // The samples takeReusing fills, freed with what their sequences hold.
   struct Kept {
     explicit Kept(const dds_topic_descriptor_t& d) : desc(&d) {}
