@@ -82,9 +82,13 @@ void PerceptionSystem::observe(const World& world, const Viewpoint& from, const 
                                double range, PerceivedObject& object, RobotId skip) {
   object.in_view = false;
   const Vec3 rel = from.to_robot * point;
-  const double distance = std::hypot(rel.x(), rel.y());
   // Out of range before the frustums: the same answer, and most of a crowded field's
-  // robots cost no projection.
+  // robots cost no projection. Clearly out (the squared distance past the range by more
+  // than rounding) costs no hypot either.
+  if (settings_.realistic &&
+      rel.x() * rel.x() + rel.y() * rel.y() > range * range * (1.0 + 1e-12))
+    return;
+  const double distance = std::hypot(rel.x(), rel.y());
   if (settings_.realistic && distance > range) return;
   int camera = -1;
   for (int c = 0; c < static_cast<int>(from.camera_count) && camera < 0; ++c)
