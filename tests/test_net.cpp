@@ -463,6 +463,45 @@ TEST(Net, TheLoopbackConfigurationHearsNothingFromOtherAddresses) {
   EXPECT_EQ(matched.current_count, 1u) << "the loopback neighbour was not matched";
 }
 
+TEST(Net, ATakeIntoKeptSamplesCarriesEachSamplesOwnSequences) {
+  // Frames taken into the samples a reader keeps (the agents' path): each take sees its own
+  // frame's sightings, however many the one before had (more, fewer, none).
+  net::Participant sim(dds(171));
+  net::Participant agent(dds(171));
+  const std::string partition = net::robotPartitionName(0, 1);
+  net::Writer<simsoccer_msg_SensorFrame> writer(sim, simsoccer_msg_SensorFrame_desc, "KeptFrames",
+                                                {true, 1, false, partition});
+  net::Reader<simsoccer_msg_SensorFrame> reader(agent, simsoccer_msg_SensorFrame_desc,
+                                                "KeptFrames", {true, 1, false, partition});
+  dds_publication_matched_status_t matched{};
+  for (const auto start = Clock::now(); matched.current_count == 0 && seconds(start) < 10.0;)
+    net::check(dds_get_publication_matched_status(writer.get(), &matched), "matched status");
+  ASSERT_EQ(matched.current_count, 1u);
+  uint64_t tick = 0;
+  for (const uint32_t seen : {3u, 1u, 0u, 21u, 2u}) {
+    ++tick;
+    std::vector<simsoccer_msg_PerceivedObject> robots(seen);
+    for (uint32_t i = 0; i < seen; ++i) robots[i].position[0] = static_cast<float>(100 * tick + i);
+    simsoccer_msg_SensorFrame f{};
+    f.team = 0;
+    f.player = 1;
+    f.tick = tick;
+    f.perception.robots._buffer = robots.data();
+    f.perception.robots._length = f.perception.robots._maximum = seen;
+    writer.write(f);
+    int taken = 0;
+    for (const auto start = Clock::now(); taken == 0 && seconds(start) < 5.0;)
+      taken = reader.takeReusing(
+          [&](const simsoccer_msg_SensorFrame& got, const dds_sample_info_t&) {
+            EXPECT_EQ(got.tick, tick);
+            ASSERT_EQ(got.perception.robots._length, seen) << "tick " << tick;
+            for (uint32_t i = 0; i < seen; ++i)
+              EXPECT_EQ(got.perception.robots._buffer[i].position[0], static_cast<float>(100 * tick + i));
+          });
+    EXPECT_EQ(taken, 1) << "tick " << tick;
+  }
+}
+
 TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   const uint32_t domain = 106;
   world::World w(teams(2));
