@@ -471,11 +471,13 @@ TEST(Net, ATakeIntoKeptSamplesCarriesEachSamplesOwnSequences) {
   const std::string partition = net::robotPartitionName(0, 1);
   net::Writer<simsoccer_msg_SensorFrame> writer(sim, simsoccer_msg_SensorFrame_desc, "KeptFrames",
                                                 {true, 1, false, partition});
-  net::Reader<simsoccer_msg_SensorFrame> reader(agent, simsoccer_msg_SensorFrame_desc,
-                                                "KeptFrames", {true, 1, false, partition});
+  net::Reader<simsoccer_msg_SensorFrame> reader(agent, simsoccer_msg_SensorFrame_desc, "KeptFrames",
+                                                {true, 1, false, partition});
   dds_publication_matched_status_t matched{};
-  for (const auto start = Clock::now(); matched.current_count == 0 && seconds(start) < 10.0;)
+  for (const auto start = Clock::now(); matched.current_count == 0 && seconds(start) < 10.0;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
     net::check(dds_get_publication_matched_status(writer.get(), &matched), "matched status");
+  }
   ASSERT_EQ(matched.current_count, 1u);
   uint64_t tick = 0;
   for (const uint32_t seen : {3u, 1u, 0u, 21u, 2u}) {
@@ -490,13 +492,15 @@ TEST(Net, ATakeIntoKeptSamplesCarriesEachSamplesOwnSequences) {
     f.perception.robots._length = f.perception.robots._maximum = seen;
     writer.write(f);
     int taken = 0;
-    for (const auto start = Clock::now(); taken == 0 && seconds(start) < 5.0;)
-      taken = reader.takeReusing(
-          [&](const simsoccer_msg_SensorFrame& got, const dds_sample_info_t&) {
+    for (const auto start = Clock::now(); taken == 0 && seconds(start) < 5.0;
+         std::this_thread::sleep_for(std::chrono::milliseconds(1)))
+      taken =
+          reader.takeReusing([&](const simsoccer_msg_SensorFrame& got, const dds_sample_info_t&) {
             EXPECT_EQ(got.tick, tick);
             ASSERT_EQ(got.perception.robots._length, seen) << "tick " << tick;
             for (uint32_t i = 0; i < seen; ++i)
-              EXPECT_EQ(got.perception.robots._buffer[i].position[0], static_cast<float>(100 * tick + i));
+              EXPECT_EQ(got.perception.robots._buffer[i].position[0],
+                        static_cast<float>(100 * tick + i));
           });
     EXPECT_EQ(taken, 1) << "tick " << tick;
   }
