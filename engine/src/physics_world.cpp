@@ -54,6 +54,8 @@ Pose fromBt(const btTransform& t) {
 
 // Marks free rigid bodies (their BodyId is in user index 2).
 constexpr int kRigidBodyTag = -7;
+// User index 3 of the ground plane (addGround: z = 0), which the near callback recognises.
+constexpr int kGroundTag = -8;
 
 // Small margins: Bullet's default 4 cm would round a 35 mm foot box away.
 constexpr btScalar kBoxMargin = 0.001f;
@@ -120,21 +122,13 @@ void groundCullingNearCallback(btBroadphasePair& pair, btCollisionDispatcher& di
   if (pair.m_algorithm) {
     auto* a = static_cast<btCollisionObject*>(pair.m_pProxy0->m_clientObject);
     auto* b = static_cast<btCollisionObject*>(pair.m_pProxy1->m_clientObject);
-    const auto ground = [](const btCollisionObject* o) {
-      if (o->getCollisionShape()->getShapeType() != STATIC_PLANE_PROXYTYPE) return false;
-      const auto* plane = static_cast<const btStaticPlaneShape*>(o->getCollisionShape());
-      return plane->getPlaneNormal() == btVector3(0, 0, 1) &&
-             o->getWorldTransform().getBasis() == btMatrix3x3::getIdentity();
-    };
-    btCollisionObject* plane = ground(a) ? a : ground(b) ? b : nullptr;
-    btCollisionObject* link = plane == a ? b : a;
-    if (plane && btMultiBodyLinkCollider::upcast(link) && dispatcher.needsCollision(a, b)) {
+    const btCollisionObject* link = a->getUserIndex3() == kGroundTag   ? b
+                                    : b->getUserIndex3() == kGroundTag ? a
+                                                                       : nullptr;
+    if (link && btMultiBodyLinkCollider::upcast(link) && dispatcher.needsCollision(a, b)) {
       btVector3 low, high;
       link->getCollisionShape()->getAabb(link->getWorldTransform(), low, high);
-      const btScalar height =
-          low.z() -
-          (static_cast<const btStaticPlaneShape*>(plane->getCollisionShape())->getPlaneConstant() +
-           plane->getWorldTransform().getOrigin().z());
+      const btScalar height = low.z();  // above the ground plane, z = 0
       thread_local btManifoldArray manifolds;
       manifolds.resize(0);
       pair.m_algorithm->getAllContactManifolds(manifolds);
@@ -686,6 +680,7 @@ void PhysicsWorld::addGround(const Material& material) {
   auto obj = std::make_unique<btCollisionObject>();
   obj->setCollisionShape(plane);
   obj->setUserIndex(-1);
+  obj->setUserIndex3(kGroundTag);
   applyMaterial(obj.get(), material);
   m.world->addCollisionObject(obj.get(), btBroadphaseProxy::StaticFilter,
                               btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
