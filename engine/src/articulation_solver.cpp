@@ -379,6 +379,15 @@ void ArticulationSolver::findJointRows() {
         !single(row.m_jacBindex, joint.coordinate_b, joint.value_b))
       continue;
     joint.sparse = true;
+    joint.envelope_slope = 0;
+    if (row.m_orgConstraint &&
+        row.m_orgConstraint->getConstraintType() == MULTIBODY_CONSTRAINT_1DOF_JOINT_MOTOR &&
+        row.m_friction > 0) {
+      joint.envelope_slope = row.m_friction;
+      joint.upper = row.m_upperLimit;
+      joint.lower = row.m_lowerLimit;
+      joint.inv_mass = row.m_rhsPenetration;
+    }
     const btScalar* response_b = &m_data.m_deltaVelocitiesUnitImpulse[row.m_jacBindex];
     joint.response_b = false;
     for (int i = 0; i < n; ++i) joint.response_b = joint.response_b || response_b[i] != 0;
@@ -394,8 +403,14 @@ btScalar ArticulationSolver::resolveNonContactRow(int index) {
   // same numbers as the dense sums, whose other terms are all zero.
   const btScalar* dv_a = &m_data.m_deltaVelocities[row.m_deltaVelAindex];
   const btScalar* dv_b = &m_data.m_deltaVelocities[row.m_deltaVelBindex];
-  const btScalar delta = clampedUpdate(
-      row, joint.value_a * dv_a[joint.coordinate_a] + joint.value_b * dv_b[joint.coordinate_b]);
+  const btScalar velocity =
+      joint.value_a * dv_a[joint.coordinate_a] + joint.value_b * dv_b[joint.coordinate_b];
+  if (joint.envelope_slope > 0) {
+    const btScalar others = velocity - joint.inv_mass * btScalar(row.m_appliedImpulse);
+    row.m_upperLimit = joint.upper - joint.envelope_slope * others;
+    row.m_lowerLimit = joint.lower - joint.envelope_slope * others;
+  }
+  const btScalar delta = clampedUpdate(row, velocity);
   const int n = row.m_multiBodyA->getNumDofs() + 6;
   auto apply = [&](int response_index, int block) {
     const btScalar* r = &m_data.m_deltaVelocitiesUnitImpulse[response_index];

@@ -142,6 +142,7 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
     int coordinate_a = 0, coordinate_b = 0;
     btScalar value_a = 0, value_b = 0;
     bool response_b = false;
+    btScalar envelope_slope = 0, upper = 0, lower = 0, inv_mass = 0;
   };
   std::vector<JointRow> joint_rows_;
   std::vector<char> applied_;  // per delta-velocity block: added to its articulation

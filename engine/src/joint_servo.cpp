@@ -143,6 +143,8 @@ JointServoBatch::Row JointServoBatch::row(size_t i) const {
   r.feedforward = feedforward_[i];
   r.lower = lo_[i];
   r.upper = hi_[i];
+  r.drive = stiffness_[i] * stall_[i];
+  r.inv_no_load = inv_no_load_[i];
   return r;
 }
 
@@ -154,9 +156,13 @@ double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inert
   const Row r = row(i);
   if (!r.active) return 0.0;
   // qdot' = qdot + P / I  and  qdot' = beta / dt (target - q) - gamma P, with P
-  // the whole impulse (feedforward included).
+  // the whole impulse (feedforward included), bounded by the torque-speed
+  // line at qdot': P / dt <= drive (1 - qdot' / w0), and likewise below.
   const double p = (r.beta / dt_ * (r.target - q) + r.bias - qdot) / (1.0 / inertia + r.gamma);
-  return std::clamp(p / dt_, r.lower, r.upper);
+  const double k = dt_ * r.drive * r.inv_no_load, scale = 1.0 / (1.0 + k / inertia);
+  const double upper = (dt_ * r.drive - k * qdot) * scale,
+               lower = (-dt_ * r.drive - k * qdot) * scale;
+  return std::clamp(p, lower, upper) / dt_;
 }
 
 }  // namespace simsoccer::engine

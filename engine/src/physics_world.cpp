@@ -357,12 +357,14 @@ btMultiBodySolverConstraint& addJointRow(btMultiBodyConstraintArray& rows,
 class ServoConstraint : public btMultiBodyJointMotor {
  public:
   // `inertias` null: the response from Bullet's articulated-body pass.
+  // `envelope_in_solver`: see PhysicsSettings.
   ServoConstraint(btMultiBody* body, int link, const JointServoBatch& batch, size_t servo,
-                  ArticulationInertias* inertias)
+                  ArticulationInertias* inertias, bool envelope_in_solver)
       : btMultiBodyJointMotor(body, link, 0, 1),
         batch_(batch),
         servo_(servo),
-        inertias_(inertias) {}
+        inertias_(inertias),
+        envelope_in_solver_(envelope_in_solver) {}
 
   // The impulse applied in the last step (0 without a row), N m s.
   btScalar impulse() { return row_made_ ? getAppliedImpulse(0) : btScalar(0); }
@@ -405,6 +407,22 @@ class ServoConstraint : public btMultiBodyJointMotor {
     row.m_cfm = gamma * soft;
     row.m_lowerLimit = static_cast<btScalar>((r.lower - r.feedforward) * h);
     row.m_upperLimit = static_cast<btScalar>((r.upper - r.feedforward) * h);
+    if (inertias_ && envelope_in_solver_ && r.drive > 0.0) {
+      // The engine's solver bounds the motor's torque on its torque-speed
+      // line at the speed it solves for (JointServoBatch::Row): with the
+      // row's impulse p, w' = velocity + inv_mass p + (what the other rows
+      // add), and dt feedforward + p <= dt drive (1 - w'/w0) gives
+      // p <= upper - slope (what the other rows add), likewise below. The
+      // solver reads the slope from m_friction and inv_mass from
+      // m_rhsPenetration, which a joint row does not use otherwise.
+      const double k = h * r.drive * r.inv_no_load;  // N m s per rad/s
+      const double scale = 1.0 / (1.0 + k * inv_mass);
+      const double rest = -h * r.feedforward - k * velocity;
+      row.m_upperLimit = static_cast<btScalar>((h * r.drive + rest) * scale);
+      row.m_lowerLimit = static_cast<btScalar>((-h * r.drive + rest) * scale);
+      row.m_friction = static_cast<btScalar>(k * scale);
+      row.m_rhsPenetration = inv_mass;
+    }
     row_made_ = true;
   }
 
@@ -412,6 +430,7 @@ class ServoConstraint : public btMultiBodyJointMotor {
   const JointServoBatch& batch_;
   size_t servo_;
   ArticulationInertias* inertias_;
+  bool envelope_in_solver_;
   bool row_made_ = false;
 };
 
@@ -656,6 +675,7 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   m.world->setGravity(toBt(settings.gravity));
   btContactSolverInfo& info = m.world->getSolverInfo();
   info.m_numIterations = settings.solver_iterations;
+  info.m_numNonContactInnerIterations = settings.joint_sweeps;
   // Two friction rows per contact: Bullet's multibody contacts take their
   // friction directions from the contact normal alone (btPlaneSpace1), so a
   // single row would resist slip along one fixed tangent only.
@@ -847,7 +867,8 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       m.servo_link.push_back(j);
       if (motor.implicit_servo) {
         auto row = std::make_unique<ServoConstraint>(
-            raw, j, m.servos, s, settings_.bullet_solver ? nullptr : &m.inertias);
+            raw, j, m.servos, s, settings_.bullet_solver ? nullptr : &m.inertias,
+            settings_.envelope_in_solver);
         m.servo_rows.push_back(row.get());
         m.world->addMultiBodyConstraint(row.get());
         m.constraints.push_back(std::move(row));

@@ -105,16 +105,20 @@ Scenario loadScenario(const std::filesystem::path& file) {
     if (!std::filesystem::exists(path)) root.failKey(key, "file not found: " + path.string());
 
   const ConfigNode ph = root["physics"];
-  ph.allowOnly({"dt", "control_period", "solver_iterations", "friction_directions", "bullet_solver",
-                "cull_ground_pairs", "gravity", "threads"});
+  ph.allowOnly({"dt", "control_period", "solver_iterations", "joint_sweeps", "friction_directions",
+                "bullet_solver", "envelope_in_solver", "cull_ground_pairs", "gravity", "threads"});
   s.physics.dt = ph["dt"].positive();
   s.physics.control_period = ph["control_period"].positive();
   s.physics.solver_iterations = ph.integer("solver_iterations", s.physics.solver_iterations);
   if (s.physics.solver_iterations < 1) ph.failKey("solver_iterations", "must be >= 1");
+  s.physics.joint_sweeps = ph.integer("joint_sweeps", s.physics.joint_sweeps);
+  if (s.physics.joint_sweeps < 1 || s.physics.joint_sweeps > 16)
+    ph.failKey("joint_sweeps", "must be 1..16");
   s.physics.friction_directions = ph.integer("friction_directions", s.physics.friction_directions);
   if (s.physics.friction_directions != 1 && s.physics.friction_directions != 2)
     ph.failKey("friction_directions", "must be 1 or 2");
   s.physics.bullet_solver = ph.boolean("bullet_solver", s.physics.bullet_solver);
+  s.physics.envelope_in_solver = ph.boolean("envelope_in_solver", s.physics.envelope_in_solver);
   s.physics.cull_ground_pairs = ph.boolean("cull_ground_pairs", s.physics.cull_ground_pairs);
   s.physics.gravity = ph.number("gravity", s.physics.gravity);
   if (const auto threads = ph.optional("threads")) {

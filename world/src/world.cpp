@@ -40,6 +40,8 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     scenarioError(scenario_, "physics.control_period", "must be a whole multiple of dt");
   if (pc.solver_iterations < 1)
     scenarioError(scenario_, "physics.solver_iterations", "must be >= 1");
+  if (pc.joint_sweeps < 1 || pc.joint_sweeps > 16)
+    scenarioError(scenario_, "physics.joint_sweeps", "must be 1..16");
   if (pc.friction_directions != 1 && pc.friction_directions != 2)
     scenarioError(scenario_, "physics.friction_directions", "must be 1 or 2");
   steps_per_control_ = static_cast<int>(std::lround(ratio));
@@ -48,8 +50,10 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   engine::PhysicsSettings settings;
   settings.dt = pc.dt;
   settings.solver_iterations = pc.solver_iterations;
+  settings.joint_sweeps = pc.joint_sweeps;
   settings.friction_directions = pc.friction_directions;
   settings.bullet_solver = pc.bullet_solver;
+  settings.envelope_in_solver = pc.envelope_in_solver;
   settings.cull_ground_pairs = pc.cull_ground_pairs;
   settings.gravity = Vec3(0, 0, pc.gravity);
   settings.solver_threads = solverThreads(pc);

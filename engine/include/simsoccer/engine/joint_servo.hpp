@@ -94,7 +94,14 @@ class JointServoBatch {
     double bias = 0.0;                // rad/s: a commanded velocity and torque's share
     double gamma = 0.0;               // compliance, rad/s per N m s
     double feedforward = 0.0;         // N m
-    double lower = 0.0, upper = 0.0;  // motor torque bounds, N m
+    // The motor torque's bounds from the speed predicted in prepare(), N m
+    // (for Bullet's solver, whose bounds are fixed over its iterations).
+    double lower = 0.0, upper = 0.0;
+    // The envelope at the joint's speed w' at the end of the step, as the
+    // engine's solver applies it: drive (-1 - w'/w0) <= motor torque <=
+    // drive (1 - w'/w0), w' the speed it solves for.
+    double drive = 0.0;        // N m: stiffness x stall torque
+    double inv_no_load = 0.0;  // 1 / w0, s/rad
   };
   Row row(size_t i) const;
 

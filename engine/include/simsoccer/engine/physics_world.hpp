@@ -28,6 +28,9 @@ using BodyId = Id<struct BodyTag>;                  // a free rigid body (the ba
 struct PhysicsSettings {
   double dt = 0.005;            // s, physics step
   int solver_iterations = 10;   // sequential-impulse iterations per step
+  // Gauss-Seidel sweeps over the joint rows (servos, limits, gears) in each
+  // iteration: cheap, one coordinate each; see world::PhysicsConfig.
+  int joint_sweeps = 1;
   int friction_directions = 2;  // friction rows per contact (see world::PhysicsConfig)
   // Threads that solve the simulation islands (robots and what touches them)
   // side by side. The result is the same bit for bit for any number.
@@ -38,6 +41,12 @@ struct PhysicsSettings {
   // iterations, and with one thread Bullet's own island loop (for
   // comparisons). The two agree up to rounding.
   bool bullet_solver = false;
+  // true (the default): the engine's solver bounds an implicit servo's torque
+  // by its motor's torque-speed line at the joint speed it solves for
+  // (JointServoBatch::Row::drive); false: by the bounds predicted before the
+  // step, the only kind Bullet's solver can apply (to compare the two).
+  // Bullet's solver (bullet_solver) always uses the predicted bounds.
+  bool envelope_in_solver = true;
   // true: no narrowphase between the ground plane and a robot link clearly above it (the
   // same state bit for bit, less collision time); false: Bullet's for every link (to compare).
   bool cull_ground_pairs = true;

@@ -24,6 +24,11 @@ struct PhysicsConfig {
   double dt = 0.005;              // s
   double control_period = 0.010;  // s, a whole multiple of dt
   int solver_iterations = 10;
+  // Gauss-Seidel sweeps over the joint rows (implicit servos, joint limits,
+  // gears) in each solver iteration, the contacts swept once. A joint row
+  // costs one coordinate, a contact a whole robot's; at a 10 ms step the
+  // servos of a leg pushing on the carpet need two sweeps to converge.
+  int joint_sweeps = 1;
   // Friction rows per contact: 2 (a pyramid; the default) or 1. With 1,
   // Bullet gives a multibody contact a single row along a fixed tangent
   // (btPlaneSpace1 of the normal: the y axis on flat ground), not along the
@@ -34,6 +39,10 @@ struct PhysicsConfig {
   // comparisons; false (the default): the engine's (engine/src/
   // articulation_solver.hpp), the same physics up to rounding, faster.
   bool bullet_solver = false;
+  // true (the default): an implicit servo's torque is bounded by its motor's
+  // torque-speed line at the joint speed the solver finds; false: by bounds
+  // predicted before the step (as with bullet_solver), for comparisons.
+  bool envelope_in_solver = true;
   // true (the default): robot links clearly above the ground skip Bullet's narrowphase with
   // it (the same state bit for bit); false: Bullet's for every link, for comparisons.
   bool cull_ground_pairs = true;
