@@ -79,6 +79,11 @@ TEST_F(ConfigErrors, MissingKey) {
   expectError("scenario.yaml", "physics.dt", "missing required key");
 }
 
+TEST_F(ConfigErrors, JointSweepsMustBeACountFrom1To16) {
+  replace(scenario_, "joint_sweeps: 1", "joint_sweeps: 0");
+  expectError("scenario.yaml", "physics.joint_sweeps", "must be 1..16");
+}
+
 TEST_F(ConfigErrors, WrongType) {
   replace(scenario_, "solver_iterations: 10", "solver_iterations: many");
   expectError("scenario.yaml", "physics.solver_iterations", "expected an integer");
@@ -221,6 +226,12 @@ TEST_F(ConfigErrors, DirectoryInsteadOfFile) {
 TEST_F(ConfigErrors, UnknownServoIntegration) {
   replace(robot_, "leg_pitch: {servo: implicit,", "leg_pitch: {servo: semi,");
   expectError("robot.yaml", "motors.leg_pitch.servo", "must be implicit or explicit, not 'semi'");
+}
+
+TEST_F(ConfigErrors, ExplicitUpToOnlyForAnExplicitServo) {
+  replace(robot_, "leg_pitch: {servo: implicit,",
+          "leg_pitch: {servo: implicit, explicit_up_to: 0.005,");
+  expectError("robot.yaml", "motors.leg_pitch.explicit_up_to", "only for an explicit servo");
 }
 
 // Found by probing as a hostile user would: keys that are not strings, keys

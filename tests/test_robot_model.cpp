@@ -51,6 +51,28 @@ TEST(RobotModel, H25ActuatorsAreInTheProtocolsOrder) {
     EXPECT_EQ(nao.actuators[a].name, protocol::kNaoActuatorOrder[a]) << "entry " << a;
 }
 
+// Which servos are implicit depends on the step: the leg pitch motors at
+// any step, the other leg and the arm motors above 5 ms (their explicit servo
+// was measured stable up to it), the head, wrists and hands never.
+TEST(RobotModel, H25ServosImplicitWhereTheirExplicitServoIsNotStable) {
+  const auto nao = robots::loadRobotModel(test::naoH25());
+  auto motor = [&](const std::string& name) -> const engine::Motor& {
+    for (const engine::Motor& m : nao.body->motors)
+      if (m.name == name) return m;
+    throw std::runtime_error("no motor " + name);
+  };
+  for (const char* name : {"leg_pitch"}) {
+    EXPECT_TRUE(motor(name).implicitAt(0.003)) << name;
+    EXPECT_TRUE(motor(name).implicitAt(0.010)) << name;
+  }
+  for (const char* name : {"leg_yaw_roll", "shoulder_pitch", "arm_yaw", "arm_roll"}) {
+    EXPECT_FALSE(motor(name).implicitAt(0.005)) << name;
+    EXPECT_TRUE(motor(name).implicitAt(0.010)) << name;
+  }
+  for (const char* name : {"head_yaw", "head_pitch", "wrist", "hand"})
+    EXPECT_FALSE(motor(name).implicitAt(0.010)) << name;
+}
+
 TEST(RobotModel, H21TotalMassMatchesReference) {
   const auto nao = robots::loadRobotModel(test::naoH21());
   EXPECT_NEAR(nao.body->totalMass(), 5.029, 0.01 * 5.029);  // nao.md 1: H21 (V4) 5.029 kg

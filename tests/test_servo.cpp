@@ -44,7 +44,7 @@ TEST(JointServoBatch, TorqueEnvelope) {
     SCOPED_TRACE(implicit ? "implicit" : "explicit");
     // A huge inertia bound: the predicted speed is the current one (explicit envelope).
     engine::JointServoBatch batch;
-    batch.add(testMotor(100.0, implicit), 0.0, -1.0, 1.0, 1e12);
+    batch.add(testMotor(100.0, implicit), 0.0, -1.0, 1.0, 1e12, implicit);
     const double dt = 0.005;
     auto torque = [&](double q, double qd) {
       batch.resetHistory(0);
@@ -74,7 +74,7 @@ TEST(JointServoBatch, PredictedSpeedNeverPassesNoLoad) {
     SCOPED_TRACE(implicit ? "implicit" : "explicit");
     engine::JointServoBatch batch;
     const double inertia = 1e-3, dt = 0.005;  // stall * dt / I = 10 rad/s > 5 rad/s
-    batch.add(testMotor(1000.0, implicit), 0.0, -10.0, 10.0, inertia);
+    batch.add(testMotor(1000.0, implicit), 0.0, -10.0, 10.0, inertia, implicit);
     batch.setTarget(0, 9.0, 1.0);
     double q = 0.0, qd = 0.0, peak = 0.0;
     for (int i = 0; i < 200; ++i) {
@@ -94,7 +94,7 @@ TEST(JointServoBatch, LoadedJointGetsFullStallTorque) {
   for (const bool implicit : {false, true}) {
     SCOPED_TRACE(implicit ? "implicit" : "explicit");
     engine::JointServoBatch batch;
-    batch.add(testMotor(1000.0, implicit), 0.0, -1.0, 1.0, 1e-3);
+    batch.add(testMotor(1000.0, implicit), 0.0, -1.0, 1.0, 1e-3, implicit);
     batch.setTarget(0, 0.5, 1.0);
     double tau = 0.0;
     for (int i = 0; i < 400; ++i) tau = stepAlone(batch, 0.0, 0.0, 1e-3, 0.005);
@@ -124,7 +124,7 @@ TEST(JointServoBatch, ImplicitServoIsStableWhereTheExplicitOneDiverges) {
     m.no_load_speed = 1e6;
     engine::JointServoBatch batch;
     const double inertia = 3e-4, dt = 0.005;
-    batch.add(m, 0.0, -10.0, 10.0, inertia);
+    batch.add(m, 0.0, -10.0, 10.0, inertia, m.implicit_servo);
     batch.setTarget(0, 0.1, 1.0);
     double q = 0.0, qd = 0.0, late = 0.0;
     for (int i = 0; i < 60; ++i) {  // short: the explicit swing grows 4-fold per step
@@ -152,7 +152,7 @@ TEST(JointServoBatch, CommandWithItsOwnGains) {
     motor.stall_torque = 50.0;
     motor.no_load_speed = 1e6;  // no speed limit to speak of
     engine::JointServoBatch batch;
-    batch.add(motor, 0.0, -1.0, 1.0, 1e12);
+    batch.add(motor, 0.0, -1.0, 1.0, 1e12, motor.implicit_servo);
     const double dt = 0.005;
     auto torque = [&](double q, double qd) {
       batch.resetHistory(0);
@@ -179,7 +179,7 @@ TEST(JointServoBatch, CommandWithItsOwnGains) {
 // old one before.
 TEST(JointServoBatch, CommandedGainsEnterTheStateOnceUsed) {
   engine::JointServoBatch batch;
-  batch.add(testMotor(100.0, true), 0.0, -1.0, 1.0, 1.0);
+  batch.add(testMotor(100.0, true), 0.0, -1.0, 1.0, 1.0, true);
   std::vector<double> before, after;
   batch.appendState(before);
   EXPECT_EQ(before.size(), 6u);  // target, stiffness, prev qdot, load, torque, history

@@ -18,7 +18,8 @@ namespace {
 
 const char* kHelp =
     "usage: simsoccer bench physics [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
-    "                               [--dt 0.005,0.01] [--iterations N] [--threads N]\n"
+    "                               [--dt 0.005,0.01] [--iterations N] [--joint-sweeps N]\n"
+    "                               [--threads N]\n"
     "                               [--repeat N] [--csv FILE]\n"
     "\n"
     "Places N Naos on the field in side-by-side pairs, all joints tracking slow sinusoids\n"
@@ -35,6 +36,8 @@ const char* kHelp =
     "  --dt LIST       physics steps in seconds (default: the config's); the control period\n"
     "                  is the config's, rounded to a whole number of steps\n"
     "  --iterations N  constraint solver iterations (default: the config's)\n"
+    "  --joint-sweeps N  sweeps over the joint rows per iteration (default: the config's;\n"
+    "                  a 10 ms step needs 2, docs/models.md)\n"
     "  --threads N     solver threads (default: the config's physics.threads, else one per\n"
     "                  core up to 4); the result is the same for any number\n"
     "  --repeat N      time each robot count N times (fresh world each) and report the run\n"
@@ -53,9 +56,9 @@ world::PhysicsConfig withStep(world::PhysicsConfig physics, double dt) {
 }  // namespace
 
 int benchPhysics(int argc, char** argv, int first) {
-  const Options opt(
-      argc, argv, first, {"help"},
-      {"config", "robots", "seconds", "dt", "iterations", "threads", "repeat", "csv"});
+  const Options opt(argc, argv, first, {"help"},
+                    {"config", "robots", "seconds", "dt", "iterations", "joint-sweeps", "threads",
+                     "repeat", "csv"});
   if (opt.help(kHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
@@ -67,6 +70,8 @@ int benchPhysics(int argc, char** argv, int first) {
       opt.wholeNumber("threads", cfg.base.physics.threads, 1, world::PhysicsConfig::kMaxThreads);
   cfg.base.physics.solver_iterations =
       opt.wholeNumber("iterations", cfg.base.physics.solver_iterations, 1, 1000);
+  cfg.base.physics.joint_sweeps =
+      opt.wholeNumber("joint-sweeps", cfg.base.physics.joint_sweeps, 1, 16);
   const int threads = world::solverThreads(cfg.base.physics);
   // The project's default step is always measured, first, as the reference.
   const double default_dt = world::PhysicsConfig{}.dt;
@@ -89,9 +94,11 @@ int benchPhysics(int argc, char** argv, int first) {
     step_list += (step_list.empty() ? "" : ", ") + engine::formatNumber(dt * 1e3);
   std::printf(
       "simsoccer bench physics: %s, field %s, dt %s ms, control %.1f ms (whole steps), %d solver "
-      "iterations, %d solver thread%s, %.1f s settling + %.1f s timed per row\n",
+      "iterations (%d sweep%s over the joint rows each), %d solver thread%s, %.1f s settling + "
+      "%.1f s timed per row\n",
       config_file.string().c_str(), field.name.c_str(), step_list.c_str(),
-      cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations, threads,
+      cfg.base.physics.control_period * 1e3, cfg.base.physics.solver_iterations,
+      cfg.base.physics.joint_sweeps, cfg.base.physics.joint_sweeps == 1 ? "" : "s", threads,
       threads == 1 ? "" : "s", cfg.settle, cfg.seconds);
   std::fflush(stdout);
 

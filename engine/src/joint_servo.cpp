@@ -10,7 +10,7 @@ constexpr double kLoadFilter = 0.1;  // per step: a 50 ms time constant at 5 ms
 }  // namespace
 
 size_t JointServoBatch::add(const Motor& motor, double damping, double lower, double upper,
-                            double min_inertia) {
+                            double min_inertia, bool implicit) {
   if (!(motor.no_load_speed > 0.0)) throw std::invalid_argument("motor no_load_speed must be > 0");
   if (!(min_inertia > 0.0)) throw std::invalid_argument("servo min_inertia must be > 0");
   if (!(motor.kp >= 0.0) || !(motor.kd >= 0.0) || !(motor.kp + motor.kd > 0.0))
@@ -31,7 +31,7 @@ size_t JointServoBatch::add(const Motor& motor, double damping, double lower, do
   min_inertia_.push_back(min_inertia);
   prev_qdot_.push_back(0.0);
   has_history_.push_back(0);
-  implicit_.push_back(motor.implicit_servo ? 1 : 0);
+  implicit_.push_back(implicit ? 1 : 0);
   load_.push_back(0.0);
   motor_tau_.push_back(0.0);
   passive_tau_.push_back(0.0);

@@ -861,11 +861,13 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
           link.inertia +
           link.mass * (link.com.squaredNorm() * Mat3::Identity() - link.com * link.com.transpose());
       const double min_inertia = motor.armature + a.dot(about_joint * a);
-      const size_t s = m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia);
+      const bool implicit = motor.implicitAt(settings_.dt);
+      const size_t s =
+          m.servos.add(motor, joint.damping, joint.lower, joint.upper, min_inertia, implicit);
       art.servo[static_cast<size_t>(j)] = static_cast<int>(s);
       m.servo_body.push_back(raw);
       m.servo_link.push_back(j);
-      if (motor.implicit_servo) {
+      if (implicit) {
         auto row = std::make_unique<ServoConstraint>(
             raw, j, m.servos, s, settings_.bullet_solver ? nullptr : &m.inertias,
             settings_.envelope_in_solver);

@@ -172,7 +172,7 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
   for (const auto& [name, n] : root["motors"].entries()) {
     n.allowOnly({"motor_type", "gear_ratio", "stall_torque", "no_load_speed", "armature", "kp",
                  "kd", "damping", "torque_constant", "resistance", "no_load_current",
-                 "thermal_resistance", "thermal_time_constant", "servo"});
+                 "thermal_resistance", "thermal_time_constant", "servo", "explicit_up_to"});
     engine::Motor m;
     m.name = name;
     m.stall_torque = n["stall_torque"].positive();
@@ -185,6 +185,10 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
       if (servo != "implicit" && servo != "explicit")
         n["servo"].fail("must be implicit or explicit, not '" + servo + "'");
       m.implicit_servo = servo == "implicit";
+    }
+    if (n.has("explicit_up_to")) {
+      if (m.implicit_servo) n["explicit_up_to"].fail("only for an explicit servo");
+      m.explicit_up_to = n["explicit_up_to"].positive();
     }
     m.gear_ratio = n["gear_ratio"].positive();
     m.torque_constant = n["torque_constant"].positive();

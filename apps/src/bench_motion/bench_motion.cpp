@@ -51,6 +51,8 @@ const char* kHelp =
     "                as in a match of that mode); default: the matches' (%s)\n"
     "  --dt S, --control-period S  the physics step and control period (default 0.005 and\n"
     "                0.010; a LoLA match runs 0.003 and 0.012)\n"
+    "  --joint-sweeps N  sweeps over the joint rows per solver iteration (default 1; a 10 ms\n"
+    "                step needs 2: docs/models.md)\n"
     "  --csv FILE    also write the table as CSV\n";
 
 }  // namespace
@@ -107,7 +109,8 @@ int benchMotion(int argc, char** argv, int first) {
                                   "block-trials",
                                   "mode",
                                   "dt",
-                                  "control-period"};
+                                  "control-period",
+                                  "joint-sweeps"};
   for (const auto& k : knobs) valued.push_back(k.first);
   const Options opt(
       argc, argv, first,
@@ -149,6 +152,7 @@ int benchMotion(int argc, char** argv, int first) {
   c.dt = opt.number("dt", 0.0);
   c.control_period = opt.number("control-period", 0.0);
   if (c.dt < 0 || c.control_period < 0) throw UsageError("--dt and --control-period must be > 0");
+  c.joint_sweeps = opt.wholeNumber("joint-sweeps", 0, 1, 16);
   const auto seed = opt.seed("seed", 1);
   if (opt.has("get-up")) {  // one get-up, for tuning
     const std::string side = opt.get("get-up", "");

@@ -74,6 +74,7 @@ sim::SimulationConfig simulationConfig(sim::Mode mode) {
 world::Scenario withTiming(world::Scenario s, const TrialContext& c) {
   if (c.dt > 0) s.physics.dt = c.dt;
   if (c.control_period > 0) s.physics.control_period = c.control_period;
+  if (c.joint_sweeps > 0) s.physics.joint_sweeps = c.joint_sweeps;
   return s;
 }
 }  // namespace

@@ -51,6 +51,7 @@ struct TrialContext {
   // The physics step and control period (0: emptyField's 5 ms and 10 ms);
   // 3 ms and 12 ms are a LoLA match's.
   double dt = 0.0, control_period = 0.0;
+  int joint_sweeps = 0;  // 0: the scenario's
 };
 
 // The bench's robot at (-3, 0) facing +x on its empty field, the ball out of the way.

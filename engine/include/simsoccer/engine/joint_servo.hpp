@@ -41,8 +41,10 @@ namespace simsoccer::engine {
 class JointServoBatch {
  public:
   // Appends one servo; returns its index in the batch. `min_inertia` is a
-  // lower bound of the inertia the joint moves (kg m^2, > 0).
-  size_t add(const Motor& motor, double damping, double lower, double upper, double min_inertia);
+  // lower bound of the inertia the joint moves (kg m^2, > 0); `implicit`: the
+  // servo's kind at the world's step (Motor::implicitAt).
+  size_t add(const Motor& motor, double damping, double lower, double upper, double min_inertia,
+             bool implicit);
   size_t size() const { return target_.size(); }
 
   // Target angles are clamped to the joint limits; stiffness to [0, 1]. The

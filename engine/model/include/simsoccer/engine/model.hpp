@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -62,6 +63,11 @@ struct Motor {
   // The servo's PD solved implicitly, by Bullet's constraint solver (stable
   // for any inertia, costs a solver row), or explicitly (a joint torque).
   bool implicit_servo = false;
+  // An explicit servo's largest stable physics step, s: above it the servo
+  // is solved implicitly (infinity: explicit at any step).
+  double explicit_up_to = std::numeric_limits<double>::infinity();
+  // Whether the servo is implicit in a world stepping dt seconds.
+  bool implicitAt(double dt) const { return implicit_servo || dt > explicit_up_to; }
   // Electrical and thermal model (sensors: current, temperature).
   double gear_ratio = 1.0;
   double torque_constant = 0.0;        // N m/A at the motor shaft
