@@ -17,7 +17,8 @@ namespace simsoccer::apps {
 
 int benchScaling(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help", "cameras", "shared-cores"},
-                    {"robots", "seconds", "csv", "png", "domain", "modes", "threads", "robot"});
+                    {"robots", "seconds", "csv", "png", "domain", "modes", "threads", "robot", "dt",
+                     "joint-sweeps"});
   if (opt.help(kBenchScalingHelp)) return 0;
   opt.noPositional();
   const std::vector<int> counts = opt.intList("robots", {1, 2, 4, 8, 11, 22});
@@ -55,6 +56,10 @@ int benchScaling(int argc, char** argv, int first) {
     const motion::MotionBench b = motion::loadMotionBench(bench);
     robot = {b.robot_model, b.field, b.agents};
   }
+  robot.dt = opt.number("dt", 0.0);
+  if (robot.dt != 0.0 && robot.dt != 0.005 && robot.dt != 0.01)
+    throw UsageError("--dt: 0.005 or 0.01 (a whole part of the 10 ms control period)");
+  robot.joint_sweeps = opt.wholeNumber("joint-sweeps", 0, 1, 16);
   const auto domain = opt.domain("domain", 43);
   const std::filesystem::path png = opt.get("png", "scaling.png");
   std::printf(

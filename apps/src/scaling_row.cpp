@@ -33,6 +33,8 @@ world::Scenario scalingScenario(int n, bool cameras, int threads, const ScalingR
   s.perception.realistic = true;
   s.cameras.enabled = cameras;
   s.physics.threads = threads;
+  if (robot.dt > 0) s.physics.dt = robot.dt;
+  if (robot.joint_sweeps > 0) s.physics.joint_sweeps = robot.joint_sweeps;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
   const double hl = f.halfLength(), hw = f.halfWidth();
   // The behaviour's kick-off formation (shares of the half-length / half-width).

@@ -28,6 +28,9 @@ struct ScalingRow {
 // (configs/bench/motion_<robot>.yaml: the K1 on the HSL M-Field).
 struct ScalingRobot {
   std::filesystem::path robot_model, field, agents;  // empty field: the Nao's choice
+  // The physics step and the sweeps over the joint rows (0: the defaults).
+  double dt = 0.0;
+  int joint_sweeps = 0;
 };
 
 // N robots in two teams at their kick-off places, perception on.
