@@ -56,7 +56,8 @@ TEST(BenchPhysicsApp, RejectsBadOptions) {
       runCommand(std::string(SIMSOCCER_BIN) + " bench physics --robots 0", status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--robots"), std::string::npos) << out;
-  for (const char* bad : {"--dt 0", "--dt 0.005,x", "--dt 1", "--iterations 0"}) {
+  for (const char* bad :
+       {"--dt 0", "--dt 0.005,x", "--dt 1", "--iterations 0", "--joint-sweeps 0"}) {
     const std::string refused =
         runCommand(std::string(SIMSOCCER_BIN) + " bench physics " + bad, status);
     EXPECT_NE(status, 0) << bad;
