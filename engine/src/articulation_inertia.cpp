@@ -83,6 +83,7 @@ void ArticulationInertia::setUp(const btMultiBody& body) {
 }
 
 bool ArticulationInertia::factor(const btMultiBody& body) {
+  columns_ready_ = false;
   const int links = body.getNumLinks();
   const auto n = static_cast<size_t>(n_);
 
@@ -166,6 +167,38 @@ bool ArticulationInertia::factor(const btMultiBody& body) {
   return true;
 }
 
+void ArticulationInertia::setColumnCoordinates(std::vector<int> coordinates) {
+  column_coordinates_ = std::move(coordinates);
+  column_slot_.assign(static_cast<size_t>(n_), -1);
+  for (size_t s = 0; s < column_coordinates_.size(); ++s)
+    column_slot_.at(static_cast<size_t>(column_coordinates_[s])) = static_cast<int>(s);
+  // Whole blocks of six: the last one padded with zero forces.
+  const size_t blocks = (column_coordinates_.size() + 5) / 6;
+  columns_.assign(blocks * 6 * static_cast<size_t>(n_), btScalar(0));
+  columns_ready_ = false;
+}
+
+const btScalar* ArticulationInertia::column(int coordinate) const {
+  if (coordinate < 0 || coordinate >= n_) return nullptr;
+  const int slot = column_slot_.empty() ? -1 : column_slot_[static_cast<size_t>(coordinate)];
+  if (slot < 0) return nullptr;
+  const auto n = static_cast<size_t>(n_);
+  if (!columns_ready_) {
+    // Unit forces, six per block solve. A unit force's solve touches rows off
+    // its own chain with zeros only, so each column is the same as solve()'s.
+    std::vector<btScalar>& forces = unit_forces_;
+    forces.assign(6 * n, btScalar(0));
+    for (size_t first = 0; first < column_coordinates_.size(); first += 6) {
+      std::fill(forces.begin(), forces.end(), btScalar(0));
+      for (size_t r = 0; r < 6 && first + r < column_coordinates_.size(); ++r)
+        forces[r * n + static_cast<size_t>(column_coordinates_[first + r])] = 1;
+      solveBlock<6>(forces.data(), &columns_[first * n], -1);
+    }
+    columns_ready_ = true;
+  }
+  return &columns_[static_cast<size_t>(slot) * n];
+}
+
 void ArticulationInertia::solve(const btScalar* force, btScalar* response, int chain) const {
   solveBlock<1>(force, response, chain);
 }
@@ -242,7 +275,10 @@ const ArticulationInertia* ArticulationInertias::of(btMultiBody& body) {
   if (!e.set_up) {  // the model's structure: once
     e.set_up = true;
     e.supported = ArticulationInertia::supports(body);
-    if (e.supported) e.inertia.setUp(body);
+    if (e.supported) {
+      e.inertia.setUp(body);
+      e.inertia.setColumnCoordinates(e.column_coordinates);
+    }
   }
   e.factored = e.supported && e.inertia.factor(body);
   if (!e.factored) return nullptr;

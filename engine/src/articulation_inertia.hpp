@@ -53,6 +53,14 @@ class ArticulationInertia {
   void solve(const btScalar* force, btScalar* response, int chain = -1) const;
   // Six at once (a link's basis), each of size() entries one after the other.
   void solveSix(const btScalar* forces, btScalar* responses, int chain = -1) const;
+  // The coordinates whose joint rows (implicit servos) will ask for their
+  // response each step: column() solves all of them together.
+  void setColumnCoordinates(std::vector<int> coordinates);
+  // The response to a unit force at `coordinate` (column `coordinate` of
+  // M^-1, size() entries), the same numbers as solve() of that unit force:
+  // on the first call after factor() every registered coordinate's, six
+  // right-hand sides per block solve. Null for a coordinate not registered.
+  const btScalar* column(int coordinate) const;
   // The last coordinate on the path from a link (-1: the base) to the root.
   int chainOf(int link) const { return last_coordinate_[static_cast<size_t>(link + 1)]; }
 
@@ -88,6 +96,11 @@ class ArticulationInertia {
   std::vector<int> coordinate_body_;                             // per coordinate
   std::vector<int> last_coordinate_;  // per body: its own last coordinate or the nearest above
   mutable std::vector<double> scratch_;
+  std::vector<int> column_coordinates_;  // registered, in order
+  std::vector<int> column_slot_;         // per coordinate: its slot in columns_, or -1
+  mutable std::vector<btScalar> columns_;
+  mutable std::vector<btScalar> unit_forces_;
+  mutable bool columns_ready_ = false;
 };
 
 // The factorisations of a world's articulations (by their user index), one
@@ -97,6 +110,11 @@ class ArticulationInertia {
 class ArticulationInertias {
  public:
   void resize(size_t articulations) { entries_.resize(articulations); }
+  // The joint coordinates of articulation `index` with a row each step that
+  // asks for its column (ArticulationInertia::column).
+  void setColumnCoordinates(size_t index, std::vector<int> coordinates) {
+    entries_.at(index).column_coordinates = std::move(coordinates);
+  }
   // Call before a step's rows are built, after its forward kinematics.
   void newStep() { ++step_; }
   // The body's factorisation this step; null where it is not supported.
@@ -118,6 +136,7 @@ class ArticulationInertias {
     bool set_up = false, supported = false;
     bool factored = false;  // this step
     double mismatch = -1;
+    std::vector<int> column_coordinates;
   };
   // The largest relative difference of one factorisation against Bullet.
   static double checkAgainstBullet(btMultiBody& body, const ArticulationInertia& inertia);

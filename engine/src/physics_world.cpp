@@ -389,7 +389,10 @@ class ServoConstraint : public btMultiBodyJointMotor {
       response[ndof + i] = 0;
     }
     const int coordinate = 6 + mb->getLink(m_linkA).m_dofOffset;
-    if (const ArticulationInertia* inertia = inertias_ ? inertias_->of(*mb) : nullptr)
+    const ArticulationInertia* inertia = inertias_ ? inertias_->of(*mb) : nullptr;
+    if (const btScalar* column = inertia ? inertia->column(coordinate) : nullptr)
+      std::copy(column, column + ndof, response);  // solved with the robot's other servos
+    else if (inertia)
       inertia->solve(jac, response, coordinate);
     else
       mb->calcAccelerationDeltasMultiDof(jac, response, data.scratch_r, data.scratch_v);
@@ -833,6 +836,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
 
   // Joint limits as unilateral constraints (rows only while at a limit) and
   // one servo per motorised joint.
+  std::vector<int> column_coordinates;  // the implicit servos' (their responses solved together)
   for (int j = 0; j < num_links; ++j) {
     const Joint& joint = model.joints[static_cast<size_t>(j)];
     auto limit = std::make_unique<btMultiBodyJointLimitConstraint>(
@@ -868,6 +872,7 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       m.servo_body.push_back(raw);
       m.servo_link.push_back(j);
       if (implicit) {
+        column_coordinates.push_back(6 + raw->getLink(j).m_dofOffset);
         auto row = std::make_unique<ServoConstraint>(
             raw, j, m.servos, s, settings_.bullet_solver ? nullptr : &m.inertias,
             settings_.envelope_in_solver);
@@ -877,6 +882,8 @@ ArticulationId PhysicsWorld::addArticulation(std::shared_ptr<const ArticulatedMo
       }
     }
   }
+  m.inertias.setColumnCoordinates(static_cast<size_t>(raw->getUserIndex()),
+                                  std::move(column_coordinates));
   m.q.resize(m.servos.size());
   m.qdot.resize(m.servos.size());
 
