@@ -40,6 +40,7 @@ Outcome run(const std::filesystem::path& robot, bool own, int friction_direction
   s.robot_model_file = robot;
   s.physics.bullet_solver = !own;
   s.physics.envelope_in_solver = false;  // the bounds Bullet's solver can apply
+  s.physics.contact_warm_start = 0.0;    // Bullet's contact rows start from zero
   s.physics.friction_directions = friction_directions;
   if (touching) {
     s.robots[1].x = s.robots[0].x;

@@ -79,6 +79,11 @@ TEST_F(ConfigErrors, MissingKey) {
   expectError("scenario.yaml", "physics.dt", "missing required key");
 }
 
+TEST_F(ConfigErrors, ContactWarmStartIsAShare) {
+  replace(scenario_, "contact_warm_start: 1.0", "contact_warm_start: 1.5");
+  expectError("scenario.yaml", "physics.contact_warm_start", "must be 0..1");
+}
+
 TEST_F(ConfigErrors, JointSweepsMustBeACountFrom1To16) {
   replace(scenario_, "joint_sweeps: 1", "joint_sweeps: 0");
   expectError("scenario.yaml", "physics.joint_sweeps", "must be 1..16");

@@ -87,6 +87,15 @@ void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int n
     else
       convertContact(manifold, info);
   }
+  // Warm start: the contact rows' starting impulses (a share of the last
+  // step's) applied before the iterations, as the iterations would apply them.
+  if (warm_start_ > 0)
+    for (btMultiBodyConstraintArray* rows :
+         {&m_multiBodyNormalContactConstraints, &m_multiBodyFrictionContactConstraints})
+      for (int j = 0; j < rows->size(); ++j) {
+        btMultiBodySolverConstraint& row = (*rows)[j];
+        if (row.m_appliedImpulse != 0) applyImpulse(row, btScalar(row.m_appliedImpulse));
+      }
   // The articulations' own constraints (limits, servos, gears); without
   // articulated warm starting their rows start from zero impulse.
   for (int i = 0; i < m_tmpNumMultiBodyConstraints; ++i) {
@@ -193,6 +202,7 @@ void ArticulationSolver::convertOwnContact(btPersistentManifold& manifold, int p
     btMultiBodySolverConstraint& normal =
         m_multiBodyNormalContactConstraints.expandNonInitializing();
     addRow(normal, point, point.m_normalWorldOnB, /*friction=*/false, info);
+    normal.m_appliedImpulse = warm_start_ * point.m_appliedImpulse;
     normal.m_frictionIndex = m_multiBodyFrictionContactConstraints.size();
     // Friction along two fixed tangents of the normal, as Bullet's multibody
     // contacts; the solver clamps the pair to the friction cone.
@@ -204,6 +214,8 @@ void ArticulationSolver::convertOwnContact(btPersistentManifold& manifold, int p
           m_multiBodyFrictionContactConstraints.expandNonInitializing();
       addRow(row, point, d == 0 ? point.m_lateralFrictionDir1 : point.m_lateralFrictionDir2,
              /*friction=*/true, info);
+      row.m_appliedImpulse =
+          warm_start_ * (d == 0 ? point.m_appliedImpulseLateral1 : point.m_appliedImpulseLateral2);
       row.m_frictionIndex = normal_index;
     }
     if (two_directions &&

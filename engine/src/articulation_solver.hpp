@@ -60,6 +60,9 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   // Responses from these factorised inertias where they support the body
   // (null: Bullet's articulated-body pass for every row).
   void setInertias(ArticulationInertias* inertias) { inertias_ = inertias; }
+  // Contact rows start from this share of their point's impulses of the last
+  // step (normal and both friction directions; 0: from zero, as Bullet's).
+  void setWarmStart(btScalar share) { warm_start_ = share; }
 
  protected:
   void convertContacts(btPersistentManifold** manifolds, int num_manifolds,
@@ -129,6 +132,7 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   };
 
   bool own_;
+  btScalar warm_start_ = 0;
   ArticulationInertias* inertias_ = nullptr;
   long basis_rows_ = 0;
   long solved_rows_ = 0;

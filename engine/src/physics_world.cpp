@@ -660,7 +660,10 @@ PhysicsWorld::PhysicsWorld(const PhysicsSettings& settings)
   }
   if (!settings.bullet_solver) {
     m.world->inertias = &m.inertias;
-    for (ArticulationSolver* solver : m.all_solvers) solver->setInertias(&m.inertias);
+    for (ArticulationSolver* solver : m.all_solvers) {
+      solver->setInertias(&m.inertias);
+      solver->setWarmStart(static_cast<btScalar>(settings.contact_warm_start));
+    }
   }
   // Restitution: the bouncier of the two materials decides (Bullet's default
   // multiplies them). A soft ball bounces off a hard foot, post or shin as it

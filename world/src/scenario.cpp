@@ -105,8 +105,9 @@ Scenario loadScenario(const std::filesystem::path& file) {
     if (!std::filesystem::exists(path)) root.failKey(key, "file not found: " + path.string());
 
   const ConfigNode ph = root["physics"];
-  ph.allowOnly({"dt", "control_period", "solver_iterations", "joint_sweeps", "friction_directions",
-                "bullet_solver", "envelope_in_solver", "cull_ground_pairs", "gravity", "threads"});
+  ph.allowOnly({"dt", "control_period", "solver_iterations", "joint_sweeps", "contact_warm_start",
+                "friction_directions", "bullet_solver", "envelope_in_solver", "cull_ground_pairs",
+                "gravity", "threads"});
   s.physics.dt = ph["dt"].positive();
   s.physics.control_period = ph["control_period"].positive();
   s.physics.solver_iterations = ph.integer("solver_iterations", s.physics.solver_iterations);
@@ -114,6 +115,9 @@ Scenario loadScenario(const std::filesystem::path& file) {
   s.physics.joint_sweeps = ph.integer("joint_sweeps", s.physics.joint_sweeps);
   if (s.physics.joint_sweeps < 1 || s.physics.joint_sweeps > 16)
     ph.failKey("joint_sweeps", "must be 1..16");
+  s.physics.contact_warm_start = ph.number("contact_warm_start", s.physics.contact_warm_start);
+  if (!(s.physics.contact_warm_start >= 0.0 && s.physics.contact_warm_start <= 1.0))
+    ph.failKey("contact_warm_start", "must be 0..1");
   s.physics.friction_directions = ph.integer("friction_directions", s.physics.friction_directions);
   if (s.physics.friction_directions != 1 && s.physics.friction_directions != 2)
     ph.failKey("friction_directions", "must be 1 or 2");

@@ -42,6 +42,8 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     scenarioError(scenario_, "physics.solver_iterations", "must be >= 1");
   if (pc.joint_sweeps < 1 || pc.joint_sweeps > 16)
     scenarioError(scenario_, "physics.joint_sweeps", "must be 1..16");
+  if (!(pc.contact_warm_start >= 0.0 && pc.contact_warm_start <= 1.0))
+    scenarioError(scenario_, "physics.contact_warm_start", "must be 0..1");
   if (pc.friction_directions != 1 && pc.friction_directions != 2)
     scenarioError(scenario_, "physics.friction_directions", "must be 1 or 2");
   steps_per_control_ = static_cast<int>(std::lround(ratio));
@@ -51,6 +53,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
   settings.dt = pc.dt;
   settings.solver_iterations = pc.solver_iterations;
   settings.joint_sweeps = pc.joint_sweeps;
+  settings.contact_warm_start = pc.contact_warm_start;
   settings.friction_directions = pc.friction_directions;
   settings.bullet_solver = pc.bullet_solver;
   settings.envelope_in_solver = pc.envelope_in_solver;

@@ -31,6 +31,10 @@ struct PhysicsSettings {
   // Gauss-Seidel sweeps over the joint rows (servos, limits, gears) in each
   // iteration: cheap, one coordinate each; see world::PhysicsConfig.
   int joint_sweeps = 1;
+  // The engine's solver starts each contact's rows from this share of its
+  // point's impulses of the last step (0: from zero, as Bullet's; see
+  // world::PhysicsConfig). Bullet's solver (bullet_solver) starts from zero.
+  double contact_warm_start = 1.0;
   int friction_directions = 2;  // friction rows per contact (see world::PhysicsConfig)
   // Threads that solve the simulation islands (robots and what touches them)
   // side by side. The result is the same bit for bit for any number.

@@ -33,6 +33,12 @@ struct PhysicsConfig {
   // slows to 0.19 m/s, kicks fall short, get-ups fail): use two there (at
   // 5 ms a second sweep costs 2.5 % of a 22-robot step).
   int joint_sweeps = 1;
+  // Each contact's rows start the solver from this share of its point's
+  // impulses of the last step (normal and friction; 0: from zero, as
+  // Bullet's multibody contacts). Resting contacts then converge across
+  // steps: at 10 ms without it a standing Nao rocked 4 deg and leaned 0.9,
+  // with it 0.5 and 0.4, as at 5 ms.
+  double contact_warm_start = 1.0;
   // Friction rows per contact: 2 (a pyramid; the default) or 1. With 1,
   // Bullet gives a multibody contact a single row along a fixed tangent
   // (btPlaneSpace1 of the normal: the y axis on flat ground), not along the
