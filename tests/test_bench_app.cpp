@@ -34,20 +34,20 @@ TEST(BenchPhysicsApp, PrintsTableAndWritesCsv) {
   EXPECT_NE(row2.find(",2/2,"), std::string::npos) << row2;
 }
 
-// --dt adds rows at other steps; the project's default step (5 ms) is always
+// --dt adds rows at other steps; the project's default step (10 ms) is always
 // run first, and the summary gives each other step's real-time factor against it.
 TEST(BenchPhysicsApp, OtherStepsBesideTheDefaultStep) {
   const test::BenchRun run = test::runBench(
-      SIMSOCCER_BIN, "bench physics --robots 1 --seconds 0.2 --dt 0.01 --iterations 5");
+      SIMSOCCER_BIN, "bench physics --robots 1 --seconds 0.2 --dt 0.005 --iterations 5");
   ASSERT_EQ(run.status, 0) << run.out;
   EXPECT_NE(run.out.find("5 solver iterations"), std::string::npos) << run.out;
   ASSERT_GE(run.lines.size(), 3u);
   EXPECT_EQ(run.lines[0].rfind("robots,dt_ms,steps_per_s,", 0), 0u) << run.lines[0];
-  EXPECT_EQ(run.lines[1].rfind("1,5,", 0), 0u) << run.lines[1];
-  EXPECT_EQ(run.lines[2].rfind("1,10,", 0), 0u) << run.lines[2];
+  EXPECT_EQ(run.lines[1].rfind("1,10,", 0), 0u) << run.lines[1];
+  EXPECT_EQ(run.lines[2].rfind("1,5,", 0), 0u) << run.lines[2];
   EXPECT_NE(run.out.find("1 robots: real-time factor "), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find(" at the default step (5 ms); "), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find(" at 10 ms ("), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(" at the default step (10 ms); "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(" at 5 ms ("), std::string::npos) << run.out;
 }
 
 TEST(BenchPhysicsApp, RejectsBadOptions) {

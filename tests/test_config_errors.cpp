@@ -75,7 +75,7 @@ TEST_F(ConfigErrors, ValidFilesLoad) {
 }
 
 TEST_F(ConfigErrors, MissingKey) {
-  replace(scenario_, "  dt: 0.005               # s, physics step\n", "");
+  replace(scenario_, "  dt: 0.010               # s, physics step\n", "");
   expectError("scenario.yaml", "physics.dt", "missing required key");
 }
 
@@ -85,7 +85,7 @@ TEST_F(ConfigErrors, ContactWarmStartIsAShare) {
 }
 
 TEST_F(ConfigErrors, JointSweepsMustBeACountFrom1To16) {
-  replace(scenario_, "joint_sweeps: 1", "joint_sweeps: 0");
+  replace(scenario_, "joint_sweeps: 2", "joint_sweeps: 0");
   expectError("scenario.yaml", "physics.joint_sweeps", "must be 1..16");
 }
 

@@ -27,7 +27,7 @@ const char* kHelp =
     "and physics step: steps/s, real-time factor, ms per step, contacts per step (all, and\n"
     "robot against robot), the constraint batches solved side by side per step, robots\n"
     "standing at the end, and the share of the step spent in each stage; then, per N, the\n"
-    "real-time factor at the project's default step (5 ms, run as well when --dt leaves it\n"
+    "real-time factor at the project's default step (10 ms, run as well when --dt leaves it\n"
     "out) and each other step's against it.\n"
     "\n"
     "  --config FILE   benchmark scenario (default configs/bench/physics.yaml)\n"

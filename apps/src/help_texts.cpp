@@ -132,7 +132,7 @@ const char* const kBenchScalingHelp =
     "a CPU of their own, their solver one thread on it, the agents the other CPUs;\n"
     "--shared-cores leaves placement to the scheduler). --threads N: the physics' solver\n"
     "threads (default: one per core, up to 4). --dt, --joint-sweeps: the physics step and the\n"
-    "sweeps over the joint rows per solver iteration (default 0.005 and 1; 0.01 needs 2).\n"
+    "sweeps over the joint rows per solver iteration (default 0.01 and 2; 0.005 needs 1).\n"
     "--cameras also renders every robot's two cameras (640x480 and 320x240 at 30 Hz) through\n"
     "EGL and sends them to the agents. Prints steps/s, control frames per second, the\n"
     "real-time factor and the time per control period split into physics, sensors,\n"

@@ -21,18 +21,19 @@ struct RobotPlacement {
 };
 
 struct PhysicsConfig {
-  // The robot models' servos are implicit where their explicit servo is not
-  // stable at the step (Motor::explicit_up_to).
-  double dt = 0.005;              // s
+  // The project's default step: one physics step per control period. The
+  // robot models' servos are implicit where their explicit servo is not
+  // stable at it (Motor::explicit_up_to).
+  double dt = 0.010;              // s
   double control_period = 0.010;  // s, a whole multiple of dt
   int solver_iterations = 10;
   // Gauss-Seidel sweeps over the joint rows (implicit servos, joint limits,
   // gears) in each solver iteration, the contacts swept once. A joint row
   // costs one coordinate, a contact a whole robot's. At a 10 ms step one
   // sweep leaves the legs' servos unconverged (the Nao's walk drifts and
-  // slows to 0.19 m/s, kicks fall short, get-ups fail): use two there (at
-  // 5 ms a second sweep costs 2.5 % of a 22-robot step).
-  int joint_sweeps = 1;
+  // slows to 0.19 m/s, kicks fall short, get-ups fail): two, the default,
+  // keep every figure (at 5 ms one is enough; a second costs 2.5 % there).
+  int joint_sweeps = 2;
   // Each contact's rows start the solver from this share of its point's
   // impulses of the last step (normal and friction; 0: from zero, as
   // Bullet's multibody contacts). Resting contacts then converge across
