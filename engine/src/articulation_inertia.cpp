@@ -187,9 +187,8 @@ const btScalar* ArticulationInertia::column(int coordinate) const {
     // Unit forces, six per block solve. A unit force's solve touches rows off
     // its own chain with zeros only, so each column is the same as solve()'s.
     std::vector<btScalar>& forces = unit_forces_;
-    forces.assign(6 * n, btScalar(0));
     for (size_t first = 0; first < column_coordinates_.size(); first += 6) {
-      std::fill(forces.begin(), forces.end(), btScalar(0));
+      forces.assign(6 * n, btScalar(0));
       for (size_t r = 0; r < 6 && first + r < column_coordinates_.size(); ++r)
         forces[r * n + static_cast<size_t>(column_coordinates_[first + r])] = 1;
       solveBlock<6>(forces.data(), &columns_[first * n], -1);

@@ -372,24 +372,24 @@ void ArticulationSolver::findJointRows() {
     JointRow& joint = joint_rows_[static_cast<size_t>(j)];
     joint.sparse = false;
     if (!row.m_multiBodyA || row.m_multiBodyB != row.m_multiBodyA) continue;
-    const bool motor = row.m_orgConstraint && row.m_orgConstraint->getConstraintType() ==
-                                                  MULTIBODY_CONSTRAINT_1DOF_JOINT_MOTOR;
     joint.envelope_slope = 0;
-    if (motor && row.m_friction > 0) {  // the motor's envelope (ServoConstraint)
-      joint.envelope_slope = row.m_friction;
-      joint.upper = row.m_upperLimit;
-      joint.lower = row.m_lowerLimit;
-      joint.inv_mass = row.m_rhsPenetration;
-    }
-    if (motor) {
+    if (row.m_orgConstraint &&
+        row.m_orgConstraint->getConstraintType() == MULTIBODY_CONSTRAINT_1DOF_JOINT_MOTOR) {
       // An implicit servo's row (the engine's ServoConstraint, the only joint
-      // motor here): its joint's coordinate on side A, nothing on side B.
+      // motor here): its joint's coordinate on side A, nothing on side B, and
+      // with a slope its motor's envelope (the bounds at no other impulse).
       joint.sparse = true;
       joint.coordinate_a = 6 + row.m_multiBodyA->getLink(row.m_linkA).m_dofOffset;
       joint.value_a = m_data.m_jacobians[row.m_jacAindex + joint.coordinate_a];
       joint.coordinate_b = 0;
       joint.value_b = 0;
       joint.response_b = false;
+      if (row.m_friction > 0) {
+        joint.envelope_slope = row.m_friction;
+        joint.upper = row.m_upperLimit;
+        joint.lower = row.m_lowerLimit;
+        joint.inv_mass = row.m_rhsPenetration;
+      }
       continue;
     }
     const int n = row.m_multiBodyA->getNumDofs() + 6;

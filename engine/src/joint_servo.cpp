@@ -159,10 +159,8 @@ double JointServoBatch::solveAlone(size_t i, double q, double qdot, double inert
   // the whole impulse (feedforward included), bounded by the torque-speed
   // line at qdot': P / dt <= drive (1 - qdot' / w0), and likewise below.
   const double p = (r.beta / dt_ * (r.target - q) + r.bias - qdot) / (1.0 / inertia + r.gamma);
-  const double k = dt_ * r.drive * r.inv_no_load, scale = 1.0 / (1.0 + k / inertia);
-  const double upper = (dt_ * r.drive - k * qdot) * scale,
-               lower = (-dt_ * r.drive - k * qdot) * scale;
-  return std::clamp(p, lower, upper) / dt_;
+  const Row::ImpulseBounds b = r.envelope(dt_, 1.0 / inertia, qdot, 0.0);
+  return std::clamp(p, b.lower, b.upper) / dt_;
 }
 
 }  // namespace simsoccer::engine

@@ -408,23 +408,22 @@ class ServoConstraint : public btMultiBodyJointMotor {
     row.m_jacDiagABInv = soft;
     row.m_rhs = (goal - velocity) * soft;
     row.m_cfm = gamma * soft;
-    row.m_lowerLimit = static_cast<btScalar>((r.lower - r.feedforward) * h);
-    row.m_upperLimit = static_cast<btScalar>((r.upper - r.feedforward) * h);
     if (inertias_ && envelope_in_solver_ && r.drive > 0.0) {
       // The engine's solver bounds the motor's torque on its torque-speed
-      // line at the speed it solves for (JointServoBatch::Row): with the
-      // row's impulse p, w' = velocity + inv_mass p + (what the other rows
-      // add), and dt feedforward + p <= dt drive (1 - w'/w0) gives
-      // p <= upper - slope (what the other rows add), likewise below. The
-      // solver reads the slope from m_friction and inv_mass from
-      // m_rhsPenetration, which a joint row does not use otherwise.
-      const double k = h * r.drive * r.inv_no_load;  // N m s per rad/s
-      const double scale = 1.0 / (1.0 + k * inv_mass);
-      const double rest = -h * r.feedforward - k * velocity;
-      row.m_upperLimit = static_cast<btScalar>((h * r.drive + rest) * scale);
-      row.m_lowerLimit = static_cast<btScalar>((-h * r.drive + rest) * scale);
-      row.m_friction = static_cast<btScalar>(k * scale);
+      // line at the speed it solves for (JointServoBatch::Row::envelope; the
+      // feedforward's impulse is in `velocity` already). It moves the bounds
+      // with what the other rows add, reading the slope from m_friction and
+      // inv_mass from m_rhsPenetration, which a joint row does not use
+      // otherwise.
+      const JointServoBatch::Row::ImpulseBounds b =
+          r.envelope(h, inv_mass, velocity, h * r.feedforward);
+      row.m_lowerLimit = static_cast<btScalar>(b.lower);
+      row.m_upperLimit = static_cast<btScalar>(b.upper);
+      row.m_friction = static_cast<btScalar>(b.slope);
       row.m_rhsPenetration = inv_mass;
+    } else {
+      row.m_lowerLimit = static_cast<btScalar>((r.lower - r.feedforward) * h);
+      row.m_upperLimit = static_cast<btScalar>((r.upper - r.feedforward) * h);
     }
     row_made_ = true;
   }

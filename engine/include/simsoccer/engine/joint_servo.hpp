@@ -104,6 +104,21 @@ class JointServoBatch {
     // drive (1 - w'/w0), w' the speed it solves for.
     double drive = 0.0;        // N m: stiffness x stall torque
     double inv_no_load = 0.0;  // 1 / w0, s/rad
+
+    // That envelope as bounds on an impulse p over a step of h seconds: the
+    // joint reaches w' = speed + inv_mass p (speed: without p; inv_mass:
+    // J M^-1 J^T) and the motor's impulse is preapplied + p, so
+    // lower <= p <= upper; each rad/s that other impulses add to w' lowers
+    // both bounds by slope.
+    struct ImpulseBounds {
+      double lower, upper, slope;
+    };
+    ImpulseBounds envelope(double h, double inv_mass, double speed, double preapplied) const {
+      const double k = h * drive * inv_no_load;  // N m s per rad/s
+      const double scale = 1.0 / (1.0 + k * inv_mass);
+      const double rest = -preapplied - k * speed;
+      return {(-h * drive + rest) * scale, (h * drive + rest) * scale, k * scale};
+    }
   };
   Row row(size_t i) const;
 
