@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <future>
 #include <string>
@@ -154,6 +155,60 @@ TEST_F(CoreClaimTest, ARunKeepsOffTheCpusOtherRunsHoldAndNeedsTwoFree) {
     ASSERT_GE(held.back(), 0);
   }
   for (const int fd : held) ::close(fd);
+}
+
+TEST_F(CoreClaimTest, BalanceLendsTheClaimedCpuToAChildWhileTheRestIsBusier) {
+  // Two CPUs for this test (so the rest is one CPU whatever the machine), two children
+  // busy on it and the claiming thread asleep: one child moves over as a guest, at
+  // SCHED_IDLE, and stays one; the other stays. Afterwards both as before the claim.
+  cpu_set_t two;
+  CPU_ZERO(&two);
+  CPU_SET(all_[0], &two);
+  CPU_SET(all_[1], &two);
+  ASSERT_EQ(sched_setaffinity(0, sizeof two, &two), 0);
+  const std::vector<int> both{all_[0], all_[1]};
+  const auto spawnBusy = [] {
+    pid_t pid = -1;
+    char sh[] = "/bin/sh", c[] = "-c", loop[] = "while :; do :; done";
+    char* argv[] = {sh, c, loop, nullptr};
+    EXPECT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv, environ), 0);
+    return pid;
+  };
+  std::vector<pid_t> children;
+  {
+    sim::CoreClaim claim(dir_);
+    ASSERT_TRUE(claim.held());
+    for (int i = 0; i < 2; ++i)
+      sim::CoreClaim::spawnOnOtherCpus([&] { children.push_back(spawnBusy()); });
+    EXPECT_EQ(claim.balance(), 0u);  // the first call only measures
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ASSERT_EQ(claim.balance(), 1u);
+    const auto isGuest = [&](pid_t pid) {
+      return cpusOf(pid) == std::vector<int>{claim.cpu()} && sched_getscheduler(pid) == SCHED_IDLE;
+    };
+    const auto isRest = [&](pid_t pid) {
+      return cpusOf(pid) == claim.otherCpus() && sched_getscheduler(pid) == SCHED_OTHER;
+    };
+    const pid_t guest = isGuest(children[0]) ? children[0] : children[1];
+    const pid_t rest = guest == children[0] ? children[1] : children[0];
+    EXPECT_TRUE(isGuest(guest));
+    EXPECT_TRUE(isRest(rest));
+    // Each now alone on a CPU: the guest still relieves the busier side.
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(claim.balance(), 1u);
+    EXPECT_TRUE(isGuest(guest));
+    EXPECT_TRUE(isRest(rest));
+  }
+  for (const pid_t pid : children) {
+    EXPECT_EQ(cpusOf(pid), both);
+    EXPECT_EQ(sched_getscheduler(pid), SCHED_OTHER);
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+  }
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  for (const int cpu : all_) CPU_SET(cpu, &all);
+  EXPECT_EQ(sched_setaffinity(0, sizeof all, &all), 0);
 }
 
 // Records, in each observe stage, the CPUs the period thread may use and the solver

@@ -70,7 +70,7 @@ int benchScaling(int argc, char** argv, int first) {
   Table table;
   table.header = {"robots",     "mode",       "steps_per_s",   "fps",          "rtf",
                   "physics_ms", "sensors_ms", "perception_ms", "messaging_ms", "referee_ms",
-                  "render_ms",  "missed",     "cpu_ms",        "period_cpu"};
+                  "render_ms",  "missed",     "cpu_ms",        "period_cpu",   "guests"};
   std::vector<ScalingRow> rows, plotted;
   for (int n : counts) {
     for (const sim::Mode mode : modes) {
@@ -82,7 +82,8 @@ int benchScaling(int argc, char** argv, int first) {
                             fmt(r.sensors_ms, 2), fmt(r.perception_ms, 3), fmt(r.messaging_ms, 2),
                             fmt(r.referee_ms, 3), fmt(r.render_ms, 2), std::to_string(r.missed),
                             r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a",
-                            r.period_cpu >= 0 ? std::to_string(r.period_cpu) : "-"});
+                            r.period_cpu >= 0 ? std::to_string(r.period_cpu) : "-",
+                            r.period_cpu >= 0 ? std::to_string(r.guests) : "-"});
       std::fprintf(stderr, "  %d robots, %s done\n", n, sim::modeName(mode));
     }
   }
@@ -96,7 +97,9 @@ int benchScaling(int argc, char** argv, int first) {
       "missed: lockstep periods an agent did not answer in time; cpu_ms: CPU time of the "
       "simulator and all agent processes per period (against cores x wall ms per period: how "
       "full the machine was); period_cpu: the CPU a pipelined row's periods had to themselves "
-      "(its solver on that one; the agents and the other threads on the rest; -: none). "
+      "(its solver on that one; the agents and the other threads on the rest; -: none); "
+      "guests: agents that ran on that CPU at idle priority, in the periods' waits, at the "
+      "row's last balance (sim/cores.hpp). "
       "USARSim (published): 1 Nao 110 fps, 2: 55, 3: 30, 4: 10.",
       opt.get("csv", ""));
   std::vector<ScalingPoint> points;

@@ -121,6 +121,7 @@ ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threa
   for (world::RobotId r = 0; r < w.robotCount(); ++r) row.missed += server.stats(r).missed;
   if (cpu0 >= 0 && cpu1 >= 0) row.cpu_ms = (cpu1 - cpu0) * per;
   row.period_cpu = run.period_cpu;
+  row.guests = run.guests;
   for (auto& a : agents) a->stop();
   return row;
 }

@@ -21,6 +21,7 @@ struct ScalingRow {
   uint64_t missed = 0;
   double cpu_ms = -1;  // CPU time of the simulator and all agents per period (-1: unknown)
   int period_cpu = -1;  // the CPU the periods had to themselves (-1: none; sim/cores.hpp)
+  size_t guests = 0;    // agents lent that CPU's waits at the run's last balance
 };
 
 // The robot: a Nao on the SPL field (the 3D-league-sized field beyond 14 robots) with the

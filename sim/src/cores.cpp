@@ -53,11 +53,9 @@ std::vector<long> tasksIn(const std::filesystem::path& folder) {
   return tids;
 }
 
-// Every thread of this process but `skip`, and every thread of its child
-// processes (the agents it started).
-std::vector<long> otherThreads(long skip) {
-  std::vector<long> tids = tasksIn("/proc/self/task");
-  std::erase(tids, skip);
+// The child processes of this process (the agents it started).
+std::vector<long> childProcesses() {
+  std::vector<long> pids;
   const std::string me = std::to_string(::getpid());
   std::error_code ec;
   std::filesystem::directory_iterator it("/proc", ec);
@@ -73,11 +71,40 @@ std::vector<long> otherThreads(long skip) {
     std::istringstream rest(line.substr(close + 1));
     std::string state, ppid;
     rest >> state >> ppid;
-    if (ppid != me) continue;
-    const std::vector<long> child = tasksIn(it->path() / "task");
+    if (ppid == me) pids.push_back(std::strtol(name.c_str(), nullptr, 10));
+  }
+  std::sort(pids.begin(), pids.end());
+  return pids;
+}
+
+std::filesystem::path taskFolder(long pid) {
+  return std::filesystem::path("/proc") / std::to_string(pid) / "task";
+}
+
+// Every thread of this process but `skip`, and every thread of its child
+// processes.
+std::vector<long> otherThreads(long skip) {
+  std::vector<long> tids = tasksIn("/proc/self/task");
+  std::erase(tids, skip);
+  for (const long pid : childProcesses()) {
+    const std::vector<long> child = tasksIn(taskFolder(pid));
     tids.insert(tids.end(), child.begin(), child.end());
   }
   return tids;
+}
+
+// CPU time a thread has run, ns (the first field of schedstat); 0 for a
+// thread that ended or a kernel without schedstat.
+uint64_t runtimeNs(const std::filesystem::path& task) {
+  std::ifstream in(task / "schedstat");
+  uint64_t ns = 0;
+  if (!(in >> ns)) return 0;
+  return ns;
+}
+
+bool setPolicy(long tid, int policy) {
+  const sched_param param{};
+  return sched_setscheduler(static_cast<pid_t>(tid), policy, &param) == 0;
 }
 
 }  // namespace
@@ -152,6 +179,9 @@ CoreClaim::~CoreClaim() {
 }
 
 void CoreClaim::restoreAll() {
+  for (const long pid : guests_)
+    for (const long tid : tasksIn(taskFolder(pid))) (void)setPolicy(tid, SCHED_OTHER);
+  guests_.clear();
   // Each thread as it was before the claim; those started during it on every CPU.
   const auto restore = [&](long tid) {
     const auto known =
@@ -169,11 +199,88 @@ void CoreClaim::placeOtherThreads() {
 }
 
 void CoreClaim::placeThreads(bool at_claim) {
+  std::set<long> guest_threads;
+  for (const long pid : guests_)
+    for (const long tid : tasksIn(taskFolder(pid))) guest_threads.insert(tid);
   for (const long tid : otherThreads(owner_tid_)) {
+    if (guest_threads.count(tid)) continue;
     // A thread found later was started during the claim (its mask inherited): not saved.
     if (at_claim) saved_.emplace_back(tid, cpusOf(tid));
     setCpus(tid, others_);
   }
+}
+
+bool CoreClaim::setGuest(long pid, bool guest) {
+  bool ok = true;
+  for (const long tid : tasksIn(taskFolder(pid))) {
+    if (guest) {
+      setCpus(tid, {cpu_});
+      (void)setPolicy(tid, SCHED_IDLE);
+    } else if (setPolicy(tid, SCHED_OTHER)) {
+      setCpus(tid, others_);
+    } else {
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+size_t CoreClaim::balance() {
+  std::lock_guard lock(g_mutex);
+  if (cpu_ < 0) return 0;
+  std::map<long, uint64_t> now;
+  const auto used = [&](const std::filesystem::path& folder, long tid) {
+    const uint64_t ns = runtimeNs(folder / std::to_string(tid));
+    now[tid] = ns;
+    const auto before = runtime_ns_.find(tid);
+    const uint64_t from = before == runtime_ns_.end() ? 0 : before->second;
+    return ns > from ? 1e-9 * static_cast<double>(ns - from) : 0.0;
+  };
+  // The claimed CPU's own load, and the rest's: this process's other threads
+  // and every child, as if all were on the other CPUs.
+  double claimed = 0.0, rest = 0.0;
+  for (const long tid : tasksIn("/proc/self/task"))
+    (tid == owner_tid_ ? claimed : rest) += used("/proc/self/task", tid);
+  struct Child {
+    long pid;
+    double seconds = 0.0;
+  };
+  std::vector<Child> children;
+  for (const long pid : childProcesses()) {
+    Child c{pid};
+    for (const long tid : tasksIn(taskFolder(pid))) c.seconds += used(taskFolder(pid), tid);
+    rest += c.seconds;
+    children.push_back(c);
+  }
+  runtime_ns_ = std::move(now);
+  std::erase_if(guests_, [&](long pid) {
+    return std::none_of(children.begin(), children.end(),
+                        [&](const Child& c) { return c.pid == pid; });
+  });
+  if (!measured_) {
+    measured_ = true;
+    return guests_.size();
+  }
+  // Greedy, the present guests first (fewer moves): a child moves over while
+  // that makes the busier side less busy.
+  std::stable_partition(children.begin(), children.end(),
+                        [&](const Child& c) { return guests_.count(c.pid) > 0; });
+  const double cpus = static_cast<double>(others_.size());
+  std::set<long> next;
+  for (const Child& c : children) {
+    if (std::max(claimed + c.seconds, (rest - c.seconds) / cpus) < std::max(claimed, rest / cpus)) {
+      claimed += c.seconds;
+      rest -= c.seconds;
+      next.insert(c.pid);
+    }
+  }
+  for (const Child& c : children) {
+    const bool was = guests_.count(c.pid) > 0, is = next.count(c.pid) > 0;
+    if (is && !was) setGuest(c.pid, true);
+    if (was && !is && !setGuest(c.pid, false)) next.insert(c.pid);  // may not be raised back
+  }
+  guests_ = std::move(next);
+  return guests_.size();
 }
 
 void CoreClaim::spawnOnOtherCpus(const std::function<void()>& spawn) {

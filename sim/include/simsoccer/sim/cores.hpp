@@ -16,10 +16,20 @@
 // free for itself and one more for the rest, or a process allowed fewer than
 // two CPUs, claims nothing and leaves placement to the scheduler. Placement
 // changes when threads run, never what they compute.
+//
+// The claimed CPU idles while the period thread waits for the agents' answers.
+// balance() lends that time to some of the child processes (the agents) as
+// guests: pinned to the claimed CPU at SCHED_IDLE, so they run only while the
+// period thread waits and never preempt it. How many comes from the CPU time
+// every thread used since the last call, so that the busier side (the claimed
+// CPU, or each of the others) is as little busy as it can be.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -46,6 +56,14 @@ class CoreClaim {
   // and the frame sender's threads).
   void placeOtherThreads();
 
+  // Measures the CPU time (/proc's schedstat) each thread of this process
+  // and of its child processes used since the last call and moves child
+  // processes to or from the claimed CPU as guests, by the rule above. The
+  // first call only measures. Returns the number of guests. A guest this
+  // process may not raise back from SCHED_IDLE (not root) stays one.
+  size_t balance();
+  size_t guests() const { return guests_.size(); }
+
   // Runs `spawn` with the calling thread on the other CPUs of the claim in
   // force, if any, so that a process it starts inherits them.
   static void spawnOnOtherCpus(const std::function<void()>& spawn);
@@ -57,12 +75,19 @@ class CoreClaim {
  private:
   void placeThreads(bool at_claim);
   void restoreAll();
+  // Pins every thread of child process `pid` to the claimed CPU at SCHED_IDLE
+  // (guest), or puts it back on the other CPUs at SCHED_OTHER; false if it
+  // could not be raised back.
+  bool setGuest(long pid, bool guest);
 
   int cpu_ = -1;
   int lock_fd_ = -1;
   long owner_tid_ = 0;
   std::vector<int> all_, others_;
   std::vector<std::pair<long, std::vector<int>>> saved_;  // thread id, CPUs before the claim
+  std::set<long> guests_;                                 // child processes on the claimed CPU
+  std::map<long, uint64_t> runtime_ns_;                   // thread id: CPU time at the last balance
+  bool measured_ = false;
 };
 
 }  // namespace simsoccer::sim

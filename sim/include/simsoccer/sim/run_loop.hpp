@@ -17,6 +17,7 @@ struct RunStats {
   long late = 0;        // real time: periods that started late (the simulation fell behind)
   double wall_s = 0.0;  // wall time of the run
   int period_cpu = -1;  // pipelined: the CPU the periods had to themselves (-1: none; cores.hpp)
+  size_t guests = 0;    // child processes (agents) lent its waits at the last balance (cores.hpp)
 };
 
 class RunLoop {
