@@ -50,7 +50,7 @@ const char* kHelp =
     "  --mode M      the control period: serial or pipelined (one period of actuation delay,\n"
     "                as in a match of that mode); default: the matches' (%s)\n"
     "  --dt S, --control-period S  the physics step and control period (default 0.010 and\n"
-    "                0.010; a LoLA match runs 0.003 and 0.012)\n"
+    "                0.010; a LoLA match runs 0.006 and 0.012)\n"
     "  --joint-sweeps N  sweeps over the joint rows per solver iteration (default 2; a 5 ms\n"
     "                step needs 1: docs/models.md)\n"
     "  --csv FILE    also write the table as CSV\n";
