@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <future>
@@ -157,10 +158,11 @@ TEST_F(CoreClaimTest, ARunKeepsOffTheCpusOtherRunsHoldAndNeedsTwoFree) {
   for (const int fd : held) ::close(fd);
 }
 
-TEST_F(CoreClaimTest, BalanceLendsTheClaimedCpuToAChildWhileTheRestIsBusier) {
-  // Two CPUs for this test (so the rest is one CPU whatever the machine), two children
-  // busy on it and the claiming thread asleep: one child moves over as a guest, at
-  // SCHED_IDLE, and stays one; the other stays. Afterwards both as before the claim.
+TEST_F(CoreClaimTest, BalanceLendsTheClaimedCpuToAChildOnlyWhileNothingElseRunsThere) {
+  // Two CPUs for this test (so the rest is one CPU whatever the machine) and two children
+  // busy on the rest while the claiming thread sleeps. With another thread busy on the
+  // claimed CPU nothing is lent; once it stops, one child moves over as a guest, at
+  // SCHED_IDLE, and stays one, the other stays. Afterwards both as before the claim.
   cpu_set_t two;
   CPU_ZERO(&two);
   CPU_SET(all_[0], &two);
@@ -181,23 +183,59 @@ TEST_F(CoreClaimTest, BalanceLendsTheClaimedCpuToAChildWhileTheRestIsBusier) {
     for (int i = 0; i < 2; ++i)
       sim::CoreClaim::spawnOnOtherCpus([&] { children.push_back(spawnBusy()); });
     EXPECT_EQ(claim.balance(), 0u);  // the first call only measures
+    // Another program on the claimed CPU (here a thread of this one, not the period thread).
+    std::atomic<bool> stop{false};
+    std::thread other([&] {
+      cpu_set_t mine;
+      CPU_ZERO(&mine);
+      CPU_SET(claim.cpu(), &mine);
+      (void)sched_setaffinity(0, sizeof mine, &mine);
+      while (!stop.load(std::memory_order_relaxed)) {
+      }
+    });
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    ASSERT_EQ(claim.balance(), 1u);
+    EXPECT_EQ(claim.balance(), 0u);
+    EXPECT_TRUE(claim.shared());
+    EXPECT_GT(claim.foreignShare(), 0.3);
+    stop = true;
+    other.join();
+    claim.balance();  // a window of its own from here
     const auto isGuest = [&](pid_t pid) {
       return cpusOf(pid) == std::vector<int>{claim.cpu()} && sched_getscheduler(pid) == SCHED_IDLE;
     };
     const auto isRest = [&](pid_t pid) {
       return cpusOf(pid) == claim.otherCpus() && sched_getscheduler(pid) == SCHED_OTHER;
     };
-    const pid_t guest = isGuest(children[0]) ? children[0] : children[1];
+    // The tests beside this one may use the claimed CPU too: windows they spoil lend nothing.
+    pid_t guest = -1;
+    for (int window = 0; window < 20 && guest < 0; ++window) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      const size_t n = claim.balance();
+      if (claim.shared()) {
+        EXPECT_EQ(n, 0u);
+        continue;
+      }
+      ASSERT_EQ(n, 1u);
+      guest = isGuest(children[0]) ? children[0] : children[1];
+    }
+    if (guest < 0) {
+      for (const pid_t pid : children) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, nullptr, 0);
+      }
+      GTEST_SKIP() << "other programs used the claimed CPU in every window";
+    }
     const pid_t rest = guest == children[0] ? children[1] : children[0];
     EXPECT_TRUE(isGuest(guest));
     EXPECT_TRUE(isRest(rest));
     // Each now alone on a CPU: the guest still relieves the busier side.
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    EXPECT_EQ(claim.balance(), 1u);
-    EXPECT_TRUE(isGuest(guest));
-    EXPECT_TRUE(isRest(rest));
+    const size_t n = claim.balance();
+    if (!claim.shared()) {
+      EXPECT_EQ(n, 1u);
+      EXPECT_TRUE(isGuest(guest));
+      EXPECT_TRUE(isRest(rest));
+    }
   }
   for (const pid_t pid : children) {
     EXPECT_EQ(cpusOf(pid), both);

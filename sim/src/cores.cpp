@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
@@ -100,6 +101,22 @@ uint64_t runtimeNs(const std::filesystem::path& task) {
   uint64_t ns = 0;
   if (!(in >> ns)) return 0;
   return ns;
+}
+
+// Ticks (1/CLK_TCK s) CPU `cpu` spent running tasks (user, nice and system
+// time in /proc/stat); 0 if unreadable.
+uint64_t busyTicks(int cpu) {
+  std::ifstream in("/proc/stat");
+  const std::string name = "cpu" + std::to_string(cpu);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, name.size() + 1, name + " ") != 0) continue;
+    std::istringstream fields(line.substr(name.size()));
+    uint64_t user = 0, nice = 0, system = 0;
+    fields >> user >> nice >> system;
+    return user + nice + system;
+  }
+  return 0;
 }
 
 bool setPolicy(long tid, int policy) {
@@ -257,17 +274,36 @@ size_t CoreClaim::balance() {
     return std::none_of(children.begin(), children.end(),
                         [&](const Child& c) { return c.pid == pid; });
   });
+  // What else ran on the claimed CPU (other programs, runs that claimed
+  // nothing): the CPU's busy time less the period thread's and the guests'.
+  const uint64_t ticks = busyTicks(cpu_);
+  const auto at = std::chrono::steady_clock::now();
+  double foreign = -claimed, window = 0.0;
+  if (measured_) {
+    foreign +=
+        static_cast<double>(ticks - busy_ticks_) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+    window = std::chrono::duration<double>(at - measured_at_).count();
+    for (const Child& c : children)
+      if (guests_.count(c.pid)) foreign -= c.seconds;
+  }
+  busy_ticks_ = ticks;
+  measured_at_ = at;
   if (!measured_) {
     measured_ = true;
     return guests_.size();
   }
+  foreign_share_ = window > 0 ? foreign / window : 0.0;
   // Greedy, the present guests first (fewer moves): a child moves over while
   // that makes the busier side less busy.
   std::stable_partition(children.begin(), children.end(),
                         [&](const Child& c) { return guests_.count(c.pid) > 0; });
   const double cpus = static_cast<double>(others_.size());
   std::set<long> next;
+  // A guest at idle priority waits behind any other program on that CPU: none
+  // where others use it (beyond two ticks of sampling error and 5 %).
+  shared_ = foreign > 0.05 * window + 2.0 / static_cast<double>(::sysconf(_SC_CLK_TCK));
   for (const Child& c : children) {
+    if (shared_) break;
     if (std::max(claimed + c.seconds, (rest - c.seconds) / cpus) < std::max(claimed, rest / cpus)) {
       claimed += c.seconds;
       rest -= c.seconds;

@@ -22,9 +22,11 @@
 // guests: pinned to the claimed CPU at SCHED_IDLE, so they run only while the
 // period thread waits and never preempt it. How many comes from the CPU time
 // every thread used since the last call, so that the busier side (the claimed
-// CPU, or each of the others) is as little busy as it can be.
+// CPU, or each of the others) is as little busy as it can be; none while other
+// programs use the claimed CPU, since an idle-priority guest waits behind them.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -63,6 +65,11 @@ class CoreClaim {
   // process may not raise back from SCHED_IDLE (not root) stays one.
   size_t balance();
   size_t guests() const { return guests_.size(); }
+  // Over the last balance's window: the share of wall time other programs
+  // (and runs that claimed nothing) ran on the claimed CPU, and whether that
+  // was enough to lend nothing (more than 5 % and two clock ticks).
+  double foreignShare() const { return foreign_share_; }
+  bool shared() const { return shared_; }
 
   // Runs `spawn` with the calling thread on the other CPUs of the claim in
   // force, if any, so that a process it starts inherits them.
@@ -88,6 +95,10 @@ class CoreClaim {
   std::set<long> guests_;                                 // child processes on the claimed CPU
   std::map<long, uint64_t> runtime_ns_;                   // thread id: CPU time at the last balance
   bool measured_ = false;
+  uint64_t busy_ticks_ = 0;  // the claimed CPU's busy ticks at the last balance
+  std::chrono::steady_clock::time_point measured_at_;
+  double foreign_share_ = 0.0;
+  bool shared_ = false;
 };
 
 }  // namespace simsoccer::sim
