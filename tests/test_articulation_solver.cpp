@@ -120,8 +120,9 @@ void compare(const char* what, const Outcome& own, const Outcome& bullet, double
       what, torso, joint, ball, own.most_basis_rows, own.inertia_mismatch);
   std::printf("%s: in 1 s %ld contact rows solved one by one, %ld between two robots\n", what,
               own.solved_rows, own.between_articulations);
-  // Every step's factorisation of each robot, column by column, and every
-  // link's basis Jacobians and their responses: the same up to the rounding
+  // Every step's factorisation of each robot, column by column (also the
+  // implicit servo rows' columns, solved six at a time), and every link's
+  // basis Jacobians and their responses: the same up to the rounding
   // of Bullet's single-precision pass (its own inverse is symmetric to about
   // 1e-7 of its largest entry; the basis responses agree to about 1.4e-4 of
   // their largest entry, the columns of M^-1 to 2e-5); a wrong axis, pivot,

@@ -308,13 +308,15 @@ double ArticulationInertias::checkAgainstBullet(btMultiBody& body,
   btAlignedObjectArray<btVector3> scratch_v;
   btAlignedObjectArray<btMatrix3x3> scratch_m;
   double worst = 0;
-  // M^-1, column by column.
+  // M^-1, column by column; and the columns the servo rows take, solved six at a time.
   for (size_t i = 0; i < n; ++i) {
     unit[i] = 1;
     inertia.solve(unit.data(), ours.data());
     body.calcAccelerationDeltasMultiDof(unit.data(), bullets.data(), scratch_r, scratch_v);
     unit[i] = 0;
     worst = std::max(worst, relativeDifference(ours.data(), bullets.data(), n));
+    if (const btScalar* column = inertia.column(static_cast<int>(i)))
+      worst = std::max(worst, relativeDifference(column, bullets.data(), n));
   }
   // Each link's basis rows and their responses as the solver gets them (the
   // six at once, along the link's path only).
