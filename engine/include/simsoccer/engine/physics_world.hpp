@@ -26,11 +26,11 @@ using ArticulationId = Id<struct ArticulationTag>;  // a robot's articulated bod
 using BodyId = Id<struct BodyTag>;                  // a free rigid body (the ball)
 
 struct PhysicsSettings {
-  double dt = 0.005;            // s, physics step
+  double dt = 0.010;            // s, physics step (world::PhysicsConfig's default)
   int solver_iterations = 10;   // sequential-impulse iterations per step
   // Gauss-Seidel sweeps over the joint rows (servos, limits, gears) in each
   // iteration: cheap, one coordinate each; see world::PhysicsConfig.
-  int joint_sweeps = 1;
+  int joint_sweeps = 2;
   // The engine's solver starts each contact's rows from this share of its
   // point's impulses of the last step (0: from zero, as Bullet's; see
   // world::PhysicsConfig). Bullet's solver (bullet_solver) starts from zero.
