@@ -1,8 +1,11 @@
 // Robots holding the stand pose on the carpet, and collapsing limp (real Bullet).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "simsoccer/world/world.hpp"
 #include "test_support.hpp"
@@ -86,3 +89,68 @@ TEST_P(LimpModels, ZeroStiffnessCollapses) {
 
 INSTANTIATE_TEST_SUITE_P(Robots, LimpModels,
                          ::testing::Values("nao_v6_h25.yaml", "booster_k1.yaml"));
+
+// A referee moves a robot as it is: lifted and set down elsewhere with the same joint
+// angles, servo targets, height and tilt. Teleported into the stand pose instead, a
+// Booster K1 held in its gait's bent stance got one period of the old targets against the
+// new pose and tipped over (shoot-out keepers on their line, robots sent off).
+TEST(MovedRobots, AStandingRobotIsSetDownAsItIsAndAFallenOneInTheStandPose) {
+  world::Scenario s = test::scenario(2);
+  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";
+  s.robot_model_file = test::sourceDir() / "robots" / "booster_k1.yaml";
+  world::World w(s);
+  const auto& model = *w.robot(0).model;
+  const auto& joints = model.body->joints;
+  // Robot 0 in a deeper stance than the stand pose (knees 0.2 rad more bent), on its feet.
+  std::vector<double> stance = model.pose("stand");
+  for (size_t j = 0; j < joints.size(); ++j) {
+    const std::string& name = joints[j].name;
+    if (name.find("Knee") != std::string::npos) stance[j] += 0.2;
+    if (name.find("HipPitch") != std::string::npos || name.find("AnklePitch") != std::string::npos)
+      stance[j] -= 0.1;
+  }
+  const auto hold = [&] {
+    for (size_t j = 0; j < joints.size(); ++j)
+      if (joints[j].mimic_of < 0) w.setJointTarget(0, static_cast<int>(j), stance[j], 1.0);
+  };
+  for (int i = 0; i < 150; ++i) {
+    hold();
+    w.step();
+  }
+  // Robot 1 pushed over: lying.
+  w.physics().setRootVelocity(w.robot(1).body, engine::Vec3(0, 1.5, 0), engine::Vec3(3.0, 0, 0));
+  for (int i = 0; i < 200; ++i) w.step();
+  ASSERT_FALSE(w.isStanding(1));
+  ASSERT_TRUE(w.isStanding(0));
+
+  const engine::Pose before = w.torsoPose(0);
+  std::vector<double> q_before;
+  for (size_t j = 0; j < joints.size(); ++j)
+    q_before.push_back(w.jointPosition(0, static_cast<int>(j)));
+  w.moveRobot(0, 2.0, -1.0, 1.0);
+  w.moveRobot(1, -2.0, 1.0, 0.0);
+  const engine::Pose after = w.torsoPose(0);
+  EXPECT_NEAR(after.translation().x(), 2.0, 1e-6);
+  EXPECT_NEAR(after.translation().y(), -1.0, 1e-6);
+  EXPECT_NEAR(after.translation().z(), before.translation().z(), 1e-6);
+  EXPECT_NEAR(std::atan2(after.linear()(1, 0), after.linear()(0, 0)), 1.0, 1e-6);
+  EXPECT_NEAR(after.linear()(2, 2), before.linear()(2, 2), 1e-6);  // the same tilt
+  for (size_t j = 0; j < joints.size(); ++j)
+    EXPECT_NEAR(w.jointPosition(0, static_cast<int>(j)), q_before[j], 1e-6) << joints[j].name;
+  // The fallen one: upright in the stand pose at its spot.
+  EXPECT_TRUE(w.isStanding(1, 0.22, world::World::kUprightForMoving));
+  EXPECT_NEAR(w.torsoPose(1).translation().x(), -2.0, 1e-6);
+  const std::vector<double>& stand = model.pose("stand");
+  for (size_t j = 0; j < joints.size(); ++j)
+    EXPECT_NEAR(w.jointPosition(1, static_cast<int>(j)), stand[j], 1e-6) << joints[j].name;
+  // Robot 0 goes on holding its stance where it was put, without a jolt.
+  double rocked = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    hold();
+    w.step();
+    rocked = std::max(rocked, std::abs(tiltOf(w.torsoPose(0)) - tiltOf(after)));
+  }
+  std::printf("moved K1: tilt within %.4f rad of where it was set down over 2 s\n", rocked);
+  EXPECT_LT(rocked, 0.02);
+  EXPECT_TRUE(w.isStanding(0));
+}

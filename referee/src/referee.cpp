@@ -304,7 +304,7 @@ void Referee::onEnterSet() {
     if (config_.auto_placement) {
       const Vec3 p = nearestLegalPosition(r, taken);
       taken.push_back(p);
-      world_.placeRobot(r, p.x(), p.y(), teamSign(info.team) < 0 ? 0.0 : M_PI);
+      world_.moveRobot(r, p.x(), p.y(), teamSign(info.team) < 0 ? 0.0 : M_PI);
       game_.recordEvent(EventType::Placement, info.team, info.number, "auto-placed to a legal position");
     } else {
       game_.penalise(info.team, info.number, gc::Penalty::IllegalPositionInSet);
@@ -521,15 +521,15 @@ void Referee::removePenalised() {
       // Removed at once, and kept there (re-placed if it wanders off).
       if (!parked_[r] ||
           (world_.torsoPose(r).translation() - spot.translation()).head<2>().norm() > 0.5) {
-        world_.placeRobot(r, spot.translation().x(), spot.translation().y(), yaw);
+        world_.moveRobot(r, spot.translation().x(), spot.translation().y(), yaw);
         parked_[r] = true;
       }
     } else if (parked_[r]) {
       // Re-entry: on the touchline beside its waiting spot, facing the field.
       const world::Pose spot = world_.torsoPose(r);
       const double side = spot.translation().y() > 0 ? 1.0 : -1.0;
-      world_.placeRobot(r, spot.translation().x(), side * world_.field().halfWidth(),
-                        side > 0 ? -M_PI / 2 : M_PI / 2);
+      world_.moveRobot(r, spot.translation().x(), side * world_.field().halfWidth(),
+                       side > 0 ? -M_PI / 2 : M_PI / 2);
       parked_[r] = false;
     }
     if (!out) slot_[r] = -1;
@@ -544,12 +544,12 @@ void Referee::startShootoutKick(int striker, int keeper) {
   placeBall(mark, 0.0);
   const int team = game_.kickingTeam();
   if (const auto r = robot(team, striker)) {
-    world_.placeRobot(*r, mark - side * 0.35, 0.0, side > 0 ? 0.0 : M_PI);
+    world_.moveRobot(*r, mark - side * 0.35, 0.0, side > 0 ? 0.0 : M_PI);
     parked_[*r] = false;
   }
   if (keeper > 0) {
     if (const auto r = robot(1 - team, keeper)) {
-      world_.placeRobot(*r, side * (f.halfLength() - 0.05), 0.0, side > 0 ? M_PI : 0.0);
+      world_.moveRobot(*r, side * (f.halfLength() - 0.05), 0.0, side > 0 ? M_PI : 0.0);
       parked_[*r] = false;
     }
   }

@@ -282,6 +282,36 @@ void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture)
   sensors_->robotPlaced(*physics_, r);
 }
 
+void World::moveRobot(RobotId r, double x, double y, double yaw) {
+  const RobotInfo& info = robots_.at(r);
+  const robots::RobotModel& model = *info.model;
+  // On both feet: each foot link touched the carpet in the last step.
+  bool on_both_feet = model.hasLegs();
+  for (const robots::LegChain& leg : model.legs) {
+    const bool down = std::any_of(contacts_.begin(), contacts_.end(), [&](const auto& c) {
+      return c.articulation == info.body && c.link == leg.foot_link && !c.with_articulation &&
+             c.other_body < 0 && c.impulse > 0.0;
+    });
+    on_both_feet = on_both_feet && down;
+  }
+  if (!on_both_feet || !isStanding(r, 0.22, kUprightForMoving)) {
+    placeRobot(r, x, y, yaw);
+    return;
+  }
+  const Pose torso = torsoPose(r);
+  const double heading = std::atan2(torso.linear()(1, 0), torso.linear()(0, 0));
+  Pose moved = Pose::Identity();
+  moved.translation() = Vec3(x, y, torso.translation().z());
+  moved.linear() =
+      Eigen::AngleAxisd(yaw - heading, Vec3::UnitZ()).toRotationMatrix() * torso.linear();
+  std::vector<double> q(info.model->body->joints.size());
+  for (size_t j = 0; j < q.size(); ++j)
+    q[j] = physics_->jointPosition(info.body, static_cast<int>(j));
+  // The servos keep their targets: the robot's controller goes on from where it was.
+  physics_->resetArticulation(info.body, moved, q);
+  sensors_->robotPlaced(*physics_, r);
+}
+
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {
   const Pose torso = torsoPose(r);
   const double up_z = torso.linear()(2, 2);

@@ -114,6 +114,13 @@ class World {
   // Puts the robot's torso at `torso` (field frame) with its joints in `posture`, at rest
   // (e.g. lying on the ground for get-up trials; the caller keeps it clear of the ground).
   void placeRobot(RobotId r, const Pose& torso, const std::string& posture);
+  // As a referee moves a robot: lifted and set down at rest with its torso at (x, y) facing
+  // `yaw`, as it was: the same joint angles, servo targets, height and tilt, only carried
+  // and turned about the vertical. One that is not upright on both feet (tilted more than
+  // kUprightForMoving, or a foot off the carpet: mid-step, fallen) is set down in the stand
+  // pose instead (placeRobot).
+  void moveRobot(RobotId r, double x, double y, double yaw);
+  static constexpr double kUprightForMoving = 0.35;  // rad from the vertical
 
   // The sensor frame of the last completed control period (stays the
   // initial one when the scenario turns sensors off).
