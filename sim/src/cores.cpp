@@ -276,40 +276,38 @@ size_t CoreClaim::balance() {
   });
   // What else ran on the claimed CPU (other programs, runs that claimed
   // nothing): the CPU's busy time less the period thread's and the guests'.
+  const double tick = 1.0 / static_cast<double>(::sysconf(_SC_CLK_TCK));  // s
   const uint64_t ticks = busyTicks(cpu_);
   const auto at = std::chrono::steady_clock::now();
-  double foreign = -claimed, window = 0.0;
-  if (measured_) {
-    foreign +=
-        static_cast<double>(ticks - busy_ticks_) / static_cast<double>(::sysconf(_SC_CLK_TCK));
-    window = std::chrono::duration<double>(at - measured_at_).count();
-    for (const Child& c : children)
-      if (guests_.count(c.pid)) foreign -= c.seconds;
-  }
+  const double busy = static_cast<double>(ticks - busy_ticks_) * tick;
+  const double window = std::chrono::duration<double>(at - measured_at_).count();
   busy_ticks_ = ticks;
   measured_at_ = at;
   if (!measured_) {
     measured_ = true;
     return guests_.size();
   }
+  double foreign = busy - claimed;
+  for (const Child& c : children)
+    if (guests_.count(c.pid)) foreign -= c.seconds;
   foreign_share_ = window > 0 ? foreign / window : 0.0;
+  // A guest at idle priority waits behind any other program on that CPU: none
+  // where others use it (beyond two ticks of sampling error and 5 %).
+  shared_ = foreign > 0.05 * window + 2.0 * tick;
   // Greedy, the present guests first (fewer moves): a child moves over while
   // that makes the busier side less busy.
   std::stable_partition(children.begin(), children.end(),
                         [&](const Child& c) { return guests_.count(c.pid) > 0; });
   const double cpus = static_cast<double>(others_.size());
   std::set<long> next;
-  // A guest at idle priority waits behind any other program on that CPU: none
-  // where others use it (beyond two ticks of sampling error and 5 %).
-  shared_ = foreign > 0.05 * window + 2.0 / static_cast<double>(::sysconf(_SC_CLK_TCK));
-  for (const Child& c : children) {
-    if (shared_) break;
-    if (std::max(claimed + c.seconds, (rest - c.seconds) / cpus) < std::max(claimed, rest / cpus)) {
-      claimed += c.seconds;
-      rest -= c.seconds;
-      next.insert(c.pid);
-    }
-  }
+  if (!shared_)
+    for (const Child& c : children)
+      if (std::max(claimed + c.seconds, (rest - c.seconds) / cpus) <
+          std::max(claimed, rest / cpus)) {
+        claimed += c.seconds;
+        rest -= c.seconds;
+        next.insert(c.pid);
+      }
   for (const Child& c : children) {
     const bool was = guests_.count(c.pid) > 0, is = next.count(c.pid) > 0;
     if (is && !was) setGuest(c.pid, true);

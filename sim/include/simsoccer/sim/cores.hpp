@@ -64,7 +64,6 @@ class CoreClaim {
   // first call only measures. Returns the number of guests. A guest this
   // process may not raise back from SCHED_IDLE (not root) stays one.
   size_t balance();
-  size_t guests() const { return guests_.size(); }
   // Over the last balance's window: the share of wall time other programs
   // (and runs that claimed nothing) ran on the claimed CPU, and whether that
   // was enough to lend nothing (more than 5 % and two clock ticks).
