@@ -152,6 +152,7 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("avoid_ball: -1"), "avoid_ball");
   EXPECT_EQ(refusedAt("ball_velocity_window: 0.01"), "ball_velocity_window");
   EXPECT_EQ(refusedAt("ball_outlier_distance: 0"), "ball_outlier_distance");
+  EXPECT_EQ(refusedAt("obstacle_memory: -1"), "obstacle_memory");
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
 }
 
@@ -366,6 +367,56 @@ TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
   EXPECT_LT(walk(-1.6, std::make_pair(0.38, 0.05), 0).forward, 0.5 * at_ball.forward);
   const MotionRequest teammate_further = walk(-1.6, std::make_pair(0.5, 0.6), 0);
   EXPECT_DOUBLE_EQ(teammate_further.forward, at_ball.forward);  // further from the ball
+}
+
+// A robot that leaves the cameras' view (the head turned to the ball) is still
+// stepped past where it was seen on the field, from wherever the walker is now,
+// for obstacle_memory; then it is forgotten.
+TEST(SoccerBehaviour, RobotsOutOfViewAreRememberedWhereTheyWereSeen) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  ASSERT_GT(cfg.obstacle_memory, 1.0);
+  agents::SoccerBehaviour with(cfg, f, 0, 1, 2, Role::Striker, 1);
+  agents::SoccerBehaviour without(cfg, f, 0, 1, 2, Role::Striker, 1);
+  // t = 0: at (-2, 0) facing +x, an opponent seen 0.6 m ahead, 0.1 m to the left:
+  // on the field at (-1.4, 0.1). The ball at (1, 0).
+  auto frame = [&](double t, double x, double yaw, bool robot_in_view) {
+    auto p = seeing(x, 0.0, yaw, 1.0, 0.0, t);
+    agents::PerceivedIn o;
+    o.kind = 2;
+    o.team = 1;
+    o.in_view = robot_in_view;
+    o.last_seen = 0.0;
+    o.x = 0.6f;  // out of view: the last sighting's numbers, from where it was taken
+    o.y = 0.1f;
+    p.robots.push_back(o);
+    return p;
+  };
+  auto step = [&](double t, double x, double yaw, bool robot_in_view) {
+    agents::PerceptionIn p = frame(t, x, yaw, robot_in_view);
+    agents::PerceptionIn empty = p;
+    empty.robots.clear();
+    agents::SoccerBehaviour::Input in;
+    in.time = t;
+    in.perception = &p;
+    const MotionRequest r = with.update(in);
+    in.perception = &empty;
+    return std::make_pair(r, without.update(in));
+  };
+  const auto [seen, free0] = step(0.0, -2.0, 0.0, true);
+  ASSERT_EQ(free0.kind, MotionRequest::Kind::Walk);
+  EXPECT_LT(seen.forward, free0.forward - 0.05);
+  // t = 1: out of view, the walker 0.15 m on and turned 0.4 rad to the left: the
+  // robot is now 0.45 m ahead, 0.08 m to its right (its stale numbers would say
+  // 0.6 m ahead, 0.1 m to the left). Hardly any approach left, a step to the left.
+  const auto [remembered, free1] = step(1.0, -1.85, 0.4, false);
+  ASSERT_EQ(free1.kind, MotionRequest::Kind::Walk);
+  EXPECT_LT(remembered.forward, 0.5 * free1.forward);
+  EXPECT_GT(remembered.left, free1.left + 0.03);
+  // After obstacle_memory it is forgotten.
+  const auto [forgotten, free2] = step(cfg.obstacle_memory + 0.1, -1.85, 0.4, false);
+  EXPECT_DOUBLE_EQ(forgotten.forward, free2.forward);
+  EXPECT_DOUBLE_EQ(forgotten.left, free2.left);
 }
 
 // The shoot-out keeper waits for the kick with the ball on the penalty mark,

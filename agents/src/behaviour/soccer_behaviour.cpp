@@ -122,7 +122,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "dive_reach",
                   "avoid_near",
                   "avoid_far",
-                  "avoid_ball"});
+                  "avoid_ball",
+                  "obstacle_memory"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -147,6 +148,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.avoid_near = root.number("avoid_near", c.avoid_near);
   c.avoid_far = root.number("avoid_far", c.avoid_far);
   c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
+  c.obstacle_memory = root.number("obstacle_memory", c.obstacle_memory);
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
@@ -157,7 +159,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   if (!(c.avoid_far > c.avoid_near))
     (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
         .fail("avoid_far must be greater than avoid_near");
-  for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball"})
+  for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
@@ -258,8 +260,10 @@ void SoccerBehaviour::readGame(const Input& in) {
                      (state_ != last_state_ && (state_ == kSet || state_ == kInitial));
   if (moved) {
     restart_motion_ = true;
-    // The ball's track from before a placement would read as a roll.
+    // The ball's track from before a placement would read as a roll, and the
+    // robots around are no longer where they were seen.
     forgetBallTrack();
+    obstacles_.clear();
   }
   was_penalised_ = penalised_;
   last_state_ = state_;
@@ -271,15 +275,26 @@ bool SoccerBehaviour::takeMotionRestart() {
   return r;
 }
 
+void SoccerBehaviour::rememberRobots(const std::vector<PerceivedIn>& robots, double time) {
+  obstacles_.resize(robots.size());
+  const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+  robots_seen_.clear();
+  for (size_t i = 0; i < robots.size(); ++i) {
+    const PerceivedIn& o = robots[i];
+    RememberedRobot& m = obstacles_[i];
+    if (o.in_view) {
+      m.at = {self_.x + c * o.x - s * o.y, self_.y + s * o.x + c * o.y};
+      m.seen = time;
+      m.teammate = o.team == team_;
+    }
+    if (time - m.seen < config_.obstacle_memory)
+      robots_seen_.push_back({toRobot(m.at), m.teammate});
+  }
+}
+
 void SoccerBehaviour::updateBall(const Input& in) {
   if (in.perception) {
     const PerceptionIn& p = *in.perception;
-    robots_seen_.clear();
-    for (const PerceivedIn& o : p.robots)
-      // Seen in the last 0.3 s (a perception miss drops a robot for a
-      // period; it has not moved far since).
-      if (o.last_seen >= 0.0 && in.time - o.last_seen < 0.3)
-        robots_seen_.push_back({{o.x, o.y}, o.team == team_});
     if (phase_ == kPhasePenaltyShoot) {
       // Every shoot-out kick goes at one goal, and the referee puts both the
       // kicker (at the penalty mark) and the keeper (on the line) in that
@@ -290,6 +305,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
     const Vec2 own = toOwn(p.self_pose[0], p.self_pose[1]);
     self_ = {own.x, own.y, wrap(p.self_pose[2] + (attack_sign_ > 0 ? 0.0 : kPi))};
     self_known_ = true;
+    rememberRobots(p.robots, in.time);
     if (p.ball.last_seen >= 0) {
       ball_seen_at_ = p.ball.last_seen;
       ball_robot_ = {p.ball.x, p.ball.y};

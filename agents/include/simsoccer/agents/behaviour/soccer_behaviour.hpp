@@ -94,6 +94,11 @@ struct BehaviourConfig {
   double avoid_near = 0.45;  // m, torso to torso
   double avoid_far = 1.0;    // m
   double avoid_ball = 0.6;   // m
+  // A robot seen is kept where it was seen (on the field, moved with the own
+  // pose) for obstacle_memory after it left the cameras' view: with the head
+  // turned to the ball the robots beside and behind are out of view, and
+  // turning or stepping sideways into them made robots fall in crowds.
+  double obstacle_memory = 2.0;  // s
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
@@ -153,6 +158,8 @@ class SoccerBehaviour {
   };
   void readGame(const Input& in);
   void updateBall(const Input& in);
+  // Robots in view into obstacles_, and robots_seen_ from those seen within obstacle_memory.
+  void rememberRobots(const std::vector<PerceivedIn>& robots, double time);
   Role chooseRole(const Input& in);
   MotionRequest play(const Input& in);
   MotionRequest ready();
@@ -203,7 +210,13 @@ class SoccerBehaviour {
     Vec2 at;  // robot frame
     bool teammate;
   };
-  std::vector<SeenRobot> robots_seen_;  // other robots in view now
+  std::vector<SeenRobot> robots_seen_;  // other robots seen within obstacle_memory
+  struct RememberedRobot {
+    Vec2 at;             // own frame, where it was last seen
+    double seen = -1e9;  // s
+    bool teammate = false;
+  };
+  std::vector<RememberedRobot> obstacles_;  // per perceived robot, in perception's order
   void updateBallVelocity(double time, const Vec2& ball);
   void forgetBallTrack();
   std::vector<Teammate> mates_;
