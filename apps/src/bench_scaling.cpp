@@ -79,7 +79,7 @@ int benchScaling(int argc, char** argv, int first) {
       if (mode == modes.back()) plotted.push_back(r);
       table.rows.push_back({std::to_string(n), sim::modeName(r.mode), fmt(r.steps_per_s, 0),
                             fmt(r.fps, 0), fmt(r.rtf, 2), fmt(r.physics_ms, 2),
-                            fmt(r.sensors_ms, 2), fmt(r.perception_ms, 3), fmt(r.messaging_ms, 2),
+                            fmt(r.sensors_ms, 3), fmt(r.perception_ms, 3), fmt(r.messaging_ms, 2),
                             fmt(r.referee_ms, 3), fmt(r.render_ms, 2), std::to_string(r.missed),
                             r.cpu_ms >= 0 ? fmt(r.cpu_ms, 2) : "n/a",
                             r.period_cpu >= 0 ? std::to_string(r.period_cpu) : "-",

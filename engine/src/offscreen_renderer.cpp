@@ -741,7 +741,12 @@ RenderView pinholeView(const Pose& pose, int width, int height, double horizonta
 }
 
 bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, double& v) {
-  const Vec3 p = view.pose.inverse() * world_point;  // camera frame: x forward, y left, z up
+  // The pose is rigid: its inverse is the transposed rotation (no general 3x3 inverse).
+  return projectCameraPoint(view, view.pose.inverse(Eigen::Isometry) * world_point, u, v);
+}
+
+bool projectCameraPoint(const RenderView& view, const Vec3& p, double& u, double& v) {
+  // p in the camera frame: x forward, y left, z up.
   if (p.x() <= 1e-9) return false;
   u = view.cx - view.fx * p.y() / p.x();
   v = view.cy - view.fy * p.z() / p.x();

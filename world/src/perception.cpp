@@ -54,9 +54,10 @@ double PerceptionSystem::uniform() {
   return static_cast<double>(uniform_() >> 11) * 0x1.0p-53;
 }
 
-bool PerceptionSystem::inFrustum(const engine::RenderView& v, const Vec3& point) {
+bool PerceptionSystem::inFrustum(const engine::RenderView& v, const engine::Pose& from_field,
+                                 const Vec3& point) {
   double u = 0, w = 0;
-  if (!engine::projectPoint(v, point, u, w)) return false;
+  if (!engine::projectCameraPoint(v, from_field * point, u, w)) return false;
   return u >= 0 && u < v.width && w >= 0 && w < v.height;
 }
 
@@ -71,7 +72,7 @@ bool PerceptionSystem::blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3
     const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y()), d2(b.x() - a.x(), b.y() - a.y());
     const double len2 = d2.squaredNorm();
     const double t = len2 > 0 ? std::clamp(-a2.dot(d2) / len2, 0.0, 1.0) : 0.0;
-    if ((a2 + t * d2).norm() > 0.12) continue;
+    if ((a2 + t * d2).squaredNorm() > 0.12 * 0.12) continue;
     const double z = a.z() + t * (b.z() - a.z());
     if (t > 0.02 && t < 0.98 && z < 0.58) return true;
   }
@@ -92,7 +93,9 @@ void PerceptionSystem::observe(const World& world, const Viewpoint& from, const 
   if (settings_.realistic && distance > range) return;
   int camera = -1;
   for (int c = 0; c < static_cast<int>(from.camera_count) && camera < 0; ++c)
-    if (inFrustum(from.cameras[static_cast<size_t>(c)], point)) camera = c;
+    if (inFrustum(from.cameras[static_cast<size_t>(c)], from.from_field[static_cast<size_t>(c)],
+                  point))
+      camera = c;
   if (camera < 0) return;
   if (settings_.realistic) {
     const Vec3 eye = from.cameras[static_cast<size_t>(camera)].pose.translation();
@@ -122,12 +125,14 @@ void PerceptionSystem::update(const World& world) {
     p.tick = tick;
     p.time = world.time();
     // The robot's frame and camera views, once for all the objects it looks at.
-    Viewpoint from{r, robotFrame(world, r), {}, {}};
-    from.to_robot = from.frame.inverse();
+    Viewpoint from{r, robotFrame(world, r), {}, {}, {}};
+    from.to_robot = from.frame.inverse(Eigen::Isometry);
     const robots::RobotModel& model = *world.robot(r).model;
     from.camera_count = std::min(model.cameraCount(), from.cameras.size());
-    for (size_t c = 0; c < from.camera_count; ++c)
+    for (size_t c = 0; c < from.camera_count; ++c) {
       from.cameras[c] = robotCameraView(world, r, model.camera(c), kSize[c][0], kSize[c][1]);
+      from.from_field[c] = from.cameras[c].pose.inverse(Eigen::Isometry);
+    }
     const engine::Pose& frame = from.frame;
     // Where the robot thinks it is.
     const double yaw = std::atan2(frame.linear()(1, 0), frame.linear()(0, 0));

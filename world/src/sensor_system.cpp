@@ -251,7 +251,7 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     if (!r.feet_posed) {
       for (int k = 0; k < 2; ++k)
         r.foot_from_world[static_cast<size_t>(k)] =
-            physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link).inverse();
+            physics.linkPose(r.body, r.feet[static_cast<size_t>(k)].link).inverse(Eigen::Isometry);
       r.feet_posed = true;
     }
     const Foot& foot = r.feet[static_cast<size_t>(f)];

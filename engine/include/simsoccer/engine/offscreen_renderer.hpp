@@ -61,6 +61,9 @@ RenderView pinholeView(const Pose& pose, int width, int height, double horizonta
                        double vertical_fov);
 // Where a world point lands in a view (u right, v down, px); false if behind.
 bool projectPoint(const RenderView& view, const Vec3& world_point, double& u, double& v);
+// The same for a point already in the camera frame (`pose`'s inverse applied): a caller
+// projecting many points into one view inverts its pose once.
+bool projectCameraPoint(const RenderView& view, const Vec3& camera_point, double& u, double& v);
 
 struct RenderTiming {
   double draw_ms = 0.0, readback_ms = 0.0;

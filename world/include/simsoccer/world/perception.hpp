@@ -50,7 +50,8 @@ class PerceptionSystem {
   const PerceptionSettings& settings() const { return settings_; }
 
   // Whether a field-frame point is inside a camera view's frustum (and in front of it).
-  static bool inFrustum(const engine::RenderView& view, const Vec3& point);
+  static bool inFrustum(const engine::RenderView& view, const engine::Pose& from_field,
+                        const Vec3& point);
 
  private:
   // One robot's view of the world this period: its frame and its cameras.
@@ -59,6 +60,7 @@ class PerceptionSystem {
     engine::Pose frame;                         // robot frame in the field
     engine::Pose to_robot;                      // its inverse: field to robot frame
     std::array<engine::RenderView, 2> cameras;  // the robot's first two cameras
+    std::array<engine::Pose, 2> from_field;     // field to each camera's frame
     size_t camera_count = 0;
   };
   void observe(const World& world, const Viewpoint& from, const Vec3& point, double range,
