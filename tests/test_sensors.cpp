@@ -192,6 +192,47 @@ TEST(Sonar, NeverSeesItsOwnRobot) {
   for (int s = 0; s < 2; ++s) EXPECT_GT(f.sonar[s], 0.5f);
 }
 
+// The sonar scene holds only the robots another robot's sonar can reach
+// (0.8 m of range plus the robot's own reach): two robots face to face, four
+// more in the field's corners, 3.9 m and more from every other. The echoes are the same as
+// Bullet's, which has every robot.
+TEST(Sonar, RobotsOutOfEverySonarsReachAreLeftOutWithTheSameEchoes) {
+  world::Scenario s = single(0.0, 0.0, 0.0);
+  s.sensors.sonar_rays = 32;
+  world::RobotPlacement facing{1, 1, 0.55, 0.05, kPi, "stand", ""};
+  s.robots.push_back(facing);
+  const double far[4][2] = {{-3.0, 2.5}, {-3.0, -2.5}, {3.0, 2.5}, {3.0, -2.5}};
+  for (int i = 0; i < 4; ++i)
+    s.robots.push_back({1, i + 2, far[i][0], far[i][1], 0.0, "stand", ""});
+  world::World w(s);
+  for (int i = 0; i < 20; ++i) w.stepControlPeriod();
+  std::vector<engine::RayHit> batched, reference;
+  w.sensors().traceBatched(w.physics(), batched);
+  w.sensors().traceReference(w.physics(), reference);
+  ASSERT_EQ(batched.size(), 6u * 2u * 32u);
+  int robot_hits = 0;
+  for (size_t i = 0; i < batched.size(); ++i) {
+    ASSERT_EQ(std::isfinite(batched[i].distance), std::isfinite(reference[i].distance)) << i;
+    if (!std::isfinite(batched[i].distance)) continue;
+    // Bullet's rounded margins: 1.1 mm off the surface, up to 7 mm along a grazing ray.
+    EXPECT_NEAR(batched[i].distance, reference[i].distance, 0.007) << i;
+    robot_hits += batched[i].object >= 1000;
+  }
+  EXPECT_GT(robot_hits, 10);  // the two facing robots see each other
+  // The scene: the ball, the goals and two robots' shapes, not six.
+  world::World alone(single(0.0, 0.0, 0.0));
+  std::vector<engine::RayHit> unused;
+  alone.sensors().traceBatched(alone.physics(), unused);
+  const size_t without_robots = alone.sensors().sonarScene().primitiveCount();  // it sees no one
+  world::Scenario pair = s;
+  pair.robots.resize(2);
+  world::World two(pair);
+  two.sensors().traceBatched(two.physics(), unused);
+  const size_t per_robot = (two.sensors().sonarScene().primitiveCount() - without_robots) / 2;
+  ASSERT_GT(per_robot, 10u);
+  EXPECT_EQ(w.sensors().sonarScene().primitiveCount(), without_robots + 2 * per_robot);
+}
+
 TEST(Sonar, BatchedAndReferenceTracersAgreeOnRandomScene) {
   // 22 robots packed into 4 x 3 m with random headings and postures, so that
   // many rays hit robots, the ball, the goal or the carpet.

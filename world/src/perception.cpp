@@ -48,6 +48,12 @@ PerceptionSystem::PerceptionSystem(const World& world, const PerceptionSettings&
   }
   for (auto& p : state_)
     for (auto& post : p.posts) post.kind = PerceivedKind::GoalPost;
+  views_.resize(world.robotCount());
+  for (RobotId r = 0; r < world.robotCount(); ++r) {
+    const robots::RobotModel& model = *world.robot(r).model;
+    for (size_t c = 0; c < std::min(model.cameraCount(), views_[r].size()); ++c)
+      views_[r][c] = robotCameraView(world, r, model.camera(c), kSize[c][0], kSize[c][1]);
+  }
 }
 
 double PerceptionSystem::uniform() {
@@ -65,14 +71,21 @@ bool PerceptionSystem::inFrustum(const engine::RenderView& v, const engine::Pose
 // approximated by a vertical cylinder (radius 0.12 m, up to 0.58 m).
 bool PerceptionSystem::blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3& a,
                                       const Vec3& b) const {
+  constexpr double kRadius = 0.12;
+  // The segment's box widened by more than the radius: a torso outside it is
+  // clear without the closest-approach arithmetic (the same answers).
+  constexpr double kReach = kRadius + 0.01;
+  const double x_lo = std::min(a.x(), b.x()) - kReach, x_hi = std::max(a.x(), b.x()) + kReach;
+  const double y_lo = std::min(a.y(), b.y()) - kReach, y_hi = std::max(a.y(), b.y()) + kReach;
   for (RobotId r = 0; r < torsos_.size(); ++r) {
     if (r == skip_a || r == skip_b) continue;
     const Vec3& c = torsos_[r];
+    if (c.x() < x_lo || c.x() > x_hi || c.y() < y_lo || c.y() > y_hi) continue;
     // Closest approach in the ground plane along the segment.
     const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y()), d2(b.x() - a.x(), b.y() - a.y());
     const double len2 = d2.squaredNorm();
     const double t = len2 > 0 ? std::clamp(-a2.dot(d2) / len2, 0.0, 1.0) : 0.0;
-    if ((a2 + t * d2).squaredNorm() > 0.12 * 0.12) continue;
+    if ((a2 + t * d2).squaredNorm() > kRadius * kRadius) continue;
     const double z = a.z() + t * (b.z() - a.z());
     if (t > 0.02 && t < 0.98 && z < 0.58) return true;
   }
@@ -130,7 +143,8 @@ void PerceptionSystem::update(const World& world) {
     const robots::RobotModel& model = *world.robot(r).model;
     from.camera_count = std::min(model.cameraCount(), from.cameras.size());
     for (size_t c = 0; c < from.camera_count; ++c) {
-      from.cameras[c] = robotCameraView(world, r, model.camera(c), kSize[c][0], kSize[c][1]);
+      from.cameras[c] = views_[r][c];
+      from.cameras[c].pose = robotCameraPose(world, r, model.camera(c));
       from.from_field[c] = from.cameras[c].pose.inverse(Eigen::Isometry);
     }
     const engine::Pose& frame = from.frame;

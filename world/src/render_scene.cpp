@@ -145,8 +145,12 @@ engine::RenderView robotCameraView(const World& world, RobotId r, const std::str
 
 engine::RenderView robotCameraView(const World& world, RobotId r,
                                    const robots::SensorFrame& camera, int width, int height) {
-  return engine::pinholeView(world.linkPose(r, camera.link) * camera.pose, width, height,
+  return engine::pinholeView(robotCameraPose(world, r, camera), width, height,
                              camera.horizontal_fov, camera.vertical_fov);
+}
+
+engine::Pose robotCameraPose(const World& world, RobotId r, const robots::SensorFrame& camera) {
+  return world.linkPose(r, camera.link) * camera.pose;
 }
 
 engine::Pose lookAtPose(const Vec3& position, const Vec3& target) {

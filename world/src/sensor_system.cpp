@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -65,6 +66,43 @@ void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world
   }
 }
 
+// The furthest any point of a shape lies from the shape's own origin.
+double shapeReach(const engine::Shape& s) {
+  switch (s.type) {
+    case engine::ShapeType::Sphere:
+      return s.radius;
+    case engine::ShapeType::Capsule:
+      return 0.5 * s.length;  // end to end, caps included
+    case engine::ShapeType::Box:
+      return 0.5 * s.extents.norm();
+    case engine::ShapeType::Cylinder:
+      return std::hypot(0.5 * s.length, s.radius);
+  }
+  return 0.0;
+}
+
+// The furthest any collision shape of a body lies from its root link's frame,
+// whatever its joint angles: a joint turns its child about the child frame's
+// origin, so along each chain the joint offsets' lengths add up.
+double bodyReach(const engine::ArticulatedModel& body) {
+  std::vector<double> to_link(body.links.size(), 0.0);
+  std::vector<bool> known(body.links.size(), false);
+  known[0] = true;
+  const std::function<double(size_t)> reach = [&](size_t link) -> double {
+    if (!known[link]) {
+      const engine::Joint& j = body.joints.at(link - 1);  // joints[i] moves link i + 1
+      to_link[link] = reach(static_cast<size_t>(j.parent_link)) + j.origin.norm();
+      known[link] = true;
+    }
+    return to_link[link];
+  };
+  double furthest = 0.0;
+  for (size_t l = 0; l < body.links.size(); ++l)
+    for (const engine::Shape& s : body.links[l].shapes)
+      furthest = std::max(furthest, reach(l) + s.pose.translation().norm() + shapeReach(s));
+  return furthest;
+}
+
 }  // namespace
 
 SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldModel& field,
@@ -89,6 +127,17 @@ SensorSystem::SensorSystem(const SensorSettings& settings, const fields::FieldMo
     r.body = ref.body;
     r.group = ref.collision_group;
     r.model = ref.model;
+    r.reach = bodyReach(*model.body);
+    for (size_t a = 0; a < model.actuators.size(); ++a) {
+      const auto& act = model.actuators[a];
+      if (act.kind != robots::Actuator::Kind::Joint) continue;
+      const auto j = static_cast<size_t>(act.index);
+      const auto& motor = model.body->motors[static_cast<size_t>(model.body->joints[j].motor)];
+      r.joint_motors.push_back({a, j, motor.torque_constant * motor.gear_ratio,
+                                motor.no_load_current, motor.no_load_speed, motor.resistance,
+                                motor.thermal_resistance,
+                                motor.thermal_time_constant / motor.thermal_resistance});
+    }
     // Sensors are what the model has: foot pressure sensors, toe bumpers and
     // sonars are a Nao's; a robot without them (a Booster K1) reports none.
     const char* feet[2] = {"L", "R"};
@@ -283,18 +332,12 @@ void SensorSystem::afterStep(const engine::PhysicsWorld& physics,
     joint_velocity_.resize(joints);
     joint_motor_torque_.resize(joints);
     physics.readJoints(r.body, {}, joint_velocity_, joint_motor_torque_, {}, {});
-    for (size_t a = 0; a < model.actuators.size(); ++a) {
-      const auto& act = model.actuators[a];
-      if (act.kind != robots::Actuator::Kind::Joint) continue;
-      const auto j = static_cast<size_t>(act.index);
-      const auto& joint = model.body->joints[j];
-      const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
-      const double qd = std::abs(joint_velocity_[j]);
-      const double current =
-          std::abs(joint_motor_torque_[j]) / (motor.torque_constant * motor.gear_ratio) +
-          motor.no_load_current * std::min(1.0, qd / motor.no_load_speed);
-      r.current_sum[a] += current;
-      r.current_sq_sum[a] += current * current;
+    for (const JointMotor& m : r.joint_motors) {
+      const double qd = std::abs(joint_velocity_[m.joint]);
+      const double current = std::abs(joint_motor_torque_[m.joint]) / m.torque_per_amp +
+                             m.no_load_current * std::min(1.0, qd / m.no_load_speed);
+      r.current_sum[m.actuator] += current;
+      r.current_sq_sum[m.actuator] += current * current;
     }
   }
   if (timers_on_) times_.other_s += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -320,31 +363,29 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     joint_target_.resize(joints);
     joint_stiffness_.resize(joints);
     physics.readJoints(r.body, joint_position_, {}, {}, joint_target_, joint_stiffness_);
+    for (const JointMotor& m : r.joint_motors) {
+      const size_t a = m.actuator;
+      const double q = joint_position_[m.joint];
+      f.position[a] = static_cast<float>(std::round(q / resolution) * resolution);
+      f.velocity[a] = static_cast<float>((q - r.last_position[a]) / period);
+      r.last_position[a] = q;
+      f.target[a] = static_cast<float>(joint_target_[m.joint]);
+      f.stiffness[a] = static_cast<float>(joint_stiffness_[m.joint]);
+      f.current[a] = static_cast<float>(r.current_sum[a] / n);
+      // Winding temperature: copper losses heat it, the housing cools it.
+      const double power = m.resistance * r.current_sq_sum[a] / n;
+      double& temp = r.temperature[a];
+      temp += period * (power - (temp - spec.ambient_temperature) / m.thermal_resistance) /
+              m.heat_capacity;
+      f.temperature[a] = static_cast<float>(temp);
+      f.status[a] = temp >= spec.temperature_critical   ? 3
+                    : temp >= spec.temperature_very_hot ? 2
+                    : temp >= spec.temperature_hot      ? 1
+                                                        : 0;
+    }
     for (size_t a = 0; a < model.actuators.size(); ++a) {
       const auto& act = model.actuators[a];
-      if (act.kind == robots::Actuator::Kind::Joint) {
-        const auto j = static_cast<size_t>(act.index);
-        const auto& joint = model.body->joints[j];
-        const auto& motor = model.body->motors[static_cast<size_t>(joint.motor)];
-        const double q = joint_position_[j];
-        f.position[a] = static_cast<float>(std::round(q / resolution) * resolution);
-        f.velocity[a] = static_cast<float>((q - r.last_position[a]) / period);
-        r.last_position[a] = q;
-        f.target[a] = static_cast<float>(joint_target_[j]);
-        f.stiffness[a] = static_cast<float>(joint_stiffness_[j]);
-        f.current[a] = static_cast<float>(r.current_sum[a] / n);
-        // Winding temperature: copper losses heat it, the housing cools it.
-        const double power = motor.resistance * r.current_sq_sum[a] / n;
-        const double capacity = motor.thermal_time_constant / motor.thermal_resistance;  // J/K
-        double& temp = r.temperature[a];
-        temp += period * (power - (temp - spec.ambient_temperature) / motor.thermal_resistance) /
-                capacity;
-        f.temperature[a] = static_cast<float>(temp);
-        f.status[a] = temp >= spec.temperature_critical   ? 3
-                      : temp >= spec.temperature_very_hot ? 2
-                      : temp >= spec.temperature_hot      ? 1
-                                                          : 0;
-      } else if (act.kind == robots::Actuator::Kind::Hand) {
+      if (act.kind == robots::Actuator::Kind::Hand) {
         const auto h = static_cast<size_t>(act.index);
         const double before = r.hand_position[h];
         const double reach = r.hand_stiffness[h] > 0.0 ? model.hands[h].speed * period : 0.0;
@@ -445,7 +486,19 @@ void SensorSystem::buildScene(const engine::PhysicsWorld& physics) {
   for (size_t i = 0; i < static_shapes_.size(); ++i)
     addShape(scene_, static_shapes_[i], Pose::Identity(), kGoalObjectBase + static_cast<int32_t>(i),
              static_owner_[i]);
+  // Only robots a sonar of another robot can reach: their shapes are within
+  // their reach of their root, the rays within their range of their origin.
+  const size_t k = std::max<size_t>(1, rays_per_sonar_);
   for (const Robot& r : robots_) {
+    const Vec3f root = physics.linkPose(r.body, 0).translation().cast<float>();
+    bool reached = false;
+    for (size_t i = 0; i < rays_.size() && !reached; i += k) {
+      const engine::Ray& ray = rays_[i];
+      const float within = ray.max_distance + static_cast<float>(r.reach) + 0.01f;
+      reached =
+          ray.exclude_owner != r.group && (ray.origin - root).squaredNorm() <= within * within;
+    }
+    if (!reached) continue;
     const auto& links = r.model->body->links;
     for (size_t l = 0; l < links.size(); ++l) {
       if (links[l].shapes.empty()) continue;

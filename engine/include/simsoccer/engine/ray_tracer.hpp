@@ -63,6 +63,8 @@ class RayScene {
 
   // hits[i] = the nearest hit of rays[i] within its max distance.
   void trace(std::span<const Ray> rays, std::span<RayHit> hits) const;
+  // Spheres, capsules, boxes and cylinders added since the last clear().
+  size_t primitiveCount() const;
 
  private:
   // One primitive type as columns of floats (structure of arrays), with the

@@ -71,6 +71,9 @@ class PerceptionSystem {
   std::vector<Perception> state_;
   std::array<Vec3, 4> posts_;
   std::vector<Vec3> torsos_;  // every robot's torso this period (occlusion)
+  // Every robot's first two camera views with their intrinsics (constant: worked
+  // out once); their poses are set each period.
+  std::vector<std::array<engine::RenderView, 2>> views_;
   double uniform();           // [0, 1), the same on every standard library
   engine::NormalSampler noise_;
   std::mt19937_64 uniform_;

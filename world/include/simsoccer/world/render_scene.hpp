@@ -45,5 +45,7 @@ engine::RenderView robotCameraView(const World& world, RobotId r, const std::str
                                    int width, int height);
 engine::RenderView robotCameraView(const World& world, RobotId r,
                                    const robots::SensorFrame& camera, int width, int height);
+// The camera frame alone (x forward, y left, z up) in the field: a view's pose.
+engine::Pose robotCameraPose(const World& world, RobotId r, const robots::SensorFrame& camera);
 
 }  // namespace simsoccer::world

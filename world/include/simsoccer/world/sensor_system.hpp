@@ -64,6 +64,9 @@ class SensorSystem {
 
   void enableTimers(bool on) { timers_on_ = on; }
   const SensorTimes& times() const { return times_; }
+  // The scene of the last sonar trace: the ball, the goals and the robots a
+  // sonar of another robot could reach.
+  const engine::RayScene& sonarScene() const { return scene_; }
   void resetTimes() { times_ = {}; }
 
  private:
@@ -75,10 +78,20 @@ class SensorSystem {
     std::array<engine::Vec3, 2> bumper;  // left, right
     bool has_bumpers = false;
   };
+  // A joint actuator's motor constants, flat (the per-period loops read these,
+  // not the model's joints and motors).
+  struct JointMotor {
+    size_t actuator = 0;                                                // index in the sensor frame
+    size_t joint = 0;                                                   // index in the articulation
+    double torque_per_amp = 0, no_load_current = 0, no_load_speed = 0;  // N m/A, A, rad/s
+    double resistance = 0, thermal_resistance = 0, heat_capacity = 0;   // ohm, K/W, J/K
+  };
   struct Robot {
     engine::ArticulationId body;
     int group = 0;
     const robots::RobotModel* model;
+    std::vector<JointMotor> joint_motors;  // the model's joint actuators, in order
+    double reach = 0;  // m: no collision shape lies further from the root link's frame
     std::vector<uint8_t> link_cluster;            // broadphase cluster: torso 0, each limb its own
     std::vector<engine::Vec3> ray_dirs;           // sonar cone directions, sonar frame (x = axis)
     std::array<engine::Pose, 2> foot_from_world;  // this step's, computed on first use
@@ -109,6 +122,7 @@ class SensorSystem {
 
   void updateSonar(const engine::PhysicsWorld& physics);
   void restartDifferences(const engine::PhysicsWorld& physics, Robot& r);
+  // The scene the sonar rays (rays_, built first) are traced against.
   void buildScene(const engine::PhysicsWorld& physics);
 
   SensorSettings settings_;
