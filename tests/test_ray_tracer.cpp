@@ -9,7 +9,7 @@ using namespace simsoccer::engine;
 
 namespace {
 
-RayHit traceOne(const RayScene& scene, const Vec3f& origin, const Vec3f& dir, float range = 10.0f,
+RayHit traceOne(RayScene& scene, const Vec3f& origin, const Vec3f& dir, float range = 10.0f,
                 int32_t exclude = kNoOwner) {
   Ray r;
   r.origin = origin;

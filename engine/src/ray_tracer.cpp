@@ -340,13 +340,12 @@ size_t RayScene::primitiveCount() const {
   return spheres_.size() + capsules_.size() + boxes_.size() + cylinders_.size();
 }
 
-void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) const {
+void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) {
   // The blocks a ray could reach, worked out once for the rays that share its
   // origin, range and owner (a sonar's cone): a block further from the origin
   // than the range and its radius cannot pass the per-ray test below (the
   // margin keeps that so under rounding), so the hits are the same.
-  std::vector<uint32_t> near;
-  near.reserve(blocks_.size());
+  std::vector<uint32_t>& near = near_;
   const Ray* near_for = nullptr;
   for (size_t k = 0; k < rays.size(); ++k) {
     const Ray& ray = rays[k];

@@ -61,8 +61,9 @@ class RayScene {
   // spheres. Call after adding, before tracing.
   void finalize();
 
-  // hits[i] = the nearest hit of rays[i] within its max distance.
-  void trace(std::span<const Ray> rays, std::span<RayHit> hits) const;
+  // hits[i] = the nearest hit of rays[i] within its max distance. Not const:
+  // it keeps its scratch (no allocation once warm).
+  void trace(std::span<const Ray> rays, std::span<RayHit> hits);
   // Spheres, capsules, boxes and cylinders added since the last clear().
   size_t primitiveCount() const;
 
@@ -106,6 +107,7 @@ class RayScene {
     float radius = 0.0f;
   };
   std::vector<Block> blocks_;
+  std::vector<uint32_t> near_;  // trace's scratch: the blocks within the current rays' reach
 
   // The primitive a ray stopped on (to compute its normal once, at the end).
   enum class Kind : uint8_t { None, Ground, Sphere, Capsule, Box, Cylinder };
