@@ -345,18 +345,17 @@ void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) {
   // origin, range and owner (a sonar's cone): a block further from the origin
   // than the range and its radius cannot pass the per-ray test below (the
   // margin keeps that so under rounding), so the hits are the same.
-  std::vector<uint32_t>& near = near_;
   const Ray* near_for = nullptr;
   for (size_t k = 0; k < rays.size(); ++k) {
     const Ray& ray = rays[k];
     if (!near_for || ray.origin != near_for->origin || ray.max_distance != near_for->max_distance ||
         ray.exclude_owner != near_for->exclude_owner) {
-      near.clear();
+      near_.clear();
       for (uint32_t i = 0; i < blocks_.size(); ++i) {
         const Block& b = blocks_[i];
         if (b.owner != kNoOwner && b.owner == ray.exclude_owner) continue;
         const float reach = (ray.max_distance + b.radius) * 1.001f + 1e-4f;
-        if ((b.centre - ray.origin).squaredNorm() <= reach * reach) near.push_back(i);
+        if ((b.centre - ray.origin).squaredNorm() <= reach * reach) near_.push_back(i);
       }
       near_for = &ray;
     }
@@ -377,7 +376,7 @@ void RayScene::trace(std::span<const Ray> rays, std::span<RayHit> hits) {
       const float along = std::clamp(oc.dot(ray.direction), 0.0f, hit.distance);
       return (oc - along * ray.direction).squaredNorm() <= radius * radius;
     };
-    for (const uint32_t i : near) {
+    for (const uint32_t i : near_) {
       const Block& b = blocks_[i];
       if (!passes(b.centre, b.radius)) continue;
       for (uint32_t k = b.group_begin; k < b.group_end; ++k)

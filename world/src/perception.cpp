@@ -77,13 +77,14 @@ bool PerceptionSystem::blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3
   constexpr double kReach = kRadius + 0.01;
   const double x_lo = std::min(a.x(), b.x()) - kReach, x_hi = std::max(a.x(), b.x()) + kReach;
   const double y_lo = std::min(a.y(), b.y()) - kReach, y_hi = std::max(a.y(), b.y()) + kReach;
+  const Eigen::Vector2d d2(b.x() - a.x(), b.y() - a.y());
+  const double len2 = d2.squaredNorm();
   for (RobotId r = 0; r < torsos_.size(); ++r) {
     if (r == skip_a || r == skip_b) continue;
     const Vec3& c = torsos_[r];
     if (c.x() < x_lo || c.x() > x_hi || c.y() < y_lo || c.y() > y_hi) continue;
     // Closest approach in the ground plane along the segment.
-    const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y()), d2(b.x() - a.x(), b.y() - a.y());
-    const double len2 = d2.squaredNorm();
+    const Eigen::Vector2d a2(a.x() - c.x(), a.y() - c.y());
     const double t = len2 > 0 ? std::clamp(-a2.dot(d2) / len2, 0.0, 1.0) : 0.0;
     if ((a2 + t * d2).squaredNorm() > kRadius * kRadius) continue;
     const double z = a.z() + t * (b.z() - a.z());

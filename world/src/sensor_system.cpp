@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -83,23 +82,17 @@ double shapeReach(const engine::Shape& s) {
 
 // The furthest any collision shape of a body lies from its root link's frame,
 // whatever its joint angles: a joint turns its child about the child frame's
-// origin, so along each chain the joint offsets' lengths add up.
+// origin, so along each chain the joint offsets' lengths add up (the joints
+// come in tree order, parents first).
 double bodyReach(const engine::ArticulatedModel& body) {
   std::vector<double> to_link(body.links.size(), 0.0);
-  std::vector<bool> known(body.links.size(), false);
-  known[0] = true;
-  const std::function<double(size_t)> reach = [&](size_t link) -> double {
-    if (!known[link]) {
-      const engine::Joint& j = body.joints.at(link - 1);  // joints[i] moves link i + 1
-      to_link[link] = reach(static_cast<size_t>(j.parent_link)) + j.origin.norm();
-      known[link] = true;
-    }
-    return to_link[link];
-  };
+  for (const engine::Joint& j : body.joints)
+    to_link[static_cast<size_t>(j.child_link)] =
+        to_link[static_cast<size_t>(j.parent_link)] + j.origin.norm();
   double furthest = 0.0;
   for (size_t l = 0; l < body.links.size(); ++l)
     for (const engine::Shape& s : body.links[l].shapes)
-      furthest = std::max(furthest, reach(l) + s.pose.translation().norm() + shapeReach(s));
+      furthest = std::max(furthest, to_link[l] + s.pose.translation().norm() + shapeReach(s));
   return furthest;
 }
 

@@ -304,9 +304,8 @@ void World::moveRobot(RobotId r, double x, double y, double yaw) {
   moved.translation() = Vec3(x, y, torso.translation().z());
   moved.linear() =
       Eigen::AngleAxisd(yaw - heading, Vec3::UnitZ()).toRotationMatrix() * torso.linear();
-  std::vector<double> q(info.model->body->joints.size());
-  for (size_t j = 0; j < q.size(); ++j)
-    q[j] = physics_->jointPosition(info.body, static_cast<int>(j));
+  std::vector<double> q(model.body->joints.size());
+  physics_->readJoints(info.body, q, {}, {}, {}, {});
   // The servos keep their targets: the robot's controller goes on from where it was.
   physics_->resetArticulation(info.body, moved, q);
   sensors_->robotPlaced(*physics_, r);
