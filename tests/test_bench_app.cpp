@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "test_support.hpp"
 
@@ -213,6 +214,37 @@ TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsU
       test::runCommand(std::string(SIMSOCCER_BIN) + " bench motion --robot nao_h99 2>&1", status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--robot nao_h99"), std::string::npos) << out;
+}
+
+// A K1 kicks from the stance its steps leave (after four steps on the spot its feet stand 0.17 m
+// apart, not the gait's 0.19: kicked from the gait's stance it fell, the ball 0.4 m away) and
+// stays on its feet when the kick meets no ball (it fell before: the ball stops the leg).
+TEST(BenchMotionApp, TheBoosterK1KicksAfterSteppingAndStaysUpWhenItMisses) {
+  auto kick = [](const std::string& args) {
+    int status = 0;
+    const std::string out = test::runCommand(
+        std::string(SIMSOCCER_BIN) + " bench motion --robot booster_k1 --kick " + args + " 2>&1",
+        status);
+    EXPECT_EQ(status, 0) << out;
+    double distance = -1, direction = 0;
+    int fell = -1;
+    const size_t at = out.rfind("ball ");
+    EXPECT_NE(at, std::string::npos) << out;
+    if (at != std::string::npos) {
+      EXPECT_EQ(std::sscanf(out.c_str() + at, "ball %lf m at %lf deg, fell %d", &distance,
+                            &direction, &fell),
+                3)
+          << out;
+    }
+    return std::make_pair(distance, fell);
+  };
+  for (const char* foot : {"0", "1"}) {
+    const auto [distance, fell] = kick(std::string("--foot ") + foot + " --steps-first 3");
+    EXPECT_GE(distance, 4.0) << "foot " << foot;
+    EXPECT_EQ(fell, 0) << "foot " << foot;
+    EXPECT_EQ(kick(std::string("--foot ") + foot + " --ball-offset 0.5").second, 0)
+        << "foot " << foot << ", no ball in its way";
+  }
 }
 
 // The get-up tuning aids: another motions folder, the side-view snapshots

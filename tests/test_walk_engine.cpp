@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "simsoccer/agents/motion/gait.hpp"
+#include "simsoccer/agents/motion/kick_engine.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "test_support.hpp"
@@ -296,6 +297,76 @@ TEST(WalkEngine, PlannedZmpAgainstTheSupportPolygon) {
     EXPECT_GT(m.single_support, m.ticks / 2);
     EXPECT_GT(m.zmp_mean, 0.0);
     EXPECT_LE(m.zmp_outside, m.ticks / 5);  // measured: 6, 107, 23 and 61 of 549-599 ticks
+  }
+}
+
+// After walking a K1's feet stand a few cm off the gait's stance. The kick starts from where
+// they stand (its first targets keep the feet's measured offset: no push against the ground),
+// puts the kicking foot in the gait's stance while it is lifted and ends there. Without measured
+// angles, or with a foot off the ground, it starts from the gait's stance.
+TEST(KickEngine, StartsFromTheStanceTheFeetStandInAndEndsInTheGaitsStance) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  const agents::Gait gait = agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1");
+  const agents::WalkParameters& w = gait.walk;
+  agents::WalkEngine walk(model, w);  // for its kinematics
+  // The feet 0.17 m apart (not 0.19), the left one 1 cm ahead and turned 0.05 rad.
+  auto footAt = [&](double x, double y, double yaw) {
+    agents::Pose f = agents::Pose::Identity();
+    f.translation() = engine::Vec3(x, y, -w.ankle_height);
+    f.rotate(Eigen::AngleAxisd(yaw, engine::Vec3::UnitZ()));
+    return f;
+  };
+  const agents::LegSolution stood =
+      walk.kinematics().inverse(footAt(0.01, 0.085, 0.05), footAt(0.0, -0.085, 0.0));
+  ASSERT_LT(stood.position_error, 1e-4);
+  std::vector<double> measured = model.pose("stand");
+  walk.kinematics().writeTargets(stood, measured);
+  // The kicking (left) foot against the support (right) foot.
+  auto offset = [&](const std::vector<double>& q) {
+    const Feet f = feetOf(walk, q);
+    return agents::Pose(f.right.inverse() * f.left);
+  };
+  const double dt = 0.01;
+  agents::KickEngine kick(model, w, gait.kick);
+  std::vector<double> q = measured;
+  kick.start(Leg::Left, measured);
+  kick.update(dt, engine::Vec3::Zero(), q);
+  agents::Pose o = offset(q);
+  EXPECT_NEAR(o.translation().x(), 0.01, 1e-3);
+  EXPECT_NEAR(o.translation().y(), 0.17, 1e-3);
+  EXPECT_NEAR(std::atan2(o.rotation()(1, 0), o.rotation()(0, 0)), 0.05, 2e-3);
+  EXPECT_NEAR(o.translation().z(), 0.0, 1e-3);
+  // Drawn back and lifted, it is where a kick from the gait's stance has it.
+  agents::KickEngine nominal(model, w, gait.kick);
+  std::vector<double> nominal_q = measured;
+  nominal.start(Leg::Left);
+  nominal.update(dt, engine::Vec3::Zero(), nominal_q);
+  const agents::KickParameters& k = gait.kick;
+  for (double t = dt; t < k.shift_time + k.lift_time - 0.5 * dt; t += dt) {
+    kick.update(dt, engine::Vec3::Zero(), q);
+    nominal.update(dt, engine::Vec3::Zero(), nominal_q);
+  }
+  o = offset(q);
+  const agents::Pose lifted_nominal = offset(nominal_q);
+  EXPECT_LT((o.translation() - lifted_nominal.translation()).norm(), 1e-3);
+  EXPECT_LT(Eigen::AngleAxisd(o.rotation().transpose() * lifted_nominal.rotation()).angle(), 2e-3);
+  EXPECT_GT(o.translation().z(), 0.5 * k.lift);
+  while (kick.active()) kick.update(dt, engine::Vec3::Zero(), q);
+  o = offset(q);
+  EXPECT_NEAR(o.translation().x(), 0.0, 1e-3);
+  EXPECT_NEAR(o.translation().y(), w.step_width, 1e-3);
+  EXPECT_NEAR(o.translation().z(), 0.0, 1e-3);
+
+  // No measured angles, or the kicking foot 3 cm up: the gait's stance from the start.
+  const agents::LegSolution lifted = walk.kinematics().inverse(
+      footAt(0.0, 0.085, 0.0) * Eigen::Translation3d(0, 0, 0.03), footAt(0.0, -0.085, 0.0));
+  std::vector<double> lifted_q = model.pose("stand");
+  walk.kinematics().writeTargets(lifted, lifted_q);
+  for (const std::vector<double>& from : {std::vector<double>{}, lifted_q}) {
+    agents::KickEngine fresh(model, w, gait.kick);
+    fresh.start(Leg::Left, from);
+    fresh.update(dt, engine::Vec3::Zero(), q);
+    EXPECT_NEAR(offset(q).translation().y(), w.step_width, 1e-3);
   }
 }
 

@@ -15,16 +15,38 @@ struct Key {
   double shift, along, up, out, time;
 };
 
+// Both soles on the ground: the feet's frames within this height (m) and tilt (rad) of each other.
+constexpr double kFlatHeight = 0.01;
+constexpr double kFlatTilt = 0.05;
+
 }  // namespace
 
 KickEngine::KickEngine(const robots::RobotModel& model, const WalkParameters& stance,
                        const KickParameters& parameters)
     : kinematics_(model), stance_(stance), p_(parameters) {}
 
-void KickEngine::start(Leg foot) {
+void KickEngine::start(Leg foot, const std::vector<double>& joints) {
   foot_ = foot;
   t_ = 0.0;
   active_ = true;
+  const Leg support = foot == Leg::Left ? Leg::Right : Leg::Left;
+  const double side = foot == Leg::Left ? 1.0 : -1.0;
+  start_offset_ = Eigen::Vector3d(0.0, side * stance_.step_width, 0.0);
+  if (joints.empty()) return;
+  auto angles = [&](Leg leg) {
+    LegAngles q{};
+    for (size_t i = 0; i < q.size(); ++i)
+      q[i] = joints.at(static_cast<size_t>(kinematics_.joints(leg)[i]));
+    return q;
+  };
+  const Pose kicking = kinematics_.forward(foot, angles(foot));
+  const Pose rel = kinematics_.forward(support, angles(support)).inverse() * kicking;
+  // Both soles flat on the ground: the feet differ by a planar move. Otherwise (a foot lifted
+  // or tilted) the gait's stance.
+  const Vec3 up = rel.rotation().col(2);
+  if (std::abs(rel.translation().z()) > kFlatHeight || up.z() < std::cos(kFlatTilt)) return;
+  start_offset_ = Eigen::Vector3d(rel.translation().x(), rel.translation().y(),
+                                  std::atan2(rel.rotation()(1, 0), rel.rotation()(0, 0)));
 }
 
 double KickEngine::duration() const {
@@ -44,6 +66,8 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
   if (active_) t_ += dt;
   // Where in the keyframes we are.
   double shift = 0, along = 0, up = 0, outward = 0, t = t_;
+  bool both_feet_down = true;  // the kicking foot not yet lifted, or lowered again
+  double replaced = 1;         // the kicking foot's rest: 0 where it stood, 1 the gait's stance
   bool done = true;
   for (size_t k = 1; k < keys.size(); ++k) {
     if (t <= keys[k].time) {
@@ -53,25 +77,40 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
       along = keys[k - 1].along + a * (keys[k].along - keys[k - 1].along);
       up = keys[k - 1].up + a * (keys[k].up - keys[k - 1].up);
       outward = keys[k - 1].out + a * (keys[k].out - keys[k - 1].out);
+      // Put in the gait's stance while it is lifted, before the swing (the swing goes where the
+      // behaviour aimed, and the walk starts again from the stance it assumes).
+      replaced = k < 2 ? 0.0 : k == 2 ? smoothstep(t / keys[k].time) : 1.0;
+      both_feet_down = k <= 1 || k >= 6;
       done = false;
       break;
     }
     t -= keys[k].time;
   }
   if (done) active_ = false;
-  // The stance: feet side by side, the torso shifted towards the support foot.
+  // The stance: the support foot at its place in the gait's stance, the kicking foot where it
+  // stood until it is lifted, the torso from over the feet's middle shifted towards the support
+  // foot.
   const double side = foot_ == Leg::Left ? 1.0 : -1.0;  // the kicking foot's side
+  const double half = 0.5 * stance_.step_width;
+  const Eigen::Vector3d gait(0.0, side * stance_.step_width, 0.0);
+  const Eigen::Vector3d rest = start_offset_ + replaced * (gait - start_offset_);
+  const Eigen::Vector3d middle(0.5 * rest.x(), -side * half + 0.5 * rest.y(), 0.5 * rest.z());
   Pose torso = Pose::Identity();
-  torso.translation() = Vec3(stance_.torso_offset, -side * shift * p_.shift, stance_.ankle_height);
+  torso.translation() =
+      Vec3(stance_.torso_offset + (1 - shift) * middle.x(),
+           (1 - shift) * middle.y() - side * shift * p_.shift, stance_.ankle_height);
+  torso.rotate(Eigen::AngleAxisd((1 - shift) * middle.z(), Vec3::UnitZ()));
   const Pose inv = torso.inverse();
-  auto foot = [&](double y, double dx, double dz) {
+  auto foot = [&](double x, double y, double yaw, double dz) {
     Pose f = Pose::Identity();
-    f.translation() = Vec3(dx, y, dz);
+    f.translation() = Vec3(x, y, dz);
+    f.rotate(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
     return inv * f;
   };
-  const double half = 0.5 * stance_.step_width;
-  const Pose kicking = foot(side * (half + outward * p_.swing_out), along, up);
-  const Pose support = foot(-side * half, 0.0, 0.0);
+  // Along the support foot (the aim), out sideways from it.
+  const Pose kicking =
+      foot(rest.x() + along, -side * half + rest.y() + side * outward * p_.swing_out, rest.z(), up);
+  const Pose support = foot(0.0, -side * half, 0.0, 0.0);
   const LegSolution s = foot_ == Leg::Left
                             ? kinematics_.inverse(kicking, support, have_last_ ? &last_ : nullptr)
                             : kinematics_.inverse(support, kicking, have_last_ ? &last_ : nullptr);
@@ -84,6 +123,11 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
   sq[at(LegJoint::HipRoll)] += (foot_ == Leg::Left ? -1.0 : 1.0) * p_.hip_roll_compensation * shift;
   sq[at(LegJoint::AnklePitch)] += stance_.ankle_pitch_gyro * gyro.y();
   sq[at(LegJoint::AnkleRoll)] += stance_.ankle_roll_gyro * gyro.x();
+  if (both_feet_down) {  // standing on both: both ankles, as the walk's stance
+    LegAngles& kq = foot_ == Leg::Left ? out.left : out.right;
+    kq[at(LegJoint::AnklePitch)] += stance_.ankle_pitch_gyro * gyro.y();
+    kq[at(LegJoint::AnkleRoll)] += stance_.ankle_roll_gyro * gyro.x();
+  }
   kinematics_.writeTargets(out, targets);
 }
 

@@ -131,20 +131,17 @@ void MotionController::easeIntoStance() {
   enter(MotionState::Easing);
 }
 
-void MotionController::measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const {
-  const auto& joints = model_.body->joints;
-  // A frame from before the first control period carries no joint angles
-  // (all zero): read it as the stand pose the robot was placed in.
-  if (std::all_of(sensors.position.begin(), sensors.position.end(),
-                  [](float v) { return v == 0.0f; })) {
-    q = model_.pose("stand");
+void measuredJointAngles(const robots::RobotModel& model, std::span<const float> position,
+                         std::vector<double>& q) {
+  if (std::all_of(position.begin(), position.end(), [](float v) { return v == 0.0f; })) {
+    q = model.pose("stand");
     return;
   }
-  q.assign(joints.size(), 0.0);
-  for (size_t a = 0; a < model_.actuators.size() && a < sensors.position.size(); ++a)
-    if (model_.actuators[a].kind == robots::Actuator::Kind::Joint)
-      q[static_cast<size_t>(model_.actuators[a].index)] = sensors.position[a];
-  model_.body->applyMimic(q);
+  q.assign(model.body->joints.size(), 0.0);
+  for (size_t a = 0; a < model.actuators.size() && a < position.size(); ++a)
+    if (model.actuators[a].kind == robots::Actuator::Kind::Joint)
+      q[static_cast<size_t>(model.actuators[a].index)] = position[a];
+  model.body->applyMimic(q);
 }
 
 void MotionController::update(double dt, const MotionSensors& sensors, const MotionRequest& request,
@@ -157,7 +154,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   const double rate = sensors.gyro.norm();
   state_time_ += dt;
   std::vector<double> measured;
-  measuredJoints(sensors, measured);
+  measuredJointAngles(model_, sensors.position, measured);
 
   if (restart_) restartFrom(measured);
   if (placedOnItsFeet(sensors, measured, rate)) {
@@ -205,7 +202,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       standing_for_ = state_ == MotionState::Stance && !walk_.walking() ? standing_for_ + dt : 0.0;
       if (request.kind == MotionRequest::Kind::Kick && state_ == MotionState::Stance &&
           !walk_.walking() && standing_for_ >= kick_parameters_.ready_time - 1e-9) {
-        kick_.start(request.kick_foot);
+        kick_.start(request.kick_foot, measured);
         ++counters_.kicks;
         enter(MotionState::Kicking);
         kick_.update(dt, sensors.gyro, targets_);

@@ -76,14 +76,19 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
     for (int i = 0; i < static_cast<int>(std::lround(c.kick.ready_time / dt)); ++i) t.period();
     t.driver.setControl({});
   }
+  // In front of where the kicking foot swings: beside the support foot, in the gait's stance.
   const int foot_link = engine.kinematics().footLink(foot);
-  const Vec3 f = w.linkPose(0, foot_link).translation();
+  const agents::Leg support = foot == agents::Leg::Left ? agents::Leg::Right : agents::Leg::Left;
+  const Vec3 f = w.linkPose(0, engine.kinematics().footLink(support)) *
+                 Vec3(0.0, (foot == agents::Leg::Left ? 1.0 : -1.0) * c.walk.step_width, 0.0);
   engine::RigidBodyState b;
   b.pose.translation() = Vec3(f.x() + toe(model, foot_link) + w.field().ball.radius + gap,
                               f.y() + ball_offset, w.field().ball.radius);
   w.setBallState(b);
   const Vec3 start = b.pose.translation();
-  engine.start(foot);
+  std::vector<double> measured;
+  agents::measuredJointAngles(model, w.sensorFrame(0).position, measured);
+  engine.start(foot, measured);
   KickResult r;
   const double dt = t.dt();
   t.driver.setControl([&](const world::World& world, std::span<float> p, std::span<float> k) {

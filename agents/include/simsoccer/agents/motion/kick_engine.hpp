@@ -53,8 +53,14 @@ class KickEngine {
   KickEngine(const robots::RobotModel& model, const WalkParameters& stance = {},
              const KickParameters& parameters = {});
 
-  // Starts a kick with `foot`.
-  void start(Leg foot);
+  // Starts a kick with `foot` from the stance the robot stands in: `joints`, the measured
+  // joint angles (body joint order, mimics applied), place the kicking foot against the
+  // support foot. After walking the feet stand a few cm off the gait's stance (a K1 after four
+  // steps on the spot: 0.17 m apart, not 0.19), and kicking from the gait's stance pushed the
+  // legs against the ground. The support foot stays where it stands; the kicking foot is put
+  // in the gait's stance while it is lifted. Without joints (or with a foot off the ground):
+  // the gait's stance.
+  void start(Leg foot, const std::vector<double>& joints = {});
   bool active() const { return active_; }
   double duration() const;
   const LegKinematics& kinematics() const { return kinematics_; }
@@ -68,6 +74,9 @@ class KickEngine {
   bool active_ = false;
   Leg foot_ = Leg::Right;
   double t_ = 0.0;
+  // The kicking foot against the support foot at the start (x, y, yaw in the support foot's
+  // frame; the gait's stance: 0, +-step_width, 0).
+  Eigen::Vector3d start_offset_ = Eigen::Vector3d::Zero();
   LegSolution last_{};
   bool have_last_ = false;
 };

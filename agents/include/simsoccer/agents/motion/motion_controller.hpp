@@ -47,6 +47,12 @@ struct MotionSensors {
   double yaw = 0.0;
 };
 
+// The body's joint angles (body joint order, mimics applied) from the encoders (actuator order).
+// A frame from before the first control period carries none (all zero): read as the stand pose
+// the robot was placed in.
+void measuredJointAngles(const robots::RobotModel& model, std::span<const float> position,
+                         std::vector<double>& q);
+
 struct FallDetectorParameters {
   double falling_tilt = 0.65;    // rad from upright: the robot is falling
   double lying_tilt = 1.0;       // rad: it lies ...
@@ -133,7 +139,6 @@ class MotionController {
   void standUp(const std::vector<double>& measured);
   // After a keyframe motion that ends on the feet: ease into a fresh walk's stance.
   void easeIntoStance();
-  void measuredJoints(const MotionSensors& sensors, std::vector<double>& q) const;
   // Drops whatever motion runs and eases into the stance from `measured`
   // (sitting: stands up first).
   void restartFrom(const std::vector<double>& measured);
