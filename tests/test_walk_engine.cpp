@@ -370,6 +370,37 @@ TEST(KickEngine, StartsFromTheStanceTheFeetStandInAndEndsInTheGaitsStance) {
   }
 }
 
+// After its keyframes the kick holds the stance until the torso has turned slower than
+// calm_rate for calm_time, at most calm_wait longer; with calm_rate 0 it ends with its keyframes.
+TEST(KickEngine, HoldsTheStanceUntilTheTorsoIsCalm) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  agents::Gait gait = agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1");
+  gait.kick.calm_rate = 0.25;
+  gait.kick.calm_time = 0.3;
+  gait.kick.calm_wait = 2.0;
+  const double dt = 0.01;
+  // Seconds the kick lasts with the torso rocking (1 rad/s) until `rocking` s after the start.
+  auto lasts = [&](const agents::KickParameters& k, double rocking) {
+    agents::KickEngine kick(model, gait.walk, k);
+    std::vector<double> q = model.pose("stand");
+    kick.start(Leg::Right);
+    double t = 0.0;
+    while (kick.active() && t < 20.0) {
+      kick.update(dt, engine::Vec3(t < rocking ? 1.0 : 0.0, 0.0, 0.0), q);
+      t += dt;
+    }
+    return t;
+  };
+  agents::KickEngine reference(model, gait.walk, gait.kick);
+  const double keys = reference.duration();
+  EXPECT_NEAR(lasts(gait.kick, 0.0), keys, 1.5 * dt);  // calm throughout
+  EXPECT_NEAR(lasts(gait.kick, keys + 0.5), keys + 0.5 + 0.3, 1.5 * dt);
+  EXPECT_NEAR(lasts(gait.kick, 100.0), keys + 2.0, 1.5 * dt);  // rocking for good
+  agents::KickParameters no_wait = gait.kick;
+  no_wait.calm_rate = 0.0;
+  EXPECT_NEAR(lasts(no_wait, 100.0), keys, 1.5 * dt);
+}
+
 TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
   test::TempDir dir("gait");
   EXPECT_EQ(agents::loadGaitIn(dir.path()).walk.step_period, agents::WalkParameters{}.step_period);

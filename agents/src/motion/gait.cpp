@@ -87,6 +87,9 @@ const std::vector<Field<KickParameters>>& kickFields() {
       {"return_time", &K::return_time, Range::Positive},
       {"settle_time", &K::settle_time, Range::NonNegative},
       {"ready_time", &K::ready_time, Range::NonNegative},
+      {"calm_rate", &K::calm_rate, Range::NonNegative},
+      {"calm_time", &K::calm_time, Range::NonNegative},
+      {"calm_wait", &K::calm_wait, Range::NonNegative},
       {"hip_roll_compensation", &K::hip_roll_compensation, Range::Any},
       {"swing_height", &K::swing_height, Range::Any},
       {"swing_out", &K::swing_out, Range::Any}};

@@ -28,6 +28,7 @@ KickEngine::KickEngine(const robots::RobotModel& model, const WalkParameters& st
 void KickEngine::start(Leg foot, const std::vector<double>& joints) {
   foot_ = foot;
   t_ = 0.0;
+  calm_for_ = 0.0;
   active_ = true;
   const Leg support = foot == Leg::Left ? Leg::Right : Leg::Left;
   const double side = foot == Leg::Left ? 1.0 : -1.0;
@@ -86,7 +87,11 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
     }
     t -= keys[k].time;
   }
-  if (done) active_ = false;
+  // Done with the keyframes: holding the stance until the torso is calm.
+  calm_for_ = gyro.norm() < p_.calm_rate ? calm_for_ + dt : 0.0;
+  if (done && (p_.calm_rate <= 0.0 || calm_for_ >= p_.calm_time - 1e-9 ||
+               t_ >= duration() + p_.calm_wait - 1e-9))
+    active_ = false;
   // The stance: the support foot at its place in the gait's stance, the kicking foot where it
   // stood until it is lifted, the torso from over the feet's middle shifted towards the support
   // foot.

@@ -85,7 +85,10 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-hip-roll", &kp.hip_roll_compensation},
       {"kick-swing-height", &kp.swing_height},
       {"kick-swing-out", &kp.swing_out},
-      {"kick-ready-time", &kp.ready_time}};
+      {"kick-ready-time", &kp.ready_time},
+      {"kick-calm-rate", &kp.calm_rate},
+      {"kick-calm-time", &kp.calm_time},
+      {"kick-calm-wait", &kp.calm_wait}};
   std::vector<std::string> valued{"robot",
                                   "bench",
                                   "seconds",

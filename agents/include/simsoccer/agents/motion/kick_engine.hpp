@@ -31,6 +31,13 @@ struct KickParameters {
   // s held in the stance after the kick before the robot may walk again (a K1 that walked off
   // at once after its kick fell now and then; the Nao needs none).
   double settle_time = 0.0;
+  // After settle_time the kick holds the stance until the torso turns slower than calm_rate
+  // (rad/s, gyroscope) for calm_time (s), at most calm_wait (s) longer: a K1 that walked off
+  // while it still rocked from its kick (0.16 rad of roll each way, 1.3 s a swing) rocked further
+  // with the walk's sway and fell. 0: no wait (the Nao needs none).
+  double calm_rate = 0.0;
+  double calm_time = 0.3;
+  double calm_wait = 2.0;
   // s standing in the stance, the walk stopped, before a requested kick starts (the robot still
   // sways from its last steps; the Nao needs none).
   double ready_time = 0.0;
@@ -74,6 +81,7 @@ class KickEngine {
   bool active_ = false;
   Leg foot_ = Leg::Right;
   double t_ = 0.0;
+  double calm_for_ = 0.0;  // s the torso has turned slower than calm_rate
   // The kicking foot against the support foot at the start (x, y, yaw in the support foot's
   // frame; the gait's stance: 0, +-step_width, 0).
   Eigen::Vector3d start_offset_ = Eigen::Vector3d::Zero();
