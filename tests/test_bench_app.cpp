@@ -216,7 +216,7 @@ TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsU
   EXPECT_NE(out.find("--robot nao_h99"), std::string::npos) << out;
 }
 
-// A K1 kicks from the stance its steps leave (after four steps on the spot its feet stand 0.17 m
+// A K1 kicks from the stance its steps leave (after three steps on the spot its feet stand 0.17 m
 // apart, not the gait's 0.19: kicked from the gait's stance it fell, the ball 0.4 m away) and
 // stays on its feet when the kick meets no ball (it fell before: the ball stops the leg).
 TEST(BenchMotionApp, TheBoosterK1KicksAfterSteppingAndStaysUpWhenItMisses) {

@@ -27,12 +27,13 @@ const char* kHelp =
     "  --bench FILE  another such file\n"
     "With --vx/--vy/--turn: one walk at that command; with --kick [--foot 0|1] [--ball-offset M] "
     "[--ball-gap M] [--steps-first N]:\n"
-    "one kick; both for tuning, with any parameter of agents::WalkParameters / KickParameters\n"
-    "by name (--sway, --lift, --period, --torso-offset, --height, --ankle-pitch-gyro,\n"
-    "--ankle-roll-gyro, --gyro-smoothing, --forward-scale, --max-forward, --max-turn,\n"
-    "--max-turn-accel, --lean, --hip-roll, --heading-gain, --kick-reach, --kick-swing,\n"
-    "--kick-shift, --kick-lift, --kick-draw-back, --kick-hip-roll, --kick-swing-height,\n"
-    "--kick-swing-out, --kick-ready-time).\n"
+    "one kick (from the stance the feet stand in, the ball in front of where the kicking foot\n"
+    "swings: beside the support foot in the gait's stance); both for tuning, with any parameter\n"
+    "of agents::WalkParameters / KickParameters by name (--sway, --lift, --period,\n"
+    "--torso-offset, --height, --ankle-pitch-gyro, --ankle-roll-gyro, --gyro-smoothing,\n"
+    "--forward-scale, --max-forward, --max-turn, --max-turn-accel, --lean, --hip-roll,\n"
+    "--heading-gain, --kick-reach, --kick-swing, --kick-shift, --kick-lift, --kick-draw-back,\n"
+    "--kick-hip-roll, --kick-swing-height, --kick-swing-out, --kick-ready-time).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --random [--random-minutes M] [--seed N] [--verbose]: the random-commands trial alone.\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
@@ -85,10 +86,7 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-hip-roll", &kp.hip_roll_compensation},
       {"kick-swing-height", &kp.swing_height},
       {"kick-swing-out", &kp.swing_out},
-      {"kick-ready-time", &kp.ready_time},
-      {"kick-calm-rate", &kp.calm_rate},
-      {"kick-calm-time", &kp.calm_time},
-      {"kick-calm-wait", &kp.calm_wait}};
+      {"kick-ready-time", &kp.ready_time}};
   std::vector<std::string> valued{"robot",
                                   "bench",
                                   "seconds",

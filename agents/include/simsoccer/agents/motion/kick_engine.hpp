@@ -62,7 +62,7 @@ class KickEngine {
 
   // Starts a kick with `foot` from the stance the robot stands in: `joints`, the measured
   // joint angles (body joint order, mimics applied), place the kicking foot against the
-  // support foot. After walking the feet stand a few cm off the gait's stance (a K1 after four
+  // support foot. After walking the feet stand a few cm off the gait's stance (a K1 after three
   // steps on the spot: 0.17 m apart, not 0.19), and kicking from the gait's stance pushed the
   // legs against the ground. The support foot stays where it stands; the kicking foot is put
   // in the gait's stance while it is lifted. Without joints (or with a foot off the ground):
