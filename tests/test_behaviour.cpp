@@ -827,6 +827,41 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
   EXPECT_EQ(mc.state(), agents::MotionState::Stance);
 }
 
+// Penalised in the middle of a get-up: the referee sets the robot down upright on the touchline
+// and the agent restarts its motion in the same period (the GameState's penalty). The fall
+// detector restarts from the IMU too: no fall is read from the get-up's filtered tilt (before:
+// it read one, went soft for a moment and sagged, and a K1 then tipped over backwards).
+TEST(MotionController, ARestartAsTheRefereeSetsTheRobotDownIsNotAFall) {
+  world::World w(test::scenario(1));
+  agents::FallDetectorParameters fall;
+  fall.get_up = true;
+  agents::MotionController mc =
+      agents::loadMotionController(*w.robot(0).model, test::sourceDir() / "configs/motions", fall);
+  std::vector<float> position(25), stiffness(25);
+  MotionRequest request;
+  auto period = [&] { controlPeriod(w, mc, request, position, stiffness); };
+  for (int i = 0; i < 100; ++i) period();
+  engine::Pose lying = engine::Pose::Identity();
+  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // on its front
+  lying.translation() = Vec3(-2.0, 0.0, 0.16);
+  w.placeRobot(0, lying, "stand");
+  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
+  ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
+  for (int i = 0; i < 50; ++i) period();
+  const int falls = mc.counters().falls;
+  w.placeRobot(0, -2.0, 3.5, -M_PI / 2);
+  mc.restart();
+  std::set<agents::MotionState> states;
+  for (int i = 0; i < 300; ++i) {
+    period();
+    states.insert(mc.state());
+  }
+  EXPECT_EQ(mc.counters().falls, falls);
+  EXPECT_FALSE(states.count(agents::MotionState::Falling));
+  EXPECT_EQ(mc.state(), agents::MotionState::Stance);
+  EXPECT_TRUE(w.isStanding(0));
+}
+
 TEST(MatchLog, RoundTripsFramesAndSurvivesATruncatedTail) {
   world::World w(test::scenario(2));
   const test::TempDir dir("match_log");

@@ -618,3 +618,35 @@ TEST(SensorFrame, StampedWithSimulationTime) {
   EXPECT_EQ(w.sensorFrame(0).tick, 7u);
   EXPECT_NEAR(w.sensorFrame(0).time, 0.07, 1e-12);
 }
+
+// A referee places robots after the step: the frame the agents read next describes the robot
+// as placed (encoders, IMU angles and the accelerometer at rest), not where it was a moment ago.
+TEST(Sensors, TheFrameDescribesARobotAsPlaced) {
+  world::World w(test::scenario(1));
+  for (int i = 0; i < 50; ++i) w.stepControlPeriod();
+  const robots::RobotModel& model = *w.robot(0).model;
+  engine::Pose lying = engine::Pose::Identity();
+  lying.linear() = Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                   Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  lying.translation() = Eigen::Vector3d(1.0, 2.0, 0.2);
+  w.placeRobot(0, lying, "stand");
+  const world::SensorFrame& f = w.sensorFrame(0);
+  EXPECT_NEAR(f.angles[1], M_PI / 2, 1e-3);  // on its front
+  EXPECT_NEAR(f.accelerometer[0], -9.81, 0.05);
+  EXPECT_NEAR(f.accelerometer[2], 0.0, 0.05);
+  w.placeRobot(0, 1.0, 2.0, 0.8);  // upright, in the stand pose
+  EXPECT_NEAR(f.angles[0], 0.0, 1e-3);
+  EXPECT_NEAR(f.angles[1], 0.0, 1e-3);
+  EXPECT_NEAR(f.angles[2], 0.8, 1e-3);
+  EXPECT_NEAR(f.accelerometer[2], 9.81, 0.05);
+  const double resolution =
+      2.0 * std::numbers::pi / static_cast<double>(1 << model.sensor_spec.encoder_bits);
+  const std::vector<double>& stand = model.pose("stand");
+  for (size_t a = 0; a < model.actuators.size(); ++a) {
+    if (model.actuators[a].kind != robots::Actuator::Kind::Joint) continue;
+    EXPECT_NEAR(f.position[a], stand[static_cast<size_t>(model.actuators[a].index)], resolution)
+        << a;
+    EXPECT_EQ(f.velocity[a], 0.0f) << a;
+  }
+  for (size_t k = 0; k < 3; ++k) EXPECT_NEAR(f.gyroscope[k], 0.0, 0.02);
+}

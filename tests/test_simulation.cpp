@@ -154,6 +154,34 @@ TEST(Simulation, APendingAnswerOfAFreedRobotIsNotApplied) {
   EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0], ScriptedSource::headYaw(2));
 }
 
+// A robot placed or moved after the frame an answer was computed from is no longer where that
+// answer was meant for: the answer is not applied (the robot holds what it was placed with), not
+// counted as missed, and the answers to frames after the move act again. Serial answers are
+// computed after any move and act.
+TEST(Simulation, AnAnswerToAFrameFromBeforeTheRobotWasMovedIsNotApplied) {
+  for (const sim::Mode mode : {sim::Mode::Pipelined, sim::Mode::Serial}) {
+    world::World w(test::scenario(2));
+    sim::Simulation simulation(w, modeConfig(mode));
+    Trace trace;
+    ScriptedSource source(w, trace);
+    simulation.addSource(source);
+    simulation.period();
+    simulation.period();
+    ASSERT_TRUE(simulation.commandApplied(0));
+    const uint64_t placed = w.placements(0);
+    w.placeRobot(0, -1.0, 0.5, 0.0);  // as a referee between periods
+    EXPECT_EQ(w.placements(0), placed + 1);
+    simulation.period();
+    EXPECT_EQ(simulation.commandApplied(0), mode == sim::Mode::Serial);
+    EXPECT_TRUE(simulation.commandApplied(1));  // the other robot was not moved
+    EXPECT_EQ(simulation.commandStats(0).missed, 0u);
+    simulation.period();
+    EXPECT_TRUE(simulation.commandApplied(0));
+    EXPECT_DOUBLE_EQ(simulation.appliedCommand(0).position[0],
+                     ScriptedSource::headYaw(mode == sim::Mode::Serial ? 3 : 2));
+  }
+}
+
 TEST(Simulation, PipelinedModeIsDeterministicAndDiffersFromSerial) {
   // The built-in agents in this process: a striker and a keeper playing.
   const auto run = [](sim::Mode mode) {

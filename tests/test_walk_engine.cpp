@@ -370,6 +370,55 @@ TEST(KickEngine, StartsFromTheStanceTheFeetStandInAndEndsInTheGaitsStance) {
   }
 }
 
+// A robot the referee moved mid-step stands with one foot ahead. The walk takes the feet where
+// they stand (standing keeps them there: no sliding them on the carpet) and its first steps put
+// them in the gait's stance; with a foot off the ground it keeps the gait's stance.
+TEST(WalkEngine, StandsWhereTheFeetAreAndStepsIntoItsStance) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  const agents::WalkParameters w =
+      agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1").walk;
+  agents::WalkEngine e(model, w);
+  auto footAt = [&](double x, double y, double yaw, double z = 0.0) {
+    agents::Pose f = agents::Pose::Identity();
+    f.translation() = engine::Vec3(x, y, z - w.ankle_height);
+    f.rotate(Eigen::AngleAxisd(yaw, engine::Vec3::UnitZ()));
+    return f;
+  };
+  auto jointsFor = [&](const agents::Pose& left, const agents::Pose& right) {
+    std::vector<double> q = model.pose("stand");
+    e.kinematics().writeTargets(e.kinematics().inverse(left, right), q);
+    return q;
+  };
+  // The left foot against the right one in `q`'s targets.
+  auto leftAgainstRight = [&](const std::vector<double>& q) {
+    const Feet f = feetOf(e, q);
+    const agents::Pose rel = f.right.inverse() * f.left;
+    return engine::Vec3(rel.translation().x(), rel.translation().y(),
+                        std::atan2(rel.linear()(1, 0), rel.linear()(0, 0)));
+  };
+  // Mid-step: the left foot 6 cm ahead, 0.18 m to the side, turned 0.1 rad.
+  std::vector<double> q = jointsFor(footAt(0.03, 0.09, 0.1), footAt(-0.03, -0.09, 0.0));
+  agents::WalkEngine walk(model, w);
+  walk.standWhereTheFeetAre(q);
+  std::vector<double> targets = q;
+  for (int i = 0; i < 10; ++i) walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.06, 0.18, 0.1)).norm(), 2e-3);
+  // A few steps on the spot, then stopped: side by side in the gait's stance.
+  walk.setVelocity(0.0, 0.0, 0.0);
+  for (int i = 0; i < 200; ++i) walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  walk.stop();
+  for (int i = 0; i < 300 && walk.walking(); ++i)
+    walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  ASSERT_FALSE(walk.walking());
+  walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.0, w.step_width, 0.0)).norm(), 2e-3);
+  // The left foot 3 cm up: the gait's stance.
+  agents::WalkEngine lifted(model, w);
+  lifted.standWhereTheFeetAre(jointsFor(footAt(0.0, 0.09, 0.0, 0.03), footAt(0.0, -0.09, 0.0)));
+  lifted.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.0, w.step_width, 0.0)).norm(), 2e-3);
+}
+
 // After its keyframes the kick holds the stance until the torso has turned slower than
 // calm_rate for calm_time, at most calm_wait longer; with calm_rate 0 it ends with its keyframes.
 TEST(KickEngine, HoldsTheStanceUntilTheTorsoIsCalm) {

@@ -28,6 +28,8 @@ Simulation::Simulation(world::World& world, const SimulationConfig& config)
       gate_(world, config.position_margin),
       due_(world.robotCount()),
       collected_(world.robotCount()),
+      observed_placements_(world.robotCount(), 0),
+      due_placements_(world.robotCount(), 0),
       applied_(world.robotCount()),
       commanded_(world.robotCount(), false),
       accepted_(world.robotCount(), 0),
@@ -106,6 +108,8 @@ void Simulation::observe(uint64_t tick) {
   o.world = &world_;
   o.perception = perception_.get();
   o.actuation_delay = config_.mode == Mode::Pipelined ? 1 : 0;
+  for (world::RobotId r = 0; r < world_.robotCount(); ++r)
+    observed_placements_[r] = world_.placements(r);
   if (game_) {
     o.game = &*game_;
     o.left_team = officials_->leftTeam();
@@ -117,6 +121,7 @@ void Simulation::collect(uint64_t tick) {
   for (CommandSlot& s : collected_) s.answer = Answer::None;
   for (CommandSource* s : sources_) s->collect(tick, gate_, collected_);
   std::swap(collected_, due_);  // the answers the next apply() takes
+  due_placements_ = observed_placements_;
 }
 
 void Simulation::apply() {
@@ -125,6 +130,7 @@ void Simulation::apply() {
     const CommandSlot& s = due_[r];
     if (s.answer == Answer::Missed) ++missed_[r];
     if (s.answer != Answer::Given) continue;
+    if (world_.placements(r) != due_placements_[r]) continue;  // answers a robot since moved
     // The command holds kActuators slots; the robot uses its own count of them.
     const size_t n = world_.robot(r).model->actuators.size();
     const RobotCommand& c = s.command;

@@ -272,7 +272,29 @@ void SensorSystem::restartDifferences(const engine::PhysicsWorld& physics, Robot
 }
 
 void SensorSystem::robotPlaced(const engine::PhysicsWorld& physics, size_t robot) {
-  restartDifferences(physics, robots_.at(robot));
+  Robot& r = robots_.at(robot);
+  restartDifferences(physics, r);
+  // The instantaneous readings of the robot as placed, at rest (no noise drawn: the
+  // period's readings keep their sequence).
+  SensorFrame& f = frames_.at(robot);
+  const auto& spec = r.model->sensor_spec;
+  const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+  for (const JointMotor& m : r.joint_motors) {
+    const double q = r.last_position[m.actuator];
+    f.position[m.actuator] = static_cast<float>(std::round(q / resolution) * resolution);
+    f.velocity[m.actuator] = 0.0f;
+  }
+  const engine::Mat3& R = physics.linkPose(r.body, 0).linear();
+  const Vec3 accel = R.transpose() * -physics.settings().gravity;
+  const double angles[3] = {std::atan2(R(2, 1), R(2, 2)),
+                            std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
+                            std::atan2(R(1, 0), R(0, 0))};
+  for (size_t k = 0; k < 3; ++k) {
+    f.accelerometer[k] =
+        clampAbs(accel[static_cast<int>(k)] + settings_.accel_bias[k], spec.accel_range);
+    f.gyroscope[k] = clampAbs(settings_.gyro_bias[k], spec.gyro_range);
+    f.angles[k] = static_cast<float>(angles[k]);
+  }
 }
 
 void SensorSystem::afterStep(const engine::PhysicsWorld& physics,

@@ -146,6 +146,7 @@ World::World(const Scenario& scenario) : scenario_(scenario) {
     info.body = physics_->addArticulation(model->body, standingTorso(*model, q, x, y, yaw), q,
                                           static_cast<int>(i));
     robots_.push_back(info);
+    placements_.push_back(0);
     holdJoints(static_cast<RobotId>(i), q, 1.0);  // until commanded otherwise
   }
   initSensors();
@@ -280,6 +281,7 @@ void World::placeRobot(RobotId r, const Pose& torso, const std::string& posture)
   physics_->resetArticulation(info.body, torso, q);
   holdJoints(r, q, 1.0);
   sensors_->robotPlaced(*physics_, r);
+  ++placements_.at(r);
 }
 
 void World::moveRobot(RobotId r, double x, double y, double yaw) {
@@ -309,6 +311,7 @@ void World::moveRobot(RobotId r, double x, double y, double yaw) {
   // The servos keep their targets: the robot's controller goes on from where it was.
   physics_->resetArticulation(info.body, moved, q);
   sensors_->robotPlaced(*physics_, r);
+  ++placements_.at(r);
 }
 
 bool World::isStanding(RobotId r, double min_height, double max_tilt) const {

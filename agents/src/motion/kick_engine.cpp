@@ -15,10 +15,6 @@ struct Key {
   double shift, along, up, out, time;
 };
 
-// Both soles on the ground: the feet's frames within this height (m) and tilt (rad) of each other.
-constexpr double kFlatHeight = 0.01;
-constexpr double kFlatTilt = 0.05;
-
 }  // namespace
 
 KickEngine::KickEngine(const robots::RobotModel& model, const WalkParameters& stance,
@@ -34,20 +30,7 @@ void KickEngine::start(Leg foot, const std::vector<double>& joints) {
   const double side = foot == Leg::Left ? 1.0 : -1.0;
   start_offset_ = Eigen::Vector3d(0.0, side * stance_.step_width, 0.0);
   if (joints.empty()) return;
-  auto angles = [&](Leg leg) {
-    LegAngles q{};
-    for (size_t i = 0; i < q.size(); ++i)
-      q[i] = joints.at(static_cast<size_t>(kinematics_.joints(leg)[i]));
-    return q;
-  };
-  const Pose kicking = kinematics_.forward(foot, angles(foot));
-  const Pose rel = kinematics_.forward(support, angles(support)).inverse() * kicking;
-  // Both soles flat on the ground: the feet differ by a planar move. Otherwise (a foot lifted
-  // or tilted) the gait's stance.
-  const Vec3 up = rel.rotation().col(2);
-  if (std::abs(rel.translation().z()) > kFlatHeight || up.z() < std::cos(kFlatTilt)) return;
-  start_offset_ = Eigen::Vector3d(rel.translation().x(), rel.translation().y(),
-                                  std::atan2(rel.rotation()(1, 0), rel.rotation()(0, 0)));
+  if (const auto stood = kinematics_.footAgainst(foot, support, joints)) start_offset_ = *stood;
 }
 
 double KickEngine::duration() const {

@@ -89,6 +89,22 @@ LegKinematics::LegKinematics(const robots::RobotModel& model) {
   }
 }
 
+std::optional<Eigen::Vector3d> LegKinematics::footAgainst(
+    Leg foot, Leg other, const std::vector<double>& body_angles) const {
+  constexpr double kFlatHeight = 0.01, kFlatTilt = 0.05;  // m, rad
+  auto angles = [&](Leg leg) {
+    LegAngles q{};
+    for (size_t i = 0; i < q.size(); ++i)
+      q[i] = body_angles.at(static_cast<size_t>(joints(leg)[i]));
+    return q;
+  };
+  const Pose rel = forward(other, angles(other)).inverse() * forward(foot, angles(foot));
+  if (std::abs(rel.translation().z()) > kFlatHeight || rel.linear()(2, 2) < std::cos(kFlatTilt))
+    return std::nullopt;
+  return Eigen::Vector3d(rel.translation().x(), rel.translation().y(),
+                         std::atan2(rel.linear()(1, 0), rel.linear()(0, 0)));
+}
+
 Pose LegKinematics::forward(Leg leg, const LegAngles& q) const {
   const Chain& c = legs_[static_cast<size_t>(leg)];
   Pose t = Pose::Identity();

@@ -66,6 +66,7 @@ void MotionController::restartFrom(const std::vector<double>& measured) {
   }
   ease_from_ = measured;
   walk_ = WalkEngine(model_, walk_parameters_);
+  walk_.standWhereTheFeetAre(measured);
   kick_ = KickEngine(model_, walk_parameters_, kick_parameters_);
   player_ = KeyframePlayer();
   targets_ = measured;
@@ -125,6 +126,13 @@ void MotionController::standUp(const std::vector<double>& measured) {
   player_.start(motions_.stand_up, measured);
 }
 
+void MotionController::uprightFrom(const MotionSensors& sensors) {
+  const double cp = std::cos(sensors.pitch);
+  gravity_ = 9.81 * Vec3(-std::sin(sensors.pitch), cp * std::sin(sensors.roll),
+                         cp * std::cos(sensors.roll));
+  tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
+}
+
 void MotionController::easeIntoStance() {
   ease_from_ = targets_;
   walk_ = WalkEngine(model_, walk_parameters_);
@@ -156,16 +164,16 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   std::vector<double> measured;
   measuredJointAngles(model_, sensors.position, measured);
 
-  if (restart_) restartFrom(measured);
+  if (restart_) {
+    restartFrom(measured);
+    uprightFrom(sensors);
+  }
   if (placedOnItsFeet(sensors, measured, rate)) {
     // Stiff in the stance at once: one more period of a get-up's targets
     // knocks it over, and soft it sinks. The filtered "up" still says lying
     // (the next period would count a fall): restarted from the IMU's angles.
     restartFrom(measured);
-    const double cp = std::cos(sensors.pitch);
-    gravity_ = 9.81 * Vec3(-std::sin(sensors.pitch), cp * std::sin(sensors.roll),
-                           cp * std::cos(sensors.roll));
-    tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
+    uprightFrom(sensors);
   }
   // On its feet by intent: a tilt past falling_tilt is a fall (a dive is
   // meant to end on the ground; the rest are already down).

@@ -99,6 +99,21 @@ LegSolution WalkEngine::solve(const Pose2& body, double sway_y, const Pose2& lef
   return s;
 }
 
+void WalkEngine::standWhereTheFeetAre(const std::vector<double>& joints) {
+  if (walking_) return;
+  const auto left = kinematics_.footAgainst(Leg::Left, Leg::Right, joints);
+  if (!left) return;
+  // In the right foot's frame: the left foot, and the body between them.
+  const Pose2 middle{0.5 * left->x(), 0.5 * left->y(), 0.5 * left->z()};
+  const double c = std::cos(middle.yaw), s = std::sin(middle.yaw);
+  auto fromMiddle = [&](double x, double y, double yaw) {  // a foot relative to the body
+    const double dx = x - middle.x, dy = y - middle.y;
+    return compose(body_, c * dx + s * dy, -s * dx + c * dy, yaw - middle.yaw);
+  };
+  foot_[0] = fromMiddle(left->x(), left->y(), left->z());
+  foot_[1] = fromMiddle(0.0, 0.0, 0.0);
+}
+
 void WalkEngine::easeIn(const std::vector<double>& from, double t, std::vector<double>& targets) {
   std::vector<double> stance = from;
   kinematics_.writeTargets(solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0), stance);

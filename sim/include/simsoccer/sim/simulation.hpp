@@ -173,6 +173,12 @@ class Simulation {
   // the last one; none before the first collect), and the buffer collect()
   // fills before the two are swapped.
   std::vector<CommandSlot> due_, collected_;
+  // World::placements per robot when the frames were observed that collected_ / due_ answer:
+  // an answer to a frame from before the robot's last placement is not applied (pipelined, a
+  // robot the referee moved at the end of a period got its answer to the frame before the move:
+  // a K1 placed mid-kick, its leg jerked back towards the kick, tipped over). The robot holds
+  // the targets it was placed with for that period.
+  std::vector<uint64_t> observed_placements_, due_placements_;
   std::vector<RobotCommand> applied_;    // per robot, the last applied
   std::vector<bool> commanded_;          // per robot, applied in the last period
   std::vector<uint64_t> accepted_, missed_;

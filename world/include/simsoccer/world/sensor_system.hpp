@@ -47,7 +47,11 @@ class SensorSystem {
   void finishPeriod(const engine::PhysicsWorld& physics, uint64_t tick, double time);
   // A robot put somewhere else (World::placeRobot): the next period's joint
   // velocities and accelerometer start from there, not from a jump of metres
-  // and radians in one period (the referee's hands are not that fast).
+  // and radians in one period (the referee's hands are not that fast). Its
+  // frame describes it as placed (encoders, IMU angles, at rest), not as it was
+  // before: a referee places robots after the step, and the frame the agents
+  // read next would otherwise show the robot where it was (an agent restarted
+  // by the GameState's Set eased from a get-up's pose that no longer was).
   void robotPlaced(const engine::PhysicsWorld& physics, size_t robot);
 
   const SensorFrame& frame(size_t robot) const { return frames_.at(robot); }

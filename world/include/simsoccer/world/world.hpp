@@ -121,6 +121,9 @@ class World {
   // pose instead (placeRobot).
   void moveRobot(RobotId r, double x, double y, double yaw);
   static constexpr double kUprightForMoving = 0.35;  // rad from the vertical
+  // How often robot r has been placed or moved (placeRobot, moveRobot): a command computed
+  // from a frame before its last placement answers a robot that is no longer there.
+  uint64_t placements(RobotId r) const { return placements_.at(r); }
 
   // The sensor frame of the last completed control period (stays the
   // initial one when the scenario turns sensors off).
@@ -149,6 +152,7 @@ class World {
   std::shared_ptr<const fields::FieldModel> field_;
   std::unique_ptr<engine::PhysicsWorld> physics_;
   std::vector<RobotInfo> robots_;
+  std::vector<uint64_t> placements_;  // per robot
   engine::BodyId ball_ = 0;
   int steps_per_control_ = 1;
   std::unique_ptr<SensorSystem> sensors_;

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "simsoccer/robots/robot_model.hpp"
@@ -49,6 +50,11 @@ class LegKinematics {
 
   // The foot frame in the torso frame.
   Pose forward(Leg leg, const LegAngles& q) const;
+  // Where one foot stands against the other, from body joint angles (body joint order, mimics
+  // applied): `foot`'s frame in `other`'s as (x, y, yaw), when both soles are flat on one plane
+  // (within 1 cm and 0.05 rad of each other: both on the ground); nothing otherwise.
+  std::optional<Eigen::Vector3d> footAgainst(Leg foot, Leg other,
+                                             const std::vector<double>& body_angles) const;
   // Joint angles for both feet's frames in the torso frame, within the joint
   // limits. `start` (e.g. the last solution) speeds convergence up.
   LegSolution inverse(const Pose& left_foot, const Pose& right_foot,

@@ -96,6 +96,12 @@ class WalkEngine {
   // after `kEaseTime` (`t`: seconds since easing began).
   static constexpr double kEaseTime = 0.5;
   void easeIn(const std::vector<double>& from, double t, std::vector<double>& targets);
+  // Standing (not walking): takes the feet where they stand, from the measured body joint angles,
+  // as its placements (the body over their middle, heading halfway between them), so that
+  // easing in and standing keep them there and the first steps put them in the gait's stance.
+  // A robot moved by the referee mid-step stands with one foot ahead: eased into the gait's
+  // stance its feet would slide on the carpet. Left as it is with a foot off the ground.
+  void standWhereTheFeetAre(const std::vector<double>& joints);
 
  private:
   void startStep();
