@@ -86,6 +86,31 @@ double lowestTorsoOver(const world::World& w, Period&& period, int periods) {
   return lowest;
 }
 
+// Lying on its front at (-2, 0).
+engine::Pose onItsFront() {
+  engine::Pose lying = engine::Pose::Identity();
+  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();
+  lying.translation() = Vec3(-2.0, 0.0, 0.16);
+  return lying;
+}
+
+// One Nao driven by a motion controller with the get-up on, stood for 1 s, then put down on
+// its front and run until its get-up starts.
+struct GettingUp {
+  world::World w{test::scenario(1)};
+  agents::MotionController mc{agents::loadMotionController(
+      *w.robot(0).model, test::sourceDir() / "configs/motions", agents::FallDetectorParameters{})};
+  std::vector<float> position = std::vector<float>(25), stiffness = std::vector<float>(25);
+  MotionRequest request;
+
+  GettingUp() {
+    for (int i = 0; i < 100; ++i) period();
+    w.placeRobot(0, onItsFront(), "stand");
+    for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
+  }
+  void period() { controlPeriod(w, mc, request, position, stiffness); }
+};
+
 }  // namespace
 
 TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
@@ -768,20 +793,12 @@ TEST(MotionController, AnUnknownEndsValueIsRefusedNamingTheKey) {
 // feet stops the motion and eases into the stance, instead of playing the rest
 // of it from standing and falling at its waiting spot (as in a 5 v 5 match).
 TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
-  world::World w(test::scenario(1));
-  agents::FallDetectorParameters fall;
-  fall.get_up = true;
-  agents::MotionController mc =
-      agents::loadMotionController(*w.robot(0).model, test::sourceDir() / "configs/motions", fall);
-  std::vector<float> position(25), stiffness(25);
-  MotionRequest request;
-  auto period = [&] { controlPeriod(w, mc, request, position, stiffness); };
-  for (int i = 0; i < 100; ++i) period();
-  engine::Pose lying = engine::Pose::Identity();
-  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // on its front
-  lying.translation() = Vec3(-2.0, 0.0, 0.16);
-  w.placeRobot(0, lying, "stand");
-  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
+  GettingUp rig;
+  world::World& w = rig.w;
+  agents::MotionController& mc = rig.mc;
+  MotionRequest& request = rig.request;
+  auto period = [&] { rig.period(); };
+  const engine::Pose lying = onItsFront();
   ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
   for (int t : {100, 250}) {  // 1 s and 2.5 s into the get-up
     for (int i = 0; i < t; ++i) period();
@@ -832,20 +849,10 @@ TEST(MotionController, ARobotPutOnItsFeetDuringAGetUpOrADiveStaysUp) {
 // detector restarts from the IMU too: no fall is read from the get-up's filtered tilt (before:
 // it read one, went soft for a moment and sagged, and a K1 then tipped over backwards).
 TEST(MotionController, ARestartAsTheRefereeSetsTheRobotDownIsNotAFall) {
-  world::World w(test::scenario(1));
-  agents::FallDetectorParameters fall;
-  fall.get_up = true;
-  agents::MotionController mc =
-      agents::loadMotionController(*w.robot(0).model, test::sourceDir() / "configs/motions", fall);
-  std::vector<float> position(25), stiffness(25);
-  MotionRequest request;
-  auto period = [&] { controlPeriod(w, mc, request, position, stiffness); };
-  for (int i = 0; i < 100; ++i) period();
-  engine::Pose lying = engine::Pose::Identity();
-  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // on its front
-  lying.translation() = Vec3(-2.0, 0.0, 0.16);
-  w.placeRobot(0, lying, "stand");
-  for (int i = 0; i < 300 && mc.state() != agents::MotionState::GettingUp; ++i) period();
+  GettingUp rig;
+  world::World& w = rig.w;
+  agents::MotionController& mc = rig.mc;
+  auto period = [&] { rig.period(); };
   ASSERT_EQ(mc.state(), agents::MotionState::GettingUp);
   for (int i = 0; i < 50; ++i) period();
   const int falls = mc.counters().falls;

@@ -85,6 +85,20 @@ sim::SimulationConfig modeConfig(sim::Mode mode) {
   return c;
 }
 
+// `robots` robots in `mode`, answered by a ScriptedSource, two periods run.
+struct ScriptedRun {
+  ScriptedRun(int robots, sim::Mode mode)
+      : w(test::scenario(robots)), simulation(w, modeConfig(mode)), source(w, trace) {
+    simulation.addSource(source);
+    simulation.period();
+    simulation.period();
+  }
+  world::World w;
+  sim::Simulation simulation;
+  Trace trace;
+  ScriptedSource source;
+};
+
 }  // namespace
 
 TEST(Simulation, SerialStagesRunInOrderAndTheAnswerActsInItsOwnPeriod) {
@@ -138,13 +152,8 @@ TEST(Simulation, PipelinedModeStepsWithTheLastPeriodsAnswers) {
 // A transport that frees a robot (its driver crashed) drops the answer
 // waiting for the next period: the freed robot's hold is not overridden.
 TEST(Simulation, APendingAnswerOfAFreedRobotIsNotApplied) {
-  world::World w(test::scenario(1));
-  sim::Simulation simulation(w, modeConfig(sim::Mode::Pipelined));
-  Trace trace;
-  ScriptedSource source(w, trace);
-  simulation.addSource(source);
-  simulation.period();
-  simulation.period();
+  ScriptedRun run(1, sim::Mode::Pipelined);
+  sim::Simulation& simulation = run.simulation;
   ASSERT_TRUE(simulation.commandApplied(0));
   simulation.dropPending(0);
   simulation.period();
@@ -160,13 +169,9 @@ TEST(Simulation, APendingAnswerOfAFreedRobotIsNotApplied) {
 // computed after any move and act.
 TEST(Simulation, AnAnswerToAFrameFromBeforeTheRobotWasMovedIsNotApplied) {
   for (const sim::Mode mode : {sim::Mode::Pipelined, sim::Mode::Serial}) {
-    world::World w(test::scenario(2));
-    sim::Simulation simulation(w, modeConfig(mode));
-    Trace trace;
-    ScriptedSource source(w, trace);
-    simulation.addSource(source);
-    simulation.period();
-    simulation.period();
+    ScriptedRun run(2, mode);
+    world::World& w = run.w;
+    sim::Simulation& simulation = run.simulation;
     ASSERT_TRUE(simulation.commandApplied(0));
     const uint64_t placed = w.placements(0);
     w.placeRobot(0, -1.0, 0.5, 0.0);  // as a referee between periods
