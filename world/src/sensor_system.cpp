@@ -39,6 +39,20 @@ float clampAbs(double v, double range) {
   return static_cast<float>(std::clamp(v, -range, range));
 }
 
+// The encoder's step (rad), and a joint angle as the encoder reads it.
+double encoderResolution(const robots::SensorSpec& spec) {
+  return 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+}
+float encoderReading(double q, double resolution) {
+  return static_cast<float>(std::round(q / resolution) * resolution);
+}
+
+// The torso's roll, pitch and yaw (the IMU's angles) from its orientation.
+std::array<double, 3> rollPitchYaw(const engine::Mat3& R) {
+  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
+          std::atan2(R(1, 0), R(0, 0))};
+}
+
 void addShape(engine::RayScene& scene, const engine::Shape& s, const Pose& world, int32_t object,
               int32_t owner, uint8_t cluster = 0) {
   const Pose p = world * s.pose;
@@ -278,17 +292,14 @@ void SensorSystem::robotPlaced(const engine::PhysicsWorld& physics, size_t robot
   // period's readings keep their sequence).
   SensorFrame& f = frames_.at(robot);
   const auto& spec = r.model->sensor_spec;
-  const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+  const double resolution = encoderResolution(spec);
   for (const JointMotor& m : r.joint_motors) {
-    const double q = r.last_position[m.actuator];
-    f.position[m.actuator] = static_cast<float>(std::round(q / resolution) * resolution);
+    f.position[m.actuator] = encoderReading(r.last_position[m.actuator], resolution);
     f.velocity[m.actuator] = 0.0f;
   }
   const engine::Mat3& R = physics.linkPose(r.body, 0).linear();
   const Vec3 accel = R.transpose() * -physics.settings().gravity;
-  const double angles[3] = {std::atan2(R(2, 1), R(2, 2)),
-                            std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
-                            std::atan2(R(1, 0), R(0, 0))};
+  const std::array<double, 3> angles = rollPitchYaw(R);
   for (size_t k = 0; k < 3; ++k) {
     f.accelerometer[k] =
         clampAbs(accel[static_cast<int>(k)] + settings_.accel_bias[k], spec.accel_range);
@@ -372,7 +383,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     f.time = time;
 
     // Joints and hands.
-    const double resolution = 2.0 * std::numbers::pi / static_cast<double>(1 << spec.encoder_bits);
+    const double resolution = encoderResolution(spec);
     const size_t joints = model.body->joints.size();
     joint_position_.resize(joints);
     joint_target_.resize(joints);
@@ -381,7 +392,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     for (const JointMotor& m : r.joint_motors) {
       const size_t a = m.actuator;
       const double q = joint_position_[m.joint];
-      f.position[a] = static_cast<float>(std::round(q / resolution) * resolution);
+      f.position[a] = encoderReading(q, resolution);
       f.velocity[a] = static_cast<float>((q - r.last_position[a]) / period);
       r.last_position[a] = q;
       f.target[a] = static_cast<float>(joint_target_[m.joint]);
@@ -424,10 +435,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
     const Vec3 accel = rt * specific;
     const Vec3 gyro = r.gyro_sum / n;
     r.gyro_sum.setZero();
-    const engine::Mat3& R = torso.linear();
-    const double angles[3] = {std::atan2(R(2, 1), R(2, 2)),
-                              std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
-                              std::atan2(R(1, 0), R(0, 0))};
+    const std::array<double, 3> angles = rollPitchYaw(torso.linear());
     for (int k = 0; k < 3; ++k) {
       f.accelerometer[static_cast<size_t>(k)] =
           clampAbs(accel[k] + settings_.accel_bias[k] + settings_.accel_noise[k] * r.noise(),
@@ -435,7 +443,7 @@ void SensorSystem::finishPeriod(const engine::PhysicsWorld& physics, uint64_t ti
       f.gyroscope[static_cast<size_t>(k)] = clampAbs(
           gyro[k] + settings_.gyro_bias[k] + settings_.gyro_noise[k] * r.noise(), spec.gyro_range);
       f.angles[static_cast<size_t>(k)] =
-          static_cast<float>(angles[k] + settings_.angle_noise[k] * r.noise());
+          static_cast<float>(angles[static_cast<size_t>(k)] + settings_.angle_noise[k] * r.noise());
     }
 
     // Feet.
