@@ -299,6 +299,66 @@ TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
   EXPECT_THROW(engine::rgbToYuyv(cv::Mat(2, 3, CV_8UC3)), std::invalid_argument);
 }
 
+TEST(Camera, AYuvViewHoldsTheRgbViewsYuvWhicheverFormatTheOthersUse) {
+  // A view drawn in YUV is OpenCV's RGB -> YUV of the same view drawn in RGB,
+  // within the rounding of two 8-bit conversions, ball patches and the hall
+  // behind the field included, whether the framebuffer was cleared for YUV
+  // views (most of them) or for RGB ones.
+  world::World w(test::scenario(4));
+  test::putBallOnCarpet(w, -2.0, 0.3);
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  const engine::RenderView rgb = world::robotCameraView(w, 0, "CameraTop", 640, 480);
+  engine::RenderView yuv = rgb;
+  yuv.format = engine::PixelFormat::Yuv;
+  const engine::RenderView other = world::robotCameraView(w, 2, "CameraTop", 640, 480);
+  engine::RenderView other_yuv = other;
+  other_yuv.format = engine::PixelFormat::Yuv;
+  for (const auto& views :
+       {std::vector{rgb, yuv}, std::vector{yuv, other_yuv, rgb}, std::vector{rgb, other, yuv}}) {
+    std::vector<cv::Mat> images;
+    renderer().render(scene, views, images);
+    const size_t r =
+        std::find_if(views.begin(), views.end(),
+                     [](const auto& v) { return v.format == engine::PixelFormat::Rgb; }) -
+        views.begin();
+    const size_t y = &views.back() == &views[r] ? 0 : views.size() - 1;
+    ASSERT_EQ(views[y].format, engine::PixelFormat::Yuv);
+    cv::Mat expected, diff;
+    cv::cvtColor(images[r], expected, cv::COLOR_RGB2YUV);
+    cv::absdiff(expected, images[y], diff);
+    double worst = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+    std::printf("%zu views: YUV view %zu against view %zu converted: at most %.0f levels apart\n",
+                views.size(), y, r, worst);
+    EXPECT_LE(worst, 2.0);
+    // Not a flat image: the carpet, lines, the ball and the hall are all there.
+    cv::Scalar mean, spread;
+    cv::meanStdDev(images[y], mean, spread);
+    EXPECT_GT(spread[0], 10.0);
+    // The hall behind the field (the clear colour) is in the compared view.
+    cv::Mat hall;
+    cv::inRange(images[r], cv::Scalar(89, 89, 97), cv::Scalar(89, 89, 97), hall);
+    EXPECT_GT(cv::countNonZero(hall), 1000);
+  }
+}
+
+TEST(Camera, YuvPacksAsYuyvAsTheRgbConversionDoes) {
+  cv::Mat rgb(48, 66, CV_8UC3);  // a width that leaves pairs after the 32-pixel blocks
+  cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
+  cv::Mat yuv, yuva, a, b;
+  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  cv::cvtColor(yuv, yuva, cv::COLOR_RGB2RGBA);  // a fourth channel of 255, as a Yuv view has
+  const cv::Mat expected = engine::rgbToYuyv(rgb);
+  engine::yuvToYuyv(yuv, a);
+  engine::yuvToYuyv(yuva, b);
+  ASSERT_EQ(a.type(), CV_8UC2);
+  EXPECT_EQ(cv::norm(a, expected, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(b, expected, cv::NORM_INF), 0.0);
+  EXPECT_THROW(engine::yuvToYuyv(cv::Mat(2, 3, CV_8UC4), a), std::invalid_argument);
+  EXPECT_THROW(engine::yuvToYuyv(cv::Mat(2, 4, CV_8UC1), a), std::invalid_argument);
+}
+
 TEST(Camera, WritesTopCameraAndSpectatorPngs) {
   world::World w(test::scenario(10));
   test::putBallOnCarpet(w, -1.5, 0.3);

@@ -297,6 +297,59 @@ TEST(CameraSystem, JpegAndSpectatorImages) {
   }
 }
 
+TEST(CameraSystem, YuyvImagesAreTheRgbRenderingsConversionAndTheSpectatorStaysRgb) {
+  // Robot cameras delivering YUYV are drawn in YUV and only packed; the
+  // spectator in the same capture is drawn in RGB. Each image is what the
+  // RGB rendering of its view gives through the CPU conversion (the
+  // rasterisation of a view alone differs at a few edge pixels from the
+  // same view in a batch; colours differ by the rounding only).
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  world::World w(test::scenario(2));
+  world::CameraSettings c = smallCameras();
+  c.top = {true, 160, 120, 30.0};
+  c.spectator.enabled = true;
+  c.spectator.width = 320;
+  c.spectator.height = 180;
+  Collected got;
+  world::CameraSystem cameras(w, c, world::BehindPolicy::Wait, got.sink());
+  cameras.capture(w);
+  cameras.flush();
+  ASSERT_EQ(got.images.size(), 5u);
+  std::vector<engine::DrawItem> scene;
+  world::buildRenderScene(w, scene);
+  engine::OffscreenRenderer renderer;
+  for (const auto& image : got.images) {
+    engine::RenderView view = image.view;
+    view.format = engine::PixelFormat::Rgb;
+    std::vector<cv::Mat> rgb;
+    const engine::RenderView one[1] = {view};
+    renderer.render(scene, one, rgb);
+    cv::Mat expected, got_bytes;
+    if (image.camera == world::CameraId::Spectator) {
+      ASSERT_EQ(image.encoding, world::ImageEncoding::Bgr);
+      cv::cvtColor(rgb[0], expected, cv::COLOR_RGB2BGR);
+      got_bytes = image.bgr;
+    } else {
+      ASSERT_EQ(image.encoding, world::ImageEncoding::Yuyv);
+      expected = engine::rgbToYuyv(rgb[0]);
+      got_bytes =
+          cv::Mat(view.height, view.width, CV_8UC2, const_cast<uint8_t*>(image.data.data()));
+    }
+    cv::Mat diff;
+    cv::absdiff(expected, got_bytes, diff);
+    const int beyond_rounding = cv::countNonZero(diff.reshape(1) > 2);
+    const bool spectator = image.camera == world::CameraId::Spectator;
+    std::printf("%s view (robot %d): %d of %zu bytes more than 2 levels apart\n",
+                spectator ? "spectator" : "camera", static_cast<int>(image.robot), beyond_rounding,
+                diff.total() * diff.channels());
+    EXPECT_LE(beyond_rounding, static_cast<int>(diff.total() * diff.channels() / 500));
+    if (spectator) {
+      EXPECT_EQ(beyond_rounding, 0);  // RGB both ways: the same pixels
+    }
+  }
+}
+
 TEST(CameraSystem, ScenarioCamerasBlockIsReadAndChecked) {
   const test::TempDir dir("camera_cfg");
   auto write = [&](const std::string& cameras) {

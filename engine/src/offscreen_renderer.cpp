@@ -11,6 +11,7 @@
 #include <cmath>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 namespace simsoccer::engine {
 namespace {
@@ -31,13 +32,18 @@ layout(location = 2) in mat4 model;   // locations 2..5
 layout(location = 6) in vec3 colour;
 layout(location = 7) in float stretch;  // capsules: caps moved apart along z
 uniform mat4 view_projection;
+uniform mat3 colour_transform;  // the view's PixelFormat: identity, or RGB -> YUV
+uniform vec3 colour_offset;
 flat out vec3 lit_colour;
+flat out vec3 patch_colour;  // the ball's black patches in the view's colour space
 out vec3 object_position;
 void main() {
   vec3 p = position + vec3(0.0, 0.0, sign(position.z) * stretch);
   gl_Position = view_projection * model * vec4(p, 1.0);
   vec3 n = normalize(mat3(model) * normal);
-  lit_colour = colour * (0.6 + 0.4 * max(dot(n, normalize(vec3(0.3, 0.2, 1.0))), 0.0));
+  vec3 lit = colour * (0.6 + 0.4 * max(dot(n, normalize(vec3(0.3, 0.2, 1.0))), 0.0));
+  lit_colour = colour_transform * lit + colour_offset;
+  patch_colour = colour_transform * vec3(0.05) + colour_offset;
   object_position = position;
 }
 )";
@@ -52,6 +58,7 @@ void main() { fragment = vec4(lit_colour, 1.0); }
 // (a pentagon pattern's centres). Only the ball's pixels run this.
 const char* kPatternFragmentShader = R"(#version 330 core
 flat in vec3 lit_colour;
+flat in vec3 patch_colour;
 in vec3 object_position;
 out vec4 fragment;
 void main() {
@@ -59,7 +66,7 @@ void main() {
   vec3 a = abs(normalize(object_position));
   float best = max(max(dot(a, normalize(vec3(0.0, 1.0, g))), dot(a, normalize(vec3(1.0, g, 0.0)))),
                    dot(a, normalize(vec3(g, 0.0, 1.0))));
-  fragment = vec4(best > 0.93 ? vec3(0.05) : lit_colour, 1.0);
+  fragment = vec4(best > 0.93 ? patch_colour : lit_colour, 1.0);
 }
 )";
 
@@ -124,6 +131,27 @@ constexpr size_t levelOfDetail(size_t batch, float radius_px) {
 }
 
 constexpr float kIcosahedronScale = 2.0f / (1.0f + 0.7946545f);
+
+// A view's colours from the scene's linear RGB (0..1): out = transform * rgb
+// + offset. Yuv is OpenCV's RGB -> YUV (BT.601 luma, U = 0.492 (B - Y) and
+// V = 0.877 (R - Y), both offset by 128 of 255), so that a Yuv view holds
+// what rgbToYuyv would compute from the Rgb view, up to rounding.
+struct ColourTransform {
+  Eigen::Matrix3f transform = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f offset = Eigen::Vector3f::Zero();
+  Eigen::Vector3f operator()(const Eigen::Vector3f& rgb) const { return transform * rgb + offset; }
+};
+
+ColourTransform colourTransform(PixelFormat format) {
+  ColourTransform t;
+  if (format == PixelFormat::Rgb) return t;
+  const Eigen::RowVector3f y(0.299f, 0.587f, 0.114f);
+  t.transform.row(0) = y;
+  t.transform.row(1) = 0.492f * (Eigen::RowVector3f(0, 0, 1) - y);
+  t.transform.row(2) = 0.877f * (Eigen::RowVector3f(1, 0, 0) - y);
+  t.offset = Eigen::Vector3f(0.0f, 128.0f / 255.0f, 128.0f / 255.0f);
+  return t;
+}
 
 size_t batchOf(const DrawItem& d) {
   if (d.ground) return kGroundBatch;
@@ -348,6 +376,7 @@ struct OffscreenRenderer::Impl {
   EGLContext context = EGL_NO_CONTEXT;
   std::array<GLuint, 2> programs{};  // plain, ball pattern
   std::array<GLint, 2> view_projection{-1, -1};
+  std::array<GLint, 2> colour_transform{-1, -1}, colour_offset{-1, -1};
   std::array<Mesh, kMeshCount> meshes;  // by meshOf(Primitive), then the coarse ones
   GLuint instances = 0;                 // every view's instances, one buffer
   GLuint fbo = 0, colour = 0, depth = 0;
@@ -435,6 +464,8 @@ struct OffscreenRenderer::Impl {
       if (!ok) throw RenderError("renderer: shader program did not link");
       programs[i] = program;
       view_projection[i] = glGetUniformLocation(program, "view_projection");
+      colour_transform[i] = glGetUniformLocation(program, "colour_transform");
+      colour_offset[i] = glGetUniformLocation(program, "colour_offset");
     }
   }
 
@@ -672,17 +703,36 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.uploaded.size() * sizeof(Instance)),
                m.uploaded.data(), GL_STREAM_DRAW);
 
-  // One clear of the whole framebuffer (llvmpipe clears whole tiles fast;
-  // a scissored clear per view writes every pixel).
+  // One clear of the whole framebuffer in the colour space most views are
+  // drawn in (llvmpipe clears whole tiles fast; a scissored clear per view
+  // writes every pixel), then one of each view drawn in the other.
+  const Eigen::Vector3f hall(0.35f, 0.35f, 0.38f);  // the hall around the field
+  const auto yuv_views =
+      static_cast<size_t>(std::count_if(views.begin(), views.end(), [](const RenderView& v) {
+        return v.format == PixelFormat::Yuv;
+      }));
+  const PixelFormat cleared = 2 * yuv_views > views.size() ? PixelFormat::Yuv : PixelFormat::Rgb;
+  const auto clearTo = [&](PixelFormat format) {
+    const Eigen::Vector3f c = colourTransform(format)(hall);
+    glClearColor(c.x(), c.y(), c.z(), 1.0f);
+  };
   glDisable(GL_SCISSOR_TEST);
-  glClearColor(0.35f, 0.35f, 0.38f, 1.0f);  // the hall around the field
+  clearTo(cleared);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_SCISSOR_TEST);
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (views[i].format == cleared) continue;
+    const cv::Rect& r = m.rects[i];
+    glScissor(r.x, r.y, r.width, r.height);
+    clearTo(views[i].format);
+    glClear(GL_COLOR_BUFFER_BIT);
+  }
   for (size_t i = 0; i < views.size(); ++i) {
     const cv::Rect& r = m.rects[i];
     glViewport(r.x, r.y, r.width, r.height);
     glScissor(r.x, r.y, r.width, r.height);
     const Eigen::Matrix4f vp = viewProjection(views[i]);
+    const ColourTransform colours = colourTransform(views[i].format);
     for (size_t b = 0; b < kBatchMesh.size(); ++b) {
       const auto [first, count] = m.ranges[i][b];
       if (count == 0) continue;
@@ -693,6 +743,8 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
       const size_t program = b == kPatternBatch ? 1 : 0;
       glUseProgram(m.programs[program]);
       glUniformMatrix4fv(m.view_projection[program], 1, GL_FALSE, vp.data());
+      glUniformMatrix3fv(m.colour_transform[program], 1, GL_FALSE, colours.transform.data());
+      glUniform3fv(m.colour_offset[program], 1, colours.offset.data());
       const Mesh& mesh = m.meshes[kBatchMesh[b]];
       glBindVertexArray(mesh.vao);
       m.pointInstances(first);
@@ -724,7 +776,8 @@ void OffscreenRenderer::render(std::span<const DrawItem> scene, std::span<const 
                                std::vector<cv::Mat>& images) {
   render(scene, views);
   images.resize(views.size());
-  for (size_t i = 0; i < views.size(); ++i) cv::cvtColor(image(i), images[i], cv::COLOR_RGBA2RGB);
+  for (size_t i = 0; i < views.size(); ++i)
+    cv::cvtColor(image(i), images[i], cv::COLOR_RGBA2RGB);  // drops the 4th channel
 }
 
 RenderView pinholeView(const Pose& pose, int width, int height, double horizontal_fov,
@@ -755,19 +808,28 @@ bool projectCameraPoint(const RenderView& view, const Vec3& p, double& u, double
 
 namespace {
 
-// One row of packed YUV (Y U V per pixel) as YUYV: each pixel pair keeps its
-// two Y and shares the rounded means of its U and of its V. 32 pixels at a
-// time with OpenCV's universal intrinsics, the rest one pair at a time.
+// One row of packed YUV (Y U V per pixel, then a fourth byte that is skipped
+// when kChannels is 4) as YUYV: each pixel pair keeps its two Y and shares
+// the rounded means of its U and of its V. 32 pixels at a time with OpenCV's
+// universal intrinsics, the rest one pair at a time.
+template <int kChannels>
 void packYuyv(const uint8_t* in, uint8_t* out, int cols) {
+  static_assert(kChannels == 3 || kChannels == 4);
   int c = 0;
 #if CV_SIMD128
   const cv::v_uint16x8 low_byte = cv::v_setall_u16(0x00ff);
   const auto even = [&](const cv::v_uint8x16& a) { return cv::v_reinterpret_as_u16(a) & low_byte; };
   const auto odd = [](const cv::v_uint8x16& a) { return cv::v_reinterpret_as_u16(a) >> 8; };
-  for (; c + 32 <= cols; c += 32, in += 96, out += 64) {
+  for (; c + 32 <= cols; c += 32, in += 32 * kChannels, out += 64) {
     cv::v_uint8x16 y0, u0, v0, y1, u1, v1;
-    cv::v_load_deinterleave(in, y0, u0, v0);
-    cv::v_load_deinterleave(in + 48, y1, u1, v1);
+    if constexpr (kChannels == 3) {
+      cv::v_load_deinterleave(in, y0, u0, v0);
+      cv::v_load_deinterleave(in + 48, y1, u1, v1);
+    } else {
+      cv::v_uint8x16 a0, a1;
+      cv::v_load_deinterleave(in, y0, u0, v0, a0);
+      cv::v_load_deinterleave(in + 64, y1, u1, v1, a1);
+    }
     const cv::v_uint8x16 y_even = cv::v_pack(even(y0), even(y1));
     const cv::v_uint8x16 y_odd = cv::v_pack(odd(y0), odd(y1));
     const cv::v_uint8x16 u = cv::v_rshr_pack<1>(even(u0) + odd(u0), even(u1) + odd(u1));
@@ -775,12 +837,18 @@ void packYuyv(const uint8_t* in, uint8_t* out, int cols) {
     cv::v_store_interleave(out, y_even, u, y_odd, v);
   }
 #endif
-  for (; c < cols; c += 2, in += 6, out += 4) {
+  for (; c < cols; c += 2, in += 2 * kChannels, out += 4) {
     out[0] = in[0];
-    out[1] = static_cast<uint8_t>((in[1] + in[4] + 1) >> 1);
-    out[2] = in[3];
-    out[3] = static_cast<uint8_t>((in[2] + in[5] + 1) >> 1);
+    out[1] = static_cast<uint8_t>((in[1] + in[kChannels + 1] + 1) >> 1);
+    out[2] = in[kChannels];
+    out[3] = static_cast<uint8_t>((in[2] + in[kChannels + 2] + 1) >> 1);
   }
+}
+
+void checkYuyvInput(const cv::Mat& in, const char* function) {
+  if ((in.type() != CV_8UC3 && in.type() != CV_8UC4) || in.cols % 2 != 0)
+    throw std::invalid_argument(std::string(function) +
+                                ": 8-bit three or four channels with an even width expected");
 }
 
 }  // namespace
@@ -792,8 +860,7 @@ cv::Mat rgbToYuyv(const cv::Mat& rgb) {
 }
 
 void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out) {
-  if ((rgb.type() != CV_8UC3 && rgb.type() != CV_8UC4) || rgb.cols % 2 != 0)
-    throw std::invalid_argument("rgbToYuyv: 8-bit RGB or RGBA with an even width expected");
+  checkYuyvInput(rgb, "rgbToYuyv");
   out.create(rgb.rows, rgb.cols, CV_8UC2);  // kept if it already is that (caller's memory)
   // Strips of rows, each converted by OpenCV into a small YUV buffer that
   // stays in cache while it is packed (a whole-image YUV buffer made the
@@ -805,10 +872,24 @@ void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out) {
       const int r0 = s * strip, r1 = std::min(r0 + strip, rgb.rows);
       cv::cvtColor(rgb.rowRange(r0, r1), yuv, cv::COLOR_RGB2YUV);  // reads 3 or 4 channels
       for (int r = r0; r < r1; ++r)
-        packYuyv(yuv.ptr<uint8_t>(r - r0), out.ptr<uint8_t>(r), rgb.cols);
+        packYuyv<3>(yuv.ptr<uint8_t>(r - r0), out.ptr<uint8_t>(r), rgb.cols);
     }
   };
   cv::parallel_for_(cv::Range(0, (rgb.rows + strip - 1) / strip), body);
+}
+
+void yuvToYuyv(const cv::Mat& yuv, cv::Mat& out) {
+  checkYuyvInput(yuv, "yuvToYuyv");
+  out.create(yuv.rows, yuv.cols, CV_8UC2);
+  const bool four = yuv.channels() == 4;
+  cv::parallel_for_(cv::Range(0, yuv.rows), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r) {
+      if (four)
+        packYuyv<4>(yuv.ptr<uint8_t>(r), out.ptr<uint8_t>(r), yuv.cols);
+      else
+        packYuyv<3>(yuv.ptr<uint8_t>(r), out.ptr<uint8_t>(r), yuv.cols);
+    }
+  });
 }
 
 }  // namespace simsoccer::engine

@@ -51,7 +51,10 @@ CameraSystem::CameraSystem(const World& world, const CameraSettings& settings, B
       policy_(policy),
       sink_(std::move(sink)),
       seed_(world.scenario().seed),
-      control_period_(world.scenario().physics.control_period) {
+      control_period_(world.scenario().physics.control_period),
+      robot_format_(settings.encoding == "yuyv" && settings.effects.noise == 0
+                        ? engine::PixelFormat::Yuv
+                        : engine::PixelFormat::Rgb) {
   calibration_.assign(2 * world.robotCount(), engine::Pose::Identity());
   for (const CameraCalibration& c : settings_.calibration) {
     bool found = false;
@@ -143,6 +146,7 @@ void CameraSystem::capture(const World& world) {
                 engine::pinholeView(pose, specs[c]->width, specs[c]->height, s->horizontal_fov,
                                     s->vertical_fov),
                 Vec3::Zero()};
+      v.view.format = robot_format_;
       const auto& e = settings_.effects;
       if (e.motion_blur_exposure > 0 || e.rolling_shutter_readout > 0)
         v.angular_velocity = pose.linear().transpose() * linkAngularVelocity(world, r, s->link);
@@ -212,7 +216,7 @@ void CameraSystem::run() {
     for (const ViewJob& v : job->views) views.push_back(v.view);
     renderer->render(job->scene, views);
     Rendered rendered{job, {}, renderer->lastTiming()};
-    for (size_t i = 0; i < views.size(); ++i) rendered.rgba.push_back(renderer->image(i));
+    for (size_t i = 0; i < views.size(); ++i) rendered.pixels.push_back(renderer->image(i));
     {
       // The previous capture must be converted before this one is handed
       // over: the render after this one reuses that capture's readback buffer.
@@ -251,8 +255,8 @@ void CameraSystem::process(Rendered& rendered) {
   for (size_t i = 0; i < job.views.size(); ++i) {
     const ViewJob& v = job.views[i];
     const auto t0 = Clock::now();
-    cv::Mat rgba = rendered.rgba[i];
-    pixels += rgba.total();
+    cv::Mat drawn = rendered.pixels[i];  // RGBA, or YUVA (v.view.format)
+    pixels += drawn.total();
     image.camera = v.camera;
     image.robot = v.robot;
     image.team = v.team;
@@ -264,24 +268,29 @@ void CameraSystem::process(Rendered& rendered) {
     if (v.camera == CameraId::Spectator) {
       image.encoding = ImageEncoding::Bgr;
       image.data.clear();
-      cv::cvtColor(rgba, image.bgr, cv::COLOR_RGBA2BGR);
+      cv::cvtColor(drawn, image.bgr, cv::COLOR_RGBA2BGR);
     } else {
       // Noise seeded per scenario, capture, robot and camera: the same run, the same noise.
       const uint64_t key =
           seed_ * 0x9E3779B97F4A7C15ULL ^ (job.tick * 0xBF58476D1CE4E5B9ULL) ^
           ((static_cast<uint64_t>(v.robot) << 1 | static_cast<uint64_t>(v.camera)) *
            0x94D049BB133111EBULL);
-      applyCameraEffects(rgba, settings_.effects, v.view, v.angular_velocity, key);
+      // Blur and the rolling shutter move and mix pixels, the same in YUV as in RGB.
+      applyCameraEffects(drawn, settings_.effects, v.view, v.angular_velocity, key);
       if (settings_.encoding == "jpeg") {
         image.encoding = ImageEncoding::Jpeg;
         cv::Mat bgr;
-        cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+        cv::cvtColor(drawn, bgr, cv::COLOR_RGBA2BGR);
         cv::imencode(".jpg", bgr, image.data, {cv::IMWRITE_JPEG_QUALITY, settings_.jpeg_quality});
       } else {
         image.encoding = ImageEncoding::Yuyv;
-        image.data.resize(rgba.total() * 2);
-        cv::Mat yuyv(rgba.rows, rgba.cols, CV_8UC2, image.data.data());  // straight into the image
-        engine::rgbToYuyv(rgba, yuyv);
+        image.data.resize(drawn.total() * 2);
+        cv::Mat yuyv(drawn.rows, drawn.cols, CV_8UC2,
+                     image.data.data());  // straight into the image
+        if (v.view.format == engine::PixelFormat::Yuv)
+          engine::yuvToYuyv(drawn, yuyv);
+        else
+          engine::rgbToYuyv(drawn, yuyv);
       }
     }
     convert_ms += msSince(t0);

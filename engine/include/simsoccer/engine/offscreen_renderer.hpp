@@ -46,6 +46,13 @@ struct DrawItem {
   float stretch = 0.0f;  // Capsule: half the distance between the cap centres, in radii
 };
 
+// The colour space a view is drawn in. Rgb: the scene's colours, as R, G, B,
+// 255 in the four 8-bit channels. Yuv: OpenCV's RGB -> YUV of them (Y, U, V,
+// 255), computed with the lighting per vertex: a camera that delivers YUV
+// 4:2:2 then only packs pixel pairs (yuvToYuyv) instead of converting every
+// pixel on the CPU, and the rasteriser's cost per pixel stays the same.
+enum class PixelFormat : uint8_t { Rgb, Yuv };
+
 // A pinhole camera. `pose` is the camera frame in the world: x forward
 // (optical axis), y left, z up. Pixel (u, v): u right, v down, pixel i
 // covering [i, i + 1); a point at depth d projects to u = cx + fx * (-y / d).
@@ -54,6 +61,7 @@ struct RenderView {
   int width = 640, height = 480;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;  // px
   double near_clip = 0.01, far_clip = 60.0;       // m
+  PixelFormat format = PixelFormat::Rgb;
 };
 
 // Intrinsics from the fields of view (rad), centred principal point.
@@ -88,11 +96,11 @@ class OffscreenRenderer {
   // Must be called on the thread that created the renderer.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views);
   // View i of the last render as 8-bit RGBA (CV_8UC4, R first, top row
-  // first): a region of the readback. Two readback buffers alternate, so the
-  // pixels stay valid until the second render after this one: one frame's
-  // images can be converted on another thread while the next is drawn.
+  // first; Y, U, V, 255 for a Yuv view): a region of the readback. Two readback buffers alternate,
+  // so the pixels stay valid until the second render after this one: one frame's images can be
+  // converted on another thread while the next is drawn.
   cv::Mat image(size_t view) const;
-  // The same, with `images[i]` an RGB copy (CV_8UC3) of view i.
+  // The same, with `images[i]` a three-channel copy (CV_8UC3: RGB, or YUV) of view i.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views,
               std::vector<cv::Mat>& images);
   const RenderTiming& lastTiming() const { return timing_; }
@@ -109,5 +117,7 @@ class OffscreenRenderer {
 cv::Mat rgbToYuyv(const cv::Mat& rgb);
 // The same into `out` (written in place when it already is rows x cols CV_8UC2).
 void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out);
+// YUYV from 8-bit YUV or YUVA (a Yuv view): the same packing, no colour conversion.
+void yuvToYuyv(const cv::Mat& yuv, cv::Mat& out);
 
 }  // namespace simsoccer::engine

@@ -112,11 +112,12 @@ class CameraSystem {
     std::vector<ViewJob> views;
   };
 
-  // A rendered capture on its way to conversion: its views' RGBA pixels
-  // (regions of one of the renderer's two readback buffers) and timings.
+  // A rendered capture on its way to conversion: its views' four-channel
+  // pixels (RGBA, or YUVA for a view drawn in YUV; regions of one of the
+  // renderer's two readback buffers) and timings.
   struct Rendered {
     Job* job = nullptr;
-    std::vector<cv::Mat> rgba;
+    std::vector<cv::Mat> pixels;
     engine::RenderTiming timing;
   };
 
@@ -129,6 +130,9 @@ class CameraSystem {
   Sink sink_;
   uint64_t seed_;
   double control_period_;
+  // Robot cameras drawn in YUV (yuyv images without noise: the noise is
+  // given per RGB channel), so their images need only packing.
+  engine::PixelFormat robot_format_;
   std::vector<engine::Pose>
       calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
   // Per robot: its first and second camera of the model (null: none).
