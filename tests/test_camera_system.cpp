@@ -51,6 +51,19 @@ cv::Mat luma(const world::CameraImage& image) {
   return channels[0].clone();
 }
 
+// One capture of the robots' cameras as `c` sets them and a 320x180 spectator view.
+std::vector<world::CameraImage> oneCaptureWithSpectator(const world::World& w,
+                                                        world::CameraSettings c) {
+  c.spectator.enabled = true;
+  c.spectator.width = 320;
+  c.spectator.height = 180;
+  Collected got;
+  world::CameraSystem cameras(w, c, world::BehindPolicy::Wait, got.sink());
+  cameras.capture(w);
+  cameras.flush();
+  return got.images;
+}
+
 }  // namespace
 
 TEST(CameraSystem, DueAtTheCameraRate) {
@@ -274,15 +287,9 @@ TEST(CameraSystem, JpegAndSpectatorImages) {
   world::World w(test::scenario(2));
   world::CameraSettings c = smallCameras();
   c.encoding = "jpeg";
-  c.spectator.enabled = true;
-  c.spectator.width = 320;
-  c.spectator.height = 180;
-  Collected got;
-  world::CameraSystem cameras(w, c, world::BehindPolicy::Wait, got.sink());
-  cameras.capture(w);
-  cameras.flush();
-  ASSERT_EQ(got.images.size(), 5u);  // 2 robots x 2 cameras + the spectator
-  for (const auto& image : got.images) {
+  const auto images = oneCaptureWithSpectator(w, c);
+  ASSERT_EQ(images.size(), 5u);  // 2 robots x 2 cameras + the spectator
+  for (const auto& image : images) {
     if (image.camera == world::CameraId::Spectator) {
       EXPECT_EQ(image.encoding, world::ImageEncoding::Bgr);
       EXPECT_EQ(image.bgr.cols, 320);
@@ -308,18 +315,12 @@ TEST(CameraSystem, YuyvImagesAreTheRgbRenderingsConversionAndTheSpectatorStaysRg
   world::World w(test::scenario(2));
   world::CameraSettings c = smallCameras();
   c.top = {true, 160, 120, 30.0};
-  c.spectator.enabled = true;
-  c.spectator.width = 320;
-  c.spectator.height = 180;
-  Collected got;
-  world::CameraSystem cameras(w, c, world::BehindPolicy::Wait, got.sink());
-  cameras.capture(w);
-  cameras.flush();
-  ASSERT_EQ(got.images.size(), 5u);
+  const auto images = oneCaptureWithSpectator(w, c);
+  ASSERT_EQ(images.size(), 5u);
   std::vector<engine::DrawItem> scene;
   world::buildRenderScene(w, scene);
   engine::OffscreenRenderer renderer;
-  for (const auto& image : got.images) {
+  for (const auto& image : images) {
     engine::RenderView view = image.view;
     view.format = engine::PixelFormat::Rgb;
     std::vector<cv::Mat> rgb;
