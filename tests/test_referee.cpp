@@ -533,6 +533,35 @@ TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
   EXPECT_EQ(d.teams[0].score, 1);  // team 0 is on the left in the first half
 }
 
+TEST(Referee, TheSecondHalfStartsWithEveryRobotInItsNewHalf) {
+  // Wherever the first half left them, the robots are put at their start
+  // poses turned with the sides when the second half's Initial begins.
+  RuleBook rules = spl();
+  rules.half_duration = 2.0;
+  rules.half_time_break = 2.0;
+  rules.half_time_to_initial = 1.0;
+  world::World w(twoVsTwo());
+  Referee ref(w, rules, teams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  w.placeRobot(0, 2.0, -1.0, 0.5);  // team 0's keeper ends the half in the other half
+  for (int i = 0; i < 1000 && g.half() != Half::Second; ++i) run(w, ref, 0.01);
+  ASSERT_EQ(g.half(), Half::Second);
+  ASSERT_EQ(g.state(), gc::State::Initial);
+  EXPECT_EQ(g.leftTeam(), 1);
+  for (world::RobotId r = 0; r < w.robotCount(); ++r) {
+    const world::RobotPlacement& start = w.scenario().robots[r];
+    const engine::Pose torso = w.torsoPose(r);
+    const double yaw = std::atan2(torso.linear()(1, 0), torso.linear()(0, 0));
+    EXPECT_NEAR(torso.translation().x(), -start.x, 0.02) << "robot " << r;
+    EXPECT_NEAR(torso.translation().y(), -start.y, 0.02) << "robot " << r;
+    EXPECT_NEAR(std::remainder(yaw - (start.yaw + M_PI), 2 * M_PI), 0.0, 0.02) << "robot " << r;
+    // In its own half now: team 1 defends -x.
+    EXPECT_LT(torso.translation().x() * (w.robot(r).team == 1 ? 1 : -1), 0.0) << "robot " << r;
+  }
+  EXPECT_EQ(count(g, "placement"), 4);
+}
+
 TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);

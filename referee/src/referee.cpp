@@ -312,6 +312,23 @@ void Referee::onEnterSet() {
   }
 }
 
+// The teams' handlers put their robots in their own halves before a half's
+// kick-off (the rules: on the touchlines of the own half). For the second
+// half, each robot in play goes to its start pose from the scenario turned
+// with the sides (x, y and the heading turned half a turn about the centre
+// mark): otherwise both teams, wherever the first half ended, walked through
+// each other to their new halves in Ready, and pushed.
+void Referee::placeForTheSecondHalf() {
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    if (game_.penalty(info.team, info.number) == gc::Penalty::Substitute) continue;
+    const world::RobotPlacement& start = world_.scenario().robots.at(r);
+    world_.moveRobot(r, -start.x, -start.y, start.yaw + M_PI);
+    game_.recordEvent(EventType::Placement, info.team, info.number,
+                      "placed in its half for the second half");
+  }
+}
+
 int ballInGoal(const fields::FieldModel& f, const Vec3& p) {
   if (std::abs(p.x()) <= f.halfLength() + 0.5 * f.line_width + f.ball.radius) return 0;
   if (std::abs(p.y()) >= 0.5 * f.goal.inner_width || p.z() >= f.goal.clear_height) return 0;
@@ -648,6 +665,9 @@ void Referee::enterState(gc::State s) {
   still_for_ = 0.0;
   last_state_ = s;
   if (s == gc::State::Set) onEnterSet();
+  if (s == gc::State::Initial && game_.half() == Half::Second &&
+      game_.phase() != gc::GamePhase::PenaltyShoot)
+    placeForTheSecondHalf();
   if (s == gc::State::Playing) {
     touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick
     restart_seen_touch_step_ = world_.stepCount();

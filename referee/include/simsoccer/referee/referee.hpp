@@ -89,6 +89,7 @@ class Referee {
   void checkArmContact();
   void enterState(gc::State s);
   void onEnterSet();
+  void placeForTheSecondHalf();
   // Per robot: in a legal position for the coming kick-off, drop ball or
   // penalty kick (penalised robots count as legal).
   std::vector<char> legalPositions() const;
