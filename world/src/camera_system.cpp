@@ -51,10 +51,7 @@ CameraSystem::CameraSystem(const World& world, const CameraSettings& settings, B
       policy_(policy),
       sink_(std::move(sink)),
       seed_(world.scenario().seed),
-      control_period_(world.scenario().physics.control_period),
-      robot_format_(settings.encoding == "yuyv" && settings.effects.noise == 0
-                        ? engine::PixelFormat::Yuv
-                        : engine::PixelFormat::Rgb) {
+      control_period_(world.scenario().physics.control_period) {
   calibration_.assign(2 * world.robotCount(), engine::Pose::Identity());
   for (const CameraCalibration& c : settings_.calibration) {
     bool found = false;
@@ -146,7 +143,7 @@ void CameraSystem::capture(const World& world) {
                 engine::pinholeView(pose, specs[c]->width, specs[c]->height, s->horizontal_fov,
                                     s->vertical_fov),
                 Vec3::Zero()};
-      v.view.format = robot_format_;
+      v.view.format = robotFormat();
       const auto& e = settings_.effects;
       if (e.motion_blur_exposure > 0 || e.rolling_shutter_readout > 0)
         v.angular_velocity = pose.linear().transpose() * linkAngularVelocity(world, r, s->link);
@@ -172,6 +169,11 @@ void CameraSystem::capture(const World& world) {
 void CameraSystem::flush() {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return queue_.empty(); });
+}
+
+engine::PixelFormat CameraSystem::robotFormat() const {
+  return settings_.encoding == "yuyv" && settings_.effects.noise == 0 ? engine::PixelFormat::Yuv
+                                                                      : engine::PixelFormat::Rgb;
 }
 
 CameraStats CameraSystem::stats() const {

@@ -56,8 +56,16 @@ void MotionController::restart() {
   restart_ = true;
 }
 
-void MotionController::restartFrom(const std::vector<double>& measured) {
+void MotionController::restartFrom(const std::vector<double>& measured,
+                                   const MotionSensors& sensors) {
   restart_ = false;
+  // The fall detector's filtered "up" and tilt from the IMU's angles: it
+  // still holds the state from before the restart (a robot the referee took
+  // out of a get-up and set down upright read as falling, went soft and sagged).
+  const double cp = std::cos(sensors.pitch);
+  gravity_ = 9.81 * Vec3(-std::sin(sensors.pitch), cp * std::sin(sensors.roll),
+                         cp * std::cos(sensors.roll));
+  tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
   if (state_ == MotionState::SittingDown || state_ == MotionState::Sitting) {
     // Restarted while sitting (the next half's Initial): up by the stand-up
     // motion, not an ease from the crouch.
@@ -126,13 +134,6 @@ void MotionController::standUp(const std::vector<double>& measured) {
   player_.start(motions_.stand_up, measured);
 }
 
-void MotionController::uprightFrom(const MotionSensors& sensors) {
-  const double cp = std::cos(sensors.pitch);
-  gravity_ = 9.81 * Vec3(-std::sin(sensors.pitch), cp * std::sin(sensors.roll),
-                         cp * std::cos(sensors.roll));
-  tilt_ = std::acos(std::clamp(cp * std::cos(sensors.roll), -1.0, 1.0));
-}
-
 void MotionController::easeIntoStance() {
   ease_from_ = targets_;
   walk_ = WalkEngine(model_, walk_parameters_);
@@ -164,16 +165,12 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
   std::vector<double> measured;
   measuredJointAngles(model_, sensors.position, measured);
 
-  if (restart_) {
-    restartFrom(measured);
-    uprightFrom(sensors);
-  }
+  if (restart_) restartFrom(measured, sensors);
   if (placedOnItsFeet(sensors, measured, rate)) {
     // Stiff in the stance at once: one more period of a get-up's targets
     // knocks it over, and soft it sinks. The filtered "up" still says lying
     // (the next period would count a fall): restarted from the IMU's angles.
-    restartFrom(measured);
-    uprightFrom(sensors);
+    restartFrom(measured, sensors);
   }
   // On its feet by intent: a tilt past falling_tilt is a fall (a dive is
   // meant to end on the ground; the rest are already down).

@@ -124,15 +124,15 @@ class CameraSystem {
   void run();      // render thread
   void convert();  // conversion thread
   void process(Rendered& rendered);
+  // Robot cameras are drawn in YUV when they deliver YUYV without noise (the
+  // noise is given per RGB channel), so their images need only packing.
+  engine::PixelFormat robotFormat() const;
 
   CameraSettings settings_;
   BehindPolicy policy_;
   Sink sink_;
   uint64_t seed_;
   double control_period_;
-  // Robot cameras drawn in YUV (yuyv images without noise: the noise is
-  // given per RGB channel), so their images need only packing.
-  engine::PixelFormat robot_format_;
   std::vector<engine::Pose>
       calibration_;  // per robot * 2 (top, bottom): camera from calibrated camera
   // Per robot: its first and second camera of the model (null: none).

@@ -140,12 +140,8 @@ class MotionController {
   // After a keyframe motion that ends on the feet: ease into a fresh walk's stance.
   void easeIntoStance();
   // Drops whatever motion runs and eases into the stance from `measured`
-  // (sitting: stands up first).
-  void restartFrom(const std::vector<double>& measured);
-  // The fall detector's filtered "up" and tilt restarted from the IMU's angles (after a
-  // restart the filter still holds the old state: a robot the referee took out of a get-up and
-  // set down upright read as falling, went soft and sagged).
-  void uprightFrom(const MotionSensors& sensors);
+  // (sitting: stands up first); the fall detector starts again from the IMU's angles.
+  void restartFrom(const std::vector<double>& measured, const MotionSensors& sensors);
 
   const robots::RobotModel& model_;
   KeyframeMotions motions_;
