@@ -219,6 +219,42 @@ TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {
   EXPECT_EQ(keeper.role(), Role::Goalkeeper);
 }
 
+TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  const auto game = gameState(3);
+  // Players 2 and 3 about as far from the ball (0.51 and 0.52 m), within the
+  // striker's hysteresis of each other; neither has heard from the other, so
+  // both strike.
+  agents::SoccerBehaviour two(cfg, f, 0, 1, 2, Role::Auto, 1),
+      three(cfg, f, 0, 1, 3, Role::Auto, 1);
+  auto p2 = seeing(-0.5, 0.1, 0.0, 0.0, 0.0, 0.01), p3 = seeing(-0.5, -0.15, 0.0, 0.0, 0.0, 0.01);
+  agents::SoccerBehaviour::Input in2, in3;
+  in2.time = in3.time = 0.01;
+  in2.perception = &p2;
+  in3.perception = &p3;
+  in2.game = in3.game = &game;
+  two.update(in2);
+  three.update(in3);
+  ASSERT_EQ(two.role(), Role::Striker);
+  ASSERT_EQ(three.role(), Role::Striker);
+  // Each hears the other claim the role: the nearer keeps it, the other gives it up.
+  const auto from = [](int player, const std::optional<std::vector<uint8_t>>& bytes) {
+    agents::TeamMessageIn m;
+    m.from_player = player;
+    m.data = bytes.value();
+    return m;
+  };
+  const auto m2 = two.outgoing(in2), m3 = three.outgoing(in3);
+  two.receive(from(3, m3), 0.02);
+  three.receive(from(2, m2), 0.02);
+  in2.time = in3.time = 0.02;
+  two.update(in2);
+  three.update(in3);
+  EXPECT_EQ(two.role(), Role::Striker);
+  EXPECT_NE(three.role(), Role::Striker);
+}
+
 TEST(SoccerBehaviour, ObeysTheGameState) {
   const auto cfg = soccerConfig();
   const auto f = field();

@@ -357,19 +357,24 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   struct Bid {
     int player;
     double cost, x;
+    bool striker;  // strikes now (a teammate: by its last message)
   };
   const double my_cost =
       std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen() ? 2.0 : 0.0);
-  std::vector<Bid> bids{{player_, my_cost, self_.x}};
+  std::vector<Bid> bids{{player_, my_cost, self_.x, role_ == Role::Striker}};
   for (const Teammate& m : mates_) {
     if (m.data.player == goalkeeper_number_ ||
         in.time - m.received > 3.0 * config_.message_interval + 6.0)
       continue;
-    bids.push_back({m.data.player, m.data.cost, toOwn(m.data.x, m.data.y).x});
+    bids.push_back(
+        {m.data.player, m.data.cost, toOwn(m.data.x, m.data.y).x, m.data.role == Role::Striker});
   }
-  // Hysteresis: the current striker keeps the role unless clearly beaten.
+  // Hysteresis: a striker keeps the role unless clearly beaten. Every robot
+  // that claims it gets the same bonus, so that of two claimants both pick
+  // the same one (with the bonus for itself alone, each kept it and both went
+  // for the ball side by side).
   for (Bid& b : bids)
-    if (b.player == player_ && role_ == Role::Striker) b.cost -= 0.3;
+    if (b.striker) b.cost -= 0.3;
   std::sort(bids.begin(), bids.end(), [](const Bid& a, const Bid& b) {
     return a.cost != b.cost ? a.cost < b.cost : a.player < b.player;
   });
