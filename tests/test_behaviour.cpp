@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
@@ -56,6 +57,19 @@ simsoccer_msg_GameState gameState(int state, int team0_number = 1) {
     t.message_budget = 1200;
   }
   return g;
+}
+
+// A teammate's message: its pose and its striker bid (the distance to the ball).
+agents::TeamMessageIn mate(int player, double x, double y, double cost) {
+  agents::TeamMessageData d;
+  d.player = player;
+  d.x = x;
+  d.y = y;
+  d.cost = cost;
+  agents::TeamMessageIn m;
+  m.from_player = player;
+  m.data = agents::encodeTeamMessage(d);
+  return m;
 }
 
 // The motion controller with the get-up off (as `simsoccer-agent --no-get-up` runs it).
@@ -187,17 +201,6 @@ TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {
   // Player 3 of team 0 at (-1, 0), the ball at (0, 0); teammates 2 (nearer) and 4 (farther).
   agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
   const auto game = gameState(3);
-  auto mate = [](int player, double x, double y, double cost) {
-    agents::TeamMessageData d;
-    d.player = player;
-    d.x = x;
-    d.y = y;
-    d.cost = cost;
-    agents::TeamMessageIn m;
-    m.from_player = player;
-    m.data = agents::encodeTeamMessage(d);
-    return m;
-  };
   b.receive(mate(2, -0.4, 0.0, 0.4), 0.0);
   b.receive(mate(4, -3.0, 1.0, 3.2), 0.0);
   auto p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.01);
@@ -253,6 +256,57 @@ TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {
   three.update(in3);
   EXPECT_EQ(two.role(), Role::Striker);
   EXPECT_NE(three.role(), Role::Striker);
+}
+
+TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  const auto game = gameState(3);
+  // Four field players: 2 next to the ball strikes, 4 furthest up supports,
+  // 3 and 5 defend. Each defender computes its own place; the lower number
+  // takes the left one (+y) wherever the two stand, so that both agree on it
+  // even when each has the other's position from an old message (5 stands on
+  // the left here).
+  struct Player {
+    int number;
+    double x, y;
+  };
+  const std::vector<Player> team{{2, 0.5, 1.0}, {3, -3.0, -0.6}, {4, -0.5, -1.5}, {5, -2.8, 0.8}};
+  for (const Vec3& ball : {Vec3(1.0, 1.0, 0), Vec3(-2.0, 2.5, 0), Vec3(-3.0, -1.5, 0)}) {
+    std::map<int, agents::Pose2> targets;
+    for (const Player& me : team) {
+      if (me.number != 3 && me.number != 5) continue;
+      agents::SoccerBehaviour b(cfg, f, 0, 1, me.number, Role::Auto, 1);
+      for (const Player& other : team)
+        if (other.number != me.number)
+          b.receive(mate(other.number, other.x, other.y,
+                         std::hypot(ball.x() - other.x, ball.y() - other.y) -
+                             (other.number == 2 ? 5.0 : 0.0)),
+                    0.0);
+      auto p = seeing(me.x, me.y, 0.0, ball.x(), ball.y(), 0.01);
+      agents::SoccerBehaviour::Input in;
+      in.time = 0.01;
+      in.perception = &p;
+      in.game = &game;
+      b.update(in);
+      ASSERT_EQ(b.role(), Role::Defender) << "player " << me.number;
+      targets[me.number] = b.target();
+    }
+    const agents::Pose2 left = targets[3], right = targets[5];
+    const double apart = std::hypot(left.x - right.x, left.y - right.y);
+    std::printf("ball (%.1f, %.1f): defenders at (%.2f, %.2f) and (%.2f, %.2f), %.2f m apart\n",
+                ball.x(), ball.y(), left.x, left.y, right.x, right.y, apart);
+    // Apart by the spacing (less only where the field's edge or the goal line stops one) ...
+    EXPECT_GT(apart, 0.7 * cfg.defender_spacing);
+    EXPECT_LT(apart, cfg.defender_spacing + 1e-6);
+    // ... and 3 on the left of the line from the own goal to the ball, 5 on the right.
+    const double goal_x = -f.halfLength();  // the own goal's centre, y 0
+    const auto side = [&](const agents::Pose2& t) {
+      return (ball.x() - goal_x) * t.y - ball.y() * (t.x - goal_x);
+    };
+    EXPECT_GT(side(left), 0.0);
+    EXPECT_LT(side(right), 0.0);
+  }
 }
 
 TEST(SoccerBehaviour, ObeysTheGameState) {

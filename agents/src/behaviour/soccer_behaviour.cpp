@@ -123,7 +123,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "avoid_near",
                   "avoid_far",
                   "avoid_ball",
-                  "obstacle_memory"});
+                  "obstacle_memory",
+                  "defender_spacing"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -149,6 +150,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.avoid_far = root.number("avoid_far", c.avoid_far);
   c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
   c.obstacle_memory = root.number("obstacle_memory", c.obstacle_memory);
+  c.defender_spacing = root.number("defender_spacing", c.defender_spacing);
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
@@ -159,7 +161,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   if (!(c.avoid_far > c.avoid_near))
     (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
         .fail("avoid_far must be greater than avoid_near");
-  for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory"})
+  for (const char* k :
+       {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory", "defender_spacing"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
@@ -352,8 +355,10 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   if (fixed_role_ != Role::Auto) return fixed_role_;
   if (player_ == goalkeeper_number_) return Role::Goalkeeper;
   // Field players still in the game (teammates heard from recently), with
-  // their bids; the lowest bid strikes, then the one nearest the own goal
-  // defends, the rest support.
+  // their bids; the lowest bid strikes, then the half nearest the own goal
+  // defend (side by side, by player number: an order every robot sees alike,
+  // where the order they stood in across the field flipped with stale
+  // positions), the rest support.
   struct Bid {
     int player;
     double cost, x;
@@ -384,8 +389,15 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
     return a.x != b.x ? a.x < b.x : a.player < b.player;
   });
   const size_t defenders = (rest.size() + 1) / 2;
-  for (size_t i = 0; i < rest.size(); ++i)
-    if (rest[i].player == player_) return i < defenders ? Role::Defender : Role::Supporter;
+  std::vector<Bid> back(rest.begin(), rest.begin() + static_cast<ptrdiff_t>(defenders));
+  std::sort(back.begin(), back.end(),
+            [](const Bid& a, const Bid& b) { return a.player < b.player; });
+  for (size_t i = 0; i < back.size(); ++i)
+    if (back[i].player == player_) {
+      defender_slot_ = i;
+      defenders_ = back.size();
+      return Role::Defender;
+    }
   return Role::Supporter;
 }
 
@@ -644,6 +656,14 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x),
               own_goal.y + 0.45 * (ball_.y - own_goal.y), 0.0};
       t.x = std::clamp(std::min(t.x, ball_.x - 0.8), -field_.halfLength() + 0.8, 0.0);
+      // Side by side across the ball-goal line, the first from the left (+y).
+      const double across = 0.5 * static_cast<double>(defenders_ - 1) -
+                            static_cast<double>(std::min(defender_slot_, defenders_ - 1));
+      const double bearing = std::atan2(ball_.y - own_goal.y, ball_.x - own_goal.x);
+      t.x += -std::sin(bearing) * across * config_.defender_spacing;
+      t.y += std::cos(bearing) * across * config_.defender_spacing;
+      t.x = std::clamp(t.x, -field_.halfLength() + 0.8, 0.0);
+      t.y = std::clamp(t.y, -field_.halfWidth() + 0.4, field_.halfWidth() - 0.4);
       r = walkTo(t, true);
       break;
     }

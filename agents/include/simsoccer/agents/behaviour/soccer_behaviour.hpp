@@ -99,6 +99,10 @@ struct BehaviourConfig {
   // turned to the ball the robots beside and behind are out of view, and
   // turning or stepping sideways into them made robots fall in crowds.
   double obstacle_memory = 2.0;  // s
+  // Two or more defenders stand side by side across the line from the ball
+  // to the own goal, defender_spacing apart (each would otherwise walk to the
+  // same spot, and they met there, and fell; 0 puts them there again).
+  double defender_spacing = 1.2;  // m
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
@@ -146,6 +150,8 @@ class SoccerBehaviour {
   bool takeMotionRestart();
 
   Role role() const { return role_; }  // the role in force (never Auto)
+  // Where the last update walked to or aimed at, in the own team's frame (own goal at -x).
+  Pose2 target() const { return target_; }
   std::string status() const;          // one line: role, game state, ball, target
 
  private:
@@ -184,6 +190,8 @@ class SoccerBehaviour {
   int team_;  // the world's team index (0, 1), as perception labels robots
   int team_number_, player_;
   Role fixed_role_, role_ = Role::Striker;
+  // As a defender: its place among the defenders, from the left (+y, own frame), and their number.
+  size_t defender_slot_ = 0, defenders_ = 1;
   // Game.
   bool have_game_ = false;
   int state_ = 3;  // gc::State numbering; Playing without a GameState
