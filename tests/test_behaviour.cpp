@@ -258,6 +258,38 @@ TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {
   EXPECT_NE(three.role(), Role::Striker);
 }
 
+TEST(SoccerBehaviour, TakingOrGivingUpTheStrikerRoleIsSentAtOnce) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  const auto game = gameState(3);  // a full game's budget: a message every 5 s per robot
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
+  auto p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.01);
+  agents::SoccerBehaviour::Input in;
+  in.perception = &p;
+  in.game = &game;
+  const auto at = [&](double t) {
+    in.time = t;
+    p.sim_time = t;
+    p.ball.last_seen = t;
+    b.update(in);
+    return b.outgoing(in);
+  };
+  // Alone, it strikes, and says so.
+  const auto first = at(0.01);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(agents::decodeTeamMessage(*first)->role, Role::Striker);
+  // Nothing new: the next message waits for the budget's pace.
+  EXPECT_FALSE(at(0.5));
+  // Player 2 is nearer the ball: it gives the role up, and says so at once ...
+  b.receive(mate(2, -0.2, 0.0, 0.2), 0.6);
+  const auto news = at(0.7);
+  ASSERT_TRUE(news);
+  EXPECT_NE(agents::decodeTeamMessage(*news)->role, Role::Striker);
+  // ... and then waits for the pace again.
+  EXPECT_FALSE(at(1.5));
+  EXPECT_TRUE(at(5.8));
+}
+
 TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
   const auto cfg = soccerConfig();
   const auto f = field();

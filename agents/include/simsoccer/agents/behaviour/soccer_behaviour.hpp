@@ -229,6 +229,7 @@ class SoccerBehaviour {
   void forgetBallTrack();
   std::vector<Teammate> mates_;
   double last_sent_ = -1e9, now_ = 0.0;
+  Role last_sent_role_ = Role::Auto;  // the role in the last message sent
   Leg kick_foot_ = Leg::Right;
   // A kick once decided is kept asked for (the walk stops first) until the
   // motion layer is seen kicking, or this time passes.
