@@ -290,6 +290,31 @@ TEST(SoccerBehaviour, TakingOrGivingUpTheStrikerRoleIsSentAtOnce) {
   EXPECT_TRUE(at(5.8));
 }
 
+TEST(SoccerBehaviour, APenalisedTeammateIsLeftOutOfTheRoles) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  // Player 2 said it strikes, 0.2 m from the ball; player 3 is 1 m from it.
+  agents::TeamMessageIn claim = mate(2, -0.2, 0.0, 0.2);
+  {
+    agents::TeamMessageData d = *agents::decodeTeamMessage(claim.data);
+    d.role = Role::Striker;
+    claim.data = agents::encodeTeamMessage(d);
+  }
+  const auto roleOfThree = [&](bool two_penalised) {
+    auto game = gameState(3);
+    if (two_penalised) game.teams[0].players[1].penalty = 2;  // pushing
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
+    b.receive(claim, 0.0);
+    const auto p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
+    agents::SoccerBehaviour::Input in{.time = 0.5, .perception = &p, .game = &game};
+    b.update(in);
+    return b.role();
+  };
+  EXPECT_NE(roleOfThree(false), Role::Striker);
+  // Taken out by the referee, player 2 sends nothing more; its claim no longer counts.
+  EXPECT_EQ(roleOfThree(true), Role::Striker);
+}
+
 TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
   const auto cfg = soccerConfig();
   const auto f = field();

@@ -256,7 +256,9 @@ void SoccerBehaviour::readGame(const Input& in) {
   const auto& t = g.teams[side];
   goalkeeper_number_ = t.goalkeeper;
   budget_ = t.message_budget;
-  penalised_ = player_ >= 1 && player_ <= 20 && t.players[player_ - 1].penalty != 0;
+  for (size_t i = 0; i < team_penalised_.size(); ++i)
+    team_penalised_[i] = t.players[i].penalty != 0;
+  penalised_ = player_ >= 1 && player_ <= 20 && team_penalised_[static_cast<size_t>(player_ - 1)];
   // A state change that moves robots (Set: placement; leaving a penalty: the
   // robot re-enters elsewhere) restarts the motion from the stance.
   const bool moved = penalised_ != was_penalised_ ||
@@ -368,7 +370,11 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
       std::hypot(ball_.x - self_.x, ball_.y - self_.y) + (in.fallen() ? 2.0 : 0.0);
   std::vector<Bid> bids{{player_, my_cost, self_.x, role_ == Role::Striker}};
   for (const Teammate& m : mates_) {
-    if (m.data.player == goalkeeper_number_ ||
+    // A penalised teammate is out of play whatever its last message said
+    // (it sends none while out: a striker's claim would stand for seconds).
+    const bool out = m.data.player >= 1 && m.data.player <= 20 &&
+                     team_penalised_[static_cast<size_t>(m.data.player - 1)];
+    if (m.data.player == goalkeeper_number_ || out ||
         in.time - m.received > 3.0 * config_.message_interval + 6.0)
       continue;
     bids.push_back(

@@ -197,6 +197,8 @@ class SoccerBehaviour {
   int state_ = 3;  // gc::State numbering; Playing without a GameState
   int set_play_ = 0, phase_ = 0;
   bool our_kick_ = false, kick_pending_ = false, penalised_ = false, was_penalised_ = false;
+  // Per player number (index = number - 1), by the GameState: out of play.
+  std::array<bool, 20> team_penalised_{};
   int attack_sign_ = 1;  // +1: this team attacks +x
   int goalkeeper_number_ = 1, players_per_team_ = 5, secs_remaining_ = 600, budget_ = 1200;
   bool first_half_ = true;
