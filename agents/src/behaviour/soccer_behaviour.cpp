@@ -258,7 +258,7 @@ void SoccerBehaviour::readGame(const Input& in) {
   budget_ = t.message_budget;
   for (size_t i = 0; i < team_penalised_.size(); ++i)
     team_penalised_[i] = t.players[i].penalty != 0;
-  penalised_ = player_ >= 1 && player_ <= 20 && team_penalised_[static_cast<size_t>(player_ - 1)];
+  penalised_ = penalisedInGame(player_);
   // A state change that moves robots (Set: placement; leaving a penalty: the
   // robot re-enters elsewhere) restarts the motion from the stance.
   const bool moved = penalised_ != was_penalised_ ||
@@ -372,9 +372,7 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   for (const Teammate& m : mates_) {
     // A penalised teammate is out of play whatever its last message said
     // (it sends none while out: a striker's claim would stand for seconds).
-    const bool out = m.data.player >= 1 && m.data.player <= 20 &&
-                     team_penalised_[static_cast<size_t>(m.data.player - 1)];
-    if (m.data.player == goalkeeper_number_ || out ||
+    if (m.data.player == goalkeeper_number_ || penalisedInGame(m.data.player) ||
         in.time - m.received > 3.0 * config_.message_interval + 6.0)
       continue;
     bids.push_back(

@@ -199,6 +199,10 @@ class SoccerBehaviour {
   bool our_kick_ = false, kick_pending_ = false, penalised_ = false, was_penalised_ = false;
   // Per player number (index = number - 1), by the GameState: out of play.
   std::array<bool, 20> team_penalised_{};
+  bool penalisedInGame(int player) const {
+    return player >= 1 && player <= static_cast<int>(team_penalised_.size()) &&
+           team_penalised_[static_cast<size_t>(player - 1)];
+  }
   int attack_sign_ = 1;  // +1: this team attacks +x
   int goalkeeper_number_ = 1, players_per_team_ = 5, secs_remaining_ = 600, budget_ = 1200;
   bool first_half_ = true;
