@@ -58,6 +58,54 @@ TEST(WalkEngine, SwingFootLiftsAndLandsAtItsPlacement) {
   EXPECT_NEAR(apex, p.foot_lift, 0.0005);
 }
 
+// A walk started again soon after it stopped first shifts the weight: for one step the torso
+// sways over the right foot and both feet stay down; then the right foot steps. Started after
+// standing longer (or with start_shift_time 0, the Nao's), the left foot lifts at once.
+TEST(WalkEngine, AWalkStartedSoonAfterItStoppedFirstShiftsTheWeight) {
+  const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
+  agents::WalkParameters p;
+  p.start_shift_time = 1.0;
+  p.hip_roll_compensation = 0.0;  // pure geometry (as above)
+  agents::WalkEngine e(model, p);
+  std::vector<double> q = model.pose("stand");
+  const int step = static_cast<int>(std::lround(p.step_period / 0.01));
+  // Lift of each foot above the other, highest over the next `periods` periods.
+  const auto lifts = [&](int periods) {
+    std::pair<double, double> most{-1.0, -1.0};
+    for (int i = 0; i < periods; ++i) {
+      e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+      const Feet f = feetOf(e, q);
+      const double d = f.left.translation().z() - f.right.translation().z();
+      most = {std::max(most.first, d), std::max(most.second, -d)};
+    }
+    return most;
+  };
+  // Never walked: the left foot steps at once.
+  e.setVelocity(0.1, 0.0, 0.0);
+  EXPECT_NEAR(lifts(step - 1).first, p.foot_lift, 0.001);
+  lifts(3 * step);
+  e.stop();
+  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  ASSERT_FALSE(e.walking());
+  lifts(30);  // stood 0.3 s
+  const double walked = e.odometry().x;
+  e.setVelocity(0.1, 0.0, 0.0);
+  const auto shift = lifts(step - 1);
+  EXPECT_NEAR(shift.first, 0.0, 1e-6);  // both feet down
+  EXPECT_NEAR(shift.second, 0.0, 1e-6);
+  EXPECT_EQ(e.odometry().x, walked);  // nor did the body move on
+  lifts(2);                           // the next step: the right foot swings
+  const auto next = lifts(step - 3);
+  EXPECT_NEAR(next.second, p.foot_lift, 0.001);
+  EXPECT_LT(next.first, 1e-6);
+  // Stood longer than start_shift_time: no weight shift.
+  e.stop();
+  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  lifts(110);
+  e.setVelocity(0.1, 0.0, 0.0);
+  EXPECT_NEAR(lifts(step - 1).first, p.foot_lift, 0.001);
+}
+
 TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
   const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
   agents::WalkEngine e(model);

@@ -65,6 +65,7 @@ const std::vector<Field<WalkParameters>>& walkFields() {
       {"hip_roll_compensation", &W::hip_roll_compensation, Range::Any},
       {"heading_gain", &W::heading_gain, Range::NonNegative},
       {"stop_heading_tolerance", &W::stop_heading_tolerance, Range::NonNegative},
+      {"start_shift_time", &W::start_shift_time, Range::NonNegative},
       {"ankle_pitch_gyro", &W::ankle_pitch_gyro, Range::Any},
       {"ankle_roll_gyro", &W::ankle_roll_gyro, Range::Any},
       {"gyro_smoothing", &W::gyro_smoothing, Range::Share},

@@ -38,7 +38,8 @@ void WalkEngine::setVelocity(double forward, double left, double turn) {
     walking_ = true;
     stopping_ = false;
     phase_ = 0.0;
-    support_ = Leg::Right;  // the left foot steps first
+    support_ = Leg::Right;  // the left foot steps first (the right one after a weight shift)
+    shifting_ = stood_for_ < p_.start_shift_time;
     startStep();
   }
   stopping_ = false;
@@ -51,6 +52,12 @@ void WalkEngine::stop(bool settle) {
 
 void WalkEngine::startStep() {
   const int swing = support_ == Leg::Left ? 1 : 0;
+  if (shifting_) {  // the sway alone: the body and the feet stay where they are
+    step_.setZero();
+    body_start_ = body_end_ = body_;
+    swing_start_ = swing_end_ = foot_[swing];
+    return;
+  }
   const double side = swing == 0 ? 1.0 : -1.0;  // +1: the left foot swings
   // The per-step average command ramps towards the wanted one.
   const Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
@@ -146,10 +153,12 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
         step_.setZero();
         average_.setZero();
       } else {
+        shifting_ = false;
         startStep();
       }
     }
   }
+  stood_for_ = walking_ ? 0.0 : stood_for_ + dt;
   LegSolution s;
   if (!walking_) {
     s = solve(body_, 0.0, foot_[0], foot_[1], 0.0, 0.0);
@@ -162,10 +171,13 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
     Pose2 feet[2] = {foot_[0], foot_[1]};
     feet[swing] = lerp(swing_start_, swing_end_, smoothstep(ph));
     double lift[2] = {0.0, 0.0};
-    lift[swing] = p_.foot_lift * std::sin(M_PI * ph);
+    // Shifting the weight, both feet stay down: no lift, and no sag to make up for.
+    const double single_support = shifting_ ? 0.0 : 1.0;
+    lift[swing] = single_support * p_.foot_lift * std::sin(M_PI * ph);
     s = solve(body, sway, feet[0], feet[1], lift[0], lift[1]);
     LegAngles& support_q = support_ == Leg::Left ? s.left : s.right;
-    support_q[static_cast<size_t>(kinematics_.index(LegJoint::HipRoll))] += support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
+    support_q[static_cast<size_t>(kinematics_.index(LegJoint::HipRoll))] +=
+        single_support * support_side * p_.hip_roll_compensation * std::sin(M_PI * ph);
   }
   // Balance: the support ankle (both while standing) leans against the
   // torso's rotation rate.

@@ -32,10 +32,14 @@ const char* kHelp =
     "of agents::WalkParameters / KickParameters by name (--sway, --lift, --period,\n"
     "--torso-offset, --height, --ankle-pitch-gyro, --ankle-roll-gyro, --gyro-smoothing,\n"
     "--forward-scale, --max-forward, --max-turn, --max-turn-accel, --lean, --hip-roll,\n"
-    "--heading-gain, --kick-reach, --kick-swing, --kick-shift, --kick-lift, --kick-draw-back,\n"
-    "--kick-hip-roll, --kick-swing-height, --kick-swing-out, --kick-ready-time).\n"
+    "--heading-gain, --start-shift-time, --kick-reach, --kick-swing, --kick-shift, --kick-lift,\n"
+    "--kick-draw-back, --kick-hip-roll, --kick-swing-height, --kick-swing-out,\n"
+    "--kick-ready-time).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
-    "With --random [--random-minutes M] [--seed N] [--verbose]: the random-commands trial alone.\n"
+    "With --random [--random-minutes M] [--command-seconds S] [--stand-share P] [--seed N]\n"
+    "[--verbose]: the random-commands trial alone, a new command every S s (default 2), a\n"
+    "share P of them \"stand\" (default 0; the table's stop_and_go: --command-seconds 0.5\n"
+    "--stand-share 0.3).\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
     "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
     "play: it blocks; in the shoot-out: it also dives).\n"
@@ -78,6 +82,7 @@ int benchMotion(int argc, char** argv, int first) {
       {"lean", &wp.torso_lean},
       {"hip-roll", &wp.hip_roll_compensation},
       {"heading-gain", &wp.heading_gain},
+      {"start-shift-time", &wp.start_shift_time},
       {"kick-reach", &kp.reach},
       {"kick-swing", &kp.swing_time},
       {"kick-shift", &kp.shift},
@@ -95,6 +100,8 @@ int benchMotion(int argc, char** argv, int first) {
                                   "vy",
                                   "turn",
                                   "random-minutes",
+                                  "command-seconds",
+                                  "stand-share",
                                   "seed",
                                   "foot",
                                   "ball-offset",
@@ -190,8 +197,13 @@ int benchMotion(int argc, char** argv, int first) {
   }
   if (opt.flag("random")) {  // the random-commands trial alone, for tuning
     const double seconds = opt.number("random-minutes", 10.0) * 60.0;
+    const double hold = opt.number("command-seconds", 2.0),
+                 stand_share = opt.number("stand-share", 0.0);
+    if (!(hold >= 0.01)) throw UsageError("--command-seconds: at least 0.01 s");
+    if (!(stand_share >= 0.0 && stand_share <= 1.0))
+      throw UsageError("--stand-share: a share from 0 to 1");
     std::printf("random commands: %d falls in %.0f s\n",
-                motion::randomCommandsTrial(c, seed, seconds), seconds);
+                motion::randomCommandsTrial(c, seed, seconds, hold, stand_share), seconds);
     return 0;
   }
   if (opt.has("vx") || opt.has("vy") || opt.has("turn")) {  // one walk, for tuning

@@ -165,6 +165,8 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
   {
     const double seconds = random_minutes * 60.0;
     row("random_commands", 0, 0, "-", 0, randomCommandsTrial(c, seed, seconds), seconds);
+    row("stop_and_go", 0, 0, "-", 0, randomCommandsTrial(c, seed + 900, seconds, 0.5, 0.3),
+        seconds);
   }
   table.finish(
       "walk_forward: the commanded speed for 5 m / speed + 2 s, achieved = torso displacement / "
@@ -189,7 +191,8 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
       "besides dives; "
       "random_commands: a new "
       "random velocity every 2 s on an empty field, falls counted (the robot is put back up "
-      "after each).",
+      "after each); stop_and_go: likewise, a new command every 0.5 s, 3 in 10 of them "
+      "\"stand\" (stops and starts, as a behaviour positioning near its target).",
       opt.get("csv", ""));
   return 0;
 }

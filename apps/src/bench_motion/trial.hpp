@@ -121,14 +121,19 @@ struct WalkResult {
   bool fell = false;
   double fell_at = -1.0;
 };
+// Whether the walk is asked to stand (WalkEngine::stop) at a time since it began.
+using StandSchedule = std::function<bool(double)>;
 // The walk engine alone for `seconds`; with `falls`, the robot is put back up
-// after each fall (counted) and walks on.
+// after each fall (counted) and walks on; with `stands`, it stops when they say.
 WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds,
-                     int* falls = nullptr);
+                     int* falls = nullptr, const StandSchedule& stands = {});
 
-// The table's random walk: a new seeded command every 2 s in the bench file's ranges for
-// `seconds`; the falls (the robot is put back up after each).
-int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds);
+// The table's random walk: a new seeded command every `hold` seconds in the bench file's ranges
+// for `seconds`, a share `stand_share` of them "stand"; the falls (the robot is put back up
+// after each). random_commands: every 2 s, none standing; stop_and_go: every 0.5 s, 3 in 10
+// standing, as a behaviour's positioning near its target (short commands, stops and starts).
+int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds, double hold = 2.0,
+                        double stand_share = 0.0);
 
 struct KickResult {
   double distance = 0.0, direction = 0.0;  // m, rad (field frame, 0 = the robot's heading)

@@ -9,7 +9,8 @@
 #include "trial.hpp"
 
 namespace simsoccer::apps::motion {
-WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds, int* falls) {
+WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double seconds, int* falls,
+                     const StandSchedule& stands) {
   TrialWorld t(emptyField(c), c);
   world::World& w = t.world;
   const auto& model = *w.robot(0).model;
@@ -31,8 +32,12 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   const long periods = static_cast<long>(seconds / dt);
   long i = 0;
   const auto walkControl = [&](const world::World& world, std::span<float> p, std::span<float> k) {
-    const Eigen::Vector3d v = schedule(static_cast<double>(i) * dt);
-    engine.setVelocity(v.x(), v.y(), v.z());
+    const double now = static_cast<double>(i) * dt;
+    const Eigen::Vector3d v = schedule(now);
+    if (stands && stands(now))
+      engine.stop();
+    else
+      engine.setVelocity(v.x(), v.y(), v.z());
     walkPeriod(world, engine, dt, targets, p, k);
     return true;
   };
@@ -104,8 +109,9 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   return r;
 }
 
-int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds) {
-  // A new command every 2 s in the bench file's ranges (a Nao: forward -0.1..0.3 m/s,
+int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds, double hold,
+                        double stand_share) {
+  // A new command every `hold` s in the bench file's ranges (a Nao: forward -0.1..0.3 m/s,
   // sideways -0.1..0.1 m/s, turn -0.8..0.8 rad/s), each part with a 1 in 4 chance of 0.
   const MotionBench& b = c.bench;
   std::mt19937_64 rng(seed);
@@ -114,12 +120,17 @@ int randomCommandsTrial(const TrialContext& c, uint64_t seed, double seconds) {
     return u(rng) < 0.25 ? 0.0 : range[0] + (range[1] - range[0]) * u(rng);
   };
   std::vector<Eigen::Vector3d> commands;
-  for (int i = 0; i < static_cast<int>(seconds / 2.0) + 1; ++i) {
+  std::vector<bool> stand;
+  for (int i = 0; i < static_cast<int>(seconds / hold) + 1; ++i) {
     commands.emplace_back(pick(b.random_forward), pick(b.random_sideways), pick(b.random_turn));
+    // Drawn only when asked for: random_commands keeps the sequence it always had.
+    stand.push_back(stand_share > 0.0 && u(rng) < stand_share);
   }
+  const auto at = [&](double t) { return static_cast<size_t>(t / hold); };
   int falls = 0;
   walkTrial(
-      c, [&](double t) { return commands[static_cast<size_t>(t / 2.0)]; }, seconds, &falls);
+      c, [&](double t) { return commands[at(t)]; }, seconds, &falls,
+      [&](double t) { return static_cast<bool>(stand[at(t)]); });
   return falls;
 }
 

@@ -52,6 +52,12 @@ struct WalkParameters {
   // spot. (A plain stop keeps correcting: in 5 v 5 matches, robots asked to
   // stand that settled fell twice as often as robots stepping on the spot.)
   double stop_heading_tolerance = 0.03;
+  // Starting again within this long (s) after the walk stopped: the first step only shifts the
+  // weight (the torso sways over the right foot and back, no foot lifts or moves), then the
+  // right foot steps, as in a walk under way. The body still rocks from the last steps, and a
+  // foot lifted at once can be the one it leans on; from a calm stance a step at once is safe,
+  // and quicker. 0: never (the Nao's walk does not fall without it).
+  double start_shift_time = 0.0;
   double ankle_pitch_gyro = 0.05;  // rad per rad/s of torso pitch rate
   double ankle_roll_gyro = 0.05;   // rad per rad/s of torso roll rate
   // The gyro's low-pass for that feedback: the share of each new reading
@@ -111,6 +117,8 @@ class WalkEngine {
   LegKinematics kinematics_;
   WalkParameters p_;
   bool walking_ = false, stopping_ = false, settling_ = false;
+  bool shifting_ = false;   // this step only shifts the weight (start_shift_time)
+  double stood_for_ = 1e9;  // s since the walk stopped (never walked: as if long ago)
   double phase_ = 0.0;  // 0..1 within the step
   Leg support_ = Leg::Right;
   Pose2 body_, body_start_, body_end_;
