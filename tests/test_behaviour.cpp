@@ -43,6 +43,16 @@ agents::PerceptionIn seeing(double x, double y, double yaw, double bx, double by
   return p;
 }
 
+// A behaviour takes a sighting of the ball once the next one agrees with it (a false ball lasts
+// one frame): a test's first sighting is given twice, 0.01 s apart.
+MotionRequest updateSeeing(agents::SoccerBehaviour& b, agents::SoccerBehaviour::Input in) {
+  const double t = in.time;
+  in.time = t - 0.01;
+  b.update(in);
+  in.time = t;
+  return b.update(in);
+}
+
 simsoccer_msg_GameState gameState(int state, int team0_number = 1) {
   simsoccer_msg_GameState g{};
   g.state = static_cast<uint8_t>(state);
@@ -345,7 +355,7 @@ TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
       in.time = 0.01;
       in.perception = &p;
       in.game = &game;
-      b.update(in);
+      updateSeeing(b, in);
       ASSERT_EQ(b.role(), Role::Defender) << "player " << me.number;
       targets[me.number] = b.target();
     }
@@ -416,14 +426,14 @@ TEST(SoccerBehaviour, TheStrikerKicksWhenTheBallIsInFrontOfAFootAndAimedAtTheGoa
   auto p = seeing(2.0, -0.05, 0.0, 2.17, 0.0, 0.1);
   in.time = 0.1;
   in.perception = &p;
-  MotionRequest r = b.update(in);
+  MotionRequest r = updateSeeing(b, in);
   EXPECT_EQ(r.kind, MotionRequest::Kind::Kick);
   EXPECT_EQ(r.kick_foot, agents::Leg::Left);
   // Turned 0.5 rad away from the goal: no kick, it turns back.
   agents::SoccerBehaviour c(cfg, f, 0, 1, 2, Role::Striker, 1);
   p = seeing(2.0, -0.05, 0.5, 2.0 + 0.17 * std::cos(0.5) - 0.05 * std::sin(0.5),
              -0.05 + 0.17 * std::sin(0.5) + 0.05 * std::cos(0.5), 0.1);
-  r = c.update(in);
+  r = updateSeeing(c, in);
   EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
   EXPECT_LT(r.turn, 0.0);
   // Head: towards the ball it sees.
@@ -511,7 +521,7 @@ TEST(SoccerBehaviour, WalkingRobotsStepPastTheRobotsTheySeeAhead) {
     }
     agents::SoccerBehaviour::Input in;
     in.perception = &p;
-    return striker.update(in);
+    return updateSeeing(striker, in);
   };
   const MotionRequest free = walk(1.0, std::nullopt);
   ASSERT_EQ(free.kind, MotionRequest::Kind::Walk);
@@ -571,9 +581,9 @@ TEST(SoccerBehaviour, RobotsOutOfViewAreRememberedWhereTheyWereSeen) {
     agents::SoccerBehaviour::Input in;
     in.time = t;
     in.perception = &p;
-    const MotionRequest r = with.update(in);
+    const MotionRequest r = updateSeeing(with, in);
     in.perception = &empty;
-    return std::make_pair(r, without.update(in));
+    return std::make_pair(r, updateSeeing(without, in));
   };
   const auto [seen, free0] = step(0.0, -2.0, 0.0, true);
   ASSERT_EQ(free0.kind, MotionRequest::Kind::Walk);
@@ -589,6 +599,49 @@ TEST(SoccerBehaviour, RobotsOutOfViewAreRememberedWhereTheyWereSeen) {
   const auto [forgotten, free2] = step(cfg.obstacle_memory + 0.1, -1.85, 0.4, false);
   EXPECT_DOUBLE_EQ(forgotten.forward, free2.forward);
   EXPECT_DOUBLE_EQ(forgotten.left, free2.left);
+}
+
+// A false ball (the realistic profile's: one frame, somewhere ahead) is not taken for the ball,
+// nor kept as the last sighting once out of view: the robot would walk after it, and it stays
+// ahead of a robot walking after it. A ball seen twice in a row elsewhere is the ball moved.
+TEST(SoccerBehaviour, AFalseBallSeenForOneFrameIsNotChased) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+  const auto game = gameState(3);
+  agents::SoccerBehaviour::Input in;
+  in.game = &game;
+  const auto update = [&](agents::PerceptionIn p, double t) {
+    in.time = t;
+    in.perception = &p;
+    b.update(in);
+  };
+  // At (-2, 0) facing +x, the ball at (1, 0) seen for 0.1 s, then out of view.
+  double t = 0.0;
+  for (; t < 0.1; t += 0.01) update(seeing(-2.0, 0.0, 0.0, 1.0, 0.0, t), t);
+  const double target_x = b.target().x;
+  EXPECT_NEAR(target_x, 1.0 - cfg.approach_distance, 0.05);
+  auto unseen = seeing(-2.0, 0.0, 0.0, 1.0, 0.0, t);
+  unseen.ball.in_view = false;
+  unseen.ball.last_seen = 0.09f;
+  update(unseen, t);
+  // One frame: a false ball 1.5 m ahead, at (-0.5, 0.2); then none, the perception's memory
+  // holding the false ball (its last sighting).
+  t += 0.01;
+  auto ghost = seeing(-2.0, 0.0, 0.0, -0.5, 0.2, t);
+  update(ghost, t);
+  ghost.ball.in_view = false;
+  for (int i = 0; i < 50; ++i) {
+    t += 0.01;
+    update(ghost, t);
+  }
+  EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
+  // The ball seen twice in a row at (0, 1): moved while unseen, taken.
+  for (int i = 0; i < 2; ++i) {
+    t += 0.01;
+    update(seeing(-2.0, 0.0, 0.0, 0.0, 1.0, t), t);
+  }
+  EXPECT_GT(b.target().y, 0.5) << b.status();
 }
 
 // The shoot-out keeper waits for the kick with the ball on the penalty mark,

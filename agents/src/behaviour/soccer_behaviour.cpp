@@ -311,14 +311,40 @@ void SoccerBehaviour::updateBall(const Input& in) {
     self_ = {own.x, own.y, wrap(p.self_pose[2] + (attack_sign_ > 0 ? 0.0 : kPi))};
     self_known_ = true;
     rememberRobots(p.robots, in.time);
-    if (p.ball.last_seen >= 0) {
-      ball_seen_at_ = p.ball.last_seen;
-      ball_robot_ = {p.ball.x, p.ball.y};
-      // The ball in the own frame, from where the robot is now (the sighting is relative).
-      const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
-      const Vec2 b{self_.x + c * p.ball.x - s * p.ball.y, self_.y + s * p.ball.x + c * p.ball.y};
-      if (p.ball.in_view) updateBallVelocity(in.time, b);
-      ball_ = b;
+    const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+    // A sighting in the own frame, from where the robot is now (sightings are relative).
+    const auto toOwnFrame = [&](const Vec2& r) {
+      return Vec2{self_.x + c * r.x - s * r.y, self_.y + s * r.x + c * r.y};
+    };
+    if (p.ball.in_view) {
+      // Cameras see false balls now and then (a white robot part, a line crossing: the
+      // realistic profile's false_ball_rate), each for one frame, somewhere ahead. A sighting
+      // is the ball when it agrees with the ball known (or the one before it: the ball found
+      // again elsewhere, or moved while unseen); alone it is not. Taken, a false ball 1-3 m
+      // ahead stayed ahead as the robot walked after it (the last sighting, relative, is also
+      // the memory below): K1s walked into their own goal after a ball 9 m away.
+      const Vec2 seen{p.ball.x, p.ball.y};
+      const Vec2 b = toOwnFrame(seen);
+      // Two sightings of one ball differ by the range noise (5 % each) and, against the
+      // estimate in the own frame, by the self-pose's: a margin growing with the distance.
+      const double margin = config_.ball_outlier_distance + 0.15 * std::hypot(seen.x, seen.y);
+      const bool known = in.time - ball_known_at_ < config_.ball_lost_time;
+      const bool agrees =
+          (known && std::hypot(b.x - ball_.x, b.y - ball_.y) < margin) ||
+          (in.time - sighting_at_ < 0.1 &&
+           std::hypot(seen.x - sighting_robot_.x, seen.y - sighting_robot_.y) < margin);
+      sighting_robot_ = seen;
+      sighting_at_ = in.time;
+      if (agrees) {
+        taken_robot_ = seen;
+        ball_seen_at_ = p.ball.last_seen;
+        updateBallVelocity(in.time, b);
+      }
+    }
+    if (ball_seen_at_ >= 0) {
+      // The last sighting taken, from where the robot is now.
+      ball_robot_ = taken_robot_;
+      ball_ = toOwnFrame(taken_robot_);
       ball_known_at_ = ball_seen_at_;
     }
   }

@@ -213,6 +213,10 @@ class SoccerBehaviour {
   bool self_known_ = false;
   Vec2 ball_, ball_robot_;  // own frame; robot frame (own sighting)
   double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
+  // The last sighting taken for the ball (robot frame), and the last one at all (taken or
+  // not: a sighting far from the ball is taken once the next one agrees with it).
+  Vec2 taken_robot_, sighting_robot_;
+  double sighting_at_ = -1e9;
   Vec2 ball_velocity_;
   struct Sighting {
     double time;
