@@ -394,6 +394,13 @@ TEST(SoccerBehaviour, ObeysTheGameState) {
   EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Sit);
   finished.game_phase = 1;  // penalty shoot-out
   EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Stand);
+  // The K1's config: it stands when the half is over.
+  agents::SoccerBehaviour k1(
+      agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_k1.yaml"), f, 0, 1, 4,
+      Role::Striker, 1);
+  finished.game_phase = 0;
+  EXPECT_EQ(k1.update(in).kind, MotionRequest::Kind::Stand);
+  EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Sit);
   // Ready: walks to its kick-off place (player 4: (-0.35, -0.55) of the half-sizes).
   auto g = gameState(1);
   in.game = &g;

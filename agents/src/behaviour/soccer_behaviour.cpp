@@ -124,7 +124,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "avoid_far",
                   "avoid_ball",
                   "obstacle_memory",
-                  "defender_spacing"});
+                  "defender_spacing",
+                  "sit_when_finished"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
@@ -151,6 +152,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
   c.obstacle_memory = root.number("obstacle_memory", c.obstacle_memory);
   c.defender_spacing = root.number("defender_spacing", c.defender_spacing);
+  c.sit_when_finished = root.boolean("sit_when_finished", c.sit_when_finished);
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
@@ -760,10 +762,11 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
       (penalised_ || state_ == kInitial || state_ == kStandby || state_ == kFinished)) {
     head(r, r, in);
     r.head_yaw = 0.0;
-    // A half or the game is over: it sits down and rests, as Naos do. (In the
-    // shoot-out Finished comes between the kicks: the next one is set up at
-    // once, so it stays on its feet.)
-    if (state_ == kFinished && phase_ != kPhasePenaltyShoot) r.kind = MotionRequest::Kind::Sit;
+    // A half or the game is over: it sits down and rests, as Naos do, or stands
+    // (sit_when_finished). (In the shoot-out Finished comes between the kicks:
+    // the next one is set up at once, so it stays on its feet.)
+    if (state_ == kFinished && phase_ != kPhasePenaltyShoot && config_.sit_when_finished)
+      r.kind = MotionRequest::Kind::Sit;
     return r;
   }
   role_ = chooseRole(in);

@@ -103,6 +103,10 @@ struct BehaviourConfig {
   // to the own goal, defender_spacing apart (each would otherwise walk to the
   // same spot, and they met there, and fell; 0 puts them there again).
   double defender_spacing = 1.2;  // m
+  // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
+  // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
+  // down at the whistle fell again and again through the half-time).
+  bool sit_when_finished = true;
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
