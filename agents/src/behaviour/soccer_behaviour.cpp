@@ -322,7 +322,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
       // Cameras see false balls now and then (a white robot part, a line crossing: the
       // realistic profile's false_ball_rate), each for one frame, somewhere ahead. A sighting
       // is the ball when it agrees with the ball known (or the one before it: the ball found
-      // again elsewhere, or moved while unseen); alone it is not. Taken, a false ball 1-3 m
+      // again elsewhere, or moved while unseen); alone it is not. Taken, a false ball 0.5-3.5 m
       // ahead stayed ahead as the robot walked after it (the last sighting, relative, is also
       // the memory below): K1s walked into their own goal after a ball 9 m away.
       const Vec2 seen{p.ball.x, p.ball.y};
