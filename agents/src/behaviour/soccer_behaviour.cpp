@@ -239,6 +239,10 @@ SoccerBehaviour::Vec2 SoccerBehaviour::toRobot(const Vec2& p) const {
   const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
   return {c * dx + s * dy, -s * dx + c * dy};
 }
+SoccerBehaviour::Vec2 SoccerBehaviour::fromRobot(const Vec2& r) const {
+  const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+  return {self_.x + c * r.x - s * r.y, self_.y + s * r.x + c * r.y};
+}
 
 void SoccerBehaviour::readGame(const Input& in) {
   if (!in.game) return;
@@ -284,13 +288,12 @@ bool SoccerBehaviour::takeMotionRestart() {
 
 void SoccerBehaviour::rememberRobots(const std::vector<PerceivedIn>& robots, double time) {
   obstacles_.resize(robots.size());
-  const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
   robots_seen_.clear();
   for (size_t i = 0; i < robots.size(); ++i) {
     const PerceivedIn& o = robots[i];
     RememberedRobot& m = obstacles_[i];
     if (o.in_view) {
-      m.at = {self_.x + c * o.x - s * o.y, self_.y + s * o.x + c * o.y};
+      m.at = fromRobot({o.x, o.y});
       m.seen = time;
       m.teammate = o.team == team_;
     }
@@ -313,11 +316,6 @@ void SoccerBehaviour::updateBall(const Input& in) {
     self_ = {own.x, own.y, wrap(p.self_pose[2] + (attack_sign_ > 0 ? 0.0 : kPi))};
     self_known_ = true;
     rememberRobots(p.robots, in.time);
-    const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
-    // A sighting in the own frame, from where the robot is now (sightings are relative).
-    const auto toOwnFrame = [&](const Vec2& r) {
-      return Vec2{self_.x + c * r.x - s * r.y, self_.y + s * r.x + c * r.y};
-    };
     if (p.ball.in_view) {
       // Cameras see false balls now and then (a white robot part, a line crossing: the
       // realistic profile's false_ball_rate), each for one frame, somewhere ahead. A sighting
@@ -326,7 +324,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
       // ahead stayed ahead as the robot walked after it (the last sighting, relative, is also
       // the memory below): K1s walked into their own goal after a ball 9 m away.
       const Vec2 seen{p.ball.x, p.ball.y};
-      const Vec2 b = toOwnFrame(seen);
+      const Vec2 b = fromRobot(seen);
       // Two sightings of one ball differ by the range noise (5 % each) and, against the
       // estimate in the own frame, by the self-pose's: a margin growing with the distance.
       const double margin = config_.ball_outlier_distance + 0.15 * std::hypot(seen.x, seen.y);
@@ -338,15 +336,14 @@ void SoccerBehaviour::updateBall(const Input& in) {
       sighting_robot_ = seen;
       sighting_at_ = in.time;
       if (agrees) {
-        taken_robot_ = seen;
+        ball_robot_ = seen;
         ball_seen_at_ = p.ball.last_seen;
         updateBallVelocity(in.time, b);
       }
     }
     if (ball_seen_at_ >= 0) {
       // The last sighting taken, from where the robot is now.
-      ball_robot_ = taken_robot_;
-      ball_ = toOwnFrame(taken_robot_);
+      ball_ = fromRobot(ball_robot_);
       ball_known_at_ = ball_seen_at_;
     }
   }

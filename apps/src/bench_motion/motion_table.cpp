@@ -165,8 +165,10 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
   {
     const double seconds = random_minutes * 60.0;
     row("random_commands", 0, 0, "-", 0, randomCommandsTrial(c, seed, seconds), seconds);
-    row("stop_and_go", 0, 0, "-", 0, randomCommandsTrial(c, seed + 900, seconds, 0.5, 0.3),
-        seconds);
+    // Its own commands: seeded apart from random_commands' (seed + 900).
+    constexpr uint64_t kStopAndGoSeed = 900;
+    row("stop_and_go", 0, 0, "-", 0,
+        randomCommandsTrial(c, seed + kStopAndGoSeed, seconds, 0.5, 0.3), seconds);
   }
   table.finish(
       "walk_forward: the commanded speed for 5 m / speed + 2 s, achieved = torso displacement / "

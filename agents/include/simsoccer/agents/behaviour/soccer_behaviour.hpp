@@ -188,6 +188,7 @@ class SoccerBehaviour {
   Vec2 toOwn(double fx, double fy) const;    // field -> own frame
   Vec2 fromOwn(double ox, double oy) const;  // own -> field frame
   Vec2 toRobot(const Vec2& own) const;       // own -> robot frame
+  Vec2 fromRobot(const Vec2& robot) const;   // robot -> own frame (from where it is now)
 
   BehaviourConfig config_;
   fields::FieldModel field_;
@@ -202,7 +203,7 @@ class SoccerBehaviour {
   int set_play_ = 0, phase_ = 0;
   bool our_kick_ = false, kick_pending_ = false, penalised_ = false, was_penalised_ = false;
   // Per player number (index = number - 1), by the GameState: out of play.
-  std::array<bool, 20> team_penalised_{};
+  std::array<bool, protocol::kMaxPlayers> team_penalised_{};
   bool penalisedInGame(int player) const {
     return player >= 1 && player <= static_cast<int>(team_penalised_.size()) &&
            team_penalised_[static_cast<size_t>(player - 1)];
@@ -215,11 +216,11 @@ class SoccerBehaviour {
   // Self and ball (own frame).
   Pose2 self_;
   bool self_known_ = false;
-  Vec2 ball_, ball_robot_;  // own frame; robot frame (own sighting)
+  Vec2 ball_, ball_robot_;  // own frame; robot frame (the last own sighting taken)
   double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
-  // The last sighting taken for the ball (robot frame), and the last one at all (taken or
-  // not: a sighting far from the ball is taken once the next one agrees with it).
-  Vec2 taken_robot_, sighting_robot_;
+  // The last sighting at all, taken or not (robot frame): a sighting far from the ball is
+  // taken once the next one agrees with it.
+  Vec2 sighting_robot_;
   double sighting_at_ = -1e9;
   Vec2 ball_velocity_;
   struct Sighting {
