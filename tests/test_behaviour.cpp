@@ -281,7 +281,7 @@ TEST(SoccerBehaviour, TakingOrGivingUpTheStrikerRoleIsSentAtOnce) {
     in.time = t;
     p.sim_time = t;
     p.ball.last_seen = t;
-    b.update(in);
+    updateSeeing(b, in);
     return b.outgoing(in);
   };
   // Alone, it strikes, and says so.
@@ -317,7 +317,7 @@ TEST(SoccerBehaviour, APenalisedTeammateIsLeftOutOfTheRoles) {
     b.receive(claim, 0.0);
     const auto p = seeing(-1.0, 0.0, 0.0, 0.0, 0.0, 0.5);
     agents::SoccerBehaviour::Input in{.time = 0.5, .perception = &p, .game = &game};
-    b.update(in);
+    updateSeeing(b, in);
     return b.role();
   };
   EXPECT_NE(roleOfThree(false), Role::Striker);
