@@ -409,6 +409,89 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   EXPECT_EQ(g.kickingTeam(), 1);
 }
 
+// Robot 1 is driven at `velocity` (world frame), and robot 3 at `other_velocity`, for
+// up to `seconds`, until robot 1 is penalised.
+void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double seconds,
+               const Vec3& other_velocity = Vec3::Zero()) {
+  for (int i = 0;
+       i < static_cast<int>(seconds / 0.01) && ref.game().penalty(0, 2) == gc::Penalty::None; ++i) {
+    w.physics().setRootVelocity(w.robot(1).body, velocity, Vec3::Zero());
+    if (!other_velocity.isZero())
+      w.physics().setRootVelocity(w.robot(3).body, other_velocity, Vec3::Zero());
+    run(w, ref, 0.01);
+  }
+}
+
+// Robots 1 and 3 apart for longer than a contact's gaps: the next contact is a new one.
+void apart(world::World& w, Referee& ref) {
+  w.placeRobot(1, -1.0, -2.0, 0.0);
+  w.placeRobot(3, 1.5, -2.0, M_PI);
+  run(w, ref, 0.5);
+}
+
+TEST(Referee, SwayingAgainstAnOpponentIsNotPushing) {
+  // A robot stepping in place sways its torso from side to side faster than
+  // push_speed; against an opponent at its side that is contact, not driving into it.
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.45, -1.75, M_PI);
+  putBall(w, 2.0, 1.0);
+  for (int half_cycle = 0; half_cycle < 12; ++half_cycle)  // 3 s, 0.2 m/s each way
+    driveInto(w, ref, Vec3(0.0, half_cycle % 2 ? -0.2 : 0.2, 0.0), 0.25);
+  EXPECT_EQ(count(g, "pushing"), 0);
+  // Leaning into it on average is pushing.
+  for (int half_cycle = 0; half_cycle < 12; ++half_cycle)
+    driveInto(w, ref, Vec3(0.0, half_cycle % 2 ? 0.0 : 0.4, 0.0), 0.25);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+}
+
+TEST(Referee, FrontToFrontWithTheBallBetweenIsNotPushing) {
+  // The rules' exception: two robots going for the ball meet front to front with
+  // the ball between them.
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.8, -2.0, M_PI);
+  putBall(w, 0.625, -2.0);
+  driveInto(w, ref, Vec3(0.3, 0.0, 0.0), 2.0);
+  EXPECT_EQ(count(g, "pushing"), 0);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  // The same drive with the ball away from between them is pushing.
+  apart(w, ref);
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.8, -2.0, M_PI);
+  putBall(w, 0.7, -1.7);
+  driveInto(w, ref, Vec3(0.3, 0.0, 0.0), 2.0);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+}
+
+TEST(Referee, SideContactGoingToTheBallIsNotPushing) {
+  // The rules' exception: side contact while going to the ball. Robots 1 and 3 walk
+  // side by side, robot 3 at robot 1's left; robot 1 veers left into it.
+  world::World w(twoVsTwo());
+  Referee ref(w, spl(), teams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.45, -1.75, 0.0);
+  putBall(w, 0.9, -1.35);  // ahead of robot 1, where it walks
+  driveInto(w, ref, Vec3(0.25, 0.45, 0.0), 1.5, Vec3(0.25, 0.0, 0.0));
+  EXPECT_EQ(count(g, "pushing"), 0);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  // The same walk with the ball behind them: robot 1 is not going to the ball.
+  apart(w, ref);
+  w.placeRobot(1, 0.45, -2.0, 0.0);
+  w.placeRobot(3, 0.45, -1.75, 0.0);
+  putBall(w, -0.1, -2.0);
+  driveInto(w, ref, Vec3(0.25, 0.45, 0.0), 1.5, Vec3(0.25, 0.0, 0.0));
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+}
+
 TEST(Referee, BallContactWithAnArm) {
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);

@@ -34,8 +34,16 @@ struct RefereeConfig {
   double push_gap = 0.3;   // s
   double push_displacement =
       0.15;                 // m ... or the other shoved this far since the contact began ...
-  double push_speed = 0.1;  // m/s: ... while the pusher moves towards the other this fast
+  double push_speed = 0.1;  // m/s: ... while the pusher moved towards the other this fast,
+                            // on average over the last push_time
   double foul_ball_distance = 0.5;  // m: pushing this close to the ball in open play is a foul
+  // The rules' exceptions for two robots going for the ball within contest_distance of it
+  // (torso to ball): front-to-front contact with the ball between them (within
+  // contest_corridor of the line joining their torsos), and side contact, the other robot
+  // more than contest_angle off the heading of the one walking to the ball.
+  double contest_distance = 1.0;   // m
+  double contest_corridor = 0.15;  // m
+  double contest_angle = 0.7854;   // rad (45 degrees)
   // Penalty shoot-out.
   int shootout_goal_side = 1;          // all kicks at the goal at x = side * length / 2
   double ball_stopped_speed = 0.02;    // m/s: the ball has come to a stop ...
@@ -86,6 +94,10 @@ class Referee {
   void checkGameStuck();
   void checkShot();
   void checkPushing();
+  // Contact between pusher and victim that the rules allow robots going for the ball.
+  bool contestingTheBall(world::RobotId pusher, world::RobotId victim,
+                         const engine::Vec3& velocity) const;
+  void trackTorsos();  // torso_track_ and drive_ for this period
   void checkArmContact();
   void enterState(gc::State s);
   void onEnterSet();
@@ -134,6 +146,14 @@ class Referee {
   // where both stood when the contact began.
   std::vector<double> contact_for_, contact_gap_;
   std::vector<engine::Vec3> contact_start_;
+  // Every robot's torso over the last push_time (the periods pushing was judged in), so
+  // that "drives into" is the mean velocity over that time: a walking torso's sway
+  // from step to step is faster than push_speed.
+  std::vector<engine::Vec3> torso_track_;  // robots x periods, ring
+  std::vector<double> track_clock_;        // clock_ of each period in the ring
+  size_t track_head_ = 0;
+  std::vector<double> tracked_since_;               // per robot: clock_ when its track (re)started
+  std::vector<std::optional<engine::Vec3>> drive_;  // mean velocity per robot, once known
   std::vector<std::vector<char>> arm_link_;  // per robot, per link: an arm
   uint64_t arm_checked_step_ = 0;
   // The running shoot-out kick.
