@@ -2,6 +2,7 @@
 // positions and robot placements, checked against the rules.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "referee_support.hpp"
@@ -422,13 +423,6 @@ void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double secon
   }
 }
 
-// Robots 1 and 3 apart for longer than a contact's gaps: the next contact is a new one.
-void apart(world::World& w, Referee& ref) {
-  w.placeRobot(1, -1.0, -2.0, 0.0);
-  w.placeRobot(3, 1.5, -2.0, M_PI);
-  run(w, ref, 0.5);
-}
-
 TEST(Referee, SwayingAgainstAnOpponentIsNotPushing) {
   // A robot stepping in place sways its torso from side to side faster than
   // push_speed; against an opponent at its side that is contact, not driving into it.
@@ -448,26 +442,35 @@ TEST(Referee, SwayingAgainstAnOpponentIsNotPushing) {
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
 }
 
+// Robots 1 and 3 placed at (x, y, yaw), the ball at `ball`, robot 1 driven at
+// `velocity` and robot 3 at `other_velocity` for `seconds` (world frame): whether
+// that contact was called pushing. The two start apart for longer than a contact's
+// gaps, so that it is a new contact.
+bool calledPushing(world::World& w, Referee& ref, const Vec3& one, const Vec3& three,
+                   const Vec3& ball, const Vec3& velocity, double seconds,
+                   const Vec3& other_velocity = Vec3::Zero()) {
+  w.placeRobot(1, -1.0, -2.0, 0.0);
+  w.placeRobot(3, 1.5, -2.0, M_PI);
+  run(w, ref, 0.5);
+  const int before = count(ref.game(), "pushing");
+  w.placeRobot(1, one.x(), one.y(), one.z());
+  w.placeRobot(3, three.x(), three.y(), three.z());
+  putBall(w, ball.x(), ball.y());
+  driveInto(w, ref, velocity, seconds, other_velocity);
+  return count(ref.game(), "pushing") > before;
+}
+
 TEST(Referee, FrontToFrontWithTheBallBetweenIsNotPushing) {
   // The rules' exception: two robots going for the ball meet front to front with
-  // the ball between them.
+  // the ball between them. Robot 1 drives into robot 3, facing it.
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
-  Game& g = ref.game();
   openPlay(w, ref);
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.8, -2.0, M_PI);
-  putBall(w, 0.625, -2.0);
-  driveInto(w, ref, Vec3(0.3, 0.0, 0.0), 2.0);
-  EXPECT_EQ(count(g, "pushing"), 0);
-  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  const Vec3 one(0.45, -2.0, 0.0), three(0.8, -2.0, M_PI), drive(0.3, 0.0, 0.0);
+  EXPECT_FALSE(calledPushing(w, ref, one, three, Vec3(0.625, -2.0, 0.0), drive, 2.0));
   // The same drive with the ball away from between them is pushing.
-  apart(w, ref);
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.8, -2.0, M_PI);
-  putBall(w, 0.7, -1.7);
-  driveInto(w, ref, Vec3(0.3, 0.0, 0.0), 2.0);
-  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+  EXPECT_TRUE(calledPushing(w, ref, one, three, Vec3(0.7, -1.7, 0.0), drive, 2.0));
+  EXPECT_EQ(ref.game().penalty(0, 2), gc::Penalty::PlayerPushing);
 }
 
 TEST(Referee, SideContactGoingToTheBallIsNotPushing) {
@@ -475,21 +478,34 @@ TEST(Referee, SideContactGoingToTheBallIsNotPushing) {
   // side by side, robot 3 at robot 1's left; robot 1 veers left into it.
   world::World w(twoVsTwo());
   Referee ref(w, spl(), teams(), 0);
-  Game& g = ref.game();
   openPlay(w, ref);
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.45, -1.75, 0.0);
-  putBall(w, 0.9, -1.35);  // ahead of robot 1, where it walks
-  driveInto(w, ref, Vec3(0.25, 0.45, 0.0), 1.5, Vec3(0.25, 0.0, 0.0));
-  EXPECT_EQ(count(g, "pushing"), 0);
-  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+  const Vec3 one(0.45, -2.0, 0.0), three(0.45, -1.75, 0.0);
+  const Vec3 drive(0.25, 0.45, 0.0), alongside(0.25, 0.0, 0.0);
+  // The ball ahead of robot 1, where it walks.
+  EXPECT_FALSE(calledPushing(w, ref, one, three, Vec3(0.9, -1.35, 0.0), drive, 1.5, alongside));
   // The same walk with the ball behind them: robot 1 is not going to the ball.
-  apart(w, ref);
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.45, -1.75, 0.0);
-  putBall(w, -0.1, -2.0);
-  driveInto(w, ref, Vec3(0.25, 0.45, 0.0), 1.5, Vec3(0.25, 0.0, 0.0));
-  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+  EXPECT_TRUE(calledPushing(w, ref, one, three, Vec3(-0.1, -2.0, 0.0), drive, 1.5, alongside));
+  EXPECT_EQ(ref.game().penalty(0, 2), gc::Penalty::PlayerPushing);
+}
+
+// The arm links come from the robot's description: for the Nao the shoulder to the
+// wrist; for the K1 its upper arms too, which no Nao name matches.
+TEST(Referee, ArmLinksAreTheLimbsWithNeitherAFootNorACamera) {
+  const auto arms = [](const robots::RobotModel& m) {
+    const std::vector<char> arm = referee::armLinks(m);
+    std::vector<std::string> names;
+    for (size_t l = 0; l < arm.size(); ++l)
+      if (arm[l]) names.push_back(m.body->links[l].name);
+    return names;
+  };
+  EXPECT_EQ(arms(robots::loadRobotModel(test::naoH25())),
+            (std::vector<std::string>{"LShoulder", "LBiceps", "LElbow", "LForeArm", "LWrist",
+                                      "RShoulder", "RBiceps", "RElbow", "RForeArm", "RWrist"}));
+  const std::vector<std::string> k1 = arms(robots::loadRobotModel(test::boosterK1()));
+  for (const char* link : {"LeftShoulder", "LeftUpperArm", "LeftHand", "RightUpperArm"})
+    EXPECT_NE(std::find(k1.begin(), k1.end(), link), k1.end()) << link;
+  for (const char* link : {"Trunk", "Head", "LeftFoot", "RightFoot"})
+    EXPECT_EQ(std::find(k1.begin(), k1.end(), link), k1.end()) << link;
 }
 
 TEST(Referee, BallContactWithAnArm) {

@@ -21,15 +21,31 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
   contact_for_.assign(world.robotCount() * world.robotCount(), 0.0);
   contact_gap_.assign(world.robotCount() * world.robotCount(), 1e9);
   contact_start_.assign(2 * world.robotCount() * world.robotCount(), Vec3::Zero());
-  for (RobotId r = 0; r < world.robotCount(); ++r) {
-    const auto& links = world.robot(r).model->body->links;
-    std::vector<char> arm(links.size(), 0);
-    for (size_t l = 0; l < links.size(); ++l)
-      for (const char* part : {"Shoulder", "Biceps", "Elbow", "ForeArm", "Wrist", "Hand"})
-        if (links[l].name.find(part) != std::string::npos) arm[l] = 1;
-    arm_link_.push_back(std::move(arm));
-  }
+  for (RobotId r = 0; r < world.robotCount(); ++r)
+    arm_link_.push_back(armLinks(*world.robot(r).model));
   stuck_ball_ = world.ballState().pose.translation();
+}
+
+std::vector<char> armLinks(const robots::RobotModel& model) {
+  const engine::ArticulatedModel& body = *model.body;
+  const size_t n = body.links.size();
+  std::vector<char> arm(n, 0);
+  if (!model.hasLegs()) return arm;  // no legs named: no telling the limbs apart
+  // Per link, the trunk's child it hangs from (-1: the trunk). A joint's parent
+  // link comes before its child link.
+  std::vector<int> limb(n, -1);
+  for (const engine::Joint& j : body.joints)
+    limb[static_cast<size_t>(j.child_link)] =
+        j.parent_link == 0 ? j.child_link : limb[static_cast<size_t>(j.parent_link)];
+  std::vector<char> arm_limb(n, 1);  // the limbs that hold neither a foot nor a camera
+  const auto notAnArm = [&](int link) {
+    if (link > 0 && limb[static_cast<size_t>(link)] > 0)
+      arm_limb[static_cast<size_t>(limb[static_cast<size_t>(link)])] = 0;
+  };
+  for (const robots::LegChain& leg : model.legs) notAnArm(leg.foot_link);
+  for (size_t k = 0; k < model.cameraCount(); ++k) notAnArm(model.camera(k).link);
+  for (size_t l = 1; l < n; ++l) arm[l] = limb[l] > 0 && arm_limb[static_cast<size_t>(limb[l])];
+  return arm;
 }
 
 std::optional<RobotId> Referee::robot(int team, int number) const {

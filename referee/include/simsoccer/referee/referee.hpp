@@ -57,6 +57,11 @@ struct RefereeConfig {
 // 0: not in a goal. The referee's own rule, for anyone who judges goals.
 int ballInGoal(const fields::FieldModel& field, const engine::Vec3& ball);
 
+// Per link of a robot: whether it belongs to an arm, from the robot's description
+// (the limbs hanging from the trunk that hold neither a foot nor a camera; none when
+// the description names no legs). For the rule on playing the ball with the arms.
+std::vector<char> armLinks(const robots::RobotModel& model);
+
 class Referee {
  public:
   Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,
