@@ -423,25 +423,6 @@ void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double secon
   }
 }
 
-TEST(Referee, SwayingAgainstAnOpponentIsNotPushing) {
-  // A robot stepping in place sways its torso from side to side faster than
-  // push_speed; against an opponent at its side that is contact, not driving into it.
-  world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
-  Game& g = ref.game();
-  openPlay(w, ref);
-  w.placeRobot(1, 0.45, -2.0, 0.0);
-  w.placeRobot(3, 0.45, -1.75, M_PI);
-  putBall(w, 2.0, 1.0);
-  for (int half_cycle = 0; half_cycle < 12; ++half_cycle)  // 3 s, 0.2 m/s each way
-    driveInto(w, ref, Vec3(0.0, half_cycle % 2 ? -0.2 : 0.2, 0.0), 0.25);
-  EXPECT_EQ(count(g, "pushing"), 0);
-  // Leaning into it on average is pushing.
-  for (int half_cycle = 0; half_cycle < 12; ++half_cycle)
-    driveInto(w, ref, Vec3(0.0, half_cycle % 2 ? 0.0 : 0.4, 0.0), 0.25);
-  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
-}
-
 // Robots 1 and 3 placed at (x, y, yaw), the ball at `ball`, robot 1 driven at
 // `velocity` and robot 3 at `other_velocity` for `seconds` (world frame): whether
 // that contact was called pushing. The two start apart for longer than a contact's

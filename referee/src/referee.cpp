@@ -121,41 +121,6 @@ double Referee::depthInOwnGoalArea(RobotId r) const {
   return std::min(x - (f.halfLength() - area.length), 0.5 * area.width - std::abs(p.y()));
 }
 
-void Referee::trackTorsos() {
-  const size_t n = world_.robotCount();
-  const double dt = world_.scenario().physics.control_period;
-  const size_t periods =
-      std::max<size_t>(1, static_cast<size_t>(std::lround(config_.push_time / dt)));
-  if (track_clock_.size() != periods + 1) {
-    track_clock_.assign(periods + 1, -1e9);
-    torso_track_.assign((periods + 1) * n, Vec3::Zero());
-    tracked_since_.assign(n, 0.0);
-    drive_.assign(n, std::nullopt);
-  }
-  const size_t previous = track_head_;
-  track_head_ = (track_head_ + 1) % track_clock_.size();
-  const size_t oldest = (track_head_ + 1) % track_clock_.size();
-  track_clock_[track_head_] = clock_;
-  // A track starts again after a period pushing was not judged in, and for a robot
-  // that was moved (placed, removed, put back): faster than any robot moves itself.
-  const bool continuous = std::abs(clock_ - track_clock_[previous] - dt) < 0.5 * dt;
-  constexpr double kMovedSpeed = 5.0;  // m/s
-  for (RobotId r = 0; r < n; ++r) {
-    const Vec3 p = world_.torsoPose(r).translation();
-    if (!continuous || (p - torso_track_[previous * n + r]).norm() > kMovedSpeed * dt)
-      tracked_since_[r] = clock_;
-    torso_track_[track_head_ * n + r] = p;
-    const double span = clock_ - track_clock_[oldest];
-    if (clock_ - tracked_since_[r] < span - 0.5 * dt) {
-      drive_[r].reset();
-      continue;
-    }
-    Vec3 v = (p - torso_track_[oldest * n + r]) / span;
-    v.z() = 0.0;
-    drive_[r] = v;
-  }
-}
-
 bool Referee::contestingTheBall(RobotId pusher, RobotId victim, const Vec3& velocity) const {
   const auto flat = [](Vec3 v) {
     v.z() = 0.0;
@@ -182,12 +147,12 @@ bool Referee::contestingTheBall(RobotId pusher, RobotId victim, const Vec3& velo
   // Side contact while going to the ball: the pusher walks towards the ball and
   // the victim is at its side, not in front of it.
   const Vec3 to_ball = ball - p;
-  const bool to_the_ball = velocity.dot(to_ball) >= front * velocity.norm() * to_ball.norm();
+  const Vec3 v = flat(velocity);
+  const bool to_the_ball = v.dot(to_ball) >= front * v.norm() * to_ball.norm();
   return to_the_ball && std::abs(heading(pusher).dot(towards)) < front;
 }
 
 void Referee::checkPushing() {
-  trackTorsos();
   const size_t n = world_.robotCount();
   const double dt = world_.scenario().physics.control_period;
   std::vector<char> touching(n * n, 0);
@@ -220,15 +185,16 @@ void Referee::checkPushing() {
       if (game_.penalty(ia.team, ia.number) != gc::Penalty::None ||
           game_.penalty(ib.team, ib.number) != gc::Penalty::None)
         continue;
-      // Who drives into whom: the mean horizontal speed towards the other.
-      if (!drive_[a] || !drive_[b]) continue;
+      // Who drives into whom: the horizontal speed towards the other.
       const Vec3 pa = world_.torsoPose(a).translation(), pb = world_.torsoPose(b).translation();
       Vec3 ab = pb - pa;
       ab.z() = 0.0;
       if (ab.norm() < 1e-6) continue;
       ab.normalize();
-      const double va = drive_[a]->dot(ab);
-      const double vb = -drive_[b]->dot(ab);
+      const Vec3 velocity_a = world_.physics().rootLinearVelocity(ia.body);
+      const Vec3 velocity_b = world_.physics().rootLinearVelocity(ib.body);
+      const double va = velocity_a.dot(ab);
+      const double vb = -velocity_b.dot(ab);
       const RobotId pusher = va >= vb ? a : b, victim = pusher == a ? b : a;
       const double speed = std::max(va, vb);
       const auto& ip = world_.robot(pusher);
@@ -238,7 +204,7 @@ void Referee::checkPushing() {
       if (speed < config_.push_speed || !world_.isStanding(pusher)) continue;
       if (game_.goalkeeper(ip.team) == ip.number && inOwnArea(pusher, penaltyArea())) continue;
       // Contesting the ball as the rules allow: the contact so far does not count.
-      if (contestingTheBall(pusher, victim, *drive_[pusher])) {
+      if (contestingTheBall(pusher, victim, pusher == a ? velocity_a : velocity_b)) {
         t = 0.0;
         continue;
       }

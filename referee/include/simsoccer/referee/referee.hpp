@@ -34,8 +34,7 @@ struct RefereeConfig {
   double push_gap = 0.3;   // s
   double push_displacement =
       0.15;                 // m ... or the other shoved this far since the contact began ...
-  double push_speed = 0.1;  // m/s: ... while the pusher moved towards the other this fast,
-                            // on average over the last push_time
+  double push_speed = 0.1;  // m/s: ... while the pusher moves towards the other this fast
   double foul_ball_distance = 0.5;  // m: pushing this close to the ball in open play is a foul
   // The rules' exceptions for two robots going for the ball within contest_distance of it
   // (torso to ball): front-to-front contact with the ball between them (within
@@ -102,7 +101,6 @@ class Referee {
   // Contact between pusher and victim that the rules allow robots going for the ball.
   bool contestingTheBall(world::RobotId pusher, world::RobotId victim,
                          const engine::Vec3& velocity) const;
-  void trackTorsos();  // torso_track_ and drive_ for this period
   void checkArmContact();
   void enterState(gc::State s);
   void onEnterSet();
@@ -151,14 +149,6 @@ class Referee {
   // where both stood when the contact began.
   std::vector<double> contact_for_, contact_gap_;
   std::vector<engine::Vec3> contact_start_;
-  // Every robot's torso over the last push_time (the periods pushing was judged in), so
-  // that "drives into" is the mean velocity over that time: a walking torso's sway
-  // from step to step is faster than push_speed.
-  std::vector<engine::Vec3> torso_track_;  // robots x periods, ring
-  std::vector<double> track_clock_;        // clock_ of each period in the ring
-  size_t track_head_ = 0;
-  std::vector<double> tracked_since_;               // per robot: clock_ when its track (re)started
-  std::vector<std::optional<engine::Vec3>> drive_;  // mean velocity per robot, once known
   std::vector<std::vector<char>> arm_link_;  // per robot, per link: an arm
   uint64_t arm_checked_step_ = 0;
   // The running shoot-out kick.
