@@ -135,21 +135,22 @@ bool Referee::contestingTheBall(RobotId pusher, RobotId victim, const Vec3& velo
   const auto heading = [&](RobotId r) {
     return flat(world_.torsoPose(r).linear().col(0)).normalized();
   };
+  const double facing = heading(pusher).dot(towards);  // cos of the victim's bearing
   const double front = std::cos(config_.contest_angle);
   // Front to front with the ball between them: each faces the other and the ball
   // lies on the stretch between them (their torsos, leaning over it, may be past it).
   const double along = (ball - p).dot(towards);
   const double across = (ball - p - along * towards).norm();
   const double reach = config_.contest_corridor;
-  if (heading(pusher).dot(towards) >= front && heading(victim).dot(-towards) >= front &&
-      along > -reach && along < gap + reach && across <= reach)
+  if (facing >= front && heading(victim).dot(-towards) >= front && along > -reach &&
+      along < gap + reach && across <= reach)
     return true;
   // Side contact while going to the ball: the pusher walks towards the ball and
   // the victim is at its side, not in front of it.
   const Vec3 to_ball = ball - p;
   const Vec3 v = flat(velocity);
   const bool to_the_ball = v.dot(to_ball) >= front * v.norm() * to_ball.norm();
-  return to_the_ball && std::abs(heading(pusher).dot(towards)) < front;
+  return to_the_ball && std::abs(facing) < front;
 }
 
 void Referee::checkPushing() {

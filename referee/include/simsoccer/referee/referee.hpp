@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,7 +43,7 @@ struct RefereeConfig {
   // more than contest_angle off the heading of the one walking to the ball.
   double contest_distance = 1.0;   // m
   double contest_corridor = 0.15;  // m
-  double contest_angle = 0.7854;   // rad (45 degrees)
+  double contest_angle = std::numbers::pi / 4;  // rad
   // Penalty shoot-out.
   int shootout_goal_side = 1;          // all kicks at the goal at x = side * length / 2
   double ball_stopped_speed = 0.02;    // m/s: the ball has come to a stop ...
