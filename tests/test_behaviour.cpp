@@ -325,30 +325,28 @@ TEST(SoccerBehaviour, APenalisedTeammateIsLeftOutOfTheRoles) {
   EXPECT_EQ(roleOfThree(true), Role::Striker);
 }
 
-TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
+// Four field players, two of whom defend: each defender computes its own place; the
+// two must agree on who stands left (+y) wherever they stand, even when each has the
+// other's position from an old message.
+struct FieldPlayer {
+  int number;
+  double x, y;
+};
+static void expectDefendersSideBySide(const std::vector<FieldPlayer>& team, int striker,
+                                      int left_number, int right_number) {
   const auto cfg = soccerConfig();
   const auto f = field();
   const auto game = gameState(3);
-  // Four field players: 2 next to the ball strikes, 4 furthest up supports,
-  // 3 and 5 defend. Each defender computes its own place; the lower number
-  // takes the left one (+y) wherever the two stand, so that both agree on it
-  // even when each has the other's position from an old message (5 stands on
-  // the left here).
-  struct Player {
-    int number;
-    double x, y;
-  };
-  const std::vector<Player> team{{2, 0.5, 1.0}, {3, -3.0, -0.6}, {4, -0.5, -1.5}, {5, -2.8, 0.8}};
   for (const Vec3& ball : {Vec3(1.0, 1.0, 0), Vec3(-2.0, 2.5, 0), Vec3(-3.0, -1.5, 0)}) {
     std::map<int, agents::Pose2> targets;
-    for (const Player& me : team) {
-      if (me.number != 3 && me.number != 5) continue;
+    for (const FieldPlayer& me : team) {
+      if (me.number != left_number && me.number != right_number) continue;
       agents::SoccerBehaviour b(cfg, f, 0, 1, me.number, Role::Auto, 1);
-      for (const Player& other : team)
+      for (const FieldPlayer& other : team)
         if (other.number != me.number)
           b.receive(mate(other.number, other.x, other.y,
                          std::hypot(ball.x() - other.x, ball.y() - other.y) -
-                             (other.number == 2 ? 5.0 : 0.0)),
+                             (other.number == striker ? 5.0 : 0.0)),
                     0.0);
       auto p = seeing(me.x, me.y, 0.0, ball.x(), ball.y(), 0.01);
       agents::SoccerBehaviour::Input in;
@@ -359,14 +357,15 @@ TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
       ASSERT_EQ(b.role(), Role::Defender) << "player " << me.number;
       targets[me.number] = b.target();
     }
-    const agents::Pose2 left = targets[3], right = targets[5];
+    const agents::Pose2 left = targets[left_number], right = targets[right_number];
     const double apart = std::hypot(left.x - right.x, left.y - right.y);
-    std::printf("ball (%.1f, %.1f): defenders at (%.2f, %.2f) and (%.2f, %.2f), %.2f m apart\n",
-                ball.x(), ball.y(), left.x, left.y, right.x, right.y, apart);
+    std::printf(
+        "ball (%.1f, %.1f): defenders %d at (%.2f, %.2f) and %d at (%.2f, %.2f), %.2f m apart\n",
+        ball.x(), ball.y(), left_number, left.x, left.y, right_number, right.x, right.y, apart);
     // Apart by the spacing (less only where the field's edge or the goal line stops one) ...
     EXPECT_GT(apart, 0.7 * cfg.defender_spacing);
     EXPECT_LT(apart, cfg.defender_spacing + 1e-6);
-    // ... and 3 on the left of the line from the own goal to the ball, 5 on the right.
+    // ... and the left one on the left of the line from the own goal to the ball.
     const double goal_x = -f.halfLength();  // the own goal's centre, y 0
     const auto side = [&](const agents::Pose2& t) {
       return (ball.x() - goal_x) * t.y - ball.y() * (t.x - goal_x);
@@ -374,6 +373,21 @@ TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
     EXPECT_GT(side(left), 0.0);
     EXPECT_LT(side(right), 0.0);
   }
+}
+
+TEST(SoccerBehaviour, TwoDefendersStandSideBySideAcrossTheLineToTheirGoal) {
+  // 2 next to the ball strikes, 4 furthest up supports, 3 and 5 defend: 3's ready
+  // position is further left than 5's, so 3 takes the left place (5 stands on the left here).
+  expectDefendersSideBySide({{2, 0.5, 1.0}, {3, -3.0, -0.6}, {4, -0.5, -1.5}, {5, -2.8, 0.8}}, 2, 3,
+                            5);
+}
+
+TEST(SoccerBehaviour, DefendersKeepTheSidesOfTheirReadyPositions) {
+  // 2 and 3 defend, 4 strikes, 5 supports. 2 starts on the right (ready y -0.35 of the
+  // half-width), 3 on the left (+0.35): by player number 2 took the left place and the
+  // two crossed and met head-on after every kick-off.
+  expectDefendersSideBySide({{2, -3.0, -0.8}, {3, -3.0, 0.8}, {4, 0.5, 1.0}, {5, -0.5, -1.5}}, 4, 3,
+                            2);
 }
 
 TEST(SoccerBehaviour, ObeysTheGameState) {

@@ -383,9 +383,9 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   if (player_ == goalkeeper_number_) return Role::Goalkeeper;
   // Field players still in the game (teammates heard from recently), with
   // their bids; the lowest bid strikes, then the half nearest the own goal
-  // defend (side by side, by player number: an order every robot sees alike,
-  // where the order they stood in across the field flipped with stale
-  // positions), the rest support.
+  // defend (side by side in the order of their ready positions: an order every
+  // robot sees alike, where the order they stood in across the field flipped
+  // with stale positions), the rest support.
   struct Bid {
     int player;
     double cost, x;
@@ -419,8 +419,17 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   });
   const size_t defenders = (rest.size() + 1) / 2;
   std::vector<Bid> back(rest.begin(), rest.begin() + static_cast<ptrdiff_t>(defenders));
-  std::sort(back.begin(), back.end(),
-            [](const Bid& a, const Bid& b) { return a.player < b.player; });
+  // Left to right as they stood at kick-off (their ready positions, which every
+  // teammate knows alike): in the order of player numbers, two defenders that
+  // started on the other sides crossed after each kick-off and met head-on.
+  const auto ready_y = [&](int player) {
+    const size_t i = static_cast<size_t>(std::max(0, player - 1));
+    return i < config_.ready_positions.size() ? config_.ready_positions[i].y : 0.0;
+  };
+  std::sort(back.begin(), back.end(), [&](const Bid& a, const Bid& b) {
+    const double ya = ready_y(a.player), yb = ready_y(b.player);
+    return ya != yb ? ya > yb : a.player < b.player;
+  });
   for (size_t i = 0; i < back.size(); ++i)
     if (back[i].player == player_) {
       defender_slot_ = i;
