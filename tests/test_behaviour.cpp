@@ -202,6 +202,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("ball_velocity_window: 0.01"), "ball_velocity_window");
   EXPECT_EQ(refusedAt("ball_outlier_distance: 0"), "ball_outlier_distance");
   EXPECT_EQ(refusedAt("obstacle_memory: -1"), "obstacle_memory");
+  EXPECT_EQ(refusedAt("defender_goal_distance: -0.5"), "defender_goal_distance");
+  EXPECT_EQ(refusedAt("supporter_deepest: -1.5"), "supporter_deepest");  // behind the goal line
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
 }
 
@@ -230,6 +232,40 @@ TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {
   agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
   keeper.update(in);
   EXPECT_EQ(keeper.role(), Role::Goalkeeper);
+}
+
+TEST(SoccerBehaviour, TheSupporterKeepsItsSideOfTheBallAndOutOfTheDefence) {
+  const auto cfg = soccerConfig();
+  const auto f = field();  // SPL: 4.5 m half-length, 3 m half-width
+  const auto game = gameState(3);
+  // (Positions travel as floats in the perception: within 1e-6 m.)
+  // Player 3 supports: 2 is next to the ball (strikes), 4 stands deepest (defends).
+  const auto supporterTarget = [&](double x, double y, double bx, double by) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
+    b.receive(mate(2, bx - 0.3, by, 0.3), 0.0);
+    b.receive(mate(4, -4.0, 0.0, 9.0), 0.0);
+    auto p = seeing(x, y, 0.0, bx, by, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    updateSeeing(b, in);
+    EXPECT_EQ(b.role(), Role::Supporter);
+    return b.target();
+  };
+  // Right of the ball, it stays right of it (it used to cross to the field's middle,
+  // through the striker's path).
+  auto t = supporterTarget(-1.0, -1.0, 0.0, -0.3);
+  EXPECT_NEAR(t.x, -1.2, 1e-6);
+  EXPECT_NEAR(t.y, -1.5, 1e-6);
+  t = supporterTarget(-1.0, 0.5, 0.0, -0.3);
+  EXPECT_NEAR(t.y, 0.9, 1e-6);
+  // Where the touchline leaves no room on its side (0.4 m inside it), the other side.
+  t = supporterTarget(-1.0, 2.8, 0.0, 2.3);
+  EXPECT_NEAR(t.y, 1.1, 1e-6);
+  // The ball near the own goal: not behind it among the defenders and the goalkeeper,
+  // but no deeper than supporter_deepest (a share of the half-length).
+  t = supporterTarget(-2.0, 1.5, -3.6, 0.5);
+  EXPECT_NEAR(t.x, cfg.supporter_deepest * f.halfLength(), 1e-6);
+  EXPECT_LT(t.x, -1.0);
+  EXPECT_NEAR(t.y, 1.7, 1e-6);
 }
 
 TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {

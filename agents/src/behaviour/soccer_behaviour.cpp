@@ -125,6 +125,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "avoid_ball",
                   "obstacle_memory",
                   "defender_spacing",
+                  "defender_goal_distance",
+                  "supporter_deepest",
                   "sit_when_finished"});
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
@@ -152,6 +154,10 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.avoid_ball = root.number("avoid_ball", c.avoid_ball);
   c.obstacle_memory = root.number("obstacle_memory", c.obstacle_memory);
   c.defender_spacing = root.number("defender_spacing", c.defender_spacing);
+  c.defender_goal_distance = root.number("defender_goal_distance", c.defender_goal_distance);
+  c.supporter_deepest = root.number("supporter_deepest", c.supporter_deepest);
+  if (root.has("supporter_deepest") && !(c.supporter_deepest >= -1.0 && c.supporter_deepest <= 1.0))
+    root["supporter_deepest"].fail("must be a share of the half-length, from -1 to 1");
   c.sit_when_finished = root.boolean("sit_when_finished", c.sit_when_finished);
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
@@ -163,8 +169,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   if (!(c.avoid_far > c.avoid_near))
     (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
         .fail("avoid_far must be greater than avoid_near");
-  for (const char* k :
-       {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory", "defender_spacing"})
+  for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory",
+                        "defender_spacing", "defender_goal_distance"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
@@ -690,10 +696,18 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       r = striker(0.0, false);
       break;
     case Role::Supporter: {
-      const double side = ball_.y > 0 ? -1.0 : 1.0;
-      Pose2 t{std::clamp(ball_.x - 1.2, -field_.halfLength() + 1.0, field_.halfLength() - 1.0),
-              std::clamp(ball_.y + side * 1.2, -field_.halfWidth() + 0.4, field_.halfWidth() - 0.4),
-              0.0};
+      // Beside the ball on the side it is on: the other side (the field's middle, as
+      // before) had it cross the striker's path behind the ball, and both walked up
+      // side by side in contact. It changes sides where the touchline leaves no room.
+      // (The side is kept once the ball is known.)
+      double side = supporter_side_ != 0.0 ? supporter_side_ : self_.y >= ball_.y ? 1.0 : -1.0;
+      const double room = field_.halfWidth() - 0.4;
+      if (std::abs(ball_.y + side * 1.2) > room) side = -side;
+      if (ball_known) supporter_side_ = side;
+      const double deepest = std::clamp(config_.supporter_deepest * field_.halfLength(),
+                                        -field_.halfLength() + 1.0, field_.halfLength() - 1.0);
+      Pose2 t{std::clamp(ball_.x - 1.2, deepest, field_.halfLength() - 1.0),
+              std::clamp(ball_.y + side * 1.2, -room, room), 0.0};
       r = walkTo(t, true);
       break;
     }
@@ -701,14 +715,15 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       const Vec2 own_goal{-field_.halfLength(), 0.0};
       Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x),
               own_goal.y + 0.45 * (ball_.y - own_goal.y), 0.0};
-      t.x = std::clamp(std::min(t.x, ball_.x - 0.8), -field_.halfLength() + 0.8, 0.0);
+      const double deepest = std::min(-field_.halfLength() + config_.defender_goal_distance, 0.0);
+      t.x = std::clamp(std::min(t.x, ball_.x - 0.8), deepest, 0.0);
       // Side by side across the ball-goal line, the first from the left (+y).
       const double across = 0.5 * static_cast<double>(defenders_ - 1) -
                             static_cast<double>(std::min(defender_slot_, defenders_ - 1));
       const double bearing = std::atan2(ball_.y - own_goal.y, ball_.x - own_goal.x);
       t.x += -std::sin(bearing) * across * config_.defender_spacing;
       t.y += std::cos(bearing) * across * config_.defender_spacing;
-      t.x = std::clamp(t.x, -field_.halfLength() + 0.8, 0.0);
+      t.x = std::clamp(t.x, deepest, 0.0);
       t.y = std::clamp(t.y, -field_.halfWidth() + 0.4, field_.halfWidth() - 0.4);
       r = walkTo(t, true);
       break;
@@ -776,6 +791,7 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
     return r;
   }
   role_ = chooseRole(in);
+  if (role_ != Role::Supporter) supporter_side_ = 0.0;
   if (have_game_ && state_ == kReady && phase_ != kPhasePenaltyShoot)
     r = ready();
   else if (have_game_ && state_ == kSet)

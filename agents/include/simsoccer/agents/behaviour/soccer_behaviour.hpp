@@ -103,6 +103,12 @@ struct BehaviourConfig {
   // to the own goal, defender_spacing apart (each would otherwise walk to the
   // same spot, and they met there, and fell; 0 puts them there again).
   double defender_spacing = 1.2;  // m
+  // Defenders stand no nearer their goal line than this (the goalkeeper stands at keeper_line).
+  double defender_goal_distance = 0.8;  // m
+  // The supporter stands 1.2 m behind and beside the ball, but not deeper than this (own
+  // frame x, a share of the half-length): with the ball near the own goal, behind it was
+  // among the defenders and the goalkeeper, and the robots there walked into each other.
+  double supporter_deepest = -0.5;
   // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
   // down at the whistle fell again and again through the half-time).
@@ -197,6 +203,8 @@ class SoccerBehaviour {
   Role fixed_role_, role_ = Role::Striker;
   // As a defender: its place among the defenders, from the left (+y, own frame), and their number.
   size_t defender_slot_ = 0, defenders_ = 1;
+  // As a supporter: the side of the ball it keeps (+1 left, -1 right, own frame; 0: not one).
+  double supporter_side_ = 0.0;
   // Game.
   bool have_game_ = false;
   int state_ = 3;  // gc::State numbering; Playing without a GameState
