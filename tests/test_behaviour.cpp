@@ -238,8 +238,8 @@ TEST(SoccerBehaviour, TheSupporterKeepsItsSideOfTheBallAndOutOfTheDefence) {
   const auto cfg = soccerConfig();
   const auto f = field();  // SPL: 4.5 m half-length, 3 m half-width
   const auto game = gameState(3);
-  // (Positions travel as floats in the perception: within 1e-6 m.)
   // Player 3 supports: 2 is next to the ball (strikes), 4 stands deepest (defends).
+  // (Positions travel as floats in the perception: targets within 1e-6 m.)
   const auto supporterTarget = [&](double x, double y, double bx, double by) {
     agents::SoccerBehaviour b(cfg, f, 0, 1, 3, Role::Auto, 1);
     b.receive(mate(2, bx - 0.3, by, 0.3), 0.0);

@@ -428,12 +428,8 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
   // Left to right as they stood at kick-off (their ready positions, which every
   // teammate knows alike): in the order of player numbers, two defenders that
   // started on the other sides crossed after each kick-off and met head-on.
-  const auto ready_y = [&](int player) {
-    const size_t i = static_cast<size_t>(std::max(0, player - 1));
-    return i < config_.ready_positions.size() ? config_.ready_positions[i].y : 0.0;
-  };
   std::sort(back.begin(), back.end(), [&](const Bid& a, const Bid& b) {
-    const double ya = ready_y(a.player), yb = ready_y(b.player);
+    const double ya = readyPosition(a.player).y, yb = readyPosition(b.player).y;
     return ya != yb ? ya > yb : a.player < b.player;
   });
   for (size_t i = 0; i < back.size(); ++i)
@@ -658,10 +654,14 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   return walkTo({line, y, 0.0}, false);
 }
 
+Pose2 SoccerBehaviour::readyPosition(int player) const {
+  const size_t i = static_cast<size_t>(std::max(0, player - 1));
+  if (i < config_.ready_positions.size()) return config_.ready_positions[i];
+  return {-0.2 - 0.05 * static_cast<double>(i), 0.0, 0.0};
+}
+
 MotionRequest SoccerBehaviour::ready() {
-  const size_t i = static_cast<size_t>(std::max(0, player_ - 1));
-  Pose2 t{-0.2 - 0.05 * static_cast<double>(i), 0.0, 0.0};
-  if (i < config_.ready_positions.size()) t = config_.ready_positions[i];
+  Pose2 t = readyPosition(player_);
   t.x *= field_.halfLength();
   t.y *= field_.halfWidth();
   if (our_kick_ && role_ == Role::Striker) t = config_.kick_off_position;
@@ -700,7 +700,8 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       // before) had it cross the striker's path behind the ball, and both walked up
       // side by side in contact. It changes sides where the touchline leaves no room.
       // (The side is kept once the ball is known.)
-      double side = supporter_side_ != 0.0 ? supporter_side_ : self_.y >= ball_.y ? 1.0 : -1.0;
+      double side = supporter_side_;
+      if (side == 0.0) side = self_.y >= ball_.y ? 1.0 : -1.0;
       const double room = field_.halfWidth() - 0.4;
       if (std::abs(ball_.y + side * 1.2) > room) side = -side;
       if (ball_known) supporter_side_ = side;

@@ -178,6 +178,9 @@ class SoccerBehaviour {
   void rememberRobots(const std::vector<PerceivedIn>& robots, double time);
   Role chooseRole(const Input& in);
   MotionRequest play(const Input& in);
+  // A player's kick-off place, own frame, as shares of the half-length and half-width
+  // (config ready_positions; players beyond the list stand in a line).
+  Pose2 readyPosition(int player) const;
   MotionRequest ready();
   MotionRequest striker(double aim_y, bool penalty);
   MotionRequest goalkeeper(bool shootout);
