@@ -162,3 +162,48 @@ TEST(Perception, RealisticProfileHasRangeOcclusionNoiseAndMissesAndIsSeeded) {
   // Beyond the range (6 m): not seen (false balls aside).
   EXPECT_LT(run(1, false, 4.3).first, 10);
 }
+
+// The self-pose estimate stands in for a localisation filter: its error has the profile's
+// standard deviation but drifts (correlation time pose_noise_time), so that from one period to
+// the next it moves by millimetres, as a filter's output does; pose_noise_time 0 draws each
+// period's error afresh.
+TEST(Perception, SelfPoseErrorDriftsWithTheProfilesDeviationAndCorrelationTime) {
+  auto run = [](double correlation_time) {
+    world::World w(scene());
+    world::PerceptionSettings ideal, realistic;
+    ideal.enabled = realistic.enabled = realistic.realistic = true;
+    ideal.realistic = false;
+    realistic.pose_noise_time = correlation_time;
+    world::PerceptionSystem truth(w, ideal), estimate(w, realistic);
+    std::vector<double> error_x, error_yaw;
+    for (int i = 0; i < 6000; ++i) {  // 60 s of 10 ms periods
+      w.stepControlPeriod();
+      truth.update(w);
+      estimate.update(w);
+      error_x.push_back(estimate.perception(0).self_x - truth.perception(0).self_x);
+      error_yaw.push_back(
+          std::remainder(estimate.perception(0).self_yaw - truth.perception(0).self_yaw, 2 * M_PI));
+    }
+    auto rms = [](const std::vector<double>& v) {
+      double s = 0.0;
+      for (double x : v) s += x * x;
+      return std::sqrt(s / static_cast<double>(v.size()));
+    };
+    std::vector<double> step_x;  // the error's change from one period to the next
+    for (size_t i = 1; i < error_x.size(); ++i) step_x.push_back(error_x[i] - error_x[i - 1]);
+    return std::array<double, 3>{rms(error_x), rms(error_yaw), rms(step_x)};
+  };
+  const auto drifting = run(1.0), white = run(0.0);
+  std::printf(
+      "self-pose error: 1 s correlation: %.4f m, %.4f rad, %.4f m per period; white: %.4f m, "
+      "%.4f rad, %.4f m per period\n",
+      drifting[0], drifting[1], drifting[2], white[0], white[1], white[2]);
+  // 60 s holds about 30 correlation times: the deviation within a quarter of 0.05 m.
+  EXPECT_NEAR(drifting[0], 0.05, 0.0125);
+  EXPECT_NEAR(drifting[1], 0.03, 0.0075);
+  // sqrt(2 (1 - exp(-0.01))) = 0.14 of the deviation per period, against sqrt(2) white.
+  EXPECT_NEAR(drifting[2], 0.05 * 0.141, 0.002);
+  EXPECT_NEAR(white[0], 0.05, 0.004);
+  EXPECT_NEAR(white[1], 0.03, 0.0025);
+  EXPECT_NEAR(white[2], 0.05 * std::sqrt(2.0), 0.006);
+}

@@ -29,6 +29,7 @@ PerceptionSystem::PerceptionSystem(const World& world, const PerceptionSettings&
       noise_(world.scenario().seed * 0x2545F4914F6CDD1DULL + 17),
       uniform_(world.scenario().seed * 0x9E3779B97F4A7C15ULL + 29) {
   state_.resize(world.robotCount());
+  pose_error_.assign(world.robotCount(), {0.0, 0.0, 0.0});
   for (RobotId r = 0; r < world.robotCount(); ++r)
     for (RobotId o = 0; o < world.robotCount(); ++o)
       if (o != r) {
@@ -128,12 +129,29 @@ void PerceptionSystem::observe(const World& world, const Viewpoint& from, const 
   object.last_seen = world.time();
 }
 
+void PerceptionSystem::updatePoseErrors(double time) {
+  // e' = a e + sqrt(1 - a^2) sigma n keeps the standard deviation sigma at every step; a = 0
+  // (the first period, or no correlation time) draws each error afresh.
+  const double tau = settings_.pose_noise_time;
+  const double a = pose_error_time_ < 0.0 || tau <= 0.0
+                       ? 0.0
+                       : std::exp(-std::max(0.0, time - pose_error_time_) / tau);
+  const double fresh = std::sqrt(1.0 - a * a);
+  pose_error_time_ = time;
+  for (std::array<double, 3>& e : pose_error_) {
+    e[0] = a * e[0] + fresh * settings_.pose_noise_xy * noise_();
+    e[1] = a * e[1] + fresh * settings_.pose_noise_xy * noise_();
+    e[2] = a * e[2] + fresh * settings_.pose_noise_yaw * noise_();
+  }
+}
+
 void PerceptionSystem::update(const World& world) {
   if (!settings_.enabled) return;
   const uint64_t tick = world.controlTick();
   const Vec3 ball = world.ballState().pose.translation();
   torsos_.resize(world.robotCount());
   for (RobotId r = 0; r < world.robotCount(); ++r) torsos_[r] = world.torsoPose(r).translation();
+  if (settings_.realistic) updatePoseErrors(world.time());
   for (RobotId r = 0; r < world.robotCount(); ++r) {
     Perception& p = state_[r];
     p.tick = tick;
@@ -155,9 +173,10 @@ void PerceptionSystem::update(const World& world) {
     p.self_y = frame.translation().y();
     p.self_yaw = yaw;
     if (settings_.realistic) {
-      p.self_x += settings_.pose_noise_xy * noise_();
-      p.self_y += settings_.pose_noise_xy * noise_();
-      p.self_yaw = std::remainder(p.self_yaw + settings_.pose_noise_yaw * noise_(), 2 * M_PI);
+      const std::array<double, 3>& e = pose_error_[r];
+      p.self_x += e[0];
+      p.self_y += e[1];
+      p.self_yaw = std::remainder(p.self_yaw + e[2], 2 * M_PI);
     }
     observe(world, from, ball, settings_.ball_range, p.ball, r);
     if (settings_.realistic && !p.ball.in_view && uniform() < settings_.false_ball_rate) {

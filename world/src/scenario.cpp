@@ -188,7 +188,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
   if (auto n = root.optional("perception")) {
     n->allowOnly({"enabled", "profile", "ball_range", "post_range", "robot_range", "distance_noise",
                   "bearing_noise", "miss_base", "miss_per_metre", "false_ball_rate",
-                  "pose_noise_xy", "pose_noise_yaw"});
+                  "pose_noise_xy", "pose_noise_yaw", "pose_noise_time"});
     PerceptionSettings& p = s.perception;
     p.enabled = n->boolean("enabled", true);
     const std::string profile = n->has("profile") ? (*n)["profile"].string() : "ideal";
@@ -202,7 +202,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
           std::pair{"miss_per_metre", &p.miss_per_metre},
           std::pair{"false_ball_rate", &p.false_ball_rate},
           std::pair{"pose_noise_xy", &p.pose_noise_xy},
-          std::pair{"pose_noise_yaw", &p.pose_noise_yaw}})
+          std::pair{"pose_noise_yaw", &p.pose_noise_yaw},
+          std::pair{"pose_noise_time", &p.pose_noise_time}})
       if (n->has(key)) *value = (*n)[key].nonNegative();
     for (auto [key, value] :
          {std::pair{"miss_base", p.miss_base}, std::pair{"false_ball_rate", p.false_ball_rate}})

@@ -65,12 +65,17 @@ class PerceptionSystem {
   };
   void observe(const World& world, const Viewpoint& from, const Vec3& point, double range,
                PerceivedObject& object, RobotId skip);
+  void updatePoseErrors(double time);
   bool blockedByRobot(RobotId skip_a, RobotId skip_b, const Vec3& a, const Vec3& b) const;
 
   PerceptionSettings settings_;
   std::vector<Perception> state_;
   std::array<Vec3, 4> posts_;
   std::vector<Vec3> torsos_;  // every robot's torso this period (occlusion)
+  // Per robot, the self-pose estimate's error (x m, y m, yaw rad): a first-order Gauss-Markov
+  // process with the profile's standard deviations and correlation time.
+  std::vector<std::array<double, 3>> pose_error_;
+  double pose_error_time_ = -1.0;  // sim time of its last update (-1: not started)
   // Every robot's first two camera views with their intrinsics (constant: worked
   // out once); their poses are set each period.
   std::vector<std::array<engine::RenderView, 2>> views_;

@@ -151,6 +151,10 @@ struct PerceptionSettings {
   double false_ball_rate = 0.005;  // per control period
   double pose_noise_xy = 0.05;     // m std dev of the self-pose estimate (realistic)
   double pose_noise_yaw = 0.03;    // rad
+  // s: how long the self-pose error takes to wander off (its correlation time). A localisation
+  // filter's estimate is off by a drifting amount, not by a fresh sample each period; 0 gives
+  // white noise (every period a new, independent error).
+  double pose_noise_time = 1.0;
 };
 
 struct Scenario {
