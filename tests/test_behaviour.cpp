@@ -268,6 +268,55 @@ TEST(SoccerBehaviour, TheSupporterKeepsItsSideOfTheBallAndOutOfTheDefence) {
   EXPECT_NEAR(t.y, 1.7, 1e-6);
 }
 
+TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
+  const auto cfg = soccerConfig();
+  const auto f = field();  // SPL: goal area 0.6 m deep from x = -4.5, 2.2 m wide
+  const auto game = gameState(3);
+  // Player 2 strikes (3 is far away); the ball lies in the own goal area.
+  const auto strikerTarget = [&](std::optional<bool> keeper_fallen) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Auto, 1);
+    b.receive(mate(3, 2.0, 0.0, 9.0), 0.0);
+    if (keeper_fallen) {
+      agents::TeamMessageData d;
+      d.player = 1;
+      d.x = -4.2;
+      d.fallen = *keeper_fallen;
+      b.receive(agents::TeamMessageIn{.from_player = 1, .data = agents::encodeTeamMessage(d)}, 0.0);
+    }
+    auto p = seeing(-3.2, 0.5, M_PI, -4.2, 0.3, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    updateSeeing(b, in);
+    EXPECT_EQ(b.role(), Role::Striker);
+    return b.target();
+  };
+  // The goalkeeper plays: the striker waits outside the area (avoid_near in front of it),
+  // facing the ball, instead of going round the ball between it and the goal line.
+  auto t = strikerTarget(false);
+  EXPECT_NEAR(t.x, -3.9 + cfg.avoid_near, 1e-6);
+  EXPECT_NEAR(t.y, 0.3, 1e-6);
+  // No goalkeeper heard from, or a fallen one: the striker plays the ball itself, from
+  // behind it.
+  for (const auto keeper : {std::optional<bool>{}, std::optional<bool>{true}}) {
+    t = strikerTarget(keeper);
+    EXPECT_LT(t.x, -4.2);
+  }
+  // The goalkeeper clears a slow ball anywhere in the goal area, also further than 1 m
+  // (there it used to keep to its line).
+  const auto keeperTarget = [&](double bx) {
+    agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
+    auto p = seeing(-4.15, -0.1, 0.0, bx, 1.0, 0.01);  // the ball 1.1 m or more away
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    updateSeeing(keeper, in);
+    EXPECT_EQ(keeper.role(), Role::Goalkeeper);
+    return keeper.target();
+  };
+  const double line = -4.5 + cfg.keeper_line;
+  EXPECT_NEAR(keeperTarget(-3.8).x, line, 1e-6);  // just outside the goal area: on its line
+  t = keeperTarget(-4.1);                         // inside: to the ball, round it
+  EXPECT_LT(t.x, line - 0.1);
+  EXPECT_GT(t.y, 0.6);
+}
+
 TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {
   const auto cfg = soccerConfig();
   const auto f = field();

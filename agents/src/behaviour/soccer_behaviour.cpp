@@ -649,9 +649,25 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   const bool area = field_.penalty_area &&
                     ball_.x < -field_.halfLength() + field_.penalty_area->length &&
                     std::abs(ball_.y) < 0.5 * field_.penalty_area->width;
-  if (!shootout && area && to_ball < 1.0 && std::hypot(ball_velocity_.x, ball_velocity_.y) < 0.3)
-    return striker(0.0, false);  // clear it
+  // A slow ball in the goal area is the keeper's (the field players wait outside it), one
+  // within 1 m in the penalty area too: clear it.
+  if (!shootout && ((area && to_ball < 1.0) || inOwnGoalArea(ball_)) &&
+      std::hypot(ball_velocity_.x, ball_velocity_.y) < 0.3)
+    return striker(0.0, false);
   return walkTo({line, y, 0.0}, false);
+}
+
+bool SoccerBehaviour::inOwnGoalArea(const Vec2& p) const {
+  return field_.goal_area && p.x < -field_.halfLength() + field_.goal_area->length &&
+         std::abs(p.y) < 0.5 * field_.goal_area->width;
+}
+
+bool SoccerBehaviour::keeperInPlay(double time) const {
+  for (const Teammate& m : mates_)
+    if (m.data.player == goalkeeper_number_)
+      return !penalisedInGame(m.data.player) && !m.data.fallen &&
+             time - m.received <= 3.0 * config_.message_interval + 6.0;
+  return false;
 }
 
 Pose2 SoccerBehaviour::readyPosition(int player) const {
@@ -692,6 +708,15 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
         r.turn = 0.6;
         target_ = self_;
         return r;
+      }
+      if (inOwnGoalArea(ball_) && keeperInPlay(in.time)) {
+        // The ball in the own goal area is the goalkeeper's: going round it to kick it
+        // away, the striker walked in between the ball and the goal line, where the
+        // keeper stands, and both played it at once. Wait outside the area, facing it.
+        const double front = -field_.halfLength() + field_.goal_area->length;
+        const double half = 0.5 * field_.goal_area->width;
+        r = walkTo({front + config_.avoid_near, std::clamp(ball_.y, -half, half), 0.0}, true);
+        break;
       }
       r = striker(0.0, false);
       break;

@@ -184,6 +184,11 @@ class SoccerBehaviour {
   MotionRequest ready();
   MotionRequest striker(double aim_y, bool penalty);
   MotionRequest goalkeeper(bool shootout);
+  // Whether a field-frame (own) point lies in the own goal area.
+  bool inOwnGoalArea(const Vec2& p) const;
+  // The team's goalkeeper plays, by its last message: heard from recently, not
+  // penalised, not fallen.
+  bool keeperInPlay(double time) const;
   struct Crossing {
     double t, y;  // s from now; m, own frame
   };
