@@ -105,6 +105,11 @@ TEST_F(ConfigErrors, UnknownKeyIsATypo) {
   expectError("scenario.yaml", "sede", "unknown key");
 }
 
+TEST_F(ConfigErrors, NegativeSelfPoseCorrelationTime) {
+  replace(scenario_, "seed: 7", "seed: 7\nperception: {profile: realistic, pose_noise_time: -1}");
+  expectError("scenario.yaml", "perception.pose_noise_time", "must be >= 0, got -1");
+}
+
 TEST_F(ConfigErrors, UnknownJointName) {
   replace(robot_, "stand: {LHipPitch: -0.45", "stand: {LHipPich: -0.45");
   expectError("robot.yaml", "poses.stand.LHipPich", "unknown joint 'LHipPich'");
