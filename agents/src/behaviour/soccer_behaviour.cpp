@@ -24,6 +24,18 @@ constexpr int kStandby = static_cast<int>(gc::State::Standby);
 constexpr int kPhasePenaltyShoot = static_cast<int>(gc::GamePhase::PenaltyShoot);
 constexpr uint8_t kNoTeam = gc::kKickingTeamNone;
 
+// Whether an own-frame point lies in an area in front of the own goal (centred on it).
+bool inOwnArea(const std::optional<fields::AreaSize>& area, double half_length, double x,
+               double y) {
+  return area && x < -half_length + area->length && std::abs(y) < 0.5 * area->width;
+}
+
+// A teammate counts as in the game while its last message is this recent (messages are
+// paced to the budget: a few seconds apart).
+bool heardRecently(double received, double time, const BehaviourConfig& config) {
+  return time - received <= 3.0 * config.message_interval + 6.0;
+}
+
 double wrap(double a) {
   while (a > kPi) a -= 2 * kPi;
   while (a < -kPi) a += 2 * kPi;
@@ -404,7 +416,7 @@ Role SoccerBehaviour::chooseRole(const Input& in) {
     // A penalised teammate is out of play whatever its last message said
     // (it sends none while out: a striker's claim would stand for seconds).
     if (m.data.player == goalkeeper_number_ || penalisedInGame(m.data.player) ||
-        in.time - m.received > 3.0 * config_.message_interval + 6.0)
+        !heardRecently(m.received, in.time, config_))
       continue;
     bids.push_back(
         {m.data.player, m.data.cost, toOwn(m.data.x, m.data.y).x, m.data.role == Role::Striker});
@@ -646,9 +658,7 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
     }
   }
   const double to_ball = std::hypot(ball_.x - self_.x, ball_.y - self_.y);
-  const bool area = field_.penalty_area &&
-                    ball_.x < -field_.halfLength() + field_.penalty_area->length &&
-                    std::abs(ball_.y) < 0.5 * field_.penalty_area->width;
+  const bool area = inOwnArea(field_.penalty_area, field_.halfLength(), ball_.x, ball_.y);
   // A slow ball in the goal area is the keeper's (the field players wait outside it), one
   // within 1 m in the penalty area too: clear it.
   if (!shootout && ((area && to_ball < 1.0) || inOwnGoalArea(ball_)) &&
@@ -658,15 +668,14 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
 }
 
 bool SoccerBehaviour::inOwnGoalArea(const Vec2& p) const {
-  return field_.goal_area && p.x < -field_.halfLength() + field_.goal_area->length &&
-         std::abs(p.y) < 0.5 * field_.goal_area->width;
+  return inOwnArea(field_.goal_area, field_.halfLength(), p.x, p.y);
 }
 
 bool SoccerBehaviour::keeperInPlay(double time) const {
   for (const Teammate& m : mates_)
     if (m.data.player == goalkeeper_number_)
       return !penalisedInGame(m.data.player) && !m.data.fallen &&
-             time - m.received <= 3.0 * config_.message_interval + 6.0;
+             heardRecently(m.received, time, config_);
   return false;
 }
 
