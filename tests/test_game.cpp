@@ -16,13 +16,6 @@ using namespace simsoccer::referee;
 
 namespace {
 
-RuleBook spl() {
-  return test::splRules();
-}
-std::array<TeamSetup, 2> teams() {
-  return test::twoTeams();
-}
-
 // Advances in 10 ms steps, as the simulator does.
 void run(Game& g, double seconds) {
   for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.01)); ++i) g.advance(0.01);
@@ -31,7 +24,7 @@ void run(Game& g, double seconds) {
 }  // namespace
 
 TEST(Game, KickOffFlowAndTheHalfClockStartsAtTheKickOff) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   EXPECT_EQ(g.state(), gc::State::Initial);
   run(g, 20);  // Initial: nothing runs
   EXPECT_DOUBLE_EQ(g.secondsRemaining(), 600);
@@ -53,7 +46,7 @@ TEST(Game, KickOffFlowAndTheHalfClockStartsAtTheKickOff) {
 }
 
 TEST(Game, GoalGivesTheKickOffToTheOtherTeamAndReadySetCountAfterwards) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.ready();
   g.set();
   g.playing();
@@ -71,7 +64,7 @@ TEST(Game, GoalGivesTheKickOffToTheOtherTeamAndReadySetCountAfterwards) {
 }
 
 TEST(Game, SetPlaysEndAfterTheirTimeOrWhenTheBallIsFree) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.ready();
   g.set();
   g.playing();
@@ -99,7 +92,7 @@ TEST(Game, SetPlaysEndAfterTheirTimeOrWhenTheBallIsFree) {
 }
 
 TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.ready();
   g.penalise(0, 2, gc::Penalty::PlayerPushing);
   EXPECT_DOUBLE_EQ(g.penaltyTime(0, 2), 45);
@@ -145,7 +138,7 @@ TEST(Game, PenaltiesGrowByTheTeamsIncrementAndRunOnlyInReadyAndPlaying) {
 }
 
 TEST(Game, HalfTimeSwapsSidesAndTheOtherTeamKicksOff) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   EXPECT_EQ(g.packet(0).teams[0].team_number, 13);  // team 0 on the operator's left
   g.ready();
   g.set();
@@ -174,7 +167,7 @@ TEST(Game, HalfTimeSwapsSidesAndTheOtherTeamKicksOff) {
 }
 
 TEST(Game, MercyRuleEndsTheGame) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.ready();
   g.set();
   g.playing();
@@ -190,7 +183,7 @@ TEST(Game, MercyRuleEndsTheGame) {
 }
 
 TEST(Game, TimeoutsSubstitutesAndDropBall) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.timeout(1);  // a team timeout: the other team gets the kick-off
   EXPECT_EQ(g.phase(), gc::GamePhase::Timeout);
   EXPECT_EQ(g.kickingTeam(), 0);
@@ -212,7 +205,7 @@ TEST(Game, TimeoutsSubstitutesAndDropBall) {
 }
 
 TEST(Game, PacketCarriesTheState) {
-  Game g(spl(), teams(), 1);
+  Game g(test::splRules(), test::twoTeams(), 1);
   g.ready();
   run(g, 12.3);
   g.penalise(1, 3, gc::Penalty::PlayerPushing);
@@ -249,7 +242,7 @@ namespace {
 
 // Plays both halves without goals: a drawn game, over.
 Game drawnGame() {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   for (int half = 0; half < 2; ++half) {
     g.ready();
     run(g, 45.1);
@@ -318,7 +311,7 @@ TEST(Game, ShootoutAfterADrawIsDecidedWhenATeamCanNoLongerCatchUp) {
 }
 
 TEST(Game, ShootoutSuddenDeathRanksTheKicks) {
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.startShootout(0);  // stand-alone, the rule book's 3 kicks
   for (int i = 0; i < 3; ++i) {
     kick(g, i == 0 ? ShotOutcome::Goal : ShotOutcome::Saved);  // team 0
@@ -342,7 +335,7 @@ TEST(Game, ShootoutSuddenDeathRanksTheKicks) {
 
 TEST(Game, ShootoutCoinAfterTheLastSuddenDeathRoundIsSeeded) {
   auto play = [](uint64_t seed) {
-    Game g(spl(), teams(), 0);
+    Game g(test::splRules(), test::twoTeams(), 0);
     g.startShootout(0, 1, seed);  // one regular kick each
     for (int i = 0; i < 2 * (1 + 3); ++i) kick(g, ShotOutcome::Post);
     EXPECT_TRUE(g.gameOver());
@@ -360,9 +353,9 @@ TEST(Game, ShootoutCoinAfterTheLastSuddenDeathRoundIsSeeded) {
 }
 
 TEST(Game, ShotClockRunsOnlyInPlayingAndEndsTheKick) {
-  RuleBook r = spl();
+  RuleBook r = test::splRules();
   r.sudden_death = false;
-  Game g(r, teams(), 0);
+  Game g(r, test::twoTeams(), 0);
   g.startShootout(0, 2);
   g.shootoutKick(2, 1);
   run(g, 10);
@@ -385,7 +378,7 @@ TEST(Game, ShotClockRunsOnlyInPlayingAndEndsTheKick) {
   EXPECT_TRUE(g.gameOver());
   EXPECT_FALSE(g.winner().has_value());
   // Not from the middle of a game.
-  Game h(spl(), teams(), 0);
+  Game h(test::splRules(), test::twoTeams(), 0);
   h.ready();
   EXPECT_THROW(h.startShootout(0), std::logic_error);
 }
@@ -398,7 +391,7 @@ TEST(GameControllerLink, BroadcastsAt2HzOfSimTimeAndTakesReturnPackets) {
   cfg.return_port = 0;
   cfg.return_bind = "127.0.0.1";
   GameControllerLink link(cfg);
-  Game g(spl(), teams(), 0);
+  Game g(test::splRules(), test::twoTeams(), 0);
   g.ready();
   for (int i = 0; i < 200; ++i) {  // 2 s in 10 ms control periods
     g.advance(0.01);

@@ -14,13 +14,6 @@ using engine::Vec3;
 
 namespace {
 
-RuleBook spl() {
-  return test::splRules();
-}
-std::array<TeamSetup, 2> teams() {
-  return test::twoTeams();
-}
-
 // 2 v 2 in their own halves: team 0 defends -x.
 world::Scenario twoVsTwo() {
   world::Scenario s = test::scenario(0);
@@ -96,7 +89,7 @@ void faceOff(world::World& w) {
 
 TEST(Referee, FirstHalfWithScriptedBall) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   g.ready();
   const double t0 = g.time();
@@ -164,7 +157,7 @@ TEST(Referee, FirstHalfWithScriptedBall) {
 
 TEST(Referee, LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   g.ready();
   kickOff(w, ref);
@@ -204,7 +197,7 @@ TEST(Referee, IllegalPositionInSetOrAutoPlacement) {
     world::World w(twoVsTwo());
     RefereeConfig cfg;
     cfg.auto_placement = auto_place;
-    Referee ref(w, spl(), teams(), 0, cfg);
+    Referee ref(w, test::splRules(), test::twoTeams(), 0, cfg);
     Game& g = ref.game();
     g.ready();
     w.placeRobot(3, -1.0, 1.0, M_PI);  // team 1 player 2 in the opponents' half
@@ -236,7 +229,7 @@ TEST(Referee, TooManyDefendersInTheGoalArea) {
     s.robots.push_back(p);
   }
   world::World w(s);
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   g.ready();
   kickOff(w, ref);
@@ -271,7 +264,7 @@ TEST(Referee, TooManyDefendersInTheGoalArea) {
 
 TEST(Referee, FallenRobotIsPenalisedAsInactive) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   g.ready();
   kickOff(w, ref);
@@ -286,7 +279,7 @@ TEST(Referee, FallenRobotIsPenalisedAsInactive) {
 
 TEST(Referee, StandingIdleNextToTheBallIsInactive) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   openPlay(w, ref);
   putBall(w, 2.75, 0.05);  // in front of team 1 player 1, who does not move
@@ -301,7 +294,7 @@ TEST(Referee, GameStuckLocalThenGlobal) {
   world::World w(twoVsTwo());
   RefereeConfig cfg;
   cfg.inactive_time = 1e9;  // the robot at the ball stands still: not an inactive call here
-  Referee ref(w, spl(), teams(), 0, cfg);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0, cfg);
   Game& g = ref.game();
   openPlay(w, ref);
   // The ball lies still next to robot 2 (team 1 player 1 at (3, 0)).
@@ -343,7 +336,7 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
   world::World w(twoVsTwo());
   RefereeConfig cfg;
   cfg.set_duration = 1.0;
-  Referee ref(w, spl(), teams(), 0, cfg);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0, cfg);
   Game& g = ref.game();
   g.startShootout(0, 2);  // a penalty-kick scenario: two kicks each, team 0 first
   const auto& f = w.field();
@@ -386,7 +379,7 @@ TEST(Referee, ShootoutKicksOnTheRealWorld) {
 
 TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   openPlay(w, ref);
   // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other.
@@ -445,7 +438,7 @@ TEST(Referee, FrontToFrontWithTheBallBetweenIsNotPushing) {
   // The rules' exception: two robots going for the ball meet front to front with
   // the ball between them. Robot 1 drives into robot 3, facing it.
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   openPlay(w, ref);
   const Vec3 one(0.45, -2.0, 0.0), three(0.8, -2.0, M_PI), drive(0.3, 0.0, 0.0);
   EXPECT_FALSE(calledPushing(w, ref, one, three, Vec3(0.625, -2.0, 0.0), drive, 2.0));
@@ -458,7 +451,7 @@ TEST(Referee, SideContactGoingToTheBallIsNotPushing) {
   // The rules' exception: side contact while going to the ball. Robots 1 and 3 walk
   // side by side, robot 3 at robot 1's left; robot 1 veers left into it.
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   openPlay(w, ref);
   const Vec3 one(0.45, -2.0, 0.0), three(0.45, -1.75, 0.0);
   const Vec3 drive(0.25, 0.45, 0.0), alongside(0.25, 0.0, 0.0);
@@ -491,7 +484,7 @@ TEST(Referee, ArmLinksAreTheLimbsWithNeitherAFootNorACamera) {
 
 TEST(Referee, BallContactWithAnArm) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   openPlay(w, ref);
   auto ballOnHand = [&](world::RobotId r) {
@@ -530,10 +523,10 @@ bool hasEvent(const Game& g, const std::string& type, const std::string& detail)
 // A whole (shortened) first half refereed from scripted ball positions on the
 // real world: kick-off, a goal, a kick-in, a corner kick, a goal kick.
 TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
-  RuleBook rules = spl();
+  RuleBook rules = test::splRules();
   rules.half_duration = 150.0;  // the rest of the half runs on the clock
   world::World w(twoVsTwo());
-  Referee ref(w, rules, teams(), 0);
+  Referee ref(w, rules, test::twoTeams(), 0);
   Game& g = ref.game();
   const auto& f = w.field();
   g.standby();
@@ -616,12 +609,12 @@ TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
 TEST(Referee, TheSecondHalfStartsWithEveryRobotInItsNewHalf) {
   // Wherever the first half left them, the robots are put at their start
   // poses turned with the sides when the second half's Initial begins.
-  RuleBook rules = spl();
+  RuleBook rules = test::splRules();
   rules.half_duration = 2.0;
   rules.half_time_break = 2.0;
   rules.half_time_to_initial = 1.0;
   world::World w(twoVsTwo());
-  Referee ref(w, rules, teams(), 0);
+  Referee ref(w, rules, test::twoTeams(), 0);
   Game& g = ref.game();
   openPlay(w, ref);
   w.placeRobot(0, 2.0, -1.0, 0.5);  // team 0's keeper ends the half in the other half
@@ -644,7 +637,7 @@ TEST(Referee, TheSecondHalfStartsWithEveryRobotInItsNewHalf) {
 
 TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   g.ready();
   kickOff(w, ref);  // team 0 kicks off
@@ -670,7 +663,7 @@ TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
 TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
   auto play = [] {
     world::World w(twoVsTwo());
-    Referee ref(w, spl(), teams(), 0);
+    Referee ref(w, test::splRules(), test::twoTeams(), 0);
     Game& g = ref.game();
     openPlay(w, ref);
     faceOff(w);
@@ -692,7 +685,7 @@ TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
 
 TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
   world::World w(twoVsTwo());
-  Referee ref(w, spl(), teams(), 0);
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   const auto& f = w.field();
   g.ready();
@@ -727,7 +720,7 @@ TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
   // The simleague rule book scores directly.
   world::World w2(twoVsTwo());
   Referee ref2(w2, loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"),
-               teams(), 0);
+               test::twoTeams(), 0);
   ref2.game().ready();
   kickOff(w2, ref2);
   touchBall(w2, ref2, 1);

@@ -13,7 +13,7 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kBenchCamerasHelp =
     "usage: simsoccer bench cameras [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
     "                               [--rate HZ] [--encoding yuyv|jpeg] [--csv FILE]\n"
     "\n"
@@ -46,7 +46,7 @@ double secondsSince(Clock::time_point t0) {
 int benchCameras(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"},
                     {"config", "robots", "seconds", "rate", "encoding", "csv"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBenchCamerasHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   const BenchConfig cfg = loadBenchConfig(config_file);

@@ -20,7 +20,7 @@ namespace {
 // Agent processes and what they cost, from the match runner library.
 using namespace simsoccer::match;
 
-const char* kHelp =
+const char* kBenchNetHelp =
     "usage: simsoccer bench net [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
     "                           [--domain D] [--dds-config FILE] [--csv FILE]\n"
     "\n"
@@ -40,7 +40,7 @@ using Clock = std::chrono::steady_clock;
 int benchNet(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"},
                     {"config", "robots", "seconds", "domain", "dds-config", "csv"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBenchNetHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);

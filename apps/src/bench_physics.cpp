@@ -16,7 +16,7 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kBenchPhysicsHelp =
     "usage: simsoccer bench physics [--config FILE] [--robots 1,2,4,8,11,22] [--seconds S]\n"
     "                               [--dt 0.005,0.01] [--iterations N] [--joint-sweeps N]\n"
     "                               [--threads N]\n"
@@ -59,7 +59,7 @@ int benchPhysics(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"},
                     {"config", "robots", "seconds", "dt", "iterations", "joint-sweeps", "threads",
                      "repeat", "csv"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBenchPhysicsHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   BenchConfig cfg = loadBenchConfig(config_file);

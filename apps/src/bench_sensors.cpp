@@ -14,7 +14,7 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kBenchSensorsHelp =
     "usage: simsoccer bench sensors [--config FILE] [--robots 1,2,4,8,11,22] [--rays 9,32]\n"
     "                               [--seconds S] [--csv FILE]\n"
     "\n"
@@ -65,7 +65,7 @@ world::World settledWorld(const BenchConfig& cfg, int n, int rays, const fields:
 
 int benchSensors(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"}, {"config", "robots", "rays", "seconds", "csv"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBenchSensorsHelp)) return 0;
   opt.noPositional();
   const auto config_file = findConfig(opt.get("config", ""), "configs/bench/physics.yaml");
   const BenchConfig cfg = loadBenchConfig(config_file);

@@ -19,7 +19,7 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kBoosterRunHelp =
     "usage: simsoccer booster-run --robot T:P [--profile FILE] -- PROGRAM [ARGS...]\n"
     "\n"
     "Runs PROGRAM (a team's Booster SDK client, unmodified) in the network namespace where\n"
@@ -41,7 +41,7 @@ int boosterRun(int argc, char** argv, int first) {
       break;
     }
   const Options opt(split, argv, first, {"help"}, {"robot", "profile"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kBoosterRunHelp)) return 0;
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   const std::string robot = opt.get("robot", "");

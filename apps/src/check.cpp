@@ -9,7 +9,7 @@
 namespace simsoccer::apps {
 
 namespace {
-const char* kHelp =
+const char* kCheckHelp =
     "usage: simsoccer check SCENARIO.yaml\n"
     "\n"
     "Loads the scenario, its field and robot model files, builds the world (nothing is\n"
@@ -19,7 +19,7 @@ const char* kHelp =
 
 int check(int argc, char** argv, int first) {
   const Options opt(argc, argv, first, {"help"}, {});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kCheckHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario file");
   const world::World w = world::World::fromFile(opt.positional()[0]);
   const auto& s = w.scenario();

@@ -1,14 +1,45 @@
 // Option parsing and tables for the command-line programs.
 #include "cli.hpp"
 
+#include <signal.h>
+
 #include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 namespace simsoccer::apps {
+namespace {
+
+volatile std::sig_atomic_t g_stop_signalled = 0;
+void onStopSignal(int) {
+  g_stop_signalled = 1;
+}
+
+}  // namespace
+
+void stopOnSignals() {
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
+  struct sigaction hangup {};
+  if (::sigaction(SIGHUP, nullptr, &hangup) == 0 && hangup.sa_handler != SIG_IGN)
+    std::signal(SIGHUP, onStopSignal);
+}
+
+bool stopSignalled() {
+  return g_stop_signalled != 0;
+}
+
+std::filesystem::path timestampedRunDir(const std::string& prefix) {
+  char buf[32];
+  const std::time_t t = std::time(nullptr);
+  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", std::localtime(&t));
+  return std::filesystem::path("runs") / (prefix + buf);
+}
 
 Options::Options(int argc, char** argv, int first, const std::vector<std::string>& flags,
                  const std::vector<std::string>& valued) {

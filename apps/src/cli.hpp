@@ -66,6 +66,15 @@ struct Table {
 
 std::string fmt(double value, int decimals);
 
+// A long run (a match, a soak) stops cleanly on SIGINT or SIGTERM, and on SIGHUP (a closed
+// terminal) unless that is ignored (nohup): stopOnSignals installs the handler once,
+// stopSignalled says whether one came.
+void stopOnSignals();
+bool stopSignalled();
+
+// runs/PREFIX<local date-time>, where a run writes when no --out is given.
+std::filesystem::path timestampedRunDir(const std::string& prefix);
+
 int benchPhysics(int argc, char** argv, int first);
 int lolaRun(int argc, char** argv, int first);
 int boosterRun(int argc, char** argv, int first);

@@ -29,7 +29,7 @@ extern char** environ;
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kLolaRunHelp =
     "usage: simsoccer lola-run (--socket PATH | --robot T:P [--run DIR]) [--wait S]\n"
     "                          [--net [--bridge NAME] [--prefix A.B]] -- PROGRAM [ARGS...]\n"
     "\n"
@@ -76,7 +76,7 @@ int lolaRun(int argc, char** argv, int first) {
     }
   const Options opt(split, argv, first, {"help", "net"},
                     {"socket", "robot", "run", "wait", "bridge", "prefix"});
-  if (opt.help(kHelp)) return 0;
+  if (opt.help(kLolaRunHelp)) return 0;
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   if (!opt.has("socket") && !opt.has("robot")) throw UsageError("give --socket or --robot");

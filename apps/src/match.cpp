@@ -1,11 +1,7 @@
 // simsoccer match / penalty: the main job. Parses the options, builds the
 // session and hands it to the match runner (simsoccer/match), then prints.
-#include <unistd.h>
-
 #include <algorithm>
-#include <csignal>
 #include <cstdio>
-#include <ctime>
 
 #include "cli.hpp"
 #include "help_texts.hpp"
@@ -21,21 +17,9 @@ using match::MatchConfig;
 using match::MatchSession;
 using match::RunOptions;
 
-volatile std::sig_atomic_t g_interrupted = 0;
-void onInterrupt(int) {
-  g_interrupted = 1;
-}
-
-std::filesystem::path defaultOut() {
-  char buf[32];
-  const std::time_t t = std::time(nullptr);
-  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", std::localtime(&t));
-  return std::filesystem::path("runs") / buf;
-}
-
 RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
-  o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : defaultOut();
+  o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : timestampedRunDir("");
   o.seed = opt.seed("seed", c.seed);
   o.domain = opt.domain("domain", 0);
   o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
@@ -44,17 +28,12 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
                          ? "--dds-config " + o.dds_config.string() + ": no such file"
                          : "the default DDS configuration " + o.dds_config.string() +
                                " is missing (give one with --dds-config)");
-  o.stop_requested = [] { return g_interrupted != 0; };
+  o.stop_requested = [] { return stopSignalled(); };
   o.notice = [](const std::string& line) {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   };
-  std::signal(SIGINT, onInterrupt);
-  std::signal(SIGTERM, onInterrupt);
-  // A closed terminal ends the match cleanly too, unless it runs under nohup.
-  struct sigaction hangup {};
-  if (::sigaction(SIGHUP, nullptr, &hangup) == 0 && hangup.sa_handler != SIG_IGN)
-    std::signal(SIGHUP, onInterrupt);
+  stopOnSignals();
   return o;
 }
 

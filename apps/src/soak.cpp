@@ -3,19 +3,12 @@
 // (simsoccer/match/soak.hpp); prints the table and the checks.
 #include "simsoccer/match/soak.hpp"
 
-#include <csignal>
 #include <cstdio>
-#include <ctime>
 
 #include "cli.hpp"
 
 namespace simsoccer::apps {
 namespace {
-
-volatile std::sig_atomic_t g_interrupted = 0;
-void onInterrupt(int) {
-  g_interrupted = 1;
-}
 
 const char* kSoakHelp =
     "usage: simsoccer soak [CONFIG] [--games N] [--kills N] [--stops N] [--stop-seconds S]\n"
@@ -35,13 +28,6 @@ const char* kSoakHelp =
     "the last, and it holds no more descriptors or threads after the last game than after\n"
     "the first.\n";
 
-std::string defaultOut() {
-  char buf[48];
-  const std::time_t t = std::time(nullptr);
-  std::strftime(buf, sizeof buf, "runs/soak-%Y%m%d-%H%M%S", std::localtime(&t));
-  return buf;
-}
-
 }  // namespace
 
 int soak(int argc, char** argv, int first) {
@@ -60,12 +46,11 @@ int soak(int argc, char** argv, int first) {
   o.stops_per_game = opt.wholeNumber("stops", 2, 0, 10000);
   o.stop_seconds = opt.positive("stop-seconds", 3.0);
   o.seed = opt.seed("seed", config.seed);
-  o.run.out = opt.get("out", defaultOut());
+  o.run.out = opt.get("out", timestampedRunDir("soak-").string());
   o.run.domain = opt.domain("domain", 0);
   o.run.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
-  o.run.stop_requested = [] { return g_interrupted != 0; };
-  std::signal(SIGINT, onInterrupt);
-  std::signal(SIGTERM, onInterrupt);
+  o.run.stop_requested = [] { return stopSignalled(); };
+  stopOnSignals();
   match::prepareOut(o.run.out);
   std::printf(
       "simsoccer soak %s: %d games, %d kills and %d stops of %.1f s each per game, "

@@ -12,7 +12,7 @@
 namespace simsoccer::apps {
 namespace {
 
-const char* kHelp =
+const char* kBenchMotionHelp =
     "usage: simsoccer bench motion [--robot R] [--random-minutes M] [--seed N] [--csv FILE]\n"
     "       simsoccer bench motion --vx V [--vy V] [--turn W] [--seconds S] [--verbose]\n"
     "\n"
@@ -124,7 +124,7 @@ int benchMotion(int argc, char** argv, int first) {
       argc, argv, first,
       {"help", "verbose", "kick", "striker", "penalty", "block", "shootout", "random"}, valued);
   char help[8192];
-  std::snprintf(help, sizeof help, kHelp, sim::modeName(sim::kDefaultMode));
+  std::snprintf(help, sizeof help, kBenchMotionHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
   opt.noPositional();
   motion::TrialContext c;
