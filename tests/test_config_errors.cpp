@@ -15,8 +15,8 @@
 using namespace simsoccer;
 namespace fs = std::filesystem;
 
-namespace {
-
+// At namespace scope, not in the anonymous one: GoogleTest derives each test's class from
+// it, and in a unity build GCC warns of a base that has internal linkage.
 class ConfigErrors : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -64,7 +64,7 @@ class ConfigErrors : public ::testing::Test {
   std::string robot_, scenario_;
 };
 
-}  // namespace
+namespace {}  // namespace
 
 TEST_F(ConfigErrors, ValidFilesLoad) {
   std::ofstream(dir_ / "robot.yaml") << robot_;
