@@ -608,7 +608,8 @@ TEST(Referee, WholeFirstHalfFromScriptedBallPositions) {
 
 TEST(Referee, TheSecondHalfStartsWithEveryRobotInItsNewHalf) {
   // Wherever the first half left them, the robots are put at their start
-  // poses turned with the sides when the second half's Initial begins.
+  // poses turned with the sides as the half-time break begins, and stay there
+  // into the second half's Initial.
   RuleBook rules = test::splRules();
   rules.half_duration = 2.0;
   rules.half_time_break = 2.0;
@@ -618,6 +619,10 @@ TEST(Referee, TheSecondHalfStartsWithEveryRobotInItsNewHalf) {
   Game& g = ref.game();
   openPlay(w, ref);
   w.placeRobot(0, 2.0, -1.0, 0.5);  // team 0's keeper ends the half in the other half
+  for (int i = 0; i < 1000 && g.state() != gc::State::Finished; ++i) run(w, ref, 0.01);
+  ASSERT_EQ(g.state(), gc::State::Finished);
+  ASSERT_EQ(g.half(), Half::First);
+  EXPECT_EQ(count(g, "placement"), 4);
   for (int i = 0; i < 1000 && g.half() != Half::Second; ++i) run(w, ref, 0.01);
   ASSERT_EQ(g.half(), Half::Second);
   ASSERT_EQ(g.state(), gc::State::Initial);

@@ -372,8 +372,12 @@ void Referee::onEnterSet() {
 // half, each robot in play goes to its start pose from the scenario turned
 // with the sides (x, y and the heading turned half a turn about the centre
 // mark): otherwise both teams, wherever the first half ended, walked through
-// each other to their new halves in Ready, and pushed.
+// each other to their new halves in Ready, and pushed. They take them as the
+// break begins (enterState): left where the half ended until the second half's
+// Initial, a K1 down in a crowd before a goal got up again and again into its
+// neighbours and knocked them over (7 falls in one break of a 5 v 5 game).
 void Referee::placeForTheSecondHalf() {
+  placed_for_second_half_ = true;
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
     const auto& info = world_.robot(r);
     if (game_.penalty(info.team, info.number) == gc::Penalty::Substitute) continue;
@@ -720,8 +724,12 @@ void Referee::enterState(gc::State s) {
   still_for_ = 0.0;
   last_state_ = s;
   if (s == gc::State::Set) onEnterSet();
-  if (s == gc::State::Initial && game_.half() == Half::Second &&
-      game_.phase() != gc::GamePhase::PenaltyShoot)
+  const bool normal = game_.phase() != gc::GamePhase::PenaltyShoot;
+  const bool break_begins =
+      s == gc::State::Finished && game_.half() == Half::First && game_.rules().halves == 2;
+  // (An external GameController may also go from the first half straight to the second's Initial.)
+  const bool second_half_begins = s == gc::State::Initial && game_.half() == Half::Second;
+  if (normal && !placed_for_second_half_ && (break_begins || second_half_begins))
     placeForTheSecondHalf();
   if (s == gc::State::Playing) {
     touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick

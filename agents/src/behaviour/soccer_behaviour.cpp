@@ -283,10 +283,12 @@ void SoccerBehaviour::readGame(const Input& in) {
   for (size_t i = 0; i < team_penalised_.size(); ++i)
     team_penalised_[i] = t.players[i].penalty != 0;
   penalised_ = penalisedInGame(player_);
-  // A state change that moves robots (Set: placement; leaving a penalty: the
-  // robot re-enters elsewhere) restarts the motion from the stance.
+  // A state change that moves robots (Set: placement; the half-time break: the
+  // handlers put them in their second-half places; leaving a penalty: the robot
+  // re-enters elsewhere) restarts the motion from the stance.
+  const bool half_time = state_ == kFinished && first_half_ && phase_ != kPhasePenaltyShoot;
   const bool moved = penalised_ != was_penalised_ ||
-                     (state_ != last_state_ && (state_ == kSet || state_ == kInitial));
+                     (state_ != last_state_ && (state_ == kSet || state_ == kInitial || half_time));
   if (moved) {
     restart_motion_ = true;
     // The ball's track from before a placement would read as a roll, and the
@@ -679,6 +681,12 @@ bool SoccerBehaviour::keeperInPlay(double time) const {
   return false;
 }
 
+SoccerBehaviour::Vec2 SoccerBehaviour::goalAreaWaitSpot() const {
+  const double front = -field_.halfLength() + field_.goal_area->length;
+  const double half = 0.5 * field_.goal_area->width;
+  return {front + config_.avoid_near, std::clamp(ball_.y, -half, half)};
+}
+
 Pose2 SoccerBehaviour::readyPosition(int player) const {
   const size_t i = static_cast<size_t>(std::max(0, player - 1));
   if (i < config_.ready_positions.size()) return config_.ready_positions[i];
@@ -722,9 +730,8 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
         // The ball in the own goal area is the goalkeeper's: going round it to kick it
         // away, the striker walked in between the ball and the goal line, where the
         // keeper stands, and both played it at once. Wait outside the area, facing it.
-        const double front = -field_.halfLength() + field_.goal_area->length;
-        const double half = 0.5 * field_.goal_area->width;
-        r = walkTo({front + config_.avoid_near, std::clamp(ball_.y, -half, half), 0.0}, true);
+        const Vec2 wait = goalAreaWaitSpot();
+        r = walkTo({wait.x, wait.y, 0.0}, true);
         break;
       }
       r = striker(0.0, false);

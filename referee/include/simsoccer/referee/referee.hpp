@@ -128,6 +128,7 @@ class Referee {
   RefereeConfig config_;
   Game game_;
   gc::State last_state_ = gc::State::Initial;
+  bool placed_for_second_half_ = false;
   double time_in_state_ = 0.0;
   double still_for_ = 0.0;
   engine::Vec3 set_play_ball_ = engine::Vec3::Zero();  // where the ball was when the set play began
