@@ -277,6 +277,68 @@ TEST(Referee, FallenRobotIsPenalisedAsInactive) {
   EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
 }
 
+namespace {
+
+// Tips robot r over: its ankles pitched hard (a limp robot set down upright may settle in a
+// crouch that counts as standing).
+void tipOver(world::World& w, world::RobotId r) {
+  const auto& joints = w.robot(r).model->body->joints;
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+    if (joints[static_cast<size_t>(j)].mimic_of < 0 &&
+        joints[static_cast<size_t>(j)].name.find("AnklePitch") != std::string::npos)
+      w.setJointTarget(r, j, 0.9, 1.0);
+}
+
+}  // namespace
+
+TEST(Referee, FailedGetUpsArePenalisedAsInactive) {
+  // Team 1 player 2 (robot 3) tips over; each "get-up" sets it upright, where it tips over
+  // again within 2 s. The rules: 2 failed get-ups are Inactive Player, 3 if another robot
+  // disturbed it (here team 1's keeper, robot 2, beside it).
+  for (const bool disturbed : {false, true}) {
+    world::World w(twoVsTwo());
+    Referee ref(w, test::splRules(), test::twoTeams(), 0);
+    Game& g = ref.game();
+    g.ready();
+    kickOff(w, ref);
+    const Vec3 at = w.torsoPose(3).translation();
+    if (disturbed) w.placeRobot(2, at.x(), at.y() + 0.5, M_PI);
+    tipOver(w, 3);
+    run(w, ref, 2.0);  // down from standing: a fall, not a failed get-up
+    ASSERT_FALSE(w.isStanding(3));
+    int failed = 0;
+    while (g.penalty(1, 2) == gc::Penalty::None && failed < 4) {
+      w.placeRobot(3, at.x(), at.y(), M_PI);  // up ...
+      run(w, ref, 0.2);
+      ASSERT_TRUE(w.isStanding(3));
+      tipOver(w, 3);
+      run(w, ref, 2.0);  // ... and down again within the hold time (3 s)
+      ++failed;
+      // (Penalised, it stands off the field.)
+      if (g.penalty(1, 2) == gc::Penalty::None) ASSERT_FALSE(w.isStanding(3));
+    }
+    EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer) << "disturbed " << disturbed;
+    EXPECT_EQ(failed, disturbed ? 3 : 2);
+    EXPECT_EQ(count(g, "inactive"), 1);
+    EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);  // the robot beside it
+  }
+  // A robot that stands for the hold time between two falls did get up: no call.
+  world::World w(twoVsTwo());
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  const Vec3 at = w.torsoPose(3).translation();
+  for (int fall = 0; fall < 3; ++fall) {
+    tipOver(w, 3);
+    run(w, ref, 2.0);
+    ASSERT_FALSE(w.isStanding(3));
+    w.placeRobot(3, at.x(), at.y(), M_PI);
+    run(w, ref, 3.5);
+  }
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
+}
+
 TEST(Referee, StandingIdleNextToTheBallIsInactive) {
   world::World w(twoVsTwo());
   Referee ref(w, test::splRules(), test::twoTeams(), 0);

@@ -13,6 +13,7 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
                  int kick_off_team, const RefereeConfig& config)
     : world_(world), config_(config), game_(rules, teams, kick_off_team) {
   fallen_for_.assign(world.robotCount(), 0.0);
+  get_ups_.assign(world.robotCount(), GetUps{});
   idle_for_.assign(world.robotCount(), 0.0);
   idle_anchor_.assign(world.robotCount(), Vec3::Zero());
   in_goal_area_since_.assign(world.robotCount(), -1.0);
@@ -367,6 +368,26 @@ void Referee::onEnterSet() {
   }
 }
 
+bool Referee::getUpsFailed(RobotId r, bool standing) {
+  GetUps& g = get_ups_[r];
+  if (standing && !g.was_standing) g.stood_up_at = clock_;
+  if (!standing && g.was_standing) {  // down again
+    if (clock_ - g.stood_up_at < config_.get_up_hold_time) {
+      ++g.failed;
+      const Vec3 p = world_.torsoPose(r).translation();
+      for (RobotId o = 0; o < world_.robotCount(); ++o)
+        if (o != r && (world_.torsoPose(o).translation() - p).head<2>().norm() <
+                          config_.get_up_disturbed_distance)
+          g.disturbed = true;
+    } else {
+      g.failed = 0;  // a fall from standing, not a failed get-up
+      g.disturbed = false;
+    }
+  }
+  g.was_standing = standing;
+  return g.failed >= config_.failed_get_ups + (g.disturbed ? 1 : 0);
+}
+
 // The teams' handlers put their robots in their own halves before a half's
 // kick-off (the rules: on the touchlines of the own half). For the second
 // half, each robot in play goes to its start pose from the scenario turned
@@ -461,17 +482,29 @@ void Referee::checkPenalties() {
   std::array<std::vector<RobotId>, 2> in_goal_area;
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
     const auto& info = world_.robot(r);
-    if (game_.penalty(info.team, info.number) != gc::Penalty::None) continue;
+    // Out of play, or placed by hand: its get-ups start over.
+    if (game_.penalty(info.team, info.number) != gc::Penalty::None || !in_game) {
+      get_ups_[r] = GetUps{};
+      continue;
+    }
     const Vec3 p = world_.torsoPose(r).translation();
-    if (!in_game) continue;
     // Leaving the field: off the carpet.
     if (!f.onCarpet(p.x(), p.y())) {
       game_.penalise(info.team, info.number, gc::Penalty::LeavingTheField);
       continue;
     }
-    // Fallen / inactive: down for longer than the rule's time.
-    fallen_for_[r] = world_.isStanding(r) ? 0.0 : fallen_for_[r] + dt;
+    // Fallen / inactive: down for longer than the rule's time, or its get-ups failed.
+    const bool standing = world_.isStanding(r);
+    fallen_for_[r] = standing ? 0.0 : fallen_for_[r] + dt;
     if (fallen_for_[r] >= config_.inactive_time) {
+      game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
+      fallen_for_[r] = 0.0;
+      continue;
+    }
+    if (getUpsFailed(r, standing)) {
+      game_.recordEvent(EventType::Inactive, info.team, info.number,
+                        get_ups_[r].disturbed ? "failed to get up 3 times (disturbed)"
+                                              : "failed to get up twice");
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
       fallen_for_[r] = 0.0;
       continue;

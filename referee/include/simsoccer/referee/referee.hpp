@@ -22,6 +22,13 @@ struct RefereeConfig {
   double ready_still_time = 1.0;  // Ready ends early when all stand still in legal places this long
   double still_speed = 0.05;      // m/s: a robot slower than this stands still
   double inactive_time = 10.0;  // s fallen, or standing idle near the ball, before Inactive Player
+  // The rules' other Fallen call: failed get-ups. A get-up failed when the robot stood for
+  // less than get_up_hold_time before it was down again; failed_get_ups in a row are
+  // Inactive Player, one more when another robot's torso was within get_up_disturbed_distance
+  // (torso to torso, on the ground) as one of them failed (the rules: "3 if disturbed").
+  int failed_get_ups = 2;
+  double get_up_hold_time = 3.0;           // s
+  double get_up_disturbed_distance = 0.6;  // m
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
   double free_kick_distance = 0.75;   // m: defenders keep this far from the ball at a free kick ...
@@ -134,6 +141,16 @@ class Referee {
   engine::Vec3 set_play_ball_ = engine::Vec3::Zero();  // where the ball was when the set play began
   uint64_t set_play_step_ = 0;                         // world step when it began
   std::vector<double> fallen_for_;
+  // Per robot, its get-ups since it last stood for get_up_hold_time.
+  struct GetUps {
+    bool was_standing = true;
+    double stood_up_at = -1e9;  // clock_
+    int failed = 0;
+    bool disturbed = false;
+  };
+  std::vector<GetUps> get_ups_;
+  // Counts a failed get-up when robot r is down again; true when that is one too many.
+  bool getUpsFailed(world::RobotId r, bool standing);
   std::vector<double> idle_for_;            // s standing without moving with the ball near
   std::vector<engine::Vec3> idle_anchor_;   // where the idle time started
   std::vector<double> in_goal_area_since_;  // game time of entering the own goal area; <0 outside
