@@ -289,6 +289,17 @@ void tipOver(world::World& w, world::RobotId r) {
       w.setJointTarget(r, j, 0.9, 1.0);
 }
 
+// 2 v 2 right after team 0's kick-off.
+struct KickedOff {
+  world::World w{twoVsTwo()};
+  Referee ref{w, test::splRules(), test::twoTeams(), 0};
+  Game& g = ref.game();
+  KickedOff() {
+    g.ready();
+    kickOff(w, ref);
+  }
+};
+
 }  // namespace
 
 TEST(Referee, FailedGetUpsArePenalisedAsInactive) {
@@ -296,11 +307,8 @@ TEST(Referee, FailedGetUpsArePenalisedAsInactive) {
   // again within 2 s. The rules: 2 failed get-ups are Inactive Player, 3 if another robot
   // disturbed it (here team 1's keeper, robot 2, beside it).
   for (const bool disturbed : {false, true}) {
-    world::World w(twoVsTwo());
-    Referee ref(w, test::splRules(), test::twoTeams(), 0);
-    Game& g = ref.game();
-    g.ready();
-    kickOff(w, ref);
+    KickedOff game;
+    auto& [w, ref, g] = game;
     const Vec3 at = w.torsoPose(3).translation();
     if (disturbed) w.placeRobot(2, at.x(), at.y() + 0.5, M_PI);
     tipOver(w, 3);
@@ -315,7 +323,9 @@ TEST(Referee, FailedGetUpsArePenalisedAsInactive) {
       run(w, ref, 2.0);  // ... and down again within the hold time (3 s)
       ++failed;
       // (Penalised, it stands off the field.)
-      if (g.penalty(1, 2) == gc::Penalty::None) ASSERT_FALSE(w.isStanding(3));
+      if (g.penalty(1, 2) == gc::Penalty::None) {
+        ASSERT_FALSE(w.isStanding(3));
+      }
     }
     EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer) << "disturbed " << disturbed;
     EXPECT_EQ(failed, disturbed ? 3 : 2);
@@ -323,11 +333,8 @@ TEST(Referee, FailedGetUpsArePenalisedAsInactive) {
     EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);  // the robot beside it
   }
   // A robot that stands for the hold time between two falls did get up: no call.
-  world::World w(twoVsTwo());
-  Referee ref(w, test::splRules(), test::twoTeams(), 0);
-  Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
+  KickedOff game;
+  auto& [w, ref, g] = game;
   const Vec3 at = w.torsoPose(3).translation();
   for (int fall = 0; fall < 3; ++fall) {
     tipOver(w, 3);
