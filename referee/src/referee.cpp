@@ -503,8 +503,8 @@ void Referee::checkPenalties() {
     }
     if (getUpsFailed(r, standing)) {
       game_.recordEvent(EventType::Inactive, info.team, info.number,
-                        get_ups_[r].disturbed ? "failed to get up 3 times (disturbed)"
-                                              : "failed to get up twice");
+                        "failed to get up " + std::to_string(get_ups_[r].failed) + " times" +
+                            (get_ups_[r].disturbed ? " (disturbed)" : ""));
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
       fallen_for_[r] = 0.0;
       continue;

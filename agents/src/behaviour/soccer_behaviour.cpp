@@ -681,12 +681,6 @@ bool SoccerBehaviour::keeperInPlay(double time) const {
   return false;
 }
 
-SoccerBehaviour::Vec2 SoccerBehaviour::goalAreaWaitSpot() const {
-  const double front = -field_.halfLength() + field_.goal_area->length;
-  const double half = 0.5 * field_.goal_area->width;
-  return {front + config_.avoid_near, std::clamp(ball_.y, -half, half)};
-}
-
 Pose2 SoccerBehaviour::readyPosition(int player) const {
   const size_t i = static_cast<size_t>(std::max(0, player - 1));
   if (i < config_.ready_positions.size()) return config_.ready_positions[i];
@@ -730,8 +724,9 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
         // The ball in the own goal area is the goalkeeper's: going round it to kick it
         // away, the striker walked in between the ball and the goal line, where the
         // keeper stands, and both played it at once. Wait outside the area, facing it.
-        const Vec2 wait = goalAreaWaitSpot();
-        r = walkTo({wait.x, wait.y, 0.0}, true);
+        const double front = -field_.halfLength() + field_.goal_area->length;
+        const double half = 0.5 * field_.goal_area->width;
+        r = walkTo({front + config_.avoid_near, std::clamp(ball_.y, -half, half), 0.0}, true);
         break;
       }
       r = striker(0.0, false);

@@ -189,9 +189,6 @@ class SoccerBehaviour {
   // The team's goalkeeper plays, by its last message: heard from recently, not
   // penalised, not fallen.
   bool keeperInPlay(double time) const;
-  // Where the striker waits while the goalkeeper plays the ball in the own goal area
-  // (own frame): in front of the area, across from the ball.
-  Vec2 goalAreaWaitSpot() const;
   struct Crossing {
     double t, y;  // s from now; m, own frame
   };
