@@ -42,7 +42,7 @@ TEST(WalkEngine, SwingFootLiftsAndLandsAtItsPlacement) {
       0.0;  // pure geometry: the sag compensation bends the support leg on purpose
   agents::WalkEngine e(model, p);
   std::vector<double> q = model.pose("stand");
-  e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  e.update(0.01, {}, q);
   const Feet standing = feetOf(e, q);
   EXPECT_NEAR(standing.left.translation().z(), -p.ankle_height, 1e-6);
   EXPECT_NEAR(standing.left.translation().y() - standing.right.translation().y(), p.step_width,
@@ -50,7 +50,7 @@ TEST(WalkEngine, SwingFootLiftsAndLandsAtItsPlacement) {
   e.setVelocity(0.2, 0.0, 0.0);
   double apex = -1.0;
   for (int i = 0; i < 25; ++i) {  // the first step: the left foot swings
-    e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+    e.update(0.01, {}, q);
     const Feet f = feetOf(e, q);
     apex = std::max(apex, f.left.translation().z() - f.right.translation().z());
     EXPECT_NEAR(f.right.translation().z(), -p.ankle_height, 1e-6);  // the support foot stays down
@@ -73,7 +73,7 @@ TEST(WalkEngine, AWalkStartedSoonAfterItStoppedFirstShiftsTheWeight) {
   const auto lifts = [&](int periods) {
     std::pair<double, double> most{-1.0, -1.0};
     for (int i = 0; i < periods; ++i) {
-      e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+      e.update(0.01, {}, q);
       const Feet f = feetOf(e, q);
       const double d = f.left.translation().z() - f.right.translation().z();
       most = {std::max(most.first, d), std::max(most.second, -d)};
@@ -85,7 +85,7 @@ TEST(WalkEngine, AWalkStartedSoonAfterItStoppedFirstShiftsTheWeight) {
   EXPECT_NEAR(lifts(step - 1).first, p.foot_lift, 0.001);
   lifts(3 * step);
   e.stop();
-  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, {}, q);
   ASSERT_FALSE(e.walking());
   lifts(30);  // stood 0.3 s
   const double walked = e.odometry().x;
@@ -100,10 +100,52 @@ TEST(WalkEngine, AWalkStartedSoonAfterItStoppedFirstShiftsTheWeight) {
   EXPECT_LT(next.first, 1e-6);
   // Stood longer than start_shift_time: no weight shift.
   e.stop();
-  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  for (int i = 0; i < 1000 && e.walking(); ++i) e.update(0.01, {}, q);
   lifts(110);
   e.setVelocity(0.1, 0.0, 0.0);
   EXPECT_NEAR(lifts(step - 1).first, p.foot_lift, 0.001);
+}
+
+// A step whose time is up while the torso still leans over the support foot waits in double
+// support (the swing foot down) until the lean is back, at most max_support_hold.
+TEST(WalkEngine, AStepWaitsInDoubleSupportWhileTheTorsoLeansOverItsSupportFoot) {
+  const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
+  agents::WalkParameters p;
+  p.max_support_hold = 0.3;
+  std::vector<double> q = model.pose("stand");
+  const agents::WalkSensors upright{}, leaning_right{.roll = 0.2}, leaning_left{.roll = -0.2};
+  auto walkOnTheSpot = [&](agents::WalkEngine& e, const agents::WalkSensors& imu, int periods) {
+    for (int i = 0; i < periods; ++i) e.update(0.01, imu, q);
+  };
+  // The first step stands on the right foot (the left one swings); 0.25 s, then 0.05 s more.
+  agents::WalkEngine held(model, p);
+  held.setVelocity(0.0, 0.0, 0.0);
+  walkOnTheSpot(held, leaning_right, 30);
+  EXPECT_EQ(held.supportLeg(), Leg::Right);
+  EXPECT_DOUBLE_EQ(held.phase(), 1.0);
+  const Feet down = feetOf(held, q);
+  EXPECT_NEAR(down.left.translation().z(), down.right.translation().z(), 1e-6);
+  walkOnTheSpot(held, upright, 1);  // the lean is back: the left foot takes the weight
+  EXPECT_EQ(held.supportLeg(), Leg::Left);
+  EXPECT_LT(held.phase(), 0.1);
+
+  // Leaning towards the swing foot, or with the hold off, the step ends on time.
+  agents::WalkEngine other_way(model, p);
+  other_way.setVelocity(0.0, 0.0, 0.0);
+  walkOnTheSpot(other_way, leaning_left, 30);
+  EXPECT_EQ(other_way.supportLeg(), Leg::Left);
+  agents::WalkEngine open_loop(model);
+  open_loop.setVelocity(0.0, 0.0, 0.0);
+  walkOnTheSpot(open_loop, leaning_right, 30);
+  EXPECT_EQ(open_loop.supportLeg(), Leg::Left);
+
+  // A lean that lasts: the step ends after max_support_hold anyway.
+  agents::WalkEngine lasting(model, p);
+  lasting.setVelocity(0.0, 0.0, 0.0);
+  walkOnTheSpot(lasting, leaning_right, 50);  // 0.25 s of step, 0.25 s held
+  EXPECT_EQ(lasting.supportLeg(), Leg::Right);
+  walkOnTheSpot(lasting, leaning_right, 10);
+  EXPECT_EQ(lasting.supportLeg(), Leg::Left);
 }
 
 TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
@@ -111,13 +153,13 @@ TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
   agents::WalkEngine e(model);
   std::vector<double> q = model.pose("stand");
   e.setVelocity(0.2, 0.0, 0.0);
-  for (int i = 0; i < 400; ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);  // 4 s
+  for (int i = 0; i < 400; ++i) e.update(0.01, {}, q);  // 4 s
   // Ramped up by 0.02 m per step to 0.05 m per step (0.2 m/s at 4 steps/s).
   EXPECT_GT(e.odometry().x, 0.7);
   EXPECT_LT(e.odometry().x, 0.85);
   EXPECT_NEAR(e.odometry().y, 0.0, 1e-9);
   e.stop();
-  for (int i = 0; i < 300 && e.walking(); ++i) e.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  for (int i = 0; i < 300 && e.walking(); ++i) e.update(0.01, {}, q);
   EXPECT_FALSE(e.walking());
   const Feet f = feetOf(e, q);
   EXPECT_NEAR(f.left.translation().x(), f.right.translation().x(), 1e-3);  // side by side
@@ -125,7 +167,7 @@ TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
   // A command beyond the limits is scaled into them.
   agents::WalkEngine fast(model);
   fast.setVelocity(5.0, 0.0, 0.0);
-  for (int i = 0; i < 1000; ++i) fast.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  for (int i = 0; i < 1000; ++i) fast.update(0.01, {}, q);
   EXPECT_NEAR(fast.odometry().x / 10.0, fast.parameters().max_forward / 0.25, 0.03);
 }
 
@@ -141,27 +183,27 @@ TEST(WalkEngine, SettlesToAStopAlthoughTheYawSwaysWithTheSteps) {
   // Each step's end reads +-0.012 rad, alternating with the swinging foot:
   // the correction's sign always matches the side that may turn.
   const auto yaw = [&](int i) { return -0.012 * std::cos(M_PI * i * 0.01 / period); };
-  e.update(0.01, engine::Vec3::Zero(), 0.0, q);  // its heading: yaw 0
+  e.update(0.01, {}, q);  // its heading: yaw 0
   e.setVelocity(0.1, 0.0, 0.0);
   int i = 0;
-  for (; i < 200; ++i) e.update(0.01, engine::Vec3::Zero(), yaw(i), q);
+  for (; i < 200; ++i) e.update(0.01, {.yaw = yaw(i)}, q);
   e.stop();
-  for (int k = 0; k < 300; ++k, ++i) e.update(0.01, engine::Vec3::Zero(), yaw(i), q);
+  for (int k = 0; k < 300; ++k, ++i) e.update(0.01, {.yaw = yaw(i)}, q);
   // 3 s later still stepping, correcting the sway: as documented (README,
   // Walk: every stop settling doubled the falls in 5 v 5 matches).
   EXPECT_TRUE(e.walking());
   e.stop(true);
   for (int k = 0; k < 300 && e.walking(); ++k, ++i)
-    e.update(0.01, engine::Vec3::Zero(), e.walking() ? yaw(i) : 0.0, q);
+    e.update(0.01, {.yaw = e.walking() ? yaw(i) : 0.0}, q);
   EXPECT_FALSE(e.walking());
   // A real heading error is still corrected before it stops.
   agents::WalkEngine off(model);
   off.setVelocity(0.1, 0.0, 0.0);
-  for (int k = 0; k < 200; ++k) off.update(0.01, engine::Vec3::Zero(), 0.0, q);
+  for (int k = 0; k < 200; ++k) off.update(0.01, {}, q);
   off.stop(true);
   int turned = 0;
   for (int k = 0; k < 300 && off.walking(); ++k) {
-    off.update(0.01, engine::Vec3::Zero(), -0.2, q);  // 0.2 rad right of its heading
+    off.update(0.01, {.yaw = -0.2}, q);  // 0.2 rad right of its heading
     turned += std::abs(off.odometry().yaw) > 1e-6;
   }
   EXPECT_GT(turned, 0);
@@ -228,7 +270,7 @@ SupportMargins walkSupport(const robots::RobotModel& model,
     else
       e.setVelocity(v.x(), v.y(), v.z());
     for (int i = 0; i < static_cast<int>(std::lround(seconds / dt)); ++i) {
-      e.update(dt, engine::Vec3::Zero(), yaw, q);
+      e.update(dt, {.yaw = yaw}, q);
       body.applyMimic(q);
       const std::vector<engine::Pose> frames = body.linkFramesAt(q);  // torso frame
       const int now = e.supportLeg() == Leg::Left ? 0 : 1;
@@ -449,21 +491,20 @@ TEST(WalkEngine, StandsWhereTheFeetAreAndStepsIntoItsStance) {
   agents::WalkEngine walk(model, w);
   walk.standWhereTheFeetAre(q);
   std::vector<double> targets = q;
-  for (int i = 0; i < 10; ++i) walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  for (int i = 0; i < 10; ++i) walk.update(0.01, {}, targets);
   EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.06, 0.18, 0.1)).norm(), 2e-3);
   // A few steps on the spot, then stopped: side by side in the gait's stance.
   walk.setVelocity(0.0, 0.0, 0.0);
-  for (int i = 0; i < 200; ++i) walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  for (int i = 0; i < 200; ++i) walk.update(0.01, {}, targets);
   walk.stop();
-  for (int i = 0; i < 300 && walk.walking(); ++i)
-    walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  for (int i = 0; i < 300 && walk.walking(); ++i) walk.update(0.01, {}, targets);
   ASSERT_FALSE(walk.walking());
-  walk.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  walk.update(0.01, {}, targets);
   EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.0, w.step_width, 0.0)).norm(), 2e-3);
   // The left foot 3 cm up: the gait's stance.
   agents::WalkEngine lifted(model, w);
   lifted.standWhereTheFeetAre(jointsFor(footAt(0.0, 0.09, 0.0, 0.03), footAt(0.0, -0.09, 0.0)));
-  lifted.update(0.01, engine::Vec3::Zero(), 0.0, targets);
+  lifted.update(0.01, {}, targets);
   EXPECT_LT((leftAgainstRight(targets) - engine::Vec3(0.0, w.step_width, 0.0)).norm(), 2e-3);
 }
 

@@ -69,6 +69,8 @@ const std::vector<Field<WalkParameters>>& walkFields() {
       {"ankle_pitch_gyro", &W::ankle_pitch_gyro, Range::Any},
       {"ankle_roll_gyro", &W::ankle_roll_gyro, Range::Any},
       {"gyro_smoothing", &W::gyro_smoothing, Range::Share},
+      {"support_lean", &W::support_lean, Range::NonNegative},
+      {"max_support_hold", &W::max_support_hold, Range::NonNegative},
       {"stiffness", &W::stiffness, Range::Positive}};
   return f;
 }

@@ -128,8 +128,9 @@ void WalkEngine::easeIn(const std::vector<double>& from, double t, std::vector<d
   for (size_t j = 0; j < targets.size(); ++j) targets[j] = (1 - a) * from[j] + a * stance[j];
 }
 
-void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets) {
-  gyro_filtered_ += p_.gyro_smoothing * (gyro - gyro_filtered_);
+void WalkEngine::update(double dt, const WalkSensors& imu, std::vector<double>& targets) {
+  gyro_filtered_ += p_.gyro_smoothing * (imu.gyro - gyro_filtered_);
+  const double yaw = imu.yaw;
   if (!yaw_known_) {
     yaw_offset_ = yaw - body_.yaw;
     intended_yaw_ = body_.yaw;
@@ -138,7 +139,14 @@ void WalkEngine::update(double dt, const Vec3& gyro, double yaw, std::vector<dou
   yaw_ = yaw;
   if (walking_) {
     phase_ += dt / p_.step_period;
-    if (phase_ >= 1.0) {
+    // Positive roll leans to the right.
+    const double lean_to_support = support_ == Leg::Left ? -imu.roll : imu.roll;
+    if (phase_ >= 1.0 && !shifting_ && lean_to_support > p_.support_lean &&
+        held_ < p_.max_support_hold) {
+      phase_ = 1.0;  // both feet down until the lean is back
+      held_ += dt;
+    } else if (phase_ >= 1.0) {
+      held_ = 0.0;
       // The swing foot is down: it becomes the support.
       const int swing = support_ == Leg::Left ? 1 : 0;
       foot_[swing] = swing_end_;

@@ -83,6 +83,8 @@ int benchMotion(int argc, char** argv, int first) {
       {"hip-roll", &wp.hip_roll_compensation},
       {"heading-gain", &wp.heading_gain},
       {"start-shift-time", &wp.start_shift_time},
+      {"support-lean", &wp.support_lean},
+      {"max-support-hold", &wp.max_support_hold},
       {"kick-reach", &kp.reach},
       {"kick-swing", &kp.swing_time},
       {"kick-shift", &kp.shift},

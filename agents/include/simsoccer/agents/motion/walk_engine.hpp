@@ -63,7 +63,21 @@ struct WalkParameters {
   // The gyro's low-pass for that feedback: the share of each new reading
   // (1: none). Smoothing delays the feedback, as the actuation delay does.
   double gyro_smoothing = 0.5;
+  // A step ends when its time is up, open loop, unless the torso still leans towards the support
+  // foot further than support_lean (rad, the IMU's roll; the walk's own sway stays inside it):
+  // then the swing foot is down but has not taken the weight, and lifting the support foot would
+  // tip the robot over it. The step waits in double support until the lean is back, for at most
+  // max_support_hold (s). 0: never (open loop).
+  double support_lean = 0.1;
+  double max_support_hold = 0.0;
   double stiffness = 1.0;
+};
+
+// What the walk reads from the IMU each period.
+struct WalkSensors {
+  Vec3 gyro = Vec3::Zero();        // rad/s, torso frame
+  double roll = 0.0, pitch = 0.0;  // rad, the torso's attitude
+  double yaw = 0.0;                // rad
 };
 
 struct Pose2 {
@@ -87,9 +101,8 @@ class WalkEngine {
 
   // Advances by `dt` and writes the joint targets (one per body joint, rad;
   // only the legs are written: the arms and the head are left as they are
-  // in `targets`). `gyro`: torso angular velocity (rad/s, torso frame);
-  // `yaw`: the IMU's torso yaw (rad).
-  void update(double dt, const Vec3& gyro, double yaw, std::vector<double>& targets);
+  // in `targets`).
+  void update(double dt, const WalkSensors& imu, std::vector<double>& targets);
 
   // Where the walk thinks the body is (odometry frame), and the foot placements.
   Pose2 odometry() const { return odometry_; }
@@ -120,6 +133,7 @@ class WalkEngine {
   bool shifting_ = false;   // this step only shifts the weight (start_shift_time)
   double stood_for_ = 1e9;  // s since the walk stopped (never walked: as if long ago)
   double phase_ = 0.0;  // 0..1 within the step
+  double held_ = 0.0;   // s the step's end has waited for the lean (max_support_hold)
   Leg support_ = Leg::Right;
   Pose2 body_, body_start_, body_end_;
   Pose2 odometry_;                 // the intended path (unscaled steps)
