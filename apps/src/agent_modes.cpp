@@ -45,7 +45,7 @@ void SimpleModes::answer(const simsoccer_msg_SensorFrame& frame, agents::AgentCl
       walk_.setVelocity(vx_, vy_, turn_);
       walk_.update(dt > 0 ? dt : 0.01,
                    {engine::Vec3(frame.gyroscope[0], frame.gyroscope[1], frame.gyroscope[2]),
-                    frame.angles[0], frame.angles[1], frame.angles[2]},
+                    frame.angles[0], frame.angles[2]},
                    targets_);
     }
     for (size_t a = 0; a < model_.actuators.size() && a < protocol::kActuators; ++a)

@@ -225,7 +225,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
             // the heading hold stepping: a K1 lined up at the ball stepped on for good)
         walk_.stop(request.kind == MotionRequest::Kind::Sit ||
                    request.kind == MotionRequest::Kind::Kick);
-      walk_.update(dt, {sensors.gyro, sensors.roll, sensors.pitch, sensors.yaw}, targets_);
+      walk_.update(dt, {sensors.gyro, sensors.roll, sensors.yaw}, targets_);
       state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
       break;
     case MotionState::Kicking:

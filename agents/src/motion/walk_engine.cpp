@@ -139,7 +139,6 @@ void WalkEngine::update(double dt, const WalkSensors& imu, std::vector<double>& 
   yaw_ = yaw;
   if (walking_) {
     phase_ += dt / p_.step_period;
-    // Positive roll leans to the right.
     const double lean_to_support = support_ == Leg::Left ? -imu.roll : imu.roll;
     if (phase_ >= 1.0 && !shifting_ && lean_to_support > p_.support_lean &&
         held_ < p_.max_support_hold) {

@@ -115,10 +115,9 @@ void walkPeriod(const world::World& world, agents::WalkEngine& engine, double dt
                 std::vector<double>& targets, std::span<float> position,
                 std::span<float> stiffness) {
   const auto& f = world.sensorFrame(0);
-  engine.update(
-      dt,
-      {Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[0], f.angles[1], f.angles[2]},
-      targets);
+  engine.update(dt,
+                {Vec3(f.gyroscope[0], f.gyroscope[1], f.gyroscope[2]), f.angles[0], f.angles[2]},
+                targets);
   bodyTargetsToCommand(*world.robot(0).model, targets, 1.0, position, stiffness);
 }
 

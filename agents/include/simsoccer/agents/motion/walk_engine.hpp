@@ -75,9 +75,9 @@ struct WalkParameters {
 
 // What the walk reads from the IMU each period.
 struct WalkSensors {
-  Vec3 gyro = Vec3::Zero();        // rad/s, torso frame
-  double roll = 0.0, pitch = 0.0;  // rad, the torso's attitude
-  double yaw = 0.0;                // rad
+  Vec3 gyro = Vec3::Zero();  // rad/s, torso frame
+  double roll = 0.0;         // rad, the torso's attitude (positive: leaning right)
+  double yaw = 0.0;          // rad
 };
 
 struct Pose2 {
