@@ -8,11 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <fstream>
 #include <map>
 #include <opencv2/videoio.hpp>
 #include <regex>
 #include <thread>
 
+#include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/world/match_log.hpp"
@@ -155,6 +157,49 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   const double expected = std::ceil(last * 25.0 - 1e-6);
   EXPECT_NEAR(video.get(cv::CAP_PROP_FRAME_COUNT), expected, 2.0);
   EXPECT_GT(std::filesystem::file_size(m.dir / "heatmap.png"), 1000u);
+}
+
+// A match's agents read the motions and gaits beside its config (a copied configs tree plays its
+// own gaits; before, every agent read the ones in its working directory or the source tree), or
+// the folder agents.motions names; a folder that is not there is refused, naming the key, and the
+// agent refuses a --motions folder that is not there.
+TEST(MatchConfig, TheAgentsGetTheMotionsFolderBesideTheMatchConfig) {
+  const auto configs = test::sourceDir() / "configs";
+  match::MatchConfig mc = match::loadMatchConfig(configs / "match_2v2.yaml");
+  EXPECT_TRUE(std::filesystem::equivalent(mc.agent_motions, configs / "motions"))
+      << mc.agent_motions;
+  mc.half_duration = 15;
+  const match::MatchSession session(mc, 1);
+  const auto command = match::agentCommand(session, match::RunOptions{}, 0, 1);
+  const auto at = std::find(command.begin(), command.end(), "--motions");
+  ASSERT_NE(at, command.end());
+  ASSERT_NE(at + 1, command.end());
+  EXPECT_EQ(*(at + 1), mc.agent_motions.string());
+
+  test::TempDir dir("agent_motions");
+  const std::string head =
+      "match: motions\nscenario: " + (configs / "scenarios/match_2v2.yaml").string() +
+      "\nrules: " + (configs / "rules/spl.yaml").string() + "\n";
+  std::ofstream(dir.path() / "named.yaml")
+      << head << "agents:\n  motions: " << (configs / "motions/booster_k1").string() << "\n";
+  EXPECT_EQ(match::loadMatchConfig(dir.path() / "named.yaml").agent_motions,
+            configs / "motions/booster_k1");
+  std::ofstream(dir.path() / "none.yaml") << head;  // no motions folder beside it
+  EXPECT_TRUE(match::loadMatchConfig(dir.path() / "none.yaml").agent_motions.empty());
+  std::ofstream(dir.path() / "bad.yaml") << head << "agents:\n  motions: nowhere\n";
+  try {
+    match::loadMatchConfig(dir.path() / "bad.yaml");
+    FAIL() << "a motions folder that is not there was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "agents.motions") << e.what();
+  }
+  int status = 0;
+  const std::string out =
+      test::runCommand(std::string(SIMSOCCER_AGENT_BIN) + " --team 0 --player 1 --motions " +
+                           (dir.path() / "nowhere").string() + " 2>&1",
+                       status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("--motions: no such folder"), std::string::npos) << out;
 }
 
 TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {

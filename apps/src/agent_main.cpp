@@ -29,25 +29,10 @@ int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
     const apps::Options opt(argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
-                            {"team",
-                             "player",
-                             "domain",
-                             "dds-config",
-                             "lease",
-                             "robot",
-                             "mode",
-                             "stall-after",
-                             "ticks",
-                             "claim-timeout",
-                             "vx",
-                             "vy",
-                             "turn",
-                             "role",
-                             "config",
-                             "field",
-                             "team-number",
-                             "seed",
-                             "game-state-wait",
+                            {"team",    "player", "domain",      "dds-config", "lease",
+                             "robot",   "mode",   "stall-after", "ticks",      "claim-timeout",
+                             "vx",      "vy",     "turn",        "role",       "config",
+                             "motions", "field",  "team-number", "seed",       "game-state-wait",
                              "if-owned"});
     if (opt.help(simsoccer::apps::kAgentHelp)) return 0;
     opt.noPositional();
@@ -74,6 +59,11 @@ int main(int argc, char** argv) {
     const long max_ticks = opt.wholeNumber("ticks", -1, -1, 2000000000);
 
     const robots::RobotModel model = robots::loadRobotModel(robot_file);
+    // The motions and gaits: a folder per robot model that has its own (motionsFolder).
+    const std::filesystem::path motions =
+        apps::findConfig(opt.get("motions", ""), "configs/motions");
+    if (!std::filesystem::is_directory(motions))
+      throw apps::UsageError("--motions: no such folder: " + motions.string());
 
     // Soccer (--role): behaviour and motion, loaded before claiming so a bad
     // file stops here.
@@ -96,12 +86,12 @@ int main(int argc, char** argv) {
           agents::loadBehaviourConfig(
               apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml")),
           fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml")),
-          agents::motionsFolder(apps::findConfig("", "configs/motions"), model), setup);
+          agents::motionsFolder(motions, model), setup);
     }
     const bool verbose = opt.flag("verbose");
     std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);
-    apps::SimpleModes simple(model, mode, opt.number("vx", 0.2), opt.number("vy", 0.0),
-                             opt.number("turn", 0.0));
+    apps::SimpleModes simple(model, agents::motionsFolder(motions, model), mode,
+                             opt.number("vx", 0.2), opt.number("vy", 0.0), opt.number("turn", 0.0));
     double last_time = 0.0;
 
     // Started by a match (which names itself): go when it goes, also when it

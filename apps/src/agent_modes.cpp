@@ -10,8 +10,8 @@
 
 namespace simsoccer::apps {
 
-SimpleModes::SimpleModes(const robots::RobotModel& model, std::string mode, double vx, double vy,
-                         double turn)
+SimpleModes::SimpleModes(const robots::RobotModel& model, const std::filesystem::path& motions,
+                         std::string mode, double vx, double vy, double turn)
     : model_(model),
       mode_(std::move(mode)),
       vx_(vx),
@@ -19,10 +19,7 @@ SimpleModes::SimpleModes(const robots::RobotModel& model, std::string mode, doub
       turn_(turn),
       position_(protocol::kActuators, 0.0f),
       stiffness_(protocol::kActuators, 1.0f),
-      // The robot's gait (configs/motions/NAME/gait.yaml where it has one).
-      walk_(
-          model,
-          agents::loadGaitIn(agents::motionsFolder(findConfig("", "configs/motions"), model)).walk),
+      walk_(model, agents::loadGaitIn(motions).walk),
       targets_(model.pose("stand")) {
   const auto& stand = model.pose("stand");
   for (size_t a = 0; a < model.actuators.size() && a < protocol::kActuators; ++a) {

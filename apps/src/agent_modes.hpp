@@ -13,9 +13,10 @@ namespace simsoccer::apps {
 
 class SimpleModes {
  public:
-  // mode: nod, walk, garbage or stall; (vx, vy, turn): the walk's velocity.
-  SimpleModes(const robots::RobotModel& model, std::string mode, double vx, double vy,
-              double turn);
+  // mode: nod, walk, garbage or stall; (vx, vy, turn): the walk's velocity; `motions`: the
+  // robot's motions folder (its gait.yaml, where it has one).
+  SimpleModes(const robots::RobotModel& model, const std::filesystem::path& motions,
+              std::string mode, double vx, double vy, double turn);
   // Answers one frame on `client` (garbage: an invalid command first).
   void answer(const simsoccer_msg_SensorFrame& frame, agents::AgentClient& client, int team,
               int player);

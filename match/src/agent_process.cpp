@@ -87,6 +87,7 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
   if (o.seed) a.insert(a.end(), {"--seed", std::to_string(*o.seed)});
   if (!o.robot.empty()) a.insert(a.end(), {"--robot", o.robot.string()});
   if (!o.config.empty()) a.insert(a.end(), {"--config", o.config.string()});
+  if (!o.motions.empty()) a.insert(a.end(), {"--motions", o.motions.string()});
   if (!o.dds_config.empty()) a.insert(a.end(), {"--dds-config", o.dds_config.string()});
   if (!o.get_up) a.push_back("--no-get-up");
   return a;

@@ -93,6 +93,7 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
     if (info.team == team && info.number == number) ao.robot = info.model->source_file;
   }
   ao.config = c.agent_config;
+  ao.motions = c.agent_motions;
   ao.team_number = c.team_numbers[static_cast<size_t>(team)];
   ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);
   ao.get_up = c.get_up;

@@ -75,16 +75,25 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
       root["teams"].fail("the two teams need different numbers");
   }
   if (auto a = root.optional("agents")) {
-    a->allowOnly({"config", "role", "get_up", "restart_limit"});
+    a->allowOnly({"config", "motions", "role", "get_up", "restart_limit"});
     if (a->has("config")) {
       c.agent_config = engine::resolveBeside(c.file, (*a)["config"].string());
       if (!std::filesystem::exists(c.agent_config))
         (*a)["config"].fail("no such file: " + c.agent_config.string());
     }
+    if (a->has("motions")) {
+      c.agent_motions = engine::resolveBeside(c.file, (*a)["motions"].string());
+      if (!std::filesystem::is_directory(c.agent_motions))
+        (*a)["motions"].fail("no such folder: " + c.agent_motions.string());
+    }
     if (a->has("role")) c.role = (*a)["role"].string();
     c.get_up = a->boolean("get_up", c.get_up);
     c.restart_limit = a->integer("restart_limit", c.restart_limit);
     if (c.restart_limit < 0) (*a)["restart_limit"].fail("must be >= 0");
+  }
+  if (c.agent_motions.empty()) {
+    const std::filesystem::path beside = engine::resolveBeside(c.file, "motions");
+    if (std::filesystem::is_directory(beside)) c.agent_motions = beside;
   }
   if (auto t = root.optional("team_messages")) {
     t->allowOnly({"delay", "loss"});

@@ -48,6 +48,7 @@ struct SoccerAgentOptions {
   std::filesystem::path field;
   std::filesystem::path robot;       // the robot model's file; empty: the agent's default (Nao)
   std::filesystem::path config;      // empty: the agent's default
+  std::filesystem::path motions;     // the motions and gaits folder; empty: the agent's default
   std::filesystem::path dds_config;  // Cyclone configuration; empty: the agent's default
   std::optional<int> team_number;    // GameController team number
   std::optional<uint64_t> seed;      // the agent's own random numbers

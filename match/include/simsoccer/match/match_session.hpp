@@ -57,6 +57,9 @@ struct LolaSettings {
 struct MatchConfig {
   std::string file, name;
   std::filesystem::path scenario, rules, agent_config;
+  // The agents' motions and gaits: agents.motions, else the folder `motions` beside the match's
+  // file where there is one (a copied configs tree plays its own gaits), else the agents' default.
+  std::filesystem::path agent_motions;
   std::optional<double> half_duration, half_time_break;
   std::array<int, 2> team_numbers{1, 2};
   std::string role = "auto";
