@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
         apps::findConfig(opt.get("motions", ""), "configs/motions");
     if (!std::filesystem::is_directory(motions))
       throw apps::UsageError("--motions: no such folder: " + motions.string());
+    const std::filesystem::path robot_motions = agents::motionsFolder(motions, model);
 
     // Soccer (--role): behaviour and motion, loaded before claiming so a bad
     // file stops here.
@@ -86,12 +87,12 @@ int main(int argc, char** argv) {
           agents::loadBehaviourConfig(
               apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml")),
           fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml")),
-          agents::motionsFolder(motions, model), setup);
+          robot_motions, setup);
     }
     const bool verbose = opt.flag("verbose");
     std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);
-    apps::SimpleModes simple(model, agents::motionsFolder(motions, model), mode,
-                             opt.number("vx", 0.2), opt.number("vy", 0.0), opt.number("turn", 0.0));
+    apps::SimpleModes simple(model, robot_motions, mode, opt.number("vx", 0.2),
+                             opt.number("vy", 0.0), opt.number("turn", 0.0));
     double last_time = 0.0;
 
     // Started by a match (which names itself): go when it goes, also when it
