@@ -130,6 +130,18 @@ TEST_F(ConfigErrors, UnknownFootLink) {
   expectError("robot.yaml", "legs.left", "unknown foot link 'LFot'");
 }
 
+TEST_F(ConfigErrors, FallenTorsoHeightMissing) {
+  replace(robot_, "fallen_torso_height: 0.22", "");
+  expectError("robot.yaml", "fallen_torso_height", "missing required key");
+}
+
+TEST_F(ConfigErrors, FallenTorsoHeightAboveTheStandingTorso) {
+  // A robot in its stand pose would count as fallen.
+  replace(robot_, "fallen_torso_height: 0.22", "fallen_torso_height: 0.4");
+  expectError("robot.yaml", "fallen_torso_height",
+              "must be below the torso's height in the stand pose");
+}
+
 TEST_F(ConfigErrors, BothLegsOnOneFoot) {
   replace(robot_, "legs: {left: LFoot, right: RFoot}", "legs: {left: LFoot, right: LFoot}");
   expectError("robot.yaml", "legs.right", "the right foot is the left foot's link");

@@ -138,7 +138,7 @@ TEST(MovedRobots, AStandingRobotIsSetDownAsItIsAndAFallenOneInTheStandPose) {
   for (size_t j = 0; j < joints.size(); ++j)
     EXPECT_NEAR(w.jointPosition(0, static_cast<int>(j)), q_before[j], 1e-6) << joints[j].name;
   // The fallen one: upright in the stand pose at its spot.
-  EXPECT_TRUE(w.isStanding(1, 0.22, world::World::kUprightForMoving));
+  EXPECT_TRUE(w.isStanding(1, world::World::kUprightForMoving));
   EXPECT_NEAR(w.torsoPose(1).translation().x(), -2.0, 1e-6);
   const std::vector<double>& stand = model.pose("stand");
   for (size_t j = 0; j < joints.size(); ++j)
@@ -153,4 +153,46 @@ TEST(MovedRobots, AStandingRobotIsSetDownAsItIsAndAFallenOneInTheStandPose) {
   std::printf("moved K1: tilt within %.4f rad of where it was set down over 2 s\n", rocked);
   EXPECT_LT(rocked, 0.02);
   EXPECT_TRUE(w.isStanding(0));
+}
+
+// Down is the robot's own: below its description's fallen_torso_height. A Booster K1
+// squatting on its feet, upright, as in a get-up (its torso about 0.30 m, standing 0.51) is
+// down; with the Nao's 0.22 m it counted as standing, and a referee carried it off in its
+// squat, where it toppled. Now it is set down in the stand pose.
+TEST(MovedRobots, ARobotSquattingBelowItsFallenHeightIsDownAndSetDownInTheStandPose) {
+  world::Scenario s = test::scenario(1);
+  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";
+  s.robot_model_file = test::sourceDir() / "robots" / "booster_k1.yaml";
+  world::World w(s);
+  const auto& model = *w.robot(0).model;
+  const auto& joints = model.body->joints;
+  EXPECT_DOUBLE_EQ(model.fallen_torso_height, 0.42);
+  EXPECT_DOUBLE_EQ(world::World(test::scenario(1)).robot(0).model->fallen_torso_height, 0.22);
+  // The squat of the K1's sit_down motion: hips -1.2, knees 1.8, ankles -0.8 rad.
+  std::vector<double> squat = model.pose("stand");
+  for (size_t j = 0; j < joints.size(); ++j) {
+    const std::string& name = joints[j].name;
+    if (name.find("HipPitch") != std::string::npos) squat[j] = -1.2;
+    if (name.find("KneePitch") != std::string::npos) squat[j] = 1.8;
+    if (name.find("AnklePitch") != std::string::npos) squat[j] = -0.8;
+  }
+  ASSERT_TRUE(w.isStanding(0));
+  for (int i = 0; i < 150; ++i) {
+    for (size_t j = 0; j < joints.size(); ++j)
+      if (joints[j].mimic_of < 0) w.setJointTarget(0, static_cast<int>(j), squat[j], 1.0);
+    w.step();
+  }
+  const engine::Pose squatting = w.torsoPose(0);
+  std::printf("K1 squatting: torso %.3f m high, tilted %.3f rad\n", squatting.translation().z(),
+              tiltOf(squatting));
+  ASSERT_LT(tiltOf(squatting), world::World::kUprightForMoving);  // upright, on its feet
+  ASSERT_GT(squatting.translation().z(), 0.22);  // above the Nao's height: "standing" before
+  EXPECT_LT(squatting.translation().z(), model.fallen_torso_height);
+  EXPECT_FALSE(w.isStanding(0));
+
+  w.moveRobot(0, 2.0, -1.0, 1.0);
+  EXPECT_TRUE(w.isStanding(0, world::World::kUprightForMoving));
+  const std::vector<double>& stand = model.pose("stand");
+  for (size_t j = 0; j < joints.size(); ++j)
+    EXPECT_NEAR(w.jointPosition(0, static_cast<int>(j)), stand[j], 1e-6) << joints[j].name;
 }

@@ -119,7 +119,8 @@ double RobotModel::soleDepth(const std::vector<double>& q) const {
 RobotModel loadRobotModel(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"robot", "material", "encoder", "imu", "sonar", "thermal", "motors", "links",
-                  "joints", "actuators", "absent_actuators", "hands", "sensors", "poses", "legs"});
+                  "joints", "actuators", "absent_actuators", "hands", "sensors", "poses", "legs",
+                  "fallen_torso_height"});
   RobotModel robot;
   robot.name = root["robot"].string();
   robot.source_file = file.string();
@@ -455,6 +456,15 @@ RobotModel loadRobotModel(const std::filesystem::path& file) {
       (*legs)["right"].fail("the right foot is the left foot's link");
   }
   robot.body = std::move(body);
+  // Below the standing torso: a robot in its stand pose must count as standing.
+  const ConfigNode fallen = root["fallen_torso_height"];
+  robot.fallen_torso_height = fallen.positive();
+  if (const auto stand = robot.poses.find("stand"); stand != robot.poses.end() && robot.hasLegs()) {
+    const double standing = robot.soleDepth(stand->second);
+    if (robot.fallen_torso_height >= standing)
+      fallen.fail("must be below the torso's height in the stand pose (" +
+                  engine::formatNumber(std::round(standing * 1000.0) / 1000.0) + " m)");
+  }
   return robot;
 }
 

@@ -296,7 +296,7 @@ void World::moveRobot(RobotId r, double x, double y, double yaw) {
     });
     on_both_feet = on_both_feet && down;
   }
-  if (!on_both_feet || !isStanding(r, 0.22, kUprightForMoving)) {
+  if (!on_both_feet || !isStanding(r, kUprightForMoving)) {
     placeRobot(r, x, y, yaw);
     return;
   }
@@ -314,7 +314,8 @@ void World::moveRobot(RobotId r, double x, double y, double yaw) {
   ++placements_.at(r);
 }
 
-bool World::isStanding(RobotId r, double min_height, double max_tilt) const {
+bool World::isStanding(RobotId r, double max_tilt) const {
+  const double min_height = robots_.at(r).model->fallen_torso_height;
   const Pose torso = torsoPose(r);
   const double up_z = torso.linear()(2, 2);
   return torso.translation().z() > min_height && up_z > std::cos(max_tilt);

@@ -78,6 +78,10 @@ struct RobotModel {
   // empty chains where the file names none.
   std::array<LegChain, 2> legs;
   bool hasLegs() const { return legs[0].foot_link >= 0; }
+  // Down (fallen) with the torso origin below this height above the ground (m): the
+  // file's `fallen_torso_height`, under the robot's own walk, crouch and block (a
+  // Nao's torso stands at about 0.29 m, a Booster K1's at 0.51).
+  double fallen_torso_height = 0.0;
 
   // Joint angles (one per body joint) of a named pose; throws if unknown.
   const std::vector<double>& pose(const std::string& pose_name) const;

@@ -104,8 +104,10 @@ class World {
   double jointPosition(RobotId r, int joint) const;
   engine::RigidBodyState ballState() const;
   void setBallState(const engine::RigidBodyState& state);
-  // Upright: torso origin above `min_height` and tilted less than `max_tilt`.
-  bool isStanding(RobotId r, double min_height = 0.22, double max_tilt = 0.785) const;
+  // Upright: torso origin above the robot's `fallen_torso_height` (its description's)
+  // and tilted less than `max_tilt` (rad from the vertical).
+  bool isStanding(RobotId r, double max_tilt = kFallenTilt) const;
+  static constexpr double kFallenTilt = 0.785;  // rad: 45 degrees
   // The last robot touching the ball (any link), if any has yet.
   const std::optional<BallTouch>& lastBallTouch() const { return last_touch_; }
   // Teleports a robot upright onto the carpet at (x, y, yaw) in a named pose,
@@ -117,8 +119,8 @@ class World {
   // As a referee moves a robot: lifted and set down at rest with its torso at (x, y) facing
   // `yaw`, as it was: the same joint angles, servo targets, height and tilt, only carried
   // and turned about the vertical. One that is not upright on both feet (tilted more than
-  // kUprightForMoving, or a foot off the carpet: mid-step, fallen) is set down in the stand
-  // pose instead (placeRobot).
+  // kUprightForMoving, below its fallen_torso_height, or a foot off the carpet: mid-step,
+  // fallen, squatting in a get-up) is set down in the stand pose instead (placeRobot).
   void moveRobot(RobotId r, double x, double y, double yaw);
   static constexpr double kUprightForMoving = 0.35;  // rad from the vertical
   // How often robot r has been placed or moved (placeRobot, moveRobot): a command computed
