@@ -273,8 +273,17 @@ TEST(Referee, FallenRobotIsPenalisedAsInactive) {
     if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
   run(w, ref, 9.0);
   EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
+  EXPECT_EQ(count(g, "inactive"), 0);
   run(w, ref, 3.0);
   EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
+  // The call is in the game's record, as every other penalty's reason.
+  ASSERT_EQ(count(g, "inactive"), 1);
+  for (const auto& e : g.events())
+    if (e.type == EventType::Inactive) {
+      EXPECT_EQ(e.team, 1);
+      EXPECT_EQ(e.player, 2);
+      EXPECT_NE(e.detail.find("down for 10 s"), std::string::npos) << e.detail;
+    }
 }
 
 namespace {

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <string>
+
+#include "simsoccer/engine/config.hpp"
 
 namespace simsoccer::referee {
 
@@ -497,6 +500,8 @@ void Referee::checkPenalties() {
     const bool standing = world_.isStanding(r);
     fallen_for_[r] = standing ? 0.0 : fallen_for_[r] + dt;
     if (fallen_for_[r] >= config_.inactive_time) {
+      game_.recordEvent(EventType::Inactive, info.team, info.number,
+                        "down for " + engine::formatNumber(config_.inactive_time) + " s");
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
       fallen_for_[r] = 0.0;
       continue;

@@ -81,7 +81,7 @@ enum class EventType : uint8_t {
   Placement,        // a robot was auto-placed at Set
   GoalDisallowed,   // the ball went in but the goal does not count
   IllegalPosition,  // a robot stood illegally at Set
-  Inactive,         // a robot stood idle next to the ball, or its get-ups failed
+  Inactive,         // a robot down too long, idle next to the ball, or its get-ups failed
   // An external GameController runs the game: what the automatic referee
   // would have called (detail: the call), reported only.
   Advisory,
