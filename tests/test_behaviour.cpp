@@ -475,49 +475,6 @@ TEST(SoccerBehaviour, DefendersKeepTheSidesOfTheirReadyPositions) {
                             2);
 }
 
-// The ball deeper than the defenders' line (defender_goal_distance from the goal line): the
-// line's clamp put both level with it, among the striker, the goalkeeper and the opponents
-// at the ball. They keep defender_ball_distance from it, apart from each other.
-TEST(SoccerBehaviour, DefendersKeepTheirDistanceFromABallDeeperThanTheirLine) {
-  const auto cfg = soccerConfig();
-  const auto f = field();
-  const auto game = gameState(3);
-  const std::vector<FieldPlayer> team{
-      {2, -3.0, -0.8}, {3, -3.0, 0.8}, {4, -3.6, 0.2}, {5, -0.5, -1.5}};
-  const double goal_line = -f.halfLength();
-  for (const Vec3& ball : {Vec3(goal_line + 0.5, 0.3, 0), Vec3(goal_line + 0.9, -1.0, 0)}) {
-    std::map<int, agents::Pose2> targets;
-    for (int number : {2, 3}) {
-      const FieldPlayer& me = team[static_cast<size_t>(number - 2)];
-      agents::SoccerBehaviour b(cfg, f, 0, 1, number, Role::Auto, 1);
-      for (const FieldPlayer& other : team)
-        if (other.number != number)
-          b.receive(mate(other.number, other.x, other.y,
-                         std::hypot(ball.x() - other.x, ball.y() - other.y) -
-                             (other.number == 4 ? 5.0 : 0.0)),
-                    0.0);
-      auto p = seeing(me.x, me.y, 0.0, ball.x(), ball.y(), 0.01);
-      agents::SoccerBehaviour::Input in{.time = 0.01, .perception = &p, .game = &game};
-      updateSeeing(b, in);
-      ASSERT_EQ(b.role(), Role::Defender) << "player " << number;
-      targets[number] = b.target();
-    }
-    for (const auto& [number, t] : targets) {
-      const double d = std::hypot(t.x - ball.x(), t.y - ball.y());
-      std::printf("ball (%.2f, %.2f): defender %d at (%.2f, %.2f), %.2f m from it\n", ball.x(),
-                  ball.y(), number, t.x, t.y, d);
-      EXPECT_GE(d, cfg.defender_ball_distance - 1e-6) << number;
-      EXPECT_GE(t.x, goal_line + cfg.defender_goal_distance - 1e-6) << number;
-    }
-    const double apart = std::hypot(targets[3].x - targets[2].x, targets[3].y - targets[2].y);
-    EXPECT_GT(apart, 0.5 * cfg.defender_spacing);
-    if (std::abs(ball.y()) < 0.5) {  // in front of the goal: 3 on its left (+y), 2 on its right
-      EXPECT_GT(targets[3].y, ball.y());
-      EXPECT_LT(targets[2].y, ball.y());
-    }
-  }
-}
-
 TEST(SoccerBehaviour, ObeysTheGameState) {
   const auto cfg = soccerConfig();
   const auto f = field();

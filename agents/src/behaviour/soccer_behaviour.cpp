@@ -138,7 +138,6 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "obstacle_memory",
                   "defender_spacing",
                   "defender_goal_distance",
-                  "defender_ball_distance",
                   "supporter_deepest",
                   "sit_when_finished"});
   BehaviourConfig c;
@@ -168,7 +167,6 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.obstacle_memory = root.number("obstacle_memory", c.obstacle_memory);
   c.defender_spacing = root.number("defender_spacing", c.defender_spacing);
   c.defender_goal_distance = root.number("defender_goal_distance", c.defender_goal_distance);
-  c.defender_ball_distance = root.number("defender_ball_distance", c.defender_ball_distance);
   c.supporter_deepest = root.number("supporter_deepest", c.supporter_deepest);
   if (root.has("supporter_deepest") && !(c.supporter_deepest >= -1.0 && c.supporter_deepest <= 1.0))
     root["supporter_deepest"].fail("must be a share of the half-length, from -1 to 1");
@@ -184,7 +182,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
     (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
         .fail("avoid_far must be greater than avoid_near");
   for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory",
-                        "defender_spacing", "defender_goal_distance", "defender_ball_distance"})
+                        "defender_spacing", "defender_goal_distance"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
 }
@@ -763,19 +761,7 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       t.x += -std::sin(bearing) * across * config_.defender_spacing;
       t.y += std::cos(bearing) * across * config_.defender_spacing;
       t.x = std::clamp(t.x, deepest, 0.0);
-      const double room = field_.halfWidth() - 0.4;
-      t.y = std::clamp(t.y, -room, room);
-      // Not in the crowd at the ball: with the ball deeper than the defenders' line, the
-      // clamp above put them level with it, beside the striker, the goalkeeper and the
-      // opponents there. Out sideways instead, the left one (+y: the left of the line from
-      // the goal to the ball) to the ball's left, the right one to its right.
-      const double keep = config_.defender_ball_distance, dx = t.x - ball_.x;
-      if (std::hypot(dx, t.y - ball_.y) < keep) {
-        double side = across != 0.0 ? (across > 0.0 ? 1.0 : -1.0) : (t.y >= ball_.y ? 1.0 : -1.0);
-        const double out = std::sqrt(keep * keep - dx * dx);
-        if (std::abs(ball_.y + side * out) > room) side = -side;  // no room at the touchline
-        t.y = std::clamp(ball_.y + side * out, -room, room);
-      }
+      t.y = std::clamp(t.y, -field_.halfWidth() + 0.4, field_.halfWidth() - 0.4);
       r = walkTo(t, true);
       break;
     }

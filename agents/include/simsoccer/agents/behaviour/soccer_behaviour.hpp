@@ -105,9 +105,6 @@ struct BehaviourConfig {
   double defender_spacing = 1.2;  // m
   // Defenders stand no nearer their goal line than this (the goalkeeper stands at keeper_line).
   double defender_goal_distance = 0.8;  // m
-  // Defenders stand no nearer the ball than this: with the ball deeper than their line they
-  // step out sideways (level with it, they stood in the striker's and the keeper's crowd).
-  double defender_ball_distance = 0.8;  // m
   // The supporter stands 1.2 m behind and beside the ball, but not deeper than this (own
   // frame x, a share of the half-length): with the ball near the own goal, behind it was
   // among the defenders and the goalkeeper, and the robots there walked into each other.
