@@ -18,6 +18,14 @@ double tiltOf(const engine::Pose& torso) {
   return std::acos(std::clamp(torso.linear()(2, 2), -1.0, 1.0));
 }
 
+// `robots` Booster K1s on the HSL M-Field.
+world::Scenario k1Scenario(int robots) {
+  world::Scenario s = test::scenario(robots);
+  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";
+  s.robot_model_file = test::sourceDir() / "robots" / "booster_k1.yaml";
+  return s;
+}
+
 }  // namespace
 
 struct StandCase {
@@ -95,10 +103,7 @@ INSTANTIATE_TEST_SUITE_P(Robots, LimpModels,
 // Booster K1 held in its gait's bent stance got one period of the old targets against the
 // new pose and tipped over (shoot-out keepers on their line, robots sent off).
 TEST(MovedRobots, AStandingRobotIsSetDownAsItIsAndAFallenOneInTheStandPose) {
-  world::Scenario s = test::scenario(2);
-  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";
-  s.robot_model_file = test::sourceDir() / "robots" / "booster_k1.yaml";
-  world::World w(s);
+  world::World w(k1Scenario(2));
   const auto& model = *w.robot(0).model;
   const auto& joints = model.body->joints;
   // Robot 0 in a deeper stance than the stand pose (knees 0.2 rad more bent), on its feet.
@@ -156,14 +161,11 @@ TEST(MovedRobots, AStandingRobotIsSetDownAsItIsAndAFallenOneInTheStandPose) {
 }
 
 // Down is the robot's own: below its description's fallen_torso_height. A Booster K1
-// squatting on its feet, upright, as in a get-up (its torso about 0.30 m, standing 0.51) is
-// down; with the Nao's 0.22 m it counted as standing, and a referee carried it off in its
-// squat, where it toppled. Now it is set down in the stand pose.
+// squatting on its feet, upright, as in a get-up or its sit_down crouch (its torso 0.30-0.39 m,
+// standing 0.51) is down; with the Nao's 0.22 m it counted as standing, and a referee carried it
+// off in its squat, where it toppled. Now it is set down in the stand pose.
 TEST(MovedRobots, ARobotSquattingBelowItsFallenHeightIsDownAndSetDownInTheStandPose) {
-  world::Scenario s = test::scenario(1);
-  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";
-  s.robot_model_file = test::sourceDir() / "robots" / "booster_k1.yaml";
-  world::World w(s);
+  world::World w(k1Scenario(1));
   const auto& model = *w.robot(0).model;
   const auto& joints = model.body->joints;
   EXPECT_DOUBLE_EQ(model.fallen_torso_height, 0.42);
