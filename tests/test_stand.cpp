@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "simsoccer/robots/robot_model.hpp"
 #include "simsoccer/world/world.hpp"
 #include "test_support.hpp"
 
@@ -169,7 +170,7 @@ TEST(MovedRobots, ARobotSquattingBelowItsFallenHeightIsDownAndSetDownInTheStandP
   const auto& model = *w.robot(0).model;
   const auto& joints = model.body->joints;
   EXPECT_DOUBLE_EQ(model.fallen_torso_height, 0.42);
-  EXPECT_DOUBLE_EQ(world::World(test::scenario(1)).robot(0).model->fallen_torso_height, 0.22);
+  EXPECT_DOUBLE_EQ(robots::loadRobotModel(test::naoH25()).fallen_torso_height, 0.22);
   // The squat of the K1's sit_down motion: hips -1.2, knees 1.8, ankles -0.8 rad.
   std::vector<double> squat = model.pose("stand");
   for (size_t j = 0; j < joints.size(); ++j) {

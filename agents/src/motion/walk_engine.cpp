@@ -130,13 +130,12 @@ void WalkEngine::easeIn(const std::vector<double>& from, double t, std::vector<d
 
 void WalkEngine::update(double dt, const WalkSensors& imu, std::vector<double>& targets) {
   gyro_filtered_ += p_.gyro_smoothing * (imu.gyro - gyro_filtered_);
-  const double yaw = imu.yaw;
   if (!yaw_known_) {
-    yaw_offset_ = yaw - body_.yaw;
+    yaw_offset_ = imu.yaw - body_.yaw;
     intended_yaw_ = body_.yaw;
     yaw_known_ = true;
   }
-  yaw_ = yaw;
+  yaw_ = imu.yaw;
   if (walking_) {
     phase_ += dt / p_.step_period;
     const double lean_to_support = support_ == Leg::Left ? -imu.roll : imu.roll;
