@@ -43,12 +43,14 @@ agents::PerceptionIn seeing(double x, double y, double yaw, double bx, double by
   return p;
 }
 
-// A behaviour takes a sighting of the ball once the next one agrees with it (a false ball lasts
-// one frame): a test's first sighting is given twice, 0.01 s apart.
+// A behaviour takes a sighting of a new ball once ball_new_sightings in a row agree (a false
+// ball lasts one frame): a test's first sighting is given that often, 0.01 s apart.
 MotionRequest updateSeeing(agents::SoccerBehaviour& b, agents::SoccerBehaviour::Input in) {
   const double t = in.time;
-  in.time = t - 0.01;
-  b.update(in);
+  for (int i = b.config().ball_new_sightings - 1; i > 0; --i) {
+    in.time = t - 0.01 * i;
+    b.update(in);
+  }
   in.time = t;
   return b.update(in);
 }
@@ -201,6 +203,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("avoid_ball: -1"), "avoid_ball");
   EXPECT_EQ(refusedAt("ball_velocity_window: 0.01"), "ball_velocity_window");
   EXPECT_EQ(refusedAt("ball_outlier_distance: 0"), "ball_outlier_distance");
+  EXPECT_EQ(refusedAt("ball_new_sightings: 1"), "ball_new_sightings");  // a false ball taken
+  EXPECT_EQ(refusedAt("ball_new_sightings: 2.5"), "ball_new_sightings");
   EXPECT_EQ(refusedAt("obstacle_memory: -1"), "obstacle_memory");
   EXPECT_EQ(refusedAt("defender_goal_distance: -0.5"), "defender_goal_distance");
   EXPECT_EQ(refusedAt("supporter_deepest: -1.5"), "supporter_deepest");  // behind the goal line
@@ -709,7 +713,8 @@ TEST(SoccerBehaviour, RobotsOutOfViewAreRememberedWhereTheyWereSeen) {
 
 // A false ball (the realistic profile's: one frame, somewhere ahead) is not taken for the ball,
 // nor kept as the last sighting once out of view: the robot would walk after it, and it stays
-// ahead of a robot walking after it. A ball seen twice in a row elsewhere is the ball moved.
+// ahead of a robot walking after it. Nor are two in a row. A ball seen ball_new_sightings
+// times in a row elsewhere is the ball moved.
 TEST(SoccerBehaviour, AFalseBallSeenForOneFrameIsNotChased) {
   const auto cfg = soccerConfig();
   const auto f = field();
@@ -742,11 +747,28 @@ TEST(SoccerBehaviour, AFalseBallSeenForOneFrameIsNotChased) {
     update(ghost, t);
   }
   EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
-  // The ball seen twice in a row at (0, 1): moved while unseen, taken.
-  for (int i = 0; i < 2; ++i) {
+  // Two false balls in a row, 0.08 s apart and 0.4 m from each other (a K1 goalkeeper took
+  // such a pair for a ball beside its post and walked into the post after it): not taken.
+  t += 0.01;
+  update(seeing(-2.0, 0.0, 0.0, -1.3, -0.2, t), t);
+  t += 0.08;
+  auto second = seeing(-2.0, 0.0, 0.0, -1.0, 0.05, t);
+  update(second, t);
+  second.ball.in_view = false;
+  for (int i = 0; i < 50; ++i) {
+    t += 0.01;
+    update(second, t);
+  }
+  EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
+  // The ball seen ball_new_sightings times in a row at (0, 1): moved while unseen, taken; one
+  // sighting fewer is not enough.
+  for (int i = 0; i < cfg.ball_new_sightings - 1; ++i) {
     t += 0.01;
     update(seeing(-2.0, 0.0, 0.0, 0.0, 1.0, t), t);
   }
+  EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
+  t += 0.01;
+  update(seeing(-2.0, 0.0, 0.0, 0.0, 1.0, t), t);
   EXPECT_GT(b.target().y, 0.5) << b.status();
 }
 

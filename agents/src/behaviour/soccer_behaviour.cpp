@@ -124,6 +124,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "keep_clear",
                   "ball_velocity_window",
                   "ball_outlier_distance",
+                  "ball_new_sightings",
                   "message_interval",
                   "keeper_line",
                   "shootout_keeper_line",
@@ -152,6 +153,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   c.team_ball_time = root.number("team_ball_time", c.team_ball_time);
   c.ball_velocity_window = root.number("ball_velocity_window", c.ball_velocity_window);
   c.ball_outlier_distance = root.number("ball_outlier_distance", c.ball_outlier_distance);
+  c.ball_new_sightings = root.integer("ball_new_sightings", c.ball_new_sightings);
+  if (root.has("ball_new_sightings") && c.ball_new_sightings < 2)
+    root["ball_new_sightings"].fail("must be >= 2 (one sighting alone may be a false ball)");
   c.keep_clear = root.number("keep_clear", c.keep_clear);
   c.message_interval = root.number("message_interval", c.message_interval);
   c.keeper_line = root.number("keeper_line", c.keeper_line);
@@ -339,20 +343,24 @@ void SoccerBehaviour::updateBall(const Input& in) {
     if (p.ball.in_view) {
       // Cameras see false balls now and then (a white robot part, a line crossing: the
       // realistic profile's false_ball_rate), each for one frame, somewhere ahead. A sighting
-      // is the ball when it agrees with the ball known (or the one before it: the ball found
-      // again elsewhere, or moved while unseen); alone it is not. Taken, a false ball 0.5-3.5 m
-      // ahead stayed ahead as the robot walked after it (the last sighting, relative, is also
-      // the memory below): K1s walked into their own goal after a ball 9 m away.
+      // is the ball when it agrees with the ball known, or ends a run of ball_new_sightings
+      // that agree one with the next (the ball found again elsewhere, or moved while unseen).
+      // Taken, a false ball 0.5-3.5 m ahead stays ahead as the robot walks after it (the last
+      // sighting, relative, is also the memory below): K1s walked into their own goal after a
+      // ball 9 m away. Two false balls in a row were enough: a K1 goalkeeper took two 0.08 s
+      // apart for a ball beside its post and walked into the post after it.
       const Vec2 seen{p.ball.x, p.ball.y};
       const Vec2 b = fromRobot(seen);
       // Two sightings of one ball differ by the range noise (5 % each) and, against the
       // estimate in the own frame, by the self-pose's: a margin growing with the distance.
       const double margin = config_.ball_outlier_distance + 0.15 * std::hypot(seen.x, seen.y);
       const bool known = in.time - ball_known_at_ < config_.ball_lost_time;
-      const bool agrees =
-          (known && std::hypot(b.x - ball_.x, b.y - ball_.y) < margin) ||
-          (in.time - sighting_at_ < 0.1 &&
-           std::hypot(seen.x - sighting_robot_.x, seen.y - sighting_robot_.y) < margin);
+      const bool follows =
+          in.time - sighting_at_ < 0.1 &&
+          std::hypot(seen.x - sighting_robot_.x, seen.y - sighting_robot_.y) < margin;
+      sightings_in_row_ = follows ? sightings_in_row_ + 1 : 1;
+      const bool agrees = (known && std::hypot(b.x - ball_.x, b.y - ball_.y) < margin) ||
+                          sightings_in_row_ >= config_.ball_new_sightings;
       sighting_robot_ = seen;
       sighting_at_ = in.time;
       if (agrees) {

@@ -68,6 +68,10 @@ struct BehaviourConfig {
   // shot: two sightings a few periods apart read that noise as m/s).
   double ball_velocity_window = 0.3;   // s
   double ball_outlier_distance = 0.3;  // m off the fitted line: left out (a false ball)
+  // Sightings in a row (each within 0.1 s and the margin of the one before) that take a ball
+  // found away from the one known: false balls come one frame at a time, the ball in view
+  // nearly every frame.
+  int ball_new_sightings = 3;
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
@@ -160,6 +164,7 @@ class SoccerBehaviour {
   bool takeMotionRestart();
 
   Role role() const { return role_; }  // the role in force (never Auto)
+  const BehaviourConfig& config() const { return config_; }
   // Where the last update walked to or aimed at, in the own team's frame (own goal at -x).
   Pose2 target() const { return target_; }
   std::string status() const;          // one line: role, game state, ball, target
@@ -234,10 +239,11 @@ class SoccerBehaviour {
   bool self_known_ = false;
   Vec2 ball_, ball_robot_;  // own frame; robot frame (the last own sighting taken)
   double ball_seen_at_ = -1e9, ball_known_at_ = -1e9;
-  // The last sighting at all, taken or not (robot frame): a sighting far from the ball is
-  // taken once the next one agrees with it.
+  // The last sighting at all, taken or not (robot frame), and how many in a row agreed with
+  // the one before: a sighting far from the ball is taken once ball_new_sightings agree.
   Vec2 sighting_robot_;
   double sighting_at_ = -1e9;
+  int sightings_in_row_ = 0;
   Vec2 ball_velocity_;
   struct Sighting {
     double time;
