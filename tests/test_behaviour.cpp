@@ -321,6 +321,34 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
   EXPECT_GT(t.y, 0.6);
 }
 
+// On its line the goalkeeper steps sideways to its place, facing the field, across its whole
+// goal; it used to turn towards any place more than 0.5 m away and walk there, its back to the
+// ball, and a K1 fell sideways turning back and forth. Off its line it turns and walks.
+TEST(SoccerBehaviour, TheGoalkeeperStepsSidewaysAlongItsLine) {
+  const auto cfg = soccerConfig();
+  const auto f =
+      field();  // SPL: the goal 1.5 m wide, the keeper's places within 0.6 m of its middle
+  const auto game = gameState(3);
+  const double line = -f.halfLength() + cfg.keeper_line;
+  const auto walk = [&](double x, double y, double ball_y) {
+    agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
+    auto p = seeing(x, y, 0.0, -1.0, ball_y, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    const MotionRequest r = updateSeeing(keeper, in);
+    EXPECT_EQ(keeper.role(), Role::Goalkeeper);
+    return std::pair{r, keeper.target()};
+  };
+  // From one post to the other's place: 1.2 m to its left.
+  auto [r, t] = walk(line, -0.6, 3.0);
+  EXPECT_NEAR(t.y, 0.6, 1e-6);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
+  EXPECT_NEAR(r.left, cfg.max_side, 1e-6);
+  EXPECT_NEAR(r.turn, 0.0, 1e-6);
+  // 2 m in front of its line (back from clearing the ball): it turns to walk back.
+  std::tie(r, t) = walk(line + 2.0, 0.0, 0.0);
+  EXPECT_NEAR(std::abs(r.turn), cfg.max_turn, 1e-6);
+}
+
 TEST(SoccerBehaviour, TwoRobotsClaimingTheStrikerRoleSettleOnTheSameOne) {
   const auto cfg = soccerConfig();
   const auto f = field();

@@ -501,7 +501,7 @@ std::optional<std::vector<uint8_t>> SoccerBehaviour::outgoing(const Input& in) {
   return encodeTeamMessage(d);
 }
 
-MotionRequest SoccerBehaviour::walkTo(const Pose2& target, bool face_ball) {
+MotionRequest SoccerBehaviour::walkTo(const Pose2& target, bool face_ball, double turn_beyond) {
   target_ = target;
   MotionRequest r;
   r.kind = MotionRequest::Kind::Walk;
@@ -509,7 +509,7 @@ MotionRequest SoccerBehaviour::walkTo(const Pose2& target, bool face_ball) {
   const double dist = std::hypot(rel.x, rel.y);
   double heading = target.yaw;
   if (face_ball) heading = std::atan2(ball_.y - self_.y, ball_.x - self_.x);
-  if (dist > 0.5) {
+  if (dist > turn_beyond) {
     // Far: turn towards the target and walk, forward speed falling off with the angle.
     const double bearing = std::atan2(rel.y, rel.x);
     r.turn = std::clamp(1.2 * bearing, -config_.max_turn, config_.max_turn);
@@ -674,7 +674,12 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   if (!shootout && ((area && to_ball < 1.0) || inOwnGoalArea(ball_)) &&
       std::hypot(ball_velocity_.x, ball_velocity_.y) < 0.3)
     return striker(0.0, false);
-  return walkTo({line, y, 0.0}, false);
+  // On its line, within its goal's width, the keeper steps sideways facing the field, as keepers
+  // do: turning to walk there and back turned it away from the ball and, with a crossing point
+  // that moved as the ball's velocity was refitted, had it turn back and forth (a K1 fell
+  // sideways so). Off its line (back from clearing the ball) it turns and walks.
+  const bool on_line = std::abs(self_.x - line) < 0.5;
+  return walkTo({line, y, 0.0}, false, on_line ? field_.goal.inner_width : 0.5);
 }
 
 bool SoccerBehaviour::inOwnGoalArea(const Vec2& p) const {

@@ -200,7 +200,9 @@ class SoccerBehaviour {
   // When and where the ball, rolling towards the own goal (-x) faster than
   // `speed` m/s, crosses the line at own-frame x; nothing if it does not.
   std::optional<Crossing> ballCrossing(double x, double speed) const;
-  MotionRequest walkTo(const Pose2& target, bool face_ball);
+  // Beyond turn_beyond (m) the robot turns towards the target and walks; nearer it steps there
+  // as it faces (target.yaw, or the ball).
+  MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = 0.5);
   void avoidRobots(MotionRequest& r) const;
   // The head's angles into r; `planned` is the walk before avoidRobots.
   void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
