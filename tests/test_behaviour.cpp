@@ -326,8 +326,8 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
 // ball, and a K1 fell sideways turning back and forth. Off its line it turns and walks.
 TEST(SoccerBehaviour, TheGoalkeeperStepsSidewaysAlongItsLine) {
   const auto cfg = soccerConfig();
-  const auto f =
-      field();  // SPL: the goal 1.5 m wide, the keeper's places within 0.6 m of its middle
+  // SPL: the goal 1.5 m wide, the keeper's places within 0.6 m of its middle.
+  const auto f = field();
   const auto game = gameState(3);
   const double line = -f.halfLength() + cfg.keeper_line;
   const auto walk = [&](double x, double y, double ball_y) {
@@ -764,29 +764,26 @@ TEST(SoccerBehaviour, AFalseBallSeenForOneFrameIsNotChased) {
   unseen.ball.in_view = false;
   unseen.ball.last_seen = 0.09f;
   update(unseen, t);
-  // One frame: a false ball 1.5 m ahead, at (-0.5, 0.2); then none, the perception's memory
-  // holding the false ball (its last sighting).
-  t += 0.01;
-  auto ghost = seeing(-2.0, 0.0, 0.0, -0.5, 0.2, t);
-  update(ghost, t);
-  ghost.ball.in_view = false;
-  for (int i = 0; i < 50; ++i) {
-    t += 0.01;
+  // A false ball at field (bx, by), `after` s from the last update, for one frame; then none
+  // for 0.5 s, the perception's memory holding it (its last sighting).
+  const auto falseBall = [&](double after, double bx, double by) {
+    t += after;
+    auto ghost = seeing(-2.0, 0.0, 0.0, bx, by, t);
     update(ghost, t);
-  }
+    ghost.ball.in_view = false;
+    for (int i = 0; i < 50; ++i) {
+      t += 0.01;
+      update(ghost, t);
+    }
+  };
+  // One, 1.5 m ahead at (-0.5, 0.2).
+  falseBall(0.01, -0.5, 0.2);
   EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
-  // Two false balls in a row, 0.08 s apart and 0.4 m from each other (a K1 goalkeeper took
-  // such a pair for a ball beside its post and walked into the post after it): not taken.
+  // Two in a row, 0.08 s apart and 0.4 m from each other (a K1 goalkeeper took such a pair for
+  // a ball beside its post and walked into the post after it): not taken.
   t += 0.01;
   update(seeing(-2.0, 0.0, 0.0, -1.3, -0.2, t), t);
-  t += 0.08;
-  auto second = seeing(-2.0, 0.0, 0.0, -1.0, 0.05, t);
-  update(second, t);
-  second.ball.in_view = false;
-  for (int i = 0; i < 50; ++i) {
-    t += 0.01;
-    update(second, t);
-  }
+  falseBall(0.08, -1.0, 0.05);
   EXPECT_NEAR(b.target().x, target_x, 0.05) << b.status();
   // The ball seen ball_new_sightings times in a row at (0, 1): moved while unseen, taken; one
   // sighting fewer is not enough.
