@@ -209,6 +209,10 @@ TEST(BenchMotionApp, TheBoosterK1WalksHalfAMetrePerSecondKicksFourMetresAndGetsU
   EXPECT_EQ(rows.at("kick_distance")[6], "0");
   EXPECT_EQ(rows.at("get_up_front")[3], "1.000");
   EXPECT_EQ(rows.at("get_up_back")[3], "1.000");
+  // Seated, its torso (0.385 m) is below its fallen height (0.42 m) but it is on its feet: the
+  // trial judges that by contacts and tilt, not by the referee's height (it read 0.000 so).
+  EXPECT_EQ(rows.at("sit_and_stand")[3], "1.000");
+  EXPECT_EQ(rows.at("sit_and_stand")[6], "0");
   // A robot without a motion bench is named.
   int status = 0;
   const std::string out =
