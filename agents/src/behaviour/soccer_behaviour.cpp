@@ -679,7 +679,7 @@ MotionRequest SoccerBehaviour::goalkeeper(bool shootout) {
   // that moved as the ball's velocity was refitted, had it turn back and forth (a K1 fell
   // sideways so). Off its line (back from clearing the ball) it turns and walks.
   const bool on_line = std::abs(self_.x - line) < 0.5;
-  return walkTo({line, y, 0.0}, false, on_line ? field_.goal.inner_width : 0.5);
+  return walkTo({line, y, 0.0}, false, on_line ? field_.goal.inner_width : kTurnToWalkBeyond);
 }
 
 bool SoccerBehaviour::inOwnGoalArea(const Vec2& p) const {

@@ -33,11 +33,12 @@ SitResult sitTrial(const TrialContext& c, uint64_t seed) {
     motion.update(dt, agents::motionSensors(world.sensorFrame(0)), request, p, k);
     return true;
   });
-  const robots::RobotModel& model = *w.robot(0).model;
+  const world::RobotInfo& robot = w.robot(0);
+  const robots::RobotModel& model = *robot.model;
   const auto onItsFeet = [&] {
     if (w.torsoPose(0).linear()(2, 2) < std::cos(world::World::kFallenTilt)) return false;
     for (const engine::LinkContact& k : w.contacts())
-      if (k.articulation == 0 && !k.with_articulation && k.other_body < 0 &&
+      if (k.articulation == robot.body && !k.with_articulation && k.other_body < 0 &&
           k.link != model.legs[0].foot_link && k.link != model.legs[1].foot_link)
         return false;  // a knee, a hand or the seat on the carpet
     return true;

@@ -202,7 +202,8 @@ class SoccerBehaviour {
   std::optional<Crossing> ballCrossing(double x, double speed) const;
   // Beyond turn_beyond (m) the robot turns towards the target and walks; nearer it steps there
   // as it faces (target.yaw, or the ball).
-  MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = 0.5);
+  static constexpr double kTurnToWalkBeyond = 0.5;  // m
+  MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = kTurnToWalkBeyond);
   void avoidRobots(MotionRequest& r) const;
   // The head's angles into r; `planned` is the walk before avoidRobots.
   void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
