@@ -227,6 +227,41 @@ TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
   EXPECT_EQ(withoutWallTimes(one), withoutWallTimes(two));
 }
 
+// Two runs side by side, neither given a domain: each claims a free one on
+// this host (net/domain_claim.hpp), so neither's agents hear the other's
+// frames, and both play the game one plays alone. (On one domain a second
+// game of match_k1_5v5.yaml seed 1 missed 3 commands and went elsewhere.)
+TEST(MatchApp, TwoRunsSideBySideWithoutADomainEachFindTheirOwn) {
+  test::TempDir a_dir("match_side_a"), b_dir("match_side_b");
+  std::string a_out, b_out;
+  int a_status = -1, b_status = -1;
+  const auto run = [](const test::TempDir& dir, std::string& out, int& status) {
+    out = test::runCommand(
+        kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+            " --half 15 --no-video --lockstep-timeout 5 --out " + dir.path().string(),
+        status);
+  };
+  std::thread a([&] { run(a_dir, a_out, a_status); });
+  run(b_dir, b_out, b_status);
+  a.join();
+  ASSERT_EQ(a_status, 0) << a_out;
+  ASSERT_EQ(b_status, 0) << b_out;
+  const std::regex domain_re("DDS domain ([0-9]+),");
+  std::smatch da, db;
+  ASSERT_TRUE(std::regex_search(a_out, da, domain_re)) << a_out;
+  ASSERT_TRUE(std::regex_search(b_out, db, domain_re)) << b_out;
+  EXPECT_NE(da[1].str(), db[1].str());
+  const std::string one = test::readFile(a_dir / "summary.json"),
+                    two = test::readFile(b_dir / "summary.json");
+  for (const std::string* s : {&one, &two}) {
+    const std::regex missed("\"missed_commands\": ([0-9]+)");
+    for (auto m = std::sregex_iterator(s->begin(), s->end(), missed); m != std::sregex_iterator();
+         ++m)
+      EXPECT_EQ((*m)[1].str(), "0") << "an agent missed lockstep periods";
+  }
+  EXPECT_EQ(jsonValue(one, "final_state_hash"), jsonValue(two, "final_state_hash"));
+}
+
 TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
   const ShortMatch m = shortMatch("match_c", 138, "--no-video");
   ASSERT_EQ(m.status, 0) << m.out;

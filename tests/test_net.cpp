@@ -22,6 +22,7 @@
 #include "agent_process.hpp"
 #include "gc_reader.hpp"
 #include "simsoccer/agents/agent_client.hpp"
+#include "simsoccer/net/domain_claim.hpp"
 #include "simsoccer/net/robot_keys.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/sim/run_loop.hpp"
@@ -1149,4 +1150,57 @@ TEST(NetApps, TheAgentProgramLinksNoPhysicsRendererWorldOrReferee) {
   for (const char* part : {"simsoccer::world::", "simsoccer::referee::", "simsoccer::sim::",
                            "simsoccer::engine::PhysicsWorld"})
     EXPECT_EQ(symbols.find(part), std::string::npos) << part;
+}
+
+// One simulator per DDS domain on a host (net/domain_claim.hpp): a second
+// claim of a held domain is refused, naming the holder; the Booster SDK's
+// topics are claimed apart; the claim goes with its holder.
+TEST(DomainClaim, ADomainIsClaimedOncePerHostAndFreedWithItsHolder) {
+  {
+    net::DomainClaim held = net::DomainClaim::claim(231);
+    EXPECT_EQ(held.domain(), 231u);
+    try {
+      (void)net::DomainClaim::claim(231);
+      ADD_FAILURE() << "a held domain was claimed again";
+    } catch (const net::DomainInUse& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("DDS domain 231 is in use on this host"), std::string::npos) << what;
+      EXPECT_NE(what.find("pid " + std::to_string(::getpid())), std::string::npos) << what;
+      EXPECT_NE(what.find("--domain"), std::string::npos) << what;
+    }
+    // The Booster SDK's topics share no name with simsoccer's.
+    const net::DomainClaim booster = net::DomainClaim::claim(231, net::DomainTopics::Booster);
+    EXPECT_THROW((void)net::DomainClaim::claim(231, net::DomainTopics::Booster), net::DomainInUse);
+    // Moved, it is still held.
+    const net::DomainClaim moved = std::move(held);
+    EXPECT_THROW((void)net::DomainClaim::claim(231), net::DomainInUse);
+  }
+  EXPECT_EQ(net::DomainClaim::claim(231).domain(), 231u);
+}
+
+TEST(DomainClaim, FirstFreeSkipsHeldDomains) {
+  const net::DomainClaim a = net::DomainClaim::claim(229);
+  const net::DomainClaim b = net::DomainClaim::firstFree(229, 230);
+  EXPECT_EQ(b.domain(), 230u);
+  EXPECT_THROW((void)net::DomainClaim::firstFree(229, 230), net::DomainInUse);
+}
+
+// The programs refuse a held --domain before anything runs, naming it and its
+// holder.
+TEST(NetApps, TheProgramsRefuseAHeldDomain) {
+  const net::DomainClaim held = net::DomainClaim::claim(232);
+  const std::string scenario =
+      (test::sourceDir() / "configs" / "scenarios" / "lineup_5v5.yaml").string();
+  int status = -1;
+  const std::string out = test::runCommand(
+      std::string(SIMSOCCER_BIN) + " serve " + scenario + " --domain 232 --seconds 1", status);
+  EXPECT_EQ(WEXITSTATUS(status), 1) << out;
+  EXPECT_NE(out.find("simsoccer's DDS domain 232 is in use on this host by pid " +
+                     std::to_string(::getpid())),
+            std::string::npos)
+      << out;
+  const std::string bench = test::runCommand(
+      std::string(SIMSOCCER_BIN) + " bench net --robots 1 --seconds 0.2 --domain 232", status);
+  EXPECT_EQ(WEXITSTATUS(status), 1) << bench;
+  EXPECT_NE(bench.find("DDS domain 232 is in use"), std::string::npos) << bench;
 }

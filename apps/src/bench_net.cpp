@@ -10,6 +10,7 @@
 
 #include "bench_scene.hpp"
 #include "cli.hpp"
+#include "domain_option.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/net/sim_server.hpp"
 #include "simsoccer/sim/run_loop.hpp"
@@ -31,7 +32,7 @@ const char* kBenchNetHelp =
     "simulator's and the agents' CPU time minus the CPU time of the world stepped alone: it\n"
     "does not grow when processes wait for a core), the bytes and packets per tick on the\n"
     "loopback interface, commands missed, and the real-time factor with and without the\n"
-    "network.\n";
+    "network. --domain D: the DDS domain (default the first free one on this host from 42).\n";
 
 using Clock = std::chrono::steady_clock;
 
@@ -48,7 +49,8 @@ int benchNet(int argc, char** argv, int first) {
   const double sim_seconds = opt.positive("seconds", 10.0);
   if (!(sim_seconds > 0)) throw UsageError("--seconds must be > 0");
   net::DomainConfig dds;
-  dds.domain = opt.domain("domain", 42);
+  const net::DomainClaim claim = claimDomain(opt, 42, DomainDefault::FirstFree);
+  dds.domain = claim.domain();
   dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   const std::string csv = opt.get("csv", "");
   const auto agent = agentProgram();

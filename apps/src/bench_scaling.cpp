@@ -9,6 +9,7 @@
 
 #include "bench_motion/trial.hpp"
 #include "cli.hpp"
+#include "domain_option.hpp"
 #include "help_texts.hpp"
 #include "scaling_plot.hpp"
 #include "scaling_row.hpp"
@@ -60,7 +61,8 @@ int benchScaling(int argc, char** argv, int first) {
   if (robot.dt != 0.0 && robot.dt != 0.005 && robot.dt != 0.01)
     throw UsageError("--dt: 0.005 or 0.01 (a whole part of the 10 ms control period)");
   robot.joint_sweeps = opt.wholeNumber("joint-sweeps", 0, 1, 16);
-  const auto domain = opt.domain("domain", 43);
+  const net::DomainClaim claim = claimDomain(opt, 43, DomainDefault::FirstFree);
+  const uint32_t domain = claim.domain();
   const std::filesystem::path png = opt.get("png", "scaling.png");
   std::printf(
       "simsoccer bench scaling: %s, full pipeline (physics, sensors, perception, DDS lockstep "

@@ -92,6 +92,8 @@ std::unique_ptr<BoosterRobots> openBoosterRobots(const Options& opt, const world
     booster::BoosterRobot b;
     b.robot = robots[i];
     b.domain = base + static_cast<uint32_t>(i);
+    if (!netns)
+      out->domains.push_back(net::DomainClaim::claim(b.domain, net::DomainTopics::Booster));
     // The robot's own walk for the locomotion service's Walking and Soccer modes, where
     // simsoccer has motions for its model (configs/motions/booster_k1).
     const std::filesystem::path motions =

@@ -13,6 +13,7 @@
 #include "cli.hpp"
 #include "simsoccer/booster/endpoint.hpp"
 #include "simsoccer/lola/field_network.hpp"
+#include "simsoccer/net/domain_claim.hpp"
 #include "simsoccer/sim/simulation.hpp"
 
 namespace simsoccer::apps {
@@ -32,6 +33,9 @@ lola::FieldNetwork boosterFieldNetwork();
 // bridge, loopback inside) where its domain shows as domain 0; removed when
 // this goes. Prints where each robot is served.
 struct BoosterRobots {
+  // The Booster SDK domains served here, claimed on this host (none in namespaces: each
+  // namespace's domain 0 is its own); released after the endpoint.
+  std::vector<net::DomainClaim> domains;
   std::unique_ptr<lola::FieldBridge> bridge;
   std::vector<std::unique_ptr<lola::RobotNamespace>> namespaces;
   std::unique_ptr<booster::Endpoint> endpoint;

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "domain_option.hpp"
 #include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "simsoccer/match/match_runner.hpp"
@@ -21,7 +22,6 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
   o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : timestampedRunDir("");
   o.seed = opt.seed("seed", c.seed);
-  o.domain = opt.domain("domain", 0);
   o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   if (!std::filesystem::is_regular_file(o.dds_config))
     throw UsageError(opt.has("dds-config")
@@ -85,12 +85,18 @@ int match(int argc, char** argv, int first) {
   RunOptions o = runOptions(opt, config);
   o.realtime = opt.flag("realtime") || config.external_gc_port.has_value();
   o.external = opt.flag("external-agents");
+  const uint32_t secure_max = net::CredentialsOptions{}.domain_max;
+  if (opt.has("secure") && opt.domain("domain", 0) > secure_max)
+    throw UsageError("--secure: the credentials cover DDS domains 0 to " +
+                     std::to_string(secure_max) + ", not " +
+                     std::to_string(opt.domain("domain", 0)));
+  // Agents started elsewhere are told the domain; this run's own find theirs.
+  const net::DomainClaim domain =
+      claimDomain(opt, 0, o.external ? DomainDefault::Fixed : DomainDefault::FirstFree,
+                  opt.has("secure") ? secure_max : 232);
+  o.domain = domain.domain();
   if (opt.has("secure")) {
     o.secure = opt.get("secure", "");
-    if (o.domain > net::CredentialsOptions{}.domain_max)
-      throw UsageError("--secure: the credentials cover DDS domains 0 to " +
-                       std::to_string(net::CredentialsOptions{}.domain_max) + ", not " +
-                       std::to_string(o.domain));
     for (const std::string& id : net::credentialIdentities())
       if (!std::filesystem::is_regular_file(net::credentialConfig(o.secure, id)))
         throw UsageError("--secure " + o.secure.string() + ": no " + id + ".xml" +
@@ -108,10 +114,11 @@ int match(int argc, char** argv, int first) {
   match::prepareOut(o.out);
 
   MatchSession session(config, o.seed);
-  std::printf("simsoccer match %s: %zu robots, seed %llu, %s, %s periods, output %s\n",
-              config.name.c_str(), session.world().robotCount(),
-              static_cast<unsigned long long>(o.seed), o.realtime ? "real time" : "lockstep",
-              sim::modeName(o.mode), o.out.string().c_str());
+  std::printf(
+      "simsoccer match %s: %zu robots, seed %llu, %s, %s periods, DDS domain %u, output %s\n",
+      config.name.c_str(), session.world().robotCount(), static_cast<unsigned long long>(o.seed),
+      o.realtime ? "real time" : "lockstep", sim::modeName(o.mode), o.domain,
+      o.out.string().c_str());
   std::fflush(stdout);
   const match::RunResult r = match::playMatch(session, o);
   if (tty) std::printf("\n");
@@ -150,7 +157,9 @@ int penalty(int argc, char** argv, int first) {
   const int kicks = opt.wholeNumber("kicks", config.penalty_kicks, 1, 100000);
   if (kicks < 1) throw UsageError("--kicks must be >= 1");
   const int video_kicks = opt.wholeNumber("video-kicks", 3, 0, 100000);
-  const RunOptions o = runOptions(opt, config);
+  RunOptions o = runOptions(opt, config);
+  const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::FirstFree);
+  o.domain = domain.domain();
   const match::PenaltyResult r = match::playPenalties(
       config, o, kicks, video_kicks, [](int kick, uint64_t seed, const std::string& outcome) {
         std::printf("  kick %2d (seed %llu): %s\n", kick, static_cast<unsigned long long>(seed),

@@ -7,6 +7,7 @@
 
 #include "booster_robots.hpp"
 #include "cli.hpp"
+#include "domain_option.hpp"
 #include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "serve_report.hpp"
@@ -42,7 +43,9 @@ int serve(int argc, char** argv, int first) {
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;
-  cfg.dds.domain = opt.domain("domain", 0);
+  // Agents started elsewhere are told the domain: it is what it says or refused.
+  const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::Fixed);
+  cfg.dds.domain = domain.domain();
   cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   std::optional<uint16_t> external_gc;
   if (opt.has("external-gc")) {

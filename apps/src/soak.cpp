@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "domain_option.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -21,7 +22,8 @@ const char* kSoakHelp =
     "agents.restart_limit times) and freezes --stops of them (default 2, SIGSTOP, SIGCONT\n"
     "after --stop-seconds, default 3). It samples the resident memory, file descriptors and\n"
     "threads of the simulator and its agents every 0.25 s and prints one row per game.\n"
-    "Game K plays seed+K-1 into DIR/game_K/ (default runs/soak-<date-time>/).\n"
+    "Game K plays seed+K-1 into DIR/game_K/ (default runs/soak-<date-time>/), on DDS domain\n"
+    "D (default the first free one on this host from 0).\n"
     "\n"
     "Checks, exit status 1 if one fails: every game finished with a complete summary.json,\n"
     "every kill was restarted, the simulator's peak memory grew < 5 % from the first game to\n"
@@ -47,16 +49,17 @@ int soak(int argc, char** argv, int first) {
   o.stop_seconds = opt.positive("stop-seconds", 3.0);
   o.seed = opt.seed("seed", config.seed);
   o.run.out = opt.get("out", timestampedRunDir("soak-").string());
-  o.run.domain = opt.domain("domain", 0);
+  const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::FirstFree);
+  o.run.domain = domain.domain();
   o.run.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   o.run.stop_requested = [] { return stopSignalled(); };
   stopOnSignals();
   match::prepareOut(o.run.out);
   std::printf(
       "simsoccer soak %s: %d games, %d kills and %d stops of %.1f s each per game, "
-      "output %s\n",
+      "DDS domain %u, output %s\n",
       config.name.c_str(), o.games, o.kills_per_game, o.stops_per_game, o.stop_seconds,
-      o.run.out.string().c_str());
+      o.run.domain, o.run.out.string().c_str());
   std::fflush(stdout);
   const match::SoakResult r = match::runSoak(config, o, [](const match::SoakGame& g) {
     std::printf(
