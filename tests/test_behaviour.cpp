@@ -4,6 +4,7 @@
 // motion controller's fall detector; the match log format.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -454,7 +455,8 @@ static void expectDefendersSideBySide(const std::vector<FieldPlayer>& team, int 
   const auto cfg = soccerConfig();
   const auto f = field();
   const auto game = gameState(3);
-  for (const Vec3& ball : {Vec3(1.0, 1.0, 0), Vec3(-2.0, 2.5, 0), Vec3(-3.0, -1.5, 0)}) {
+  // (Deeper than x = -2.9 the defenders stand wide: DefendersStandWideOfADeepBall.)
+  for (const Vec3& ball : {Vec3(1.0, 1.0, 0), Vec3(-2.0, 2.5, 0), Vec3(-2.6, -1.5, 0)}) {
     std::map<int, agents::Pose2> targets;
     for (const FieldPlayer& me : team) {
       if (me.number != left_number && me.number != right_number) continue;
@@ -505,6 +507,50 @@ TEST(SoccerBehaviour, DefendersKeepTheSidesOfTheirReadyPositions) {
   // two crossed and met head-on after every kick-off.
   expectDefendersSideBySide({{2, -3.0, -0.8}, {3, -3.0, 0.8}, {4, 0.5, 1.0}, {5, -0.5, -1.5}}, 4, 3,
                             2);
+}
+
+// A ball nearer the goal line than the defenders may stand in front of it (their place
+// defender_goal_distance from the line and 0.8 m in front of the ball) is the goalkeeper's and
+// the waiting striker's: the defenders stand on both sides of the goal area, avoid_near beside
+// it, the left one on the left, until the ball is 0.3 m further out again. Across the ball-goal
+// line they stood among the robots round the ball (K1 5 v 5: 42 of 70 falls came with the ball
+// within 2 m of a goal line).
+TEST(SoccerBehaviour, DefendersStandWideOfADeepBall) {
+  const auto cfg = soccerConfig();
+  const auto f = field();  // SPL: goal area 0.6 m deep, 2.2 m wide
+  const auto game = gameState(3);
+  const double deepest = -f.halfLength() + cfg.defender_goal_distance;
+  const double wide = 0.5 * f.goal_area->width + cfg.avoid_near;
+  // 2 strikes, 3 (left at kick-off) and 5 defend, 4 supports.
+  const std::vector<FieldPlayer> team{
+      {2, -3.6, 0.0}, {3, -3.2, 0.6}, {4, -1.0, -1.5}, {5, -3.2, -0.6}};
+  for (const auto& [number, y] : {std::pair{3, wide}, std::pair{5, -wide}}) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, number, Role::Auto, 1);
+    const auto at = [&](double ball_x, double ball_y, double time) {
+      for (const FieldPlayer& other : team)
+        if (other.number != number)
+          b.receive(mate(other.number, other.x, other.y,
+                         std::hypot(ball_x - other.x, ball_y - other.y) -
+                             (other.number == 2 ? 5.0 : 0.0)),
+                    time);
+      const FieldPlayer& me = *std::find_if(
+          team.begin(), team.end(), [&](const FieldPlayer& p) { return p.number == number; });
+      auto p = seeing(me.x, me.y, 0.0, ball_x, ball_y, time);
+      agents::SoccerBehaviour::Input in{.time = time, .perception = &p, .game = &game};
+      updateSeeing(b, in);
+      EXPECT_EQ(b.role(), Role::Defender) << "player " << number;
+      return b.target();
+    };
+    // In the goal area, and just deeper than the defenders' place allows: wide.
+    for (const double bx : {-4.2, deepest + 0.75}) {
+      const agents::Pose2 t = at(bx, 0.3, bx == -4.2 ? 0.1 : 0.2);
+      EXPECT_NEAR(t.x, deepest, 1e-6) << "player " << number << ", ball x " << bx;
+      EXPECT_NEAR(t.y, y, 1e-6) << "player " << number << ", ball x " << bx;
+    }
+    // Out again by less than 0.3 m: still wide; further: across the line to the goal.
+    EXPECT_NEAR(at(deepest + 1.0, 0.3, 0.3).y, y, 1e-6) << "player " << number;
+    EXPECT_LT(std::abs(at(deepest + 1.2, 0.3, 0.4).y), wide - 0.3) << "player " << number;
+  }
 }
 
 TEST(SoccerBehaviour, ObeysTheGameState) {

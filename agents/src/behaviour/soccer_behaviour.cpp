@@ -770,6 +770,23 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       // Side by side across the ball-goal line, the first from the left (+y).
       const double across = 0.5 * static_cast<double>(defenders_ - 1) -
                             static_cast<double>(std::min(defender_slot_, defenders_ - 1));
+      // A ball nearer the goal line than they can stand in front of is the goalkeeper's and the
+      // striker's (who waits in front of the goal area): the defenders stand beside the goal
+      // area, wide of the lane the attackers come up. Across the ball-goal line they stood in
+      // it, next to the waiting striker: in K1 5 v 5 games 42 of 70 falls came with the ball
+      // within 2 m of a goal line, most with 3-6 robots round it.
+      if (ball_.x < deepest + 0.8)
+        defenders_wide_ = true;
+      else if (ball_.x > deepest + 1.1)
+        defenders_wide_ = false;
+      if (defenders_wide_) {
+        const double lane =
+            field_.goal_area ? 0.5 * field_.goal_area->width : 0.5 * field_.goal.inner_width;
+        const double side =
+            across > 0.0 ? 1.0 : (across < 0.0 ? -1.0 : (ball_.y >= 0 ? -1.0 : 1.0));
+        r = walkTo({deepest, side * (lane + config_.avoid_near), 0.0}, true);
+        break;
+      }
       const double bearing = std::atan2(ball_.y - own_goal.y, ball_.x - own_goal.x);
       t.x += -std::sin(bearing) * across * config_.defender_spacing;
       t.y += std::cos(bearing) * across * config_.defender_spacing;

@@ -221,6 +221,8 @@ class SoccerBehaviour {
   size_t defender_slot_ = 0, defenders_ = 1;
   // As a supporter: the side of the ball it keeps (+1 left, -1 right, own frame; 0: not one).
   double supporter_side_ = 0.0;
+  // A ball too deep for the defenders to stand between it and their goal: they stand wide.
+  bool defenders_wide_ = false;
   // Game.
   bool have_game_ = false;
   int state_ = 3;  // gc::State numbering; Playing without a GameState
