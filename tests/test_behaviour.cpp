@@ -524,7 +524,10 @@ TEST(SoccerBehaviour, DefendersStandWideOfADeepBall) {
   // 2 strikes, 3 (left at kick-off) and 5 defend, 4 supports.
   const std::vector<FieldPlayer> team{
       {2, -3.6, 0.0}, {3, -3.2, 0.6}, {4, -1.0, -1.5}, {5, -3.2, -0.6}};
-  for (const auto& [number, y] : {std::pair{3, wide}, std::pair{5, -wide}}) {
+  // (Plain names, not a structured binding: clang before 16 cannot capture one in a lambda.)
+  for (const std::pair<int, double>& defender : {std::pair{3, wide}, std::pair{5, -wide}}) {
+    const int number = defender.first;
+    const double y = defender.second;
     agents::SoccerBehaviour b(cfg, f, 0, 1, number, Role::Auto, 1);
     const auto at = [&](double ball_x, double ball_y, double time) {
       for (const FieldPlayer& other : team)

@@ -766,7 +766,8 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       Pose2 t{own_goal.x + 0.45 * (ball_.x - own_goal.x),
               own_goal.y + 0.45 * (ball_.y - own_goal.y), 0.0};
       const double deepest = std::min(-field_.halfLength() + config_.defender_goal_distance, 0.0);
-      t.x = std::clamp(std::min(t.x, ball_.x - 0.8), deepest, 0.0);
+      constexpr double kBehindBall = 0.8;  // m, along the field, at least
+      t.x = std::clamp(std::min(t.x, ball_.x - kBehindBall), deepest, 0.0);
       // Side by side across the ball-goal line, the first from the left (+y).
       const double across = 0.5 * static_cast<double>(defenders_ - 1) -
                             static_cast<double>(std::min(defender_slot_, defenders_ - 1));
@@ -775,9 +776,10 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       // area, wide of the lane the attackers come up. Across the ball-goal line they stood in
       // it, next to the waiting striker: in K1 5 v 5 games 42 of 70 falls came with the ball
       // within 2 m of a goal line, most with 3-6 robots round it.
-      if (ball_.x < deepest + 0.8)
+      constexpr double kBackInFront = 0.3;  // m further out before they stand in front again
+      if (ball_.x < deepest + kBehindBall)
         defenders_wide_ = true;
-      else if (ball_.x > deepest + 1.1)
+      else if (ball_.x > deepest + kBehindBall + kBackInFront)
         defenders_wide_ = false;
       if (defenders_wide_) {
         const double lane =
