@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 
+#include "simsoccer/agents/behaviour/kick_approach.hpp"
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
@@ -625,6 +626,114 @@ TEST(SoccerBehaviour, TheStrikerKicksWhenTheBallIsInFrontOfAFootAndAimedAtTheGoa
   EXPECT_LT(r.turn, 0.0);
   // Head: towards the ball it sees.
   EXPECT_NEAR(r.head_yaw, std::atan2(0.05, 0.17), 0.01);
+}
+
+// The ball is lined up against the feet, not the torso: with the torso swayed 5 cm right of
+// its feet, a ball seen 5 cm left of the torso lies between the feet (no kick: it steps
+// sideways to bring a foot behind it), one seen 10 cm left lies in front of the left foot.
+TEST(SoccerBehaviour, TheStrikerLinesTheBallUpAgainstTheFeetNotTheSwayingTorso) {
+  const auto cfg = soccerConfig();  // kick_ball: 0.17 m ahead, 0.05 m beside the feet's middle
+  const auto f = field();
+  agents::SoccerBehaviour::Input in;
+  in.time = 0.1;
+  in.feet = {0.0, 0.05};
+  agents::SoccerBehaviour between(cfg, f, 0, 1, 2, Role::Striker, 1);
+  auto p = seeing(2.0, -0.05, 0.0, 2.17, 0.0, 0.1);
+  in.perception = &p;
+  MotionRequest r = updateSeeing(between, in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
+  EXPECT_GT(std::abs(r.left), 0.04);  // a whole foot's offset to go
+  agents::SoccerBehaviour in_front(cfg, f, 0, 1, 2, Role::Striker, 1);
+  p = seeing(2.0, -0.1, 0.0, 2.17, 0.0, 0.1);
+  r = updateSeeing(in_front, in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Kick);
+  EXPECT_EQ(r.kick_foot, agents::Leg::Left);
+}
+
+// The kicking foot changes only once the ball is half the foot's offset past the middle: the
+// torso's sway moves a ball near the middle back and forth, and a foot that changed as the ball
+// crossed it had the robot step left and right under the ball without kicking.
+TEST(SoccerBehaviour, TheKickingFootChangesOnlyOnceTheBallIsWellOverToTheOtherSide) {
+  const auto cfg = soccerConfig();  // kick_ball 0.05 m sideways: the foot changes beyond 0.025
+  agents::Leg foot = agents::Leg::Right;
+  const auto lineUp = [&](double ball_y) {
+    return agents::lineUpForKick(cfg, 0.17, ball_y, 0.0, 0.15, foot);
+  };
+  EXPECT_GT(lineUp(0.02).left, 0.04);  // the right foot kept: the ball 0.07 m left of it
+  EXPECT_EQ(foot, agents::Leg::Right);
+  lineUp(-0.02);
+  EXPECT_EQ(foot, agents::Leg::Right);
+  const MotionRequest kick = lineUp(0.03);  // the left foot now, the ball 2 cm inside it
+  EXPECT_EQ(foot, agents::Leg::Left);
+  EXPECT_EQ(kick.kind, MotionRequest::Kind::Kick);
+  EXPECT_EQ(kick.kick_foot, agents::Leg::Left);
+  lineUp(0.0);
+  lineUp(-0.02);
+  EXPECT_EQ(foot, agents::Leg::Left);
+  lineUp(-0.03);
+  EXPECT_EQ(foot, agents::Leg::Right);
+}
+
+// Near the goal line in front of the goal the striker aims into the middle of the angle the
+// posts leave open (a ball's width inside each), not at the goal's middle, which lies almost
+// along the line from there. The ball 0.15 m before the line, 0.5 m left of the middle, on the
+// SPL field (posts 1.5 m apart, a 0.1 m ball): the open angle's middle is -0.328 rad, the
+// goal's middle -1.279. The striker facing -0.328 with the ball before its left foot kicks.
+TEST(SoccerBehaviour, NearTheGoalLineTheStrikerAimsIntoTheOpenAngle) {
+  const auto cfg = soccerConfig();
+  const auto f = field();
+  const double bx = 4.35, by = 0.5, inside = 0.75 - 0.1;
+  const double aim = 0.5 * (std::atan2(inside - by, 4.5 - bx) + std::atan2(-inside - by, 4.5 - bx));
+  EXPECT_NEAR(aim, -0.328, 0.001);
+  const double c = std::cos(aim), s = std::sin(aim);
+  const double x = bx - (c * 0.17 - s * 0.05), y = by - (s * 0.17 + c * 0.05);
+  agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+  agents::SoccerBehaviour::Input in;
+  in.time = 0.1;
+  auto p = seeing(x, y, aim, bx, by, 0.1);
+  in.perception = &p;
+  const MotionRequest r = updateSeeing(b, in);
+  EXPECT_EQ(r.kind, MotionRequest::Kind::Kick);
+  EXPECT_EQ(r.kick_foot, agents::Leg::Left);
+}
+
+// The feet's midpoint the motion reads from its encoders and IMU angles is where the feet stand
+// under the torso (in the perception's robot frame: below the torso, along its heading), within
+// 2 mm, while the torso sways centimetres over them stepping sideways (a Nao and a K1).
+TEST(MotionController, TheFeetCentreIsWhereTheFeetStandWhileTheTorsoSways) {
+  for (const auto& file : {test::naoH25(), test::boosterK1()}) {
+    SCOPED_TRACE(file.filename().string());
+    world::Scenario s = test::scenario(1);
+    s.robot_model_file = file;
+    world::World w(s);
+    const robots::RobotModel& model = *w.robot(0).model;
+    agents::MotionController mc = agents::loadMotionController(
+        model, agents::motionsFolder(test::sourceDir() / "configs/motions", model),
+        agents::FallDetectorParameters{});
+    std::vector<float> position(model.actuators.size()), stiffness(model.actuators.size());
+    MotionRequest walk;
+    walk.kind = MotionRequest::Kind::Walk;
+    walk.left = 0.05;
+    double worst = 0.0, lowest = 1.0, highest = -1.0;
+    for (int i = 0; i < 400; ++i) {
+      const Eigen::Vector2d read = mc.feetCentre(agents::motionSensors(w.sensorFrame(0)));
+      const engine::Pose torso = w.torsoPose(0);
+      const Vec3 middle = 0.5 * (w.linkPose(0, model.legs[0].foot_link).translation() +
+                                 w.linkPose(0, model.legs[1].foot_link).translation());
+      const double yaw = std::atan2(torso.linear()(1, 0), torso.linear()(0, 0));
+      const Eigen::Vector2d truth =
+          Eigen::Rotation2Dd(-yaw) * (middle - torso.translation()).head<2>();
+      if (i >= 100) {  // walking
+        worst = std::max(worst, (read - truth).norm());
+        lowest = std::min(lowest, truth.y());
+        highest = std::max(highest, truth.y());
+      }
+      controlPeriod(w, mc, walk, position, stiffness);
+    }
+    EXPECT_TRUE(w.isStanding(0));
+    EXPECT_LT(worst, 0.002);            // 0.4 mm on the Nao, 0.1 mm on the K1
+    EXPECT_GT(highest - lowest, 0.02);  // the sway the torso frame reads: 3.9 and 8.3 cm
+  }
 }
 
 // The goalkeeper against a ball rolled at it (perceived every 0.1 s, its

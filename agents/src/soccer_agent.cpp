@@ -47,6 +47,8 @@ std::optional<std::vector<uint8_t>> SoccerAgent::step(
   in.perception = perception;
   in.game = game;
   in.motion = motion_.state();
+  const Eigen::Vector2d feet = motion_.feetCentre(sensors);
+  in.feet = {feet.x(), feet.y()};
   const MotionRequest request = behaviour_.update(in);
   if (behaviour_.takeMotionRestart()) motion_.restart();
   auto message = behaviour_.outgoing(in);

@@ -423,7 +423,8 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
       r.approach->start(time_, yaw);
       if (r.target_dir && time_ - r.target_at < 1.0) r.approach->aimAt(*r.target_dir, r.target_yaw);
     }
-    request = r.approach->update(time_, r.ball, yaw, r.motion->state());
+    request = r.approach->update(time_, r.ball, yaw, r.motion->state(),
+                                 r.motion->feetCentre(agents::motionSensors(frame)));
   } else {
     if (r.loco.takeShoot()) {
       // Shoot: one kick where it stands, with the foot on the side of a

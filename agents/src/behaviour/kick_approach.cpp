@@ -17,7 +17,12 @@ double wrap(double a) {
 
 MotionRequest lineUpForKick(const BehaviourConfig& c, double ball_x, double ball_y, double aim,
                             double max_forward, Leg& foot) {
-  if (std::abs(ball_y) > 0.02 || foot == Leg::Right) foot = ball_y >= 0 ? Leg::Left : Leg::Right;
+  // The foot changes only once the ball is half a foot's offset past the
+  // middle: switching as it crossed the middle, a K1 whose torso sways 2-3 cm
+  // a step stepped left and right under the ball for 20 s without kicking.
+  const double keep = 0.5 * c.kick_ball_y;
+  if (foot == Leg::Left && ball_y < -keep) foot = Leg::Right;
+  if (foot == Leg::Right && ball_y > keep) foot = Leg::Left;
   const double foot_y = foot == Leg::Left ? c.kick_ball_y : -c.kick_ball_y;
   const double ex = ball_x - c.kick_ball_x, ey = ball_y - foot_y;
   MotionRequest r;
@@ -51,7 +56,7 @@ void KickApproach::aimAt(double direction, double yaw) {
 }
 
 MotionRequest KickApproach::update(double time, const BallSighting& ball, double yaw,
-                                   MotionState motion) {
+                                   MotionState motion, const Eigen::Vector2d& feet) {
   const bool down = motion == MotionState::Falling || motion == MotionState::Lying ||
                     motion == MotionState::GettingUp || motion == MotionState::Diving;
   if (motion == MotionState::Kicking || down) commit_until_ = -1.0;
@@ -108,7 +113,7 @@ MotionRequest KickApproach::update(double time, const BallSighting& ball, double
       r.turn = std::clamp(1.2 * aim, -config_.max_turn, config_.max_turn);
     }
   } else {
-    r = lineUpForKick(config_, ball.x, ball.y, aim, 0.15, foot_);
+    r = lineUpForKick(config_, ball.x - feet.x(), ball.y - feet.y(), aim, 0.15, foot_);
     if (r.kind == MotionRequest::Kind::Kick) commit_until_ = time + 1.5;
   }
   lookAt(ball.x, ball.y, r);

@@ -105,6 +105,21 @@ std::optional<Eigen::Vector3d> LegKinematics::footAgainst(
                          std::atan2(rel.linear()(1, 0), rel.linear()(0, 0)));
 }
 
+Eigen::Vector2d LegKinematics::feetCentre(const std::vector<double>& body_angles, double roll,
+                                          double pitch) const {
+  Vec3 sum = Vec3::Zero();
+  for (const Leg leg : {Leg::Left, Leg::Right}) {
+    LegAngles q{};
+    for (size_t i = 0; i < q.size(); ++i)
+      q[i] = body_angles.at(static_cast<size_t>(joints(leg)[i]));
+    sum += forward(leg, q).translation();
+  }
+  // Levelled: the torso's attitude is yaw * pitch * roll (the IMU's angles, z-y-x).
+  const Vec3 level = Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
+                     Eigen::AngleAxisd(roll, Vec3::UnitX()) * (0.5 * sum);
+  return {level.x(), level.y()};
+}
+
 Pose LegKinematics::forward(Leg leg, const LegAngles& q) const {
   const Chain& c = legs_[static_cast<size_t>(leg)];
   Pose t = Pose::Identity();

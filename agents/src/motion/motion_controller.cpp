@@ -153,6 +153,12 @@ void measuredJointAngles(const robots::RobotModel& model, std::span<const float>
   model.body->applyMimic(q);
 }
 
+Eigen::Vector2d MotionController::feetCentre(const MotionSensors& sensors) const {
+  std::vector<double> measured;
+  measuredJointAngles(model_, sensors.position, measured);
+  return walk_.kinematics().feetCentre(measured, sensors.roll, sensors.pitch);
+}
+
 void MotionController::update(double dt, const MotionSensors& sensors, const MotionRequest& request,
                               std::span<float> position, std::span<float> stiffness) {
   // The direction of "up" in the torso frame from the accelerometer, low-passed

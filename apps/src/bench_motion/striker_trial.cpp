@@ -35,10 +35,16 @@ StrikerResult strikerTrial(const TrialContext& c, uint64_t seed, double limit) {
   const double dt = w.scenario().physics.control_period;
   for (int i = 0; i < static_cast<int>(limit / dt); ++i) {
     t.period();
-    if (c.verbose && (i % 100 == 0 || (i < 150 && i % 10 == 0)))
-      std::fprintf(stderr, "t %5.2f %-10s tilt %.2f %s\n", i * dt,
-                   agents::motionStateName(t.agents->motion(0).state()), t.agents->motion(0).tilt(),
+    if (c.verbose && (i % 100 == 0 || (i < 150 && i % 10 == 0))) {
+      // The true torso pose and ball beside what the striker believes.
+      const world::Pose torso = w.torsoPose(0);
+      const world::Vec3 ball = w.ballState().pose.translation();
+      std::fprintf(stderr, "t %5.2f %-10s tilt %.2f true (%.2f %.2f %.2f) ball (%.2f %.2f) %s\n",
+                   i * dt, agents::motionStateName(t.agents->motion(0).state()),
+                   t.agents->motion(0).tilt(), torso.translation().x(), torso.translation().y(),
+                   std::atan2(torso.linear()(1, 0), torso.linear()(0, 0)), ball.x(), ball.y(),
                    t.agents->behaviour(0).status().c_str());
+    }
     if (goalScored(w) == 1) {
       r.scored = true;
       r.seconds = (i + 1) * dt;

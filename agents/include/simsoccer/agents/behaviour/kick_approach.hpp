@@ -9,9 +9,9 @@
 
 namespace simsoccer::agents {
 
-// The last step to a kick: the ball seen at (ball_x, ball_y) (robot frame, m)
-// to be kicked towards `aim` (rad, robot frame). `foot` turns to the ball's
-// side (from the left foot only once the ball is 2 cm right of the middle);
+// The last step to a kick: the ball seen at (ball_x, ball_y) (m, robot frame,
+// from the feet's midpoint: SoccerBehaviour::Input::feet) to be kicked towards `aim` (rad, robot
+// frame). `foot` turns to the ball's side once the ball is half the foot's offset past the middle;
 // answers a Kick with it once the ball lies in front of it within the
 // config's tolerances, else a small walk step towards that (forward at most
 // `max_forward` m/s).
@@ -42,9 +42,11 @@ class KickApproach {
   void start(double time, double yaw);
   // Aims at `direction` (rad, robot frame when the robot's heading was `yaw`).
   void aimAt(double direction, double yaw);
-  // One period: the ball as last seen, the heading now and the motion
-  // layer's state; the request, head included.
-  MotionRequest update(double time, const BallSighting& ball, double yaw, MotionState motion);
+  // One period: the ball as last seen, the heading now, the motion layer's
+  // state and the feet's midpoint (robot frame, m: MotionController::feetCentre,
+  // which the ball is lined up against); the request, head included.
+  MotionRequest update(double time, const BallSighting& ball, double yaw, MotionState motion,
+                       const Eigen::Vector2d& feet);
 
  private:
   BehaviourConfig config_;

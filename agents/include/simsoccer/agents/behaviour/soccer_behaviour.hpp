@@ -55,7 +55,7 @@ struct BehaviourConfig {
   std::vector<Pose2> ready_positions;
   Pose2 kick_off_position{-0.25, 0.0, 0.0};  // the kicking team's striker in Ready
   double max_forward = 0.25, max_side = 0.10, max_turn = 0.8;  // m/s, m/s, rad/s
-  double kick_ball_x = 0.17;           // m ahead of the torso: the ball where a kick meets it
+  double kick_ball_x = 0.17;           // m ahead of the feet's middle, where kicks meet it
   double kick_ball_y = 0.05;           // m sideways: in front of the kicking foot
   double kick_tolerance_x = 0.03;      // m
   double kick_tolerance_y = 0.025;     // m
@@ -143,11 +143,17 @@ class SoccerBehaviour {
   SoccerBehaviour(const BehaviourConfig& config, const fields::FieldModel& field, int team,
                   int team_number, int player, Role role, uint64_t seed);
 
+  struct Vec2 {
+    double x = 0, y = 0;
+  };
   struct Input {
     double time = 0.0;                              // s of simulated time
     const PerceptionIn* perception = nullptr;       // this period's, if any
     const simsoccer_msg_GameState* game = nullptr;  // the latest, if any
     MotionState motion = MotionState::Stance;
+    // The feet's midpoint in the robot frame (m; MotionController::feetCentre): a kick lines
+    // the ball up against it, not against the swaying torso.
+    Vec2 feet{};
     // Down: falling, lying, getting up or diving (from the motion state).
     bool fallen() const {
       return motion == MotionState::Falling || motion == MotionState::Lying ||
@@ -173,9 +179,6 @@ class SoccerBehaviour {
   struct Teammate {
     TeamMessageData data;
     double received = -1.0;
-  };
-  struct Vec2 {
-    double x = 0, y = 0;
   };
   void readGame(const Input& in);
   void updateBall(const Input& in);
@@ -247,6 +250,7 @@ class SoccerBehaviour {
   // The last sighting at all, taken or not (robot frame), and how many in a row agreed with
   // the one before: a sighting far from the ball is taken once ball_new_sightings agree.
   Vec2 sighting_robot_;
+  Vec2 feet_;  // Input::feet
   double sighting_at_ = -1e9;
   int sightings_in_row_ = 0;
   Vec2 ball_velocity_;

@@ -55,6 +55,12 @@ class LegKinematics {
   // (within 1 cm and 0.05 rad of each other: both on the ground); nothing otherwise.
   std::optional<Eigen::Vector3d> footAgainst(Leg foot, Leg other,
                                              const std::vector<double>& body_angles) const;
+  // The midpoint of the feet's frames (the ankles) on the ground plane, in the frame the
+  // perception reports in (below the torso's origin, x along its heading, y left; m), from body
+  // joint angles and the IMU's roll and pitch (rad): where the ball lies against the feet,
+  // whatever the torso's sway (a K1's torso swings 7 cm over its feet while it steps).
+  Eigen::Vector2d feetCentre(const std::vector<double>& body_angles, double roll,
+                             double pitch) const;
   // Joint angles for both feet's frames in the torso frame, within the joint
   // limits. `start` (e.g. the last solution) speeds convergence up.
   LegSolution inverse(const Pose& left_foot, const Pose& right_foot,

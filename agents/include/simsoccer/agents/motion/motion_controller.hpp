@@ -128,6 +128,9 @@ class MotionController {
                        double rate) const;
   const WalkEngine& walk() const { return walk_; }
   const robots::RobotModel& model() const { return model_; }
+  // The feet's midpoint in the perception's robot frame (m): LegKinematics::feetCentre from
+  // this period's encoders and IMU angles.
+  Eigen::Vector2d feetCentre(const MotionSensors& sensors) const;
 
  private:
   void enter(MotionState s);
