@@ -642,7 +642,7 @@ TEST(SoccerBehaviour, TheStrikerLinesTheBallUpAgainstTheFeetNotTheSwayingTorso) 
   in.perception = &p;
   MotionRequest r = updateSeeing(between, in);
   EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
-  EXPECT_GT(std::abs(r.left), 0.04);  // a whole foot's offset to go
+  EXPECT_GT(r.left, 0.04);  // left, to bring its right foot (the first) behind the ball
   agents::SoccerBehaviour in_front(cfg, f, 0, 1, 2, Role::Striker, 1);
   p = seeing(2.0, -0.1, 0.0, 2.17, 0.0, 0.1);
   r = updateSeeing(in_front, in);

@@ -434,7 +434,8 @@ void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t a
       r.shoot_until = time_ + 3.0;
       const bool near =
           r.ball.age >= 0.0 && r.ball.age < 1.0 && std::hypot(r.ball.x, r.ball.y) < 1.0;
-      r.shoot_foot = near && r.ball.y >= 0.0 ? agents::Leg::Left : agents::Leg::Right;
+      const double beside = r.ball.y - r.motion->feetCentre(agents::motionSensors(frame)).y();
+      r.shoot_foot = near && beside >= 0.0 ? agents::Leg::Left : agents::Leg::Right;
     }
     // Asked for until the motion layer kicks (it stops the walk first), 3 s at most (it may be
     // getting up: the shot is dropped).

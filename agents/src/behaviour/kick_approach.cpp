@@ -18,8 +18,9 @@ double wrap(double a) {
 MotionRequest lineUpForKick(const BehaviourConfig& c, double ball_x, double ball_y, double aim,
                             double max_forward, Leg& foot) {
   // The foot changes only once the ball is half a foot's offset past the
-  // middle: switching as it crossed the middle, a K1 whose torso sways 2-3 cm
-  // a step stepped left and right under the ball for 20 s without kicking.
+  // middle: switching as it crossed the middle, a K1 (its sway moved a ball
+  // seen near the torso's middle 2-3 cm each way a step) stepped left and
+  // right under the ball for 20 s without kicking.
   const double keep = 0.5 * c.kick_ball_y;
   if (foot == Leg::Left && ball_y < -keep) foot = Leg::Right;
   if (foot == Leg::Right && ball_y > keep) foot = Leg::Left;
