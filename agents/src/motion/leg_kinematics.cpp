@@ -92,13 +92,8 @@ LegKinematics::LegKinematics(const robots::RobotModel& model) {
 std::optional<Eigen::Vector3d> LegKinematics::footAgainst(
     Leg foot, Leg other, const std::vector<double>& body_angles) const {
   constexpr double kFlatHeight = 0.01, kFlatTilt = 0.05;  // m, rad
-  auto angles = [&](Leg leg) {
-    LegAngles q{};
-    for (size_t i = 0; i < q.size(); ++i)
-      q[i] = body_angles.at(static_cast<size_t>(joints(leg)[i]));
-    return q;
-  };
-  const Pose rel = forward(other, angles(other)).inverse() * forward(foot, angles(foot));
+  const Pose rel =
+      forwardFromBody(other, body_angles).inverse() * forwardFromBody(foot, body_angles);
   if (std::abs(rel.translation().z()) > kFlatHeight || rel.linear()(2, 2) < std::cos(kFlatTilt))
     return std::nullopt;
   return Eigen::Vector3d(rel.translation().x(), rel.translation().y(),
@@ -107,17 +102,18 @@ std::optional<Eigen::Vector3d> LegKinematics::footAgainst(
 
 Eigen::Vector2d LegKinematics::feetCentre(const std::vector<double>& body_angles, double roll,
                                           double pitch) const {
-  Vec3 sum = Vec3::Zero();
-  for (const Leg leg : {Leg::Left, Leg::Right}) {
-    LegAngles q{};
-    for (size_t i = 0; i < q.size(); ++i)
-      q[i] = body_angles.at(static_cast<size_t>(joints(leg)[i]));
-    sum += forward(leg, q).translation();
-  }
+  const Vec3 middle = 0.5 * (forwardFromBody(Leg::Left, body_angles).translation() +
+                             forwardFromBody(Leg::Right, body_angles).translation());
   // Levelled: the torso's attitude is yaw * pitch * roll (the IMU's angles, z-y-x).
-  const Vec3 level = Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                     Eigen::AngleAxisd(roll, Vec3::UnitX()) * (0.5 * sum);
+  const Vec3 level =
+      Eigen::AngleAxisd(pitch, Vec3::UnitY()) * Eigen::AngleAxisd(roll, Vec3::UnitX()) * middle;
   return {level.x(), level.y()};
+}
+
+Pose LegKinematics::forwardFromBody(Leg leg, const std::vector<double>& body_angles) const {
+  LegAngles q{};
+  for (size_t i = 0; i < q.size(); ++i) q[i] = body_angles.at(static_cast<size_t>(joints(leg)[i]));
+  return forward(leg, q);
 }
 
 Pose LegKinematics::forward(Leg leg, const LegAngles& q) const {

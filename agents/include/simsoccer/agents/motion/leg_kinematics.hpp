@@ -84,6 +84,9 @@ class LegKinematics {
   Vec3 hip(Leg leg) const { return legs_[static_cast<size_t>(leg)].origin[0]; }
 
  private:
+  // forward() from body joint angles (body joint order, mimics applied).
+  Pose forwardFromBody(Leg leg, const std::vector<double>& body_angles) const;
+
   struct Chain {
     std::array<int, 6> joint{};
     std::array<Vec3, 6> origin{}, axis{};
