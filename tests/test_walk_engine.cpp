@@ -171,6 +171,75 @@ TEST(WalkEngine, OdometryFollowsTheCommandAndStopEndsWithFeetTogether) {
   EXPECT_NEAR(fast.odometry().x / 10.0, fast.parameters().max_forward / 0.25, 0.03);
 }
 
+// Turning, the swing foot turns only while it is off the ground: near lift-off and touch-down
+// (a tenth of the step at either end) it keeps its yaw, and it lands turned by the whole step.
+// (The K1: its hips turn each leg on its own; the Nao's shared hip joint tilts the yaw a little.)
+TEST(WalkEngine, TheSwingFootTurnsOnlyWhileItIsOffTheGround) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  agents::WalkParameters p =
+      agents::loadGaitIn(test::sourceDir() / "configs" / "motions" / "booster_k1").walk;
+  p.hip_roll_compensation = 0.0;  // pure geometry: it tilts the support foot on purpose
+  agents::WalkEngine e(model, p);
+  std::vector<double> q = model.pose("stand");
+  e.update(0.01, {}, q);
+  e.setVelocity(0.0, 0.0, 0.8);
+  const auto yawOf = [](const Eigen::Matrix3d& r) { return std::atan2(r(1, 0), r(0, 0)); };
+  double last_turn = 0.0, last_lift = 0.0;
+  int turned_on_the_ground = 0, turned_off_it = 0;
+  for (int i = 0; i < 50 && e.supportLeg() == Leg::Right; ++i) {  // the left foot's first step
+    e.update(0.01, {}, q);
+    const Feet f = feetOf(e, q);
+    const double turn = yawOf(f.right.linear().transpose() * f.left.linear());
+    const double lift = f.left.translation().z() - f.right.translation().z();
+    // Turned since the last period: off the ground at one end of it at least.
+    if (std::abs(turn - last_turn) > 1e-6)
+      (std::max(lift, last_lift) > 0.3 * p.foot_lift ? turned_off_it : turned_on_the_ground) += 1;
+    last_turn = turn;
+    last_lift = lift;
+  }
+  EXPECT_EQ(turned_on_the_ground, 0);
+  EXPECT_GT(turned_off_it, 20);
+  EXPECT_GT(last_turn, 0.1);  // to the left
+  // It landed turned by the step's whole turn: the support foot's yaw in the odometry.
+  EXPECT_NEAR(last_turn, e.odometry().yaw, 1e-6);
+}
+
+// Turning on the spot may take larger turning steps and ramp up faster than while walking
+// (max_turn_on_spot, max_turn_accel_on_spot); with a step forward wanted, the walk's limits hold.
+TEST(WalkEngine, TurningOnTheSpotHasItsOwnLimits) {
+  const robots::RobotModel model = robots::loadRobotModel(test::naoH25());
+  std::vector<double> q = model.pose("stand");
+  agents::WalkParameters p;
+  p.max_turn_on_spot = 0.6;
+  p.max_turn_accel_on_spot = 0.2;
+  // The largest turning step over 3 s with the IMU's yaw standing still (the robot does not
+  // turn at all, so the heading hold asks for ever more), and the first step's.
+  const auto steps = [&](double forward) {
+    agents::WalkEngine e(model, p);
+    e.update(0.01, {}, q);
+    e.setVelocity(forward, 0.0, 0.8);
+    double largest = 0.0, first = -1.0, before = 0.0;
+    for (int i = 0; i < 300; ++i) {
+      const Leg support = e.supportLeg();
+      e.update(0.01, {}, q);
+      if (e.supportLeg() != support) {
+        const double step = e.odometry().yaw - before;
+        before = e.odometry().yaw;
+        if (first < 0.0) first = step;
+        largest = std::max(largest, step);
+      }
+    }
+    return std::pair{first, largest};
+  };
+  const auto [first_on_spot, largest_on_spot] = steps(0.0);
+  EXPECT_NEAR(largest_on_spot, 0.6, 1e-9);
+  // The first step: twice the average (0.2, one ramp step) and half the heading error (0.2).
+  EXPECT_NEAR(first_on_spot, 2 * 0.2 + 0.5 * 0.2, 1e-9);
+  const auto [first_walking, largest_walking] = steps(0.1);
+  EXPECT_NEAR(largest_walking, p.max_turn, 1e-9);
+  EXPECT_NEAR(first_walking, 2 * p.max_turn_accel + 0.5 * p.max_turn_accel, 1e-9);
+}
+
 // The torso's yaw sways a little with the steps (about 0.01 rad). In step
 // with the feet, the heading hold corrects it on every step, so a plain stop
 // keeps stepping on the spot (a robot asked to stand: it holds its heading);

@@ -62,6 +62,8 @@ const std::vector<Field<WalkParameters>>& walkFields() {
       {"max_accel", &W::max_accel, Range::Positive},
       {"max_side_accel", &W::max_side_accel, Range::Positive},
       {"max_turn_accel", &W::max_turn_accel, Range::Positive},
+      {"max_turn_on_spot", &W::max_turn_on_spot, Range::NonNegative},
+      {"max_turn_accel_on_spot", &W::max_turn_accel_on_spot, Range::NonNegative},
       {"hip_roll_compensation", &W::hip_roll_compensation, Range::Any},
       {"heading_gain", &W::heading_gain, Range::NonNegative},
       {"stop_heading_tolerance", &W::stop_heading_tolerance, Range::NonNegative},

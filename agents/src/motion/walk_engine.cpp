@@ -8,6 +8,10 @@
 namespace simsoccer::agents {
 namespace {
 
+// The share of a step at either end when the swing foot is still near the ground (its lift is
+// a sine of the phase: under a third of the apex).
+const double kTurnMargin = 0.1;
+
 Pose2 compose(const Pose2& a, double dx, double dy, double dyaw) {
   const double c = std::cos(a.yaw), s = std::sin(a.yaw);
   return {a.x + c * dx - s * dy, a.y + s * dx + c * dy, a.yaw + dyaw};
@@ -61,7 +65,11 @@ void WalkEngine::startStep() {
   const double side = swing == 0 ? 1.0 : -1.0;  // +1: the left foot swings
   // The per-step average command ramps towards the wanted one.
   const Eigen::Vector3d want = stopping_ ? Eigen::Vector3d::Zero() : wanted_;
-  const Eigen::Vector3d max_change(p_.max_accel, p_.max_side_accel, p_.max_turn_accel);
+  const bool on_spot = want.head<2>().isZero() && average_.head<2>().isZero();
+  const double max_turn = on_spot && p_.max_turn_on_spot > 0.0 ? p_.max_turn_on_spot : p_.max_turn;
+  const double max_turn_accel =
+      on_spot && p_.max_turn_accel_on_spot > 0.0 ? p_.max_turn_accel_on_spot : p_.max_turn_accel;
+  const Eigen::Vector3d max_change(p_.max_accel, p_.max_side_accel, max_turn_accel);
   average_ += (want - average_).cwiseMax(-max_change).cwiseMin(max_change);
   step_.x() = average_.x();
   // Sideways and turning only on the steps that open the legs that way (the
@@ -73,9 +81,9 @@ void WalkEngine::startStep() {
   const double error = std::remainder(intended_yaw_ - measured, 2 * M_PI);
   const bool settling = stopping_ && settling_ && average_.isZero(1e-6) &&
                         std::abs(error) < p_.stop_heading_tolerance;
-  const double turn = settling ? 0.0
-                               : std::clamp(2.0 * average_.z() + p_.heading_gain * error,
-                                            -p_.max_turn, p_.max_turn);
+  const double turn =
+      settling ? 0.0
+               : std::clamp(2.0 * average_.z() + p_.heading_gain * error, -max_turn, max_turn);
   step_.z() = (turn * side > 0) ? turn : 0.0;
   body_start_ = body_;
   body_end_ = compose(body_, p_.forward_scale * step_.x(), step_.y(), step_.z());
@@ -176,6 +184,11 @@ void WalkEngine::update(double dt, const WalkSensors& imu, std::vector<double>& 
     const double sway = support_side * p_.sway * std::sin(M_PI * ph);
     Pose2 feet[2] = {foot_[0], foot_[1]};
     feet[swing] = lerp(swing_start_, swing_end_, smoothstep(ph));
+    // The swing foot turns only while it is off the ground: turned as it lifted off and set
+    // down, it twisted against the carpet and the robot turned back (the K1 turned 0.61 rad/s
+    // commanding 0.8, now 0.69).
+    const double turning = std::clamp((ph - kTurnMargin) / (1.0 - 2.0 * kTurnMargin), 0.0, 1.0);
+    feet[swing].yaw = swing_start_.yaw + (swing_end_.yaw - swing_start_.yaw) * smoothstep(turning);
     double lift[2] = {0.0, 0.0};
     // Shifting the weight, both feet stay down: no lift, and no sag to make up for.
     const double single_support = shifting_ ? 0.0 : 1.0;

@@ -31,8 +31,9 @@ const char* kBenchMotionHelp =
     "swings: beside the support foot in the gait's stance); both for tuning, with any parameter\n"
     "of agents::WalkParameters / KickParameters by name (--sway, --lift, --period,\n"
     "--torso-offset, --height, --ankle-pitch-gyro, --ankle-roll-gyro, --gyro-smoothing,\n"
-    "--forward-scale, --max-forward, --max-turn, --max-turn-accel, --lean, --hip-roll,\n"
-    "--heading-gain, --start-shift-time, --kick-reach, --kick-swing, --kick-shift, --kick-lift,\n"
+    "--forward-scale, --max-forward, --max-turn, --max-turn-accel, --max-turn-on-spot,\n"
+    "--max-turn-accel-on-spot, --lean, --hip-roll, --heading-gain, --start-shift-time,\n"
+    "--kick-reach, --kick-swing, --kick-shift, --kick-lift,\n"
     "--kick-draw-back, --kick-hip-roll, --kick-swing-height, --kick-swing-out,\n"
     "--kick-ready-time).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
@@ -79,6 +80,8 @@ int benchMotion(int argc, char** argv, int first) {
       {"max-forward", &wp.max_forward},
       {"max-turn", &wp.max_turn},
       {"max-turn-accel", &wp.max_turn_accel},
+      {"max-turn-on-spot", &wp.max_turn_on_spot},
+      {"max-turn-accel-on-spot", &wp.max_turn_accel_on_spot},
       {"lean", &wp.torso_lean},
       {"hip-roll", &wp.hip_roll_compensation},
       {"heading-gain", &wp.heading_gain},

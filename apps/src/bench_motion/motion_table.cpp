@@ -47,12 +47,10 @@ int printMotionTable(const TrialContext& c, const Options& opt, uint64_t seed) {
         100.0 * std::abs(r.lateral) / std::max(r.distance, 1e-9), r.fell, seconds);
   }
   {
-    // Less than a turn, so the angle is unambiguous.
-    const double w = b.turn, seconds = std::min(5.0, 5.0 / w);
+    const double w = b.turn, seconds = 5.0;
     const WalkResult r = walkTrial(
         quiet, [&](double) { return Eigen::Vector3d(0, 0, w); }, seconds);
-    double turned = r.turned;
-    if (turned < 0) turned += 2 * M_PI;
+    const double turned = r.turned;
     row("turn", w * 180 / M_PI, turned / seconds * 180 / M_PI, "deg/s",
         100.0 * std::abs(turned - w * seconds) / (w * seconds), r.fell, seconds);
   }

@@ -42,17 +42,26 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
     return true;
   };
   t.driver.setControl(walkControl);
+  // The torso's heading (yaw about the field's z).
+  const auto headingOf = [](const engine::Pose& p) {
+    return std::atan2(p.linear()(1, 0), p.linear()(0, 0));
+  };
   // Puts the robot on its feet at (x, y), facing as it does now, and eases it into the walk's
   // stance as at the start (the trial's clock stands still meanwhile).
   const auto restartAt = [&](double x, double y) {
     const engine::Pose p = w.torsoPose(0);
-    w.placeRobot(0, x, y, std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
+    w.placeRobot(0, x, y, headingOf(p));
     engine = agents::WalkEngine(model, c.walk);
     settleIntoStance(t, engine, targets);
     t.driver.setControl(walkControl);
   };
+  // Followed period by period, so that more than half a turn is told apart.
+  double heading = headingOf(start);
   for (i = 0; i < periods; ++i) {
     t.period();
+    const double yaw = headingOf(w.torsoPose(0));
+    r.turned += std::remainder(yaw - heading, 2 * M_PI);
+    heading = yaw;
     if (!w.isStanding(0)) {
       r.fell = true;
       r.fell_at = static_cast<double>(i) * dt;
@@ -90,10 +99,11 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
       const auto& f = w.sensorFrame(0);
       const auto& kin = engine.kinematics();
       std::fprintf(stderr,
-                   "t %.2f torso %.3f %.3f %.3f roll %+.3f pitch %+.3f odometry %.3f phase %.2f "
+                   "t %.2f torso %.3f %.3f %.3f roll %+.3f pitch %+.3f turned %+.3f odometry %.3f "
+                   "phase %.2f "
                    "support %s  feet z %.3f / %.3f\n",
                    static_cast<double>(i) * dt, p.x(), p.y(), p.z(), f.angles[0], f.angles[1],
-                   engine.odometry().x, engine.phase(),
+                   r.turned, engine.odometry().x, engine.phase(),
                    engine.supportLeg() == agents::Leg::Left ? "L" : "R",
                    w.linkPose(0, kin.footLink(agents::Leg::Left)).translation().z(),
                    w.linkPose(0, kin.footLink(agents::Leg::Right)).translation().z());
@@ -104,8 +114,6 @@ WalkResult walkTrial(const TrialContext& c, const Schedule& schedule, double sec
   r.distance = std::hypot(d.x(), d.y());
   r.speed = (vx != 0 || vy == 0 ? d.x() : d.y()) / seconds;
   r.lateral = vx != 0 || vy == 0 ? d.y() : d.x();
-  const Eigen::Matrix3d rel = start.linear().transpose() * end.linear();
-  r.turned = std::atan2(rel(1, 0), rel(0, 0));
   return r;
 }
 

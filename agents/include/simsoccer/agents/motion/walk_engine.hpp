@@ -38,6 +38,12 @@ struct WalkParameters {
   double max_accel = 0.02;       // m per step per step, forward
   double max_side_accel = 0.01;  // m per step per step (average sideways step)
   double max_turn_accel = 0.05;  // rad per step per step (average turn per step)
+  // Turning on the spot (no step forward or sideways wanted or under way): a turning step may be
+  // larger (the command's and the heading hold's turn together; the command alone stays inside
+  // max_turn) and the average turn ramps up faster. The same while walking tips the robot over.
+  // 0: as walking.
+  double max_turn_on_spot = 0.0;        // rad per turning step
+  double max_turn_accel_on_spot = 0.0;  // rad per step per step
   // The support leg's hip roll sags under the body's weight (the servo is a
   // stiff spring, not a rigid joint): commanded this much further, peaking
   // at mid-step, so the swing foot stays off the ground.
