@@ -42,8 +42,10 @@ const char* kBenchMotionHelp =
     "share P of them \"stand\" (default 0; the table's stop_and_go: --command-seconds 0.5\n"
     "--stand-share 0.3).\n"
     "With --striker or --penalty [--seed N] [--verbose]: one striker / penalty trial.\n"
-    "With --block [--shootout] [--seed N] [--verbose]: one ball rolled at the goalkeeper (in\n"
-    "play: it blocks; in the shoot-out: it also dives).\n"
+    "With --block [--shootout] [--seed N] [--ball-offset M] [--ball-speed V] [--verbose]: one "
+    "ball\n"
+    "rolled at the goalkeeper (in play: it blocks; in the shoot-out: it also dives), passing its\n"
+    "line M m left of its middle, V m/s (default: seeded, anywhere inside the posts, 1.6-2.4).\n"
     "  --get-up-trials N, --sit-trials N  get-up trials per side, sit trials, in the table\n"
     "                (default 20, 20)\n"
     "  --motions DIR the motions from DIR (default: the bench file's; for tuning them): all of\n"
@@ -111,6 +113,7 @@ int benchMotion(int argc, char** argv, int first) {
                                   "foot",
                                   "ball-offset",
                                   "ball-gap",
+                                  "ball-speed",
                                   "steps-first",
                                   "get-up",
                                   "get-up-trials",
@@ -183,7 +186,10 @@ int benchMotion(int argc, char** argv, int first) {
     return 0;
   }
   if (opt.flag("block")) {  // one ball at the goalkeeper, for tuning
-    const motion::BlockResult r = motion::blockTrial(c, seed, opt.flag("shootout"));
+    motion::BlockShot shot;
+    if (opt.has("ball-offset")) shot.offset = opt.number("ball-offset", 0.0);
+    if (opt.has("ball-speed")) shot.speed = opt.number("ball-speed", 2.0);
+    const motion::BlockResult r = motion::blockTrial(c, seed, opt.flag("shootout"), shot);
     std::printf("block: %s (%s), %d blocks/dives, %d falls\n", r.saved ? "saved" : "not saved",
                 r.in_reach ? "in reach" : "out of reach", r.blocks, r.falls);
     return 0;

@@ -15,7 +15,7 @@ namespace simsoccer::apps::motion {
 // goal line inside the posts); 4 s to see whether it goes in. Saved: it did
 // not, and the keeper touched it. In reach: aimed within the block's reach
 // of the keeper's middle.
-BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout) {
+BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout, const BlockShot& shot) {
   world::Scenario s = emptyField(c);
   s.seed = seed;
   const fields::FieldModel f = fields::loadFieldModel(s.field_file);
@@ -38,8 +38,13 @@ BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout) {
   std::uniform_real_distribution<double> u(-1, 1);
   const double half_goal = 0.5 * f.goal.inner_width - f.ball.radius;
   const Vec3 from(line + 2.5, 0.6 * u(rng), f.ball.radius);
-  const Vec3 to(-f.halfLength(), half_goal * u(rng), f.ball.radius);
-  const double speed = 2.0 + 0.4 * u(rng);
+  Vec3 to(-f.halfLength(), half_goal * u(rng), f.ball.radius);
+  double speed = 2.0 + 0.4 * u(rng);
+  if (shot.offset) {  // aimed to pass the keeper's line there (it stands at y 0)
+    const double k = (from.x() - line) / (from.x() - to.x());
+    to.y() = from.y() + (*shot.offset - from.y()) / k;
+  }
+  if (shot.speed) speed = *shot.speed;
   engine::RigidBodyState b;
   b.pose.translation() = from;
   b.linear_velocity = speed * (to - from).normalized();

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -177,6 +178,12 @@ struct BlockResult {
   bool saved = false, in_reach = false;
   int blocks = 0, falls = 0;
 };
-BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout);
+// For tuning: where the ball passes the keeper's line (m from its middle, +: its left) and how
+// fast it starts (m/s); unset, seeded like the table's.
+struct BlockShot {
+  std::optional<double> offset, speed;
+};
+BlockResult blockTrial(const TrialContext& c, uint64_t seed, bool shootout,
+                       const BlockShot& shot = {});
 
 }  // namespace simsoccer::apps::motion
