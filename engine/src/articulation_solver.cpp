@@ -5,6 +5,8 @@
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
+#include <utility>
+
 #include "articulation_inertia.hpp"
 
 namespace simsoccer::engine {
@@ -74,6 +76,7 @@ void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int n
   if (!own_ || (info.m_solverMode &
                 (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING | SOLVER_USE_ARTICULATED_WARMSTARTING))) {
     btMultiBodyConstraintSolver::convertContacts(manifolds, num_manifolds, info);
+    alignRollingFriction();
     return;
   }
   // Manifold by manifold in Bullet's order, so the rows come in its order.
@@ -106,6 +109,37 @@ void ArticulationSolver::convertContacts(btPersistentManifold** manifolds, int n
   }
   for (int i = 0; i < m_multiBodyNonContactConstraints.size(); ++i)
     m_multiBodyNonContactConstraints[i].m_appliedImpulse = 0;
+  alignRollingFriction();
+}
+
+void ArticulationSolver::alignRollingFriction() {
+  btConstraintArray& rows = m_tmpSolverContactRollingFrictionConstraintPool;
+  for (int i = 0; i + 1 < rows.size(); ++i) {
+    btSolverConstraint& a = rows[i];
+    btSolverConstraint& b = rows[i + 1];
+    if (a.m_frictionIndex != b.m_frictionIndex) continue;
+    const auto* point = static_cast<const btManifoldPoint*>(
+        m_tmpSolverContactConstraintPool[a.m_frictionIndex].m_originalContactPoint);
+    if (!point) continue;
+    const btVector3& normal = point->m_normalWorldOnB;
+    // A rolling row's axis is its torque axis (the spinning row's is the normal).
+    const auto rolling = [&](const btSolverConstraint& row) {
+      return btFabs(row.m_relpos2CrossNormal.dot(normal)) < btScalar(0.5);
+    };
+    if (!rolling(a) || !rolling(b)) continue;
+    const btVector3 spin = m_tmpSolverBodyPool[a.m_solverBodyIdA].m_angularVelocity -
+                           m_tmpSolverBodyPool[a.m_solverBodyIdB].m_angularVelocity;
+    btVector3 along = spin - normal * spin.dot(normal);
+    if (along.length2() < btScalar(1e-12)) continue;
+    along.normalize();
+    const btVector3 across = normal.cross(along);
+    btManifoldPoint& cp = *const_cast<btManifoldPoint*>(point);
+    const btVector3 none(0, 0, 0);
+    for (auto [row, axis] : {std::pair{&a, along}, std::pair{&b, across}})
+      setupTorsionalFrictionConstraint(*row, axis, row->m_solverBodyIdA, row->m_solverBodyIdB, cp,
+                                       row->m_friction, none, none, nullptr, nullptr, 1);
+    ++i;  // the pair is done
+  }
 }
 
 int ArticulationSolver::ownContact(const btPersistentManifold& manifold) {

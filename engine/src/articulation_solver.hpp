@@ -102,6 +102,12 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   // The velocity change a row sees (both sides).
   btScalar rowVelocity(const btMultiBodySolverConstraint& row);
 
+  // Bullet limits rolling friction about two fixed axes of the contact plane, each on its own:
+  // a ball rolling at an angle to them is slowed along both, its path bends towards the nearer
+  // axis and it stops short (2 m/s with 0.3 sideways ran straight along the x axis after 0.75 s).
+  // Each contact's two rolling rows turn to the relative rolling axis and across it, so the
+  // resistance opposes the rolling whichever way it goes (its limit, per row, unchanged).
+  void alignRollingFriction();
   // Whether the engine builds the manifold's rows (returns its points within
   // the processing threshold; 0: Bullet builds them). It does for one or two
   // articulation links (factorised) against each other or something static,
