@@ -641,6 +641,14 @@ TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
       EXPECT_EQ(e.key(), "walk.gyro_smoothing") << e.what();
     }
   }
+  // Turning on the spot with smaller steps than walking is refused: it could not keep up.
+  std::ofstream(dir.path() / "gait.yaml") << "walk: {max_turn: 0.6, max_turn_on_spot: 0.5}\n";
+  try {
+    agents::loadGaitIn(dir.path());
+    ADD_FAILURE() << "max_turn_on_spot under max_turn was accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "walk.max_turn_on_spot") << e.what();
+  }
   // The Booster K1's gait in the repository loads.
   EXPECT_GT(agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1").walk.step_width,
             0.15);

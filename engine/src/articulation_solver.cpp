@@ -121,14 +121,20 @@ void ArticulationSolver::alignRollingFriction() {
     const auto* point = static_cast<const btManifoldPoint*>(
         m_tmpSolverContactConstraintPool[a.m_frictionIndex].m_originalContactPoint);
     if (!point) continue;
+    const btSolverBody& body_a = m_tmpSolverBodyPool[a.m_solverBodyIdA];
+    const btSolverBody& body_b = m_tmpSolverBodyPool[a.m_solverBodyIdB];
+    if ((body_a.m_originalBody && body_a.m_originalBody->hasAnisotropicFriction(
+                                      btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION)) ||
+        (body_b.m_originalBody && body_b.m_originalBody->hasAnisotropicFriction(
+                                      btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION)))
+      continue;
     const btVector3& normal = point->m_normalWorldOnB;
     // A rolling row's axis is its torque axis (the spinning row's is the normal).
     const auto rolling = [&](const btSolverConstraint& row) {
       return btFabs(row.m_relpos2CrossNormal.dot(normal)) < btScalar(0.5);
     };
     if (!rolling(a) || !rolling(b)) continue;
-    const btVector3 spin = m_tmpSolverBodyPool[a.m_solverBodyIdA].m_angularVelocity -
-                           m_tmpSolverBodyPool[a.m_solverBodyIdB].m_angularVelocity;
+    const btVector3 spin = body_a.m_angularVelocity - body_b.m_angularVelocity;
     btVector3 along = spin - normal * spin.dot(normal);
     if (along.length2() < btScalar(1e-12)) continue;
     along.normalize();

@@ -105,8 +105,10 @@ class ArticulationSolver : public btMultiBodyConstraintSolver {
   // Bullet limits rolling friction about two fixed axes of the contact plane, each on its own:
   // a ball rolling at an angle to them is slowed along both, its path bends towards the nearer
   // axis and it stops short (2 m/s with 0.3 sideways ran straight along the x axis after 0.75 s).
-  // Each contact's two rolling rows turn to the relative rolling axis and across it, so the
-  // resistance opposes the rolling whichever way it goes (its limit, per row, unchanged).
+  // The two rolling rows of each contact Bullet builds (a rigid body, the ball, on the carpet,
+  // a goal or another rigid body; not on a robot's link) turn to the relative rolling axis and
+  // across it, so the resistance opposes the rolling whichever way it goes (its limit, per row,
+  // unchanged). Bodies with anisotropic rolling friction keep Bullet's axes.
   void alignRollingFriction();
   // Whether the engine builds the manifold's rows (returns its points within
   // the processing threshold; 0: Bullet builds them). It does for one or two

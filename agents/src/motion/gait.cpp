@@ -107,7 +107,14 @@ Gait loadGait(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
   root.allowOnly({"walk", "kick"});
   Gait g;
-  if (auto w = root.optional("walk")) read(*w, walkFields(), g.walk);
+  if (auto w = root.optional("walk")) {
+    read(*w, walkFields(), g.walk);
+    // Below the walk's own limit, turning on the spot could not keep up with a turn the walk
+    // accepts (setVelocity caps it by max_turn): the heading hold's error would grow for ever.
+    const WalkParameters& p = g.walk;
+    if (p.max_turn_on_spot > 0.0 && p.max_turn_on_spot < p.max_turn)
+      w->failKey("max_turn_on_spot", "must be 0 (as walking) or at least max_turn");
+  }
   if (auto k = root.optional("kick")) read(*k, kickFields(), g.kick);
   return g;
 }
