@@ -123,11 +123,11 @@ void ArticulationSolver::alignRollingFriction() {
     if (!point) continue;
     const btSolverBody& body_a = m_tmpSolverBodyPool[a.m_solverBodyIdA];
     const btSolverBody& body_b = m_tmpSolverBodyPool[a.m_solverBodyIdB];
-    if ((body_a.m_originalBody && body_a.m_originalBody->hasAnisotropicFriction(
-                                      btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION)) ||
-        (body_b.m_originalBody && body_b.m_originalBody->hasAnisotropicFriction(
-                                      btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION)))
-      continue;
+    const auto anisotropic = [](const btSolverBody& body) {
+      return body.m_originalBody && body.m_originalBody->hasAnisotropicFriction(
+                                        btCollisionObject::CF_ANISOTROPIC_ROLLING_FRICTION);
+    };
+    if (anisotropic(body_a) || anisotropic(body_b)) continue;
     const btVector3& normal = point->m_normalWorldOnB;
     // A rolling row's axis is its torque axis (the spinning row's is the normal).
     const auto rolling = [&](const btSolverConstraint& row) {
