@@ -210,6 +210,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("obstacle_memory: -1"), "obstacle_memory");
   EXPECT_EQ(refusedAt("defender_goal_distance: -0.5"), "defender_goal_distance");
   EXPECT_EQ(refusedAt("supporter_deepest: -1.5"), "supporter_deepest");  // behind the goal line
+  EXPECT_EQ(refusedAt("clear_max_angle: 1.6"), "clear_max_angle");       // cleared backwards
+  EXPECT_EQ(refusedAt("clear_max_angle: -0.1"), "clear_max_angle");
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
 }
 
@@ -321,6 +323,43 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
   t = keeperTarget(-4.1);                         // inside: to the ball, round it
   EXPECT_LT(t.x, line - 0.1);
   EXPECT_GT(t.y, 0.6);
+}
+
+// A ball near the own goal line is cleared at an angle that keeps the place to line up from on
+// the field (a K1 goalkeeper walked into its goal behind a ball on its line and turned round in
+// there for 25 s), to the side whose place is nearer, kept while the sightings move about.
+TEST(SoccerBehaviour, ABallOnTheOwnGoalLineIsClearedFromTheField) {
+  auto cfg = soccerConfig();
+  EXPECT_EQ(cfg.clear_max_angle, 0.0);        // the Nao's: off
+  cfg.clear_max_angle = 75.0 * M_PI / 180.0;  // the K1's
+  const auto f = field();                     // SPL: the goal line at x = -4.5
+  const auto game = gameState(3);
+  const double bx = -4.46, by = 0.1;  // 4 cm before the line
+  const auto place = [&](double yaw_sign, double robot_y) {
+    agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
+    auto p = seeing(-4.1, robot_y, 0.0, bx, by, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    updateSeeing(keeper, in);
+    EXPECT_EQ(keeper.role(), Role::Goalkeeper);
+    const auto t = keeper.target();
+    // On the line at most (at 75 degrees, the most, the place is 9 cm behind the ball), not in
+    // the goal; on the robot's side.
+    EXPECT_GT(t.x, -4.5 - 0.06) << robot_y;
+    EXPECT_NEAR(t.yaw, yaw_sign * 75.0 * M_PI / 180.0, 1e-6) << robot_y;
+    return keeper;
+  };
+  place(-1.0, 0.6);  // left of the ball: kicks it to the right
+  place(1.0, -0.4);  // right of it: to the left
+  // Kept while the robot's sightings put the ball a little either side of it; turned when the
+  // other place is 0.3 m nearer.
+  auto keeper = place(-1.0, 0.3);
+  for (const auto& [robot_y, yaw_sign] :
+       std::vector<std::pair<double, double>>{{0.05, -1.0}, {0.15, -1.0}, {-0.25, 1.0}}) {
+    auto p = seeing(-4.1, robot_y, 0.0, bx, by, 0.1);
+    agents::SoccerBehaviour::Input in{.time = 0.1, .perception = &p, .game = &game};
+    keeper.update(in);
+    EXPECT_NEAR(keeper.target().yaw, yaw_sign * 75.0 * M_PI / 180.0, 1e-6) << robot_y;
+  }
 }
 
 // On its line the goalkeeper steps sideways to its place, facing the field, across its whole

@@ -608,6 +608,53 @@ TEST(KickEngine, HoldsTheStanceUntilTheTorsoIsCalm) {
   EXPECT_NEAR(lasts(no_wait, 100.0), keys, 1.5 * dt);
 }
 
+// With both feet down after the swing, a torso tilted beyond tilt_deadband from how it stood at
+// the kick's start is moved tilt_gain (m/rad) times the excess towards the raised side, and the
+// kick holds the stance while it is tilted (at most calm_wait).
+TEST(KickEngine, ATiltedTorsoIsMovedTowardsTheRaisedSide) {
+  const robots::RobotModel model = robots::loadRobotModel(test::boosterK1());
+  const agents::Gait gait = agents::loadGaitIn(test::sourceDir() / "configs/motions/booster_k1");
+  const agents::KickParameters& k = gait.kick;
+  ASSERT_GT(k.tilt_gain, 0.0);
+  agents::WalkEngine walk(model, gait.walk);  // for its kinematics
+  const double dt = 0.01;
+  const agents::TorsoTilt start{0.02, -0.05};
+  // The left foot's place under the torso (torso frame) after the keyframes' lowering, with
+  // the torso tilted by (roll, pitch) then; and how long the kick lasts if it stays so.
+  auto after = [&](double roll, double pitch) {
+    agents::KickEngine kick(model, gait.walk, k);
+    std::vector<double> q = model.pose("stand");
+    kick.start(Leg::Right);
+    double t = 0.0;
+    const double down = k.shift_time + k.lift_time + k.swing_time + k.retract_time + k.lower_time;
+    for (; t < down + 0.05; t += dt) kick.update(dt, engine::Vec3::Zero(), q, start);
+    const agents::TorsoTilt tilted{start.roll + roll, start.pitch + pitch};
+    kick.update(dt, engine::Vec3::Zero(), q, tilted);
+    const engine::Vec3 left = feetOf(walk, q).left.translation();
+    while (kick.active() && t < 20.0) {
+      kick.update(dt, engine::Vec3::Zero(), q, tilted);
+      t += dt;
+    }
+    return std::pair{left, t};
+  };
+  const auto [upright, upright_lasts] = after(0.0, 0.0);
+  // Leaning 0.3 rad right (roll > 0): the torso 0.2 m/rad x 0.22 rad to the left, over the feet.
+  const auto [right, right_lasts] = after(0.3, 0.0);
+  EXPECT_NEAR(upright.y() - right.y(), k.tilt_gain * (0.3 - k.tilt_deadband), 2e-3);
+  EXPECT_NEAR(upright.x() - right.x(), 0.0, 2e-3);
+  // Leaning 0.2 rad forwards (pitch > 0): the torso back.
+  const auto [forwards, forwards_lasts] = after(0.0, 0.2);
+  EXPECT_NEAR(forwards.x() - upright.x(), k.tilt_gain * (0.2 - k.tilt_deadband), 2e-3);
+  // Within the deadband: nothing moves.
+  const auto [slight, slight_lasts] = after(0.05, -0.05);
+  EXPECT_LT((slight - upright).norm(), 1e-6);
+  // Held while tilted, up to calm_wait after the keyframes.
+  agents::KickEngine reference(model, gait.walk, k);
+  EXPECT_NEAR(upright_lasts, reference.duration(), 1.5 * dt);  // calm throughout
+  EXPECT_NEAR(slight_lasts, upright_lasts, 1.5 * dt);
+  EXPECT_NEAR(right_lasts, reference.duration() + k.calm_wait, 2.5 * dt);
+}
+
 TEST(Gait, TheFileSetsTheParametersItNamesAndRefusesUnknownOnes) {
   test::TempDir dir("gait");
   EXPECT_EQ(agents::loadGaitIn(dir.path()).walk.step_period, agents::WalkParameters{}.step_period);

@@ -97,7 +97,9 @@ const std::vector<Field<KickParameters>>& kickFields() {
       {"calm_wait", &K::calm_wait, Range::NonNegative},
       {"hip_roll_compensation", &K::hip_roll_compensation, Range::Any},
       {"swing_height", &K::swing_height, Range::Any},
-      {"swing_out", &K::swing_out, Range::Any}};
+      {"swing_out", &K::swing_out, Range::Any},
+      {"tilt_gain", &K::tilt_gain, Range::NonNegative},
+      {"tilt_deadband", &K::tilt_deadband, Range::NonNegative}};
   return f;
 }
 

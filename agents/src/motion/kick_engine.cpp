@@ -25,6 +25,7 @@ void KickEngine::start(Leg foot, const std::vector<double>& joints) {
   foot_ = foot;
   t_ = 0.0;
   calm_for_ = 0.0;
+  have_tilt_start_ = false;
   active_ = true;
   const Leg support = foot == Leg::Left ? Leg::Right : Leg::Left;
   const double side = foot == Leg::Left ? 1.0 : -1.0;
@@ -38,7 +39,12 @@ double KickEngine::duration() const {
          p_.return_time + p_.settle_time;
 }
 
-void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets) {
+void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& targets,
+                        const TorsoTilt& tilt) {
+  if (!have_tilt_start_) {
+    tilt_start_ = tilt;
+    have_tilt_start_ = true;
+  }
   const std::array<Key, 8> keys{{{0, 0, 0, 0, 0},
                                  {1, 0, 0, 0, p_.shift_time},
                                  {1, -p_.draw_back, p_.lift, 1, p_.lift_time},
@@ -70,8 +76,19 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
     }
     t -= keys[k].time;
   }
-  // Done with the keyframes: holding the stance until the torso is calm.
-  calm_for_ = gyro.norm() < p_.calm_rate ? calm_for_ + dt : 0.0;
+  // The tilt reflex, once the kicking foot is down again (traced in K1 5 v 5 games: a kick into
+  // a ball pressed against an opponent's feet, or into its legs, left the robot tilted 0.3 rad
+  // onto one foot's outer edge, the other foot in the air; the stance held it there, the torso
+  // turning too slowly for the calm wait, and after 0.5 s it toppled).
+  auto beyond = [&](double a) {
+    return std::copysign(std::max(0.0, std::abs(a) - p_.tilt_deadband), a);
+  };
+  const double excess_roll = beyond(tilt.roll - tilt_start_.roll);
+  const double excess_pitch = beyond(tilt.pitch - tilt_start_.pitch);
+  const bool reflex = p_.tilt_gain > 0.0 && both_feet_down && t_ > p_.shift_time;
+  const bool tilted = reflex && (excess_roll != 0.0 || excess_pitch != 0.0);
+  // Done with the keyframes: holding the stance until the torso is calm (and upright).
+  calm_for_ = gyro.norm() < p_.calm_rate && !tilted ? calm_for_ + dt : 0.0;
   if (done && (p_.calm_rate <= 0.0 || calm_for_ >= p_.calm_time - 1e-9 ||
                t_ >= duration() + p_.calm_wait - 1e-9))
     active_ = false;
@@ -88,6 +105,10 @@ void KickEngine::update(double dt, const Vec3& gyro, std::vector<double>& target
       Vec3(stance_.torso_offset + (1 - shift) * middle.x(),
            (1 - shift) * middle.y() - side * shift * p_.shift, stance_.ankle_height);
   torso.rotate(Eigen::AngleAxisd((1 - shift) * middle.z(), Vec3::UnitZ()));
+  if (reflex) {  // the torso moved towards the raised side (roll > 0: leaning right)
+    torso.translation().x() -= p_.tilt_gain * excess_pitch;
+    torso.translation().y() += p_.tilt_gain * excess_roll;
+  }
   const Pose inv = torso.inverse();
   auto foot = [&](double x, double y, double yaw, double dz) {
     Pose f = Pose::Identity();

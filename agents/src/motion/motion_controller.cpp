@@ -216,7 +216,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
         kick_.start(request.kick_foot, measured);
         ++counters_.kicks;
         enter(MotionState::Kicking);
-        kick_.update(dt, sensors.gyro, targets_);
+        kick_.update(dt, sensors.gyro, targets_, {sensors.roll, sensors.pitch});
         break;
       }
       if (request.kind == MotionRequest::Kind::Sit && state_ == MotionState::Stance &&
@@ -235,7 +235,7 @@ void MotionController::update(double dt, const MotionSensors& sensors, const Mot
       state_ = walk_.walking() ? MotionState::Walking : MotionState::Stance;
       break;
     case MotionState::Kicking:
-      kick_.update(dt, sensors.gyro, targets_);
+      kick_.update(dt, sensors.gyro, targets_, {sensors.roll, sensors.pitch});
       if (!kick_.active()) enter(MotionState::Stance);
       break;
     case MotionState::Diving:

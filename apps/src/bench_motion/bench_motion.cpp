@@ -35,7 +35,7 @@ const char* kBenchMotionHelp =
     "--max-turn-accel-on-spot, --lean, --hip-roll, --heading-gain, --start-shift-time,\n"
     "--kick-reach, --kick-swing, --kick-shift, --kick-lift,\n"
     "--kick-draw-back, --kick-hip-roll, --kick-swing-height, --kick-swing-out,\n"
-    "--kick-ready-time).\n"
+    "--kick-ready-time, --kick-tilt-gain, --kick-tilt-deadband).\n"
     "With --get-up front|back [--seed N] [--verbose]: one get-up trial.\n"
     "With --random [--random-minutes M] [--command-seconds S] [--stand-share P] [--seed N]\n"
     "[--verbose]: the random-commands trial alone, a new command every S s (default 2), a\n"
@@ -98,7 +98,9 @@ int benchMotion(int argc, char** argv, int first) {
       {"kick-hip-roll", &kp.hip_roll_compensation},
       {"kick-swing-height", &kp.swing_height},
       {"kick-swing-out", &kp.swing_out},
-      {"kick-ready-time", &kp.ready_time}};
+      {"kick-ready-time", &kp.ready_time},
+      {"kick-tilt-gain", &kp.tilt_gain},
+      {"kick-tilt-deadband", &kp.tilt_deadband}};
   std::vector<std::string> valued{"robot",
                                   "bench",
                                   "seconds",

@@ -94,7 +94,8 @@ KickResult kickTrial(const TrialContext& c, agents::Leg foot, double ball_offset
   t.driver.setControl([&](const world::World& world, std::span<float> p, std::span<float> k) {
     if (!engine.active()) return false;  // the last targets hold
     const auto& fr = world.sensorFrame(0);
-    engine.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets);
+    engine.update(dt, Vec3(fr.gyroscope[0], fr.gyroscope[1], fr.gyroscope[2]), targets,
+                  {fr.angles[0], fr.angles[1]});
     bodyTargetsToCommand(model, targets, 1.0, p, k);
     return true;
   });

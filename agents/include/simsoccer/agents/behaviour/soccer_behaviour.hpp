@@ -113,6 +113,11 @@ struct BehaviourConfig {
   // frame x, a share of the half-length): with the ball near the own goal, behind it was
   // among the defenders and the goalkeeper, and the robots there walked into each other.
   double supporter_deepest = -0.5;
+  // A ball so near the own goal line that the place behind it to line up from (towards the
+  // opponent goal) would lie less than 0.1 m in front of the line is cleared at the angle that
+  // keeps the place there, at most this far (rad) off the field's length, to the side whose
+  // place is nearer. 0: off (lined up towards the goal, from inside the own goal if need be).
+  double clear_max_angle = 0.0;
   // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
   // down at the whistle fell again and again through the half-time).
@@ -224,6 +229,10 @@ class SoccerBehaviour {
   size_t defender_slot_ = 0, defenders_ = 1;
   // As a supporter: the side of the ball it keeps (+1 left, -1 right, own frame; 0: not one).
   double supporter_side_ = 0.0;
+  // Clearing a ball near the own goal line: the side it is kicked to (+1 left, -1 right, own
+  // frame; 0: not clearing), kept while it lasts (calls no more than 0.5 s apart) so that a
+  // sighting either side of the kicker does not turn it back and forth.
+  double clear_side_ = 0.0, cleared_at_ = 0.0;
   // A ball too deep for the defenders to stand between it and their goal: they stand wide.
   bool defenders_wide_ = false;
   // Game.

@@ -53,6 +53,20 @@ struct KickParameters {
   // foot's middle went 2.9-3.0 m (the others 4.0-4.6 m; the table's kicks 85 % >= 3 m); with
   // -0.01 every ball within 2 cm went 3.2-5.4 m (100 %).
   double swing_out = -0.01;
+  // With both feet down after the swing, a torso tilted (roll or pitch, from the IMU's angles)
+  // more than tilt_deadband (rad) beyond how it stood when the kick started is met by the legs:
+  // they move the torso tilt_gain (m/rad) times the excess towards the raised side, over the
+  // feet, so that the mass comes back inside the foot the robot has tipped onto. (Setting the
+  // legs as for the tilted torso, so that the raised foot reaches down and pushes, tips it
+  // further: the ground can only push that foot up.) The kick holds the stance until the tilt
+  // is back within the deadband (at most calm_wait). 0: off.
+  double tilt_gain = 0.0;
+  double tilt_deadband = 0.08;
+};
+
+// The IMU's torso angles (rad, as MotionSensors), for the kick's tilt reflex.
+struct TorsoTilt {
+  double roll = 0.0, pitch = 0.0;
 };
 
 class KickEngine {
@@ -71,8 +85,10 @@ class KickEngine {
   bool active() const { return active_; }
   double duration() const;
   const LegKinematics& kinematics() const { return kinematics_; }
-  // Advances by dt and writes the legs' targets (body joint order).
-  void update(double dt, const Vec3& gyro, std::vector<double>& targets);
+  // Advances by dt and writes the legs' targets (body joint order). `tilt`: the torso's angles
+  // now (the first update's are the reference the reflex measures from).
+  void update(double dt, const Vec3& gyro, std::vector<double>& targets,
+              const TorsoTilt& tilt = {});
 
  private:
   LegKinematics kinematics_;
@@ -82,6 +98,8 @@ class KickEngine {
   Leg foot_ = Leg::Right;
   double t_ = 0.0;
   double calm_for_ = 0.0;  // s the torso has turned slower than calm_rate
+  TorsoTilt tilt_start_;   // the torso's angles at the kick's first update
+  bool have_tilt_start_ = false;
   // The kicking foot against the support foot at the start (x, y, yaw in the support foot's
   // frame; the gait's stance: 0, +-step_width, 0).
   Eigen::Vector3d start_offset_ = Eigen::Vector3d::Zero();
