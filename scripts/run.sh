@@ -6,4 +6,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
-./build/apps/simsoccer match configs/match_5v5.yaml --half 120 --out runs/latest "$@"
+./build/apps/simsoccer match configs/match_5v5.yaml --half 120 --out runs/latest --overwrite "$@"

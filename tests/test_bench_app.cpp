@@ -91,6 +91,65 @@ TEST(CheckApp, ValidScenarioAndConfigError) {
       << err;
 }
 
+// Every kind of config file the programs read: a valid one is summarised, one `check` does
+// not know is refused naming it.
+TEST(CheckApp, EveryKindOfConfigFile) {
+  const std::string src = SIMSOCCER_SOURCE_DIR;
+  const std::vector<std::pair<std::string, std::string>> kinds = {
+      {"/configs/match_k1_5v5.yaml", "match config 'match_k1_5v5' is valid"},
+      {"/configs/penalty.yaml", "penalty config 'penalty' is valid"},
+      {"/fields/hsl_m.yaml", "field 'hsl_m' is valid"},
+      {"/robots/booster_k1.yaml", "robot 'booster_k1' is valid"},
+      {"/configs/rules/spl_champions_cup.yaml", "(7 players a team"},
+      {"/configs/agents/soccer_k1.yaml", "agent behaviour file is valid"},
+      {"/configs/motions/booster_k1/gait.yaml", "gait file is valid"}};
+  int status = -1;
+  for (const auto& [file, said] : kinds) {
+    const std::string out = runCommand(std::string(SIMSOCCER_BIN) + " check " + src + file, status);
+    EXPECT_EQ(status, 0) << file << ": " << out;
+    EXPECT_NE(out.find(said), std::string::npos) << file << ": " << out;
+  }
+  // A match config's scenario is checked with it: the world is built.
+  EXPECT_NE(
+      runCommand(std::string(SIMSOCCER_BIN) + " check " + src + "/configs/match_2v2.yaml", status)
+          .find("state hash"),
+      std::string::npos);
+  const std::string motion = runCommand(
+      std::string(SIMSOCCER_BIN) + " check " + src + "/configs/motions/sit_down.yaml", status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(motion.find("sit_down.yaml: (document): not a file `check` knows"), std::string::npos)
+      << motion;
+}
+
+// Found by probing the programs as a new user (2026-12-07): each of these ran (a bench to its
+// end before failing to write its table), printed nonsense, or blamed the wrong argument.
+TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
+  const std::string bin = SIMSOCCER_BIN, src = SIMSOCCER_SOURCE_DIR;
+  const test::TempDir dir("cli_refusals");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"match " + src + "/configs/match_2v2.yaml --seed --half 5", "option --seed needs a value"},
+      {"bench physics --csv " + (dir / "none" / "x.csv").string(), "x.csv: no such folder"},
+      {"bench physics --csv " + dir.path().string(), ": is a folder"},
+      {"bench scaling --png /proc/simsoccer_no/s.png", "no such folder /proc/simsoccer_no"},
+      {"bench motion --max-forward -5", "walk.max_forward: must be > 0"},
+      {"bench motion --period 0", "walk.step_period: must be > 0"},
+      {"bench motion --striker-trials -1", "--striker-trials must be a whole number from 0"},
+      {"bench motion --vx 0.2 --seconds 0", "--seconds must be > 0"},
+      {"bench motion --dt 0", "--dt must be > 0"},
+      {"bench motion --kick --foot 7", "--foot must be a whole number from 0 to 1"},
+      {"bench motion --vx 0.2 --motions " + (dir / "none").string(), "--motions: no such folder"},
+      {"replay " + dir.path().string(), ": is a folder"},
+      {"replay " + (dir / "x.log").string() + " --video out.gif",
+       "--video out.gif: .mp4, .avi or .png"},
+      {"replay " + (dir / "x.log").string() + " --from -5", "--from must be >= 0"}};
+  for (const auto& [args, message] : cases) {
+    int status = -1;
+    const std::string out = runCommand(bin + " " + args, status);
+    EXPECT_EQ(WEXITSTATUS(status), 2) << args << ": " << out;
+    EXPECT_NE(out.find(message), std::string::npos) << args << ": " << out;
+  }
+}
+
 TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
   const test::BenchRun run =
       test::runBench(SIMSOCCER_BIN, "bench sensors --robots 1,2 --rays 9,32 --seconds 0.2");

@@ -181,9 +181,12 @@ TEST(MatchConfig, TheAgentsGetTheMotionsFolderBesideTheMatchConfig) {
       "match: motions\nscenario: " + (configs / "scenarios/match_2v2.yaml").string() +
       "\nrules: " + (configs / "rules/spl.yaml").string() + "\n";
   std::ofstream(dir.path() / "named.yaml")
+      << head << "agents:\n  motions: " << (configs / "motions").string() << "\n";
+  EXPECT_EQ(match::loadMatchConfig(dir.path() / "named.yaml").agent_motions, configs / "motions");
+  // The match's Naos would read the K1's keyframes there, and every agent would stop.
+  std::ofstream(dir.path() / "k1.yaml")
       << head << "agents:\n  motions: " << (configs / "motions/booster_k1").string() << "\n";
-  EXPECT_EQ(match::loadMatchConfig(dir.path() / "named.yaml").agent_motions,
-            configs / "motions/booster_k1");
+  EXPECT_THROW(match::loadMatchConfig(dir.path() / "k1.yaml"), engine::ConfigError);
   std::ofstream(dir.path() / "none.yaml") << head;  // no motions folder beside it
   EXPECT_TRUE(match::loadMatchConfig(dir.path() / "none.yaml").agent_motions.empty());
   std::ofstream(dir.path() / "bad.yaml") << head << "agents:\n  motions: nowhere\n";
@@ -200,6 +203,77 @@ TEST(MatchConfig, TheAgentsGetTheMotionsFolderBesideTheMatchConfig) {
                        status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("--motions: no such folder"), std::string::npos) << out;
+}
+
+// What the agents would stop on is refused when the match config loads, naming the file and
+// key: before, the match started, every agent exited on its start-up, and the simulator waited
+// 60 s for claims (a penalty run counted each kick a timeout).
+TEST(MatchConfig, RefusesWhatTheAgentsOrTheRefereeWouldStopOn) {
+  const auto configs = test::sourceDir() / "configs";
+  test::TempDir dir("match_refusals");
+  std::filesystem::create_directories(dir / "agents");
+  {
+    std::ifstream in(configs / "agents/soccer.yaml");
+    std::ofstream out(dir / "agents/slow.yaml");
+    for (std::string line; std::getline(in, line);)
+      out << (line.rfind("max_forward:", 0) == 0 ? "max_forward: -0.25" : line) << "\n";
+  }
+  const std::string head =
+      "match: refusals\nscenario: " + (configs / "scenarios/match_2v2.yaml").string() +
+      "\nrules: " + (configs / "rules/spl.yaml").string() + "\n";
+  const auto refused = [&](const std::string& body, const std::string& file,
+                           const std::string& key) {
+    std::ofstream(dir / "m.yaml") << head << body;
+    try {
+      match::loadMatchConfig(dir / "m.yaml");
+      ADD_FAILURE() << body << ": accepted";
+    } catch (const engine::ConfigError& e) {
+      EXPECT_NE(e.file().find(file), std::string::npos) << body << ": " << e.what();
+      EXPECT_EQ(e.key(), key) << body << ": " << e.what();
+    }
+  };
+  refused("agents: {role: goalie_king}\n", "m.yaml", "agents.role");
+  refused("agents: {config: agents/slow.yaml}\n", "slow.yaml", "max_forward");
+  refused("seed: -7\n", "m.yaml", "seed");
+  refused("set_duration: -1\n", "m.yaml", "set_duration");
+  refused("video: {position: [1, 2, 3], look_at: [1, 2, 3]}\n", "m.yaml", "video.look_at");
+  refused("video: {horizontal_fov: 4}\n", "m.yaml", "video.horizontal_fov");
+  std::ofstream(dir / "five.yaml")
+      << "match: five\nscenario: " << (configs / "scenarios/match_7v7.yaml").string()
+      << "\nrules: " << (configs / "rules/spl.yaml").string() << "\n";
+  try {
+    match::loadMatchConfig(dir / "five.yaml");
+    ADD_FAILURE() << "seven robots a team under a rule book of five: accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "players_per_team") << e.what();
+  }
+  EXPECT_NO_THROW(match::loadMatchConfig(configs / "match_7v7.yaml"));
+}
+
+// An agent that exits before it claims its robot (a bad file, a bad option) stops the match at
+// once with its status; restarting it would fail the same way. A stand-in agent program beside
+// a copy of simsoccer exits 2 at once.
+TEST(MatchApp, AnAgentThatExitsOnItsStartUpStopsTheMatchAtOnce) {
+  const test::TempDir dir("match_agent_exits");
+  std::filesystem::copy_file(kBin, dir / "simsoccer");
+  {
+    std::ofstream agent(dir / "simsoccer-agent");
+    agent << "#!/bin/sh\necho 'simsoccer-agent: config error: made up' >&2\nexit 2\n";
+  }
+  std::filesystem::permissions(dir / "simsoccer-agent", std::filesystem::perms::owner_all);
+  int status = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string out =
+      test::runCommand((dir / "simsoccer").string() + " match " +
+                           (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --half 5 --no-video --out " + (dir / "run").string(),
+                       status);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(WEXITSTATUS(status), 1) << out;
+  EXPECT_NE(out.find("simsoccer-agent: config error: made up"), std::string::npos) << out;
+  EXPECT_NE(out.find("exited (status 2) before it claimed its robot"), std::string::npos) << out;
+  EXPECT_LT(seconds, 30.0) << "waited for claims that could not come";
 }
 
 TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {
@@ -426,6 +500,19 @@ TEST(MatchApp, BadConfigAndUnwritableOutputFailBeforeAnythingRuns) {
     EXPECT_FALSE(std::filesystem::exists(dir / "never"));
   };
   refused("--lockstep-timeout 0", "--lockstep-timeout must be > 0");
+  // A folder that holds an earlier run is not written over unless asked.
+  std::filesystem::create_directories(dir / "earlier");
+  std::ofstream(dir / "earlier" / "summary.json") << "{}\n";
+  const std::string kept =
+      test::runCommand(kBin + " match " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+                           " --out " + (dir / "earlier").string(),
+                       status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(kept.find("holds an earlier run (summary.json): give another --out, or --overwrite"),
+            std::string::npos)
+      << kept;
+  EXPECT_EQ(test::readFile(dir / "earlier" / "summary.json"), "{}\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "earlier" / "match.log"));
   refused("--dds-config /nonexistent/lan.xml", "--dds-config /nonexistent/lan.xml: no such file");
 }
 

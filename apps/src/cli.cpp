@@ -2,6 +2,7 @@
 #include "cli.hpp"
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <charconv>
 #include <cmath>
@@ -55,7 +56,10 @@ Options::Options(int argc, char** argv, int first, const std::vector<std::string
       if (in(flags, name)) {
         flags_[name] = true;
       } else if (in(valued, name)) {
-        if (i + 1 >= argc) throw UsageError("option --" + name + " needs a value");
+        // A value never starts with "--": there it is the next option, and this one's value
+        // was left out.
+        if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+          throw UsageError("option --" + name + " needs a value");
         values_[name] = argv[++i];
       } else {
         throw UsageError("unknown option " + a);
@@ -63,6 +67,24 @@ Options::Options(int argc, char** argv, int first, const std::vector<std::string
     } else {
       positional_.push_back(a);
     }
+  }
+  // Tables and plots are written after the run: a path they cannot go to is refused before it.
+  for (const char* name : {"csv", "png"}) checkWritable(name);
+}
+
+void Options::checkWritable(const std::string& name) const {
+  if (!has(name)) return;
+  {
+    const std::filesystem::path file = values_.at(name);
+    const std::string what = std::string("--") + name + " " + file.string() + ": ";
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw UsageError(what + "is a folder");
+    const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+    if (!std::filesystem::is_directory(folder, ec))
+      throw UsageError(what + "no such folder " + folder.string());
+    const bool exists = std::filesystem::exists(file, ec);
+    if (exists ? ::access(file.c_str(), W_OK) != 0 : ::access(folder.c_str(), W_OK) != 0)
+      throw UsageError(what + "not writable");
   }
 }
 

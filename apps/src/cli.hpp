@@ -43,6 +43,9 @@ class Options {
   bool help(const char* text) const;
   // Throws a UsageError if there are arguments that are not options.
   void noPositional() const;
+  // Option `name`, when given, names a file this run can write (its folder exists and is
+  // writable), else a UsageError. --csv and --png are checked when parsed.
+  void checkWritable(const std::string& name) const;
 
  private:
   std::map<std::string, bool> flags_;

@@ -9,6 +9,7 @@ const char* const kMatchHelp =
     "                       [--no-video] [--half S] [--max-seconds S] [--domain D]\n"
     "                       [--dds-config FILE] [--mode serial|pipelined] [--lola T:P,...]\n"
     "                       [--lola-net] [--external-gc PORT] [--secure DIR] [--quiet]\n"
+    "                       [--overwrite]\n"
     "\n"
     "Plays a whole game (configs/match_5v5.yaml, match_7v7.yaml, match_11v11.yaml): the\n"
     "simulator, the automatic referee (halves, half-time, goals, set plays, penalties, a\n"
@@ -24,6 +25,8 @@ const char* const kMatchHelp =
     "                hash) and the referee events; `simsoccer replay` reads it\n"
     "  match.mp4     the spectator camera rendered from the log, score and clock on top\n"
     "  heatmap.png   ball and team positions over the game\n"
+    "A DIR that holds an earlier run (its summary.json or match.log) is refused.\n"
+    "  --overwrite         replace the earlier run in DIR instead\n"
     "  --half S            half duration in s (overrides the config)\n"
     "  --max-seconds S     stop after S simulated seconds (a partial game, for trials)\n"
     "  --lockstep-timeout S  wall seconds a period waits for the agents (overrides the\n"
@@ -52,7 +55,7 @@ const char* const kMatchHelp =
 
 const char* const kPenaltyHelp =
     "usage: simsoccer penalty CONFIG [--kicks N] [--out DIR] [--seed N] [--video-kicks K]\n"
-    "                         [--domain D] [--dds-config FILE]\n"
+    "                         [--domain D] [--dds-config FILE] [--overwrite]\n"
     "\n"
     "Penalty kicks (configs/penalty.yaml): per kick a fresh world seeded SEED+k, the ball on\n"
     "the penalty mark, a striker and a goalkeeper agent (simsoccer-agent --role auto, which\n"
@@ -60,6 +63,7 @@ const char* const kPenaltyHelp =
     "(30 s per kick, the keeper on its line until the kick). Prints and writes the scoring\n"
     "rate with a 95 % confidence interval (Wilson) and each kick's outcome (goal / saved /\n"
     "missed / timeout) to DIR/penalty.json, and a video of the first K kicks (default 3).\n"
+    "A DIR that holds an earlier run is refused unless --overwrite.\n"
     "  --domain D          DDS domain id, one simulator's on this host (refused while another\n"
     "                      run holds it; default the first free one from 0 up)\n"
     "  --dds-config FILE   Cyclone DDS configuration of the simulator and its agents (default\n"

@@ -22,6 +22,7 @@ RunOptions runOptions(const Options& opt, const MatchConfig& c) {
   RunOptions o;
   o.out = opt.has("out") ? std::filesystem::path(opt.get("out", "")) : timestampedRunDir("");
   o.seed = opt.seed("seed", c.seed);
+  o.overwrite = opt.flag("overwrite");
   o.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   if (!std::filesystem::is_regular_file(o.dds_config))
     throw UsageError(opt.has("dds-config")
@@ -58,10 +59,11 @@ void printStatus(const MatchSession& session, double wall) {
 }  // namespace
 
 int match(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first,
-                    {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net"},
-                    {"out", "seed", "half", "domain", "dds-config", "max-seconds",
-                     "lockstep-timeout", "mode", "lola", "external-gc", "secure"});
+  const Options opt(
+      argc, argv, first,
+      {"help", "realtime", "external-agents", "no-video", "quiet", "lola-net", "overwrite"},
+      {"out", "seed", "half", "domain", "dds-config", "max-seconds", "lockstep-timeout", "mode",
+       "lola", "external-gc", "secure"});
   char help[4096];
   std::snprintf(help, sizeof help, kMatchHelp, sim::modeName(sim::kDefaultMode));
   if (opt.help(help)) return 0;
@@ -111,7 +113,7 @@ int match(int argc, char** argv, int first) {
   }
   const bool tty = !opt.flag("quiet") && isatty(STDOUT_FILENO);
   if (tty) o.progress = printStatus;
-  match::prepareOut(o.out);
+  match::prepareOut(o.out, o.overwrite);
 
   MatchSession session(config, o.seed);
   std::printf(
@@ -147,7 +149,7 @@ int match(int argc, char** argv, int first) {
 }
 
 int penalty(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "quiet"},
+  const Options opt(argc, argv, first, {"help", "quiet", "overwrite"},
                     {"kicks", "out", "seed", "video-kicks", "domain", "dds-config"});
   if (opt.help(kPenaltyHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one penalty config file");

@@ -1,5 +1,6 @@
 // simsoccer replay: what a match log holds, its video, and a re-run of the
 // game through the same period pipeline with the recorded commands.
+#include <cctype>
 #include <cstdio>
 
 #include "cli.hpp"
@@ -33,8 +34,17 @@ int replay(int argc, char** argv, int first) {
   if (opt.help(kReplayHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match log");
   const std::filesystem::path file = opt.positional()[0];
-  const double from = opt.number("from", 0.0), to = opt.number("to", 1e12);
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw UsageError(file.string() + ": is a folder");
+  const double from = opt.nonNegative("from", 0.0), to = opt.nonNegative("to", 1e12);
   if (to < from) throw UsageError("--to must not be before --from");
+  if (opt.has("video")) {
+    std::string ext = std::filesystem::path(opt.get("video", "")).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".mp4" && ext != ".avi" && ext != ".png")
+      throw UsageError("--video " + opt.get("video", "") + ": .mp4, .avi or .png");
+    opt.checkWritable("video");
+  }
   const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
   if (opt.has("threads") && !opt.flag("physics"))
     throw UsageError("--threads goes with --physics (the solver threads of the re-run)");
@@ -69,6 +79,9 @@ int replay(int argc, char** argv, int first) {
         static_cast<unsigned long long>(*cut), last_time);
     status = 4;
   }
+  if (opt.has("video") && (frames == 0 || from > last_time || to < first_time))
+    throw UsageError("--from " + fmt(from, 2) + " --to " + (opt.has("to") ? fmt(to, 2) : "(end)") +
+                     ": the log holds " + fmt(first_time, 2) + " .. " + fmt(last_time, 2) + " s");
   if (opt.flag("physics")) {
     if (!h.count("config")) throw std::runtime_error(file.string() + ": no config in the header");
     match::MatchConfig config = match::loadMatchConfig(h.at("config"));

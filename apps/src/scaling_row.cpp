@@ -87,9 +87,14 @@ ScalingRow runRow(int n, double seconds, bool cameras, sim::Mode mode, int threa
     agents.push_back(std::make_unique<ChildProcess>(soccerAgentCommand(ao)));
   }
   const auto t_wait = Clock::now();
-  while (!server.waitForOwners(w.robotCount(), 0.5))
+  while (!server.waitForOwners(w.robotCount(), 0.5)) {
+    for (const auto& a : agents)
+      if (!a->running())
+        throw std::runtime_error("an agent exited (status " + std::to_string(a->exitStatus()) +
+                                 ") before it claimed its robot");
     if (std::chrono::duration<double>(Clock::now() - t_wait).count() > 60)
       throw std::runtime_error("agents did not claim their robots within 60 s");
+  }
   const double period = s.physics.control_period;
   const auto periods = static_cast<long>(seconds / period);
   w.sensors().resetTimes();

@@ -14,7 +14,7 @@ namespace {
 const char* kSoakHelp =
     "usage: simsoccer soak [CONFIG] [--games N] [--kills N] [--stops N] [--stop-seconds S]\n"
     "                      [--half S] [--seed N] [--out DIR] [--domain D] [--dds-config FILE]\n"
-    "                      [--csv FILE]\n"
+    "                      [--csv FILE] [--overwrite]\n"
     "\n"
     "Plays N whole matches (default 10 of configs/match_5v5.yaml) back to back in this one\n"
     "process, as a tournament server would, without video. In each game it kills --kills\n"
@@ -23,7 +23,8 @@ const char* kSoakHelp =
     "after --stop-seconds, default 3). It samples the resident memory, file descriptors and\n"
     "threads of the simulator and its agents every 0.25 s and prints one row per game.\n"
     "Game K plays seed+K-1 into DIR/game_K/ (default runs/soak-<date-time>/), on DDS domain\n"
-    "D (default the first free one on this host from 0).\n"
+    "D (default the first free one on this host from 0). A DIR that holds an earlier run is\n"
+    "refused unless --overwrite.\n"
     "\n"
     "Checks, exit status 1 if one fails: every game finished with a complete summary.json,\n"
     "every kill was restarted, the simulator's peak memory grew < 5 % from the first game to\n"
@@ -33,7 +34,7 @@ const char* kSoakHelp =
 }  // namespace
 
 int soak(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help"},
+  const Options opt(argc, argv, first, {"help", "overwrite"},
                     {"games", "kills", "stops", "stop-seconds", "half", "seed", "out", "domain",
                      "dds-config", "csv"});
   if (opt.help(kSoakHelp)) return 0;
@@ -54,7 +55,7 @@ int soak(int argc, char** argv, int first) {
   o.run.dds_config = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   o.run.stop_requested = [] { return stopSignalled(); };
   stopOnSignals();
-  match::prepareOut(o.run.out);
+  match::prepareOut(o.run.out, opt.flag("overwrite"));
   std::printf(
       "simsoccer soak %s: %d games, %d kills and %d stops of %.1f s each per game, "
       "DDS domain %u, output %s\n",

@@ -177,6 +177,14 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   const auto stopRequested = [&] { return o.stop_requested && o.stop_requested(); };
   const size_t dds_robots = w.robotCount() - session.lolaRobots().size();
   while (!stopRequested() && !server.waitForOwners(dds_robots, 0.5)) {
+    // An agent that exits before it claims its robot exits on its start-up (its message is
+    // above): restarting it would fail the same way.
+    for (AgentSlot& a : agents)
+      if (a.process && !a.process->running())
+        throw std::runtime_error("the agent of team " + std::to_string(a.team) + " player " +
+                                 std::to_string(a.number) + " exited (status " +
+                                 std::to_string(a.process->exitStatus()) +
+                                 ") before it claimed its robot");
     if (secondsSince(t_wait) > 60.0)
       throw std::runtime_error("agents did not claim their robots within 60 s");
   }
@@ -268,8 +276,12 @@ world::MatchLogHeader logHeader(const MatchSession& s, const RunOptions& o) {
   return h;
 }
 
-void prepareOut(const std::filesystem::path& out) {
+void prepareOut(const std::filesystem::path& out, bool overwrite) {
   std::error_code ec;
+  for (const char* earlier : {"summary.json", "match.log", "penalty.json", "game_1"})
+    if (!overwrite && std::filesystem::exists(out / earlier, ec))
+      throw std::runtime_error(out.string() + " holds an earlier run (" + earlier +
+                               "): give another --out, or --overwrite to replace it");
   std::filesystem::create_directories(out, ec);
   if (ec)
     throw std::runtime_error(out.string() + ": cannot create the output folder (" + ec.message() +
@@ -282,7 +294,7 @@ void prepareOut(const std::filesystem::path& out) {
 }
 
 RunResult playMatch(MatchSession& session, const RunOptions& o) {
-  prepareOut(o.out);
+  prepareOut(o.out, o.overwrite);
   const auto log_file = o.out / "match.log";
   RunResult r;
   {
@@ -303,7 +315,7 @@ RunResult playMatch(MatchSession& session, const RunOptions& o) {
 PenaltyResult playPenalties(
     const MatchConfig& config, const RunOptions& o, int kicks, int video_kicks,
     const std::function<void(int kick, uint64_t seed, const std::string& outcome)>& on_kick) {
-  prepareOut(o.out);
+  prepareOut(o.out, o.overwrite);
   PenaltyResult result;
   std::vector<std::filesystem::path> logs;
   for (int k = 0; k < kicks && !(o.stop_requested && o.stop_requested()); ++k) {

@@ -4,11 +4,15 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/engine/state_hash.hpp"
+#include "simsoccer/fields/field_model.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
+#include "simsoccer/robots/robot_model.hpp"
 
 namespace simsoccer::match {
 namespace {
@@ -18,6 +22,27 @@ std::string fileBytes(const std::filesystem::path& p) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// Loads what the match's agents will load, for every robot model of the scenario: a bad
+// behaviour file, keyframe motion or gait stops the match here, before anything starts, not
+// each agent process after the match began. With no motions folder the agents use their own
+// default one, and only the behaviour file is checked.
+void checkAgentFiles(const MatchConfig& c, const world::Scenario& scenario) {
+  const agents::BehaviourConfig behaviour = c.agent_config.empty()
+                                                ? agents::BehaviourConfig{}
+                                                : agents::loadBehaviourConfig(c.agent_config);
+  if (c.agent_motions.empty()) return;
+  std::set<std::filesystem::path> models;
+  for (const world::RobotPlacement& r : scenario.robots)
+    models.insert(r.model_file.empty() ? scenario.robot_model_file
+                                       : std::filesystem::path(r.model_file));
+  if (models.empty()) return;
+  const fields::FieldModel field = fields::loadFieldModel(scenario.field_file);
+  for (const std::filesystem::path& file : models) {
+    const robots::RobotModel model = robots::loadRobotModel(file);
+    agents::SoccerAgent(model, behaviour, field, agents::motionsFolder(c.agent_motions, model), {});
+  }
 }
 
 }  // namespace
@@ -86,7 +111,13 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
       if (!std::filesystem::is_directory(c.agent_motions))
         (*a)["motions"].fail("no such folder: " + c.agent_motions.string());
     }
-    if (a->has("role")) c.role = (*a)["role"].string();
+    if (a->has("role")) {
+      c.role = (*a)["role"].string();
+      if (!agents::roleFromName(c.role))
+        (*a)["role"].fail(
+            "must be auto, striker, supporter, defender, goalkeeper, penalty-kicker or "
+            "penalty-goalkeeper");
+    }
     c.get_up = a->boolean("get_up", c.get_up);
     c.restart_limit = a->integer("restart_limit", c.restart_limit);
     if (c.restart_limit < 0) (*a)["restart_limit"].fail("must be >= 0");
@@ -106,7 +137,7 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     l->allowOnly({"timeout"});
     c.command_timeout = (*l)["timeout"].positive();
   }
-  c.set_duration = root.number("set_duration", c.set_duration);
+  if (root.has("set_duration")) c.set_duration = root["set_duration"].positive();
   if (auto v = root.optional("video")) {
     v->allowOnly({"enabled", "fps", "size", "position", "look_at", "horizontal_fov"});
     c.video.enabled = v->boolean("enabled", true);
@@ -120,7 +151,14 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     }
     if (v->has("position")) c.video.position = (*v)["position"].vec3();
     if (v->has("look_at")) c.video.look_at = (*v)["look_at"].vec3();
-    if (v->has("horizontal_fov")) c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
+    if (v->has("horizontal_fov")) {
+      c.video.horizontal_fov = (*v)["horizontal_fov"].positive();
+      if (c.video.horizontal_fov >= 3.0)
+        (*v)["horizontal_fov"].fail("must be under 3 rad (a pinhole camera sees less than pi)");
+    }
+    if ((c.video.look_at - c.video.position).norm() < 1e-3)
+      (v->has("look_at") ? (*v)["look_at"] : (*v)["position"])
+          .fail("the camera must look at a point away from its position");
   }
   if (auto l = root.optional("lola")) {
     l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities"});
@@ -166,14 +204,26 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
       for (const engine::ConfigNode& a : (*l)["client"].items()) c.lola.client.push_back(a.string());
     if (l->has("connect_timeout")) c.lola.connect_timeout = (*l)["connect_timeout"].positive();
   }
+  if (root.has("seed") && root["seed"].integer() < 0) root["seed"].fail("must be >= 0");
   c.seed = static_cast<uint64_t>(root.integer("seed", 1));
   if (root.has("penalty")) {
     c.penalty_kicks = root.integer("kicks", 5);
     if (c.penalty_kicks < 1) root["kicks"].fail("must be >= 1");
   }
   // The rule book and scenario must load (their own errors name them).
-  referee::loadRuleBook(c.rules);
-  world::loadScenario(c.scenario);
+  const referee::RuleBook rules = referee::loadRuleBook(c.rules);
+  const world::Scenario scenario = world::loadScenario(c.scenario);
+  for (int team = 0; team < 2; ++team) {
+    const auto players =
+        std::count_if(scenario.robots.begin(), scenario.robots.end(),
+                      [&](const world::RobotPlacement& r) { return r.team == team; });
+    if (players > rules.players_per_team)
+      throw engine::ConfigError(c.rules.string(), "players_per_team",
+                                std::to_string(rules.players_per_team) + ", but " +
+                                    c.scenario.string() + " has " + std::to_string(players) +
+                                    " robots in team " + std::to_string(team));
+  }
+  checkAgentFiles(c, scenario);
   const std::string bytes = fileBytes(file) + fileBytes(c.scenario) + fileBytes(c.rules);
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",

@@ -135,7 +135,8 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
     run.out = o.run.out / ("game_" + std::to_string(g.index));
     run.seed = g.seed;
     run.video = false;
-    prepareOut(run.out);
+    run.overwrite = true;  // this soak's own folder, checked when it started
+    prepareOut(run.out, run.overwrite);
     g.heap_start = heapInUse();
     sampleProcess(0, g.sim_start);
     g.sim_peak_rss = g.sim_start.rss_mib;

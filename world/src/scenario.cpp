@@ -8,12 +8,16 @@
 #include <thread>
 
 #include "simsoccer/engine/config.hpp"
+#include "simsoccer/protocol/wire.hpp"
 
 namespace simsoccer::world {
 
 using engine::ConfigNode;
 
 namespace {
+
+// The GameController's packets carry 20 players a team (protocol::kMaxPlayers).
+const std::string kPlayerNumbers = "player numbers are 1.." + std::to_string(protocol::kMaxPlayers);
 
 void readRate(const ConfigNode& n, double control_period, double& rate) {
   if (!n.has("rate")) return;
@@ -66,7 +70,8 @@ void readCameras(const ConfigNode& n, double control_period, CameraSettings& c) 
       x.team = k["team"].integer();
       if (x.team != 0 && x.team != 1) k.failKey("team", "must be 0 or 1");
       x.number = k["number"].integer();
-      if (x.number < 1) k.failKey("number", "player numbers start at 1");
+      if (x.number < 1 || x.number > static_cast<int>(protocol::kMaxPlayers))
+        k.failKey("number", kPlayerNumbers);
       x.camera = k["camera"].string();
       if (x.camera != "top" && x.camera != "bottom") k.failKey("camera", "must be top or bottom");
       x.rpy = k["rpy"].vec3();
@@ -223,7 +228,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
       p.team = n["team"].integer();
       if (p.team != 0 && p.team != 1) n.failKey("team", "must be 0 or 1");
       p.number = n["number"].integer();
-      if (p.number < 1) n.failKey("number", "player numbers start at 1");
+      if (p.number < 1 || p.number > static_cast<int>(protocol::kMaxPlayers))
+        n.failKey("number", kPlayerNumbers);
       const auto pose = n["pose"].numbers(3);
       p.x = pose[0];
       p.y = pose[1];

@@ -1,6 +1,7 @@
 #include "simsoccer/agents/motion/gait.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +22,36 @@ struct Field {
   double Parameters::*member;
   Range range;
 };
+
+const char* rangeProblem(double v, Range range) {
+  if (!std::isfinite(v)) return "must be a finite number";
+  switch (range) {
+    case Range::Any:
+      return nullptr;
+    case Range::NonNegative:
+      return v >= 0.0 ? nullptr : "must be >= 0";
+    case Range::Positive:
+      return v > 0.0 ? nullptr : "must be > 0";
+    case Range::Share:
+      return v > 0.0 && v <= 1.0 ? nullptr : "must be a share in (0, 1]";
+  }
+  return nullptr;
+}
+
+template <class Parameters>
+void check(const char* group, const std::vector<Field<Parameters>>& fields, const Parameters& p) {
+  for (const auto& f : fields)
+    if (const char* problem = rangeProblem(p.*(f.member), f.range))
+      throw std::invalid_argument(std::string(group) + "." + f.name + ": " + problem);
+}
+
+// Below the walk's own limit, turning on the spot could not keep up with a turn the walk
+// accepts (setVelocity caps it by max_turn): the heading hold's error would grow for ever.
+const char* turnOnSpotProblem(const WalkParameters& p) {
+  return p.max_turn_on_spot > 0.0 && p.max_turn_on_spot < p.max_turn
+             ? "must be 0 (as walking) or at least max_turn"
+             : nullptr;
+}
 
 template <class Parameters>
 void read(const ConfigNode& map, const std::vector<Field<Parameters>>& fields, Parameters& p) {
@@ -111,14 +142,17 @@ Gait loadGait(const std::filesystem::path& file) {
   Gait g;
   if (auto w = root.optional("walk")) {
     read(*w, walkFields(), g.walk);
-    // Below the walk's own limit, turning on the spot could not keep up with a turn the walk
-    // accepts (setVelocity caps it by max_turn): the heading hold's error would grow for ever.
-    const WalkParameters& p = g.walk;
-    if (p.max_turn_on_spot > 0.0 && p.max_turn_on_spot < p.max_turn)
-      w->failKey("max_turn_on_spot", "must be 0 (as walking) or at least max_turn");
+    if (const char* problem = turnOnSpotProblem(g.walk)) w->failKey("max_turn_on_spot", problem);
   }
   if (auto k = root.optional("kick")) read(*k, kickFields(), g.kick);
   return g;
+}
+
+void checkGait(const Gait& g) {
+  check("walk", walkFields(), g.walk);
+  check("kick", kickFields(), g.kick);
+  if (const char* problem = turnOnSpotProblem(g.walk))
+    throw std::invalid_argument(std::string("walk.max_turn_on_spot: ") + problem);
 }
 
 Gait loadGaitIn(const std::filesystem::path& motions_dir) {

@@ -151,14 +151,19 @@ int benchMotion(int argc, char** argv, int first) {
                                " (robots with a motion bench: nao_v6_h25, booster_k1)");
   c.bench = motion::loadMotionBench(bench_file);
   // Another motions folder (same file names) for tuning get-up motions.
+  if (opt.has("motions") && !std::filesystem::is_directory(opt.get("motions", "")))
+    throw UsageError("--motions: no such folder: " + opt.get("motions", ""));
   c.motions_dir = opt.has("motions") ? opt.get("motions", "") : c.bench.motions.string();
   // The robot's gait, then any knob given.
   const agents::Gait gait = agents::loadGaitIn(c.motions_dir);
   wp = gait.walk;
   kp = gait.kick;
   for (const auto& [name, value] : knobs) *value = opt.number(name, *value);
-  if (!(wp.gyro_smoothing > 0.0 && wp.gyro_smoothing <= 1.0))
-    throw UsageError("--gyro-smoothing must be a share in (0, 1]");
+  try {
+    agents::checkGait({wp, kp});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("the gait with the tuning options given: ") + e.what());
+  }
   c.walk = wp;
   c.kick = kp;
   c.verbose = opt.flag("verbose");
@@ -167,9 +172,16 @@ int benchMotion(int argc, char** argv, int first) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }
-  c.dt = opt.number("dt", 0.0);
-  c.control_period = opt.number("control-period", 0.0);
-  if (c.dt < 0 || c.control_period < 0) throw UsageError("--dt and --control-period must be > 0");
+  c.dt = opt.positive("dt", 0.0);  // 0: the bench file's
+  c.control_period = opt.positive("control-period", 0.0);
+  // The trials' counts and lengths, refused before any trial runs.
+  for (const char* n :
+       {"get-up-trials", "sit-trials", "striker-trials", "penalty-trials", "block-trials"})
+    (void)opt.wholeNumber(n, 0, 0, 100000);
+  (void)opt.nonNegative("random-minutes", 0.0);
+  (void)opt.positive("seconds", 0.0);
+  (void)opt.wholeNumber("foot", 0, 0, 1);
+  (void)opt.wholeNumber("steps-first", 0, 0, 1000);
   c.joint_sweeps = opt.wholeNumber("joint-sweeps", 0, 1, 16);
   const auto seed = opt.seed("seed", 1);
   if (opt.has("get-up")) {  // one get-up, for tuning

@@ -20,6 +20,7 @@ namespace simsoccer::match {
 
 struct RunOptions {
   std::filesystem::path out;  // the run's folder
+  bool overwrite = false;     // replace an earlier run's files there (else refused)
   uint64_t seed = 1;
   bool realtime = false;  // paced to the wall clock instead of lockstep
   bool external = false;  // start no agents: wait for agents started elsewhere
@@ -76,8 +77,10 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
 // heatmap.png and (o.video) match.mp4. Throws when o.out cannot be written.
 RunResult playMatch(MatchSession& session, const RunOptions& o);
 
-// Makes the output folder and proves it is writable, before anything runs.
-void prepareOut(const std::filesystem::path& out);
+// Makes the output folder and proves it is writable, before anything runs. A folder that holds
+// an earlier run (its summary.json, match.log, penalty.json or a soak's game_1) is refused
+// unless `overwrite`: the run would replace it.
+void prepareOut(const std::filesystem::path& out, bool overwrite);
 
 }  // namespace simsoccer::match
 

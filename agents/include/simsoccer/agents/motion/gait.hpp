@@ -22,5 +22,9 @@ struct Gait {
 Gait loadGait(const std::filesystem::path& file);
 // `motions_dir`/gait.yaml where it exists, else the defaults.
 Gait loadGaitIn(const std::filesystem::path& motions_dir);
+// The ranges loadGait holds a file to, for parameters set otherwise (bench motion's tuning
+// options): throws std::invalid_argument naming the first one out of range ("walk.max_forward:
+// must be > 0").
+void checkGait(const Gait& gait);
 
 }  // namespace simsoccer::agents
