@@ -141,13 +141,43 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
       {"replay " + dir.path().string(), ": is a folder"},
       {"replay " + (dir / "x.log").string() + " --video out.gif",
        "--video out.gif: .mp4, .avi or .png"},
-      {"replay " + (dir / "x.log").string() + " --from -5", "--from must be >= 0"}};
+      {"replay " + (dir / "x.log").string() + " --from -5", "--from must be >= 0"},
+      {"bench physics --seconds 1 --seconds 2", "option --seconds given twice"},
+      {"bench physics --robots 1000", "the benchmark's grid holds at most"},
+      {"serve " + src + "/configs/scenarios/k1_3v3.yaml --booster-domain 9",
+       "--booster-domain, --booster-lockstep and --booster-netns go with --booster"},
+      {"serve " + src + "/configs/scenarios/lineup_5v5.yaml --teams 1,1",
+       "--teams: two different team numbers"},
+      {"bench", "usage: simsoccer bench physics|sensors|net|cameras|motion|scaling"}};
   for (const auto& [args, message] : cases) {
     int status = -1;
     const std::string out = runCommand(bin + " " + args, status);
     EXPECT_EQ(WEXITSTATUS(status), 2) << args << ": " << out;
     EXPECT_NE(out.find(message), std::string::npos) << args << ": " << out;
   }
+  int status = -1;
+  EXPECT_NE(runCommand(bin + " bench --help", status).find("simsoccer bench NAME --help"),
+            std::string::npos);
+  EXPECT_EQ(status, 0);
+  // A soccer option without --role is refused by the agent, not ignored.
+  const std::string agent = (std::filesystem::path(bin).parent_path() / "simsoccer-agent").string();
+  const std::string seed = runCommand(agent + " --team 0 --player 1 --seed 3", status);
+  EXPECT_EQ(WEXITSTATUS(status), 2) << seed;
+  EXPECT_NE(seed.find("--seed goes with --role"), std::string::npos) << seed;
+  // A second YAML document would be read by nobody; a behaviour the agents do not have.
+  std::ofstream(dir / "two.yaml") << "field: x\n---\nfield: y\n";
+  EXPECT_NE(runCommand(bin + " check " + (dir / "two.yaml").string(), status)
+                .find("two.yaml: (document): holds 2 YAML documents"),
+            std::string::npos);
+  {
+    std::ifstream in(src + "/configs/agents/soccer.yaml");
+    std::ofstream out(dir / "chess.yaml");
+    for (std::string line; std::getline(in, line);)
+      out << (line.rfind("behaviour:", 0) == 0 ? "behaviour: chess" : line) << "\n";
+  }
+  EXPECT_NE(runCommand(bin + " check " + (dir / "chess.yaml").string(), status)
+                .find("chess.yaml: behaviour: must be soccer"),
+            std::string::npos);
 }
 
 TEST(BenchSensorsApp, PrintsTableAndWritesCsv) {
@@ -384,8 +414,9 @@ TEST(ServeApp, CommandLineNumbersAreRangeChecked) {
   };
   for (const auto& [options, message] : cases) {
     int status = -1;
+    const std::string domain = options.rfind("--domain", 0) == 0 ? " " : " --domain 149 ";
     const std::string out = test::runCommand(
-        std::string(SIMSOCCER_BIN) + " serve " + scenario + " --domain 149 " + options, status);
+        std::string(SIMSOCCER_BIN) + " serve " + scenario + domain + options, status);
     EXPECT_EQ(WEXITSTATUS(status), 2) << options << ": " << out;
     EXPECT_NE(out.find(message), std::string::npos) << options << ": " << out;
   }

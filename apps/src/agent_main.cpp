@@ -69,6 +69,12 @@ int main(int argc, char** argv) {
     // Soccer (--role): behaviour and motion, loaded before claiming so a bad
     // file stops here.
     std::unique_ptr<agents::SoccerAgent> soccer;
+    if (!opt.has("role"))
+      for (const char* soccer_only : {"seed", "config", "team-number"})
+        if (opt.has(soccer_only))
+          throw apps::UsageError(std::string("--") + soccer_only + " goes with --role");
+    if (!opt.has("role") && opt.flag("no-get-up"))
+      throw apps::UsageError("--no-get-up goes with --role");
     if (opt.has("role")) {
       const auto role = agents::roleFromName(opt.get("role", ""));
       if (!role)
@@ -117,13 +123,13 @@ int main(int argc, char** argv) {
     // robot is claimed, so the first frame is answered with it however late
     // it would have arrived (otherwise the first periods may be played
     // without it, and the same seed gives another game).
-    const double game_wait = opt.number("game-state-wait", 0.0);
+    const double game_wait = opt.nonNegative("game-state-wait", 0.0);
     if (soccer && game_wait > 0.0 && !client.waitForGameState(game_wait))
       std::fprintf(stderr,
                    "simsoccer-agent: robot (%d, %d): no GameState within %g s; playing without "
                    "it until one comes (a lockstep run may then differ between runs)\n",
                    team, player, game_wait);
-    if (!client.claim(opt.number("claim-timeout", 10.0),
+    if (!client.claim(opt.positive("claim-timeout", 10.0),
                       if_owned == "refuse" ? agents::AgentClient::IfOwned::Refuse
                                            : agents::AgentClient::IfOwned::WaitForRelease)) {
       std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cli.hpp"
 #include "simsoccer/engine/config.hpp"
 
 namespace simsoccer::apps {
@@ -45,6 +46,9 @@ world::Scenario placeRobots(const BenchConfig& c, int n, double half_length, dou
     p.x = -half_length + (col + 0.5) * (2 * half_length / columns) + 0.4 * layer;
     p.y = -half_width + (row + 0.5) * (2 * half_width / rows) + (i % 2 ? 0.5 : -0.5) * c.pair_gap;
     p.yaw = 0.0;
+    if (p.x > half_length - 0.1)
+      throw UsageError("--robots " + std::to_string(n) + ": the benchmark's grid holds at most " +
+                       std::to_string(i - i % 2) + " robots on this field");
     s.robots.push_back(p);
   }
   return s;

@@ -60,6 +60,12 @@ int main(int argc, char** argv) {
       if (sub == "cameras") return benchCameras(argc, argv, 3);
       if (sub == "motion") return benchMotion(argc, argv, 3);
       if (sub == "scaling") return benchScaling(argc, argv, 3);
+      if (sub.empty() || sub == "--help" || sub == "-h") {
+        std::printf(
+            "usage: simsoccer bench physics|sensors|net|cameras|motion|scaling [OPTIONS]\n"
+            "(simsoccer bench NAME --help explains each one)\n");
+        return sub.empty() ? 2 : 0;
+      }
       std::fprintf(stderr,
                    "simsoccer bench: unknown benchmark '%s' (available: physics, sensors, net, "
                    "cameras, motion, scaling)\n",

@@ -41,6 +41,9 @@ int serve(int argc, char** argv, int first) {
                      "out", "external-gc", "booster", "booster-domain"});
   if (opt.help(kServeHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
+  if (!opt.has("booster") &&
+      (opt.has("booster-domain") || opt.flag("booster-lockstep") || opt.flag("booster-netns")))
+    throw UsageError("--booster-domain, --booster-lockstep and --booster-netns go with --booster");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;
   // Agents started elsewhere are told the domain: it is what it says or refused.
@@ -115,7 +118,9 @@ int serve(int argc, char** argv, int first) {
     team_numbers = session->config().team_numbers;
   } else if (opt.has("teams")) {
     const std::vector<int> numbers = opt.intList("teams", {1, 2});
-    if (numbers.size() != 2) throw UsageError("--teams: two team numbers");
+    if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 254 || numbers[1] < 0 ||
+        numbers[1] > 254 || numbers[0] == numbers[1])
+      throw UsageError("--teams: two different team numbers 0..254");
     team_numbers = {numbers[0], numbers[1]};
   }
   // Booster SDK clients run on the wall clock: real time unless --booster-lockstep.

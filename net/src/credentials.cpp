@@ -265,7 +265,11 @@ void writeMatchCredentials(const CredentialsOptions& o) {
     throw std::runtime_error("Cyclone DDS's security plugins are not in '" + plugins.string() +
                              "' (Debian's libddsc0debian package has them)");
   if (o.days < 1) throw std::runtime_error("credentials must be valid for at least one day");
-  std::filesystem::create_directories(o.dir);
+  std::error_code made;
+  std::filesystem::create_directories(o.dir, made);
+  if (made)
+    throw std::runtime_error(o.dir.string() + ": cannot make the credentials folder (" +
+                             made.message() + ")");
   const std::filesystem::path dir = std::filesystem::absolute(o.dir);
   Key ca_key = newKey();
   Cert ca = newCert(ca_key.get(), "simsoccer match authority", nullptr, nullptr, o.days);

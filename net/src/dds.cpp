@@ -133,7 +133,14 @@ Participant::Participant(const DomainConfig& config) {
     const std::vector<int> before = udpSockets();
     const dds_entity_t d = dds_create_domain(config.domain, xml.str().c_str());
     // A domain this process already created keeps its configuration.
-    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) check(d, "create domain");
+    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) {
+      if (config.config_file.empty()) check(d, "create domain");
+      // Cyclone names the configuration "CYCLONEDDS_URI+0" in what it prints.
+      throw std::runtime_error(config.config_file.string() +
+                               ": Cyclone DDS refused this configuration (its messages above; "
+                               "\"CYCLONEDDS_URI+0\" is this file) and created no domain " +
+                               std::to_string(config.domain));
+    }
     if (d > 0) {
       domain_ = Entity(d);
       std::vector<int> made;

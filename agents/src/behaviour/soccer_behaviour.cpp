@@ -142,6 +142,8 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "supporter_deepest",
                   "clear_max_angle",
                   "sit_when_finished"});
+  if (root.has("behaviour") && root["behaviour"].string() != "soccer")
+    root["behaviour"].fail("must be soccer (the one behaviour the built-in agents play)");
   BehaviourConfig c;
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);

@@ -48,7 +48,13 @@ ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw ConfigError(name, "", "file not found");
   if (!std::filesystem::is_regular_file(file)) throw ConfigError(name, "", "not a regular file");
   try {
-    YAML::Node root = YAML::LoadFile(name);
+    // A second document (after ---) would be read by nobody: refused rather than ignored.
+    const std::vector<YAML::Node> documents = YAML::LoadAllFromFile(name);
+    if (documents.size() > 1)
+      throw ConfigError(name, "",
+                        "holds " + std::to_string(documents.size()) +
+                            " YAML documents (--- lines); a config file is one");
+    YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
     long budget = 100000;
     checkKeys(root, name, "", 0, budget);
