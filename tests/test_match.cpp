@@ -274,6 +274,8 @@ TEST(MatchApp, AnAgentThatExitsOnItsStartUpStopsTheMatchAtOnce) {
   EXPECT_NE(out.find("simsoccer-agent: config error: made up"), std::string::npos) << out;
   EXPECT_NE(out.find("exited (status 2) before it claimed its robot"), std::string::npos) << out;
   EXPECT_LT(seconds, 30.0) << "waited for claims that could not come";
+  // No game was played: no log's header is left to look like an earlier run.
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "match.log"));
 }
 
 TEST(MatchApp, SameSeedTwiceGivesTheSameSummaryAndFinalStateHash) {

@@ -16,8 +16,8 @@
 #include "simsoccer/match/outputs.hpp"
 #include "simsoccer/net/credentials.hpp"
 #include "simsoccer/net/robot_keys.hpp"
-#include "simsoccer/protocol/wire.hpp"
 #include "simsoccer/net/sim_server.hpp"
+#include "simsoccer/protocol/wire.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
 #include "simsoccer/sim/run_loop.hpp"
 
@@ -298,9 +298,19 @@ RunResult playMatch(MatchSession& session, const RunOptions& o) {
   const auto log_file = o.out / "match.log";
   RunResult r;
   {
-    world::MatchLogWriter log(log_file, logHeader(session, o));
-    r = play(session, o, log);
-    r.log_bytes = log.bytes();
+    std::optional<world::MatchLogWriter> log(std::in_place, log_file, logHeader(session, o));
+    try {
+      r = play(session, o, *log);
+    } catch (...) {
+      // Failed before the first period (agents, DDS, LoLA): no game to keep, and a header
+      // alone would make the folder look like an earlier run to the next one.
+      const bool empty = log->frames() == 0;
+      log.reset();
+      std::error_code ec;
+      if (empty) std::filesystem::remove(log_file, ec);
+      throw;
+    }
+    r.log_bytes = log->bytes();
   }
   writeSummary(o.out / "summary.json", session, r, o);
   if (!r.interrupted) {
