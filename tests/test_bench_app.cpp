@@ -148,7 +148,20 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
        "--booster-domain, --booster-lockstep and --booster-netns go with --booster"},
       {"serve " + src + "/configs/scenarios/lineup_5v5.yaml --teams 1,1",
        "--teams: two different team numbers"},
-      {"bench", "usage: simsoccer bench physics|sensors|net|cameras|motion|scaling"}};
+      {"bench", "usage: simsoccer bench physics|sensors|net|cameras|motion|scaling"},
+      {"match " + src + "/configs/match_2v2.yaml --lola-net", "--lola-net: no LoLA robots"},
+      {"match " + src + "/configs/match_2v2.yaml --external-gc 3939",
+       "--external-gc 3939: the GameController's own port"},
+      {"serve " + src + "/configs/match_2v2.yaml --teams 3,4",
+       "--teams: a match config names its own teams"},
+      {"serve " + src + "/configs/scenarios/match_11v11.yaml --rules " + src +
+           "/configs/rules/spl.yaml",
+       "5 players a team, but"},
+      {"lola-run --socket s --robot 1:1 -- true", "--socket and --robot exclude each other"},
+      {"lola-run --robot 1:1 --prefix 10.0 -- true", "--prefix and --bridge go with --net"},
+      {"booster-run -- true", "--robot T:P is required"},
+      {"booster-run --robot 1:1 --profile " + (dir / "none.xml").string() + " -- true",
+       "none.xml: no such file"}};
   for (const auto& [args, message] : cases) {
     int status = -1;
     const std::string out = runCommand(bin + " " + args, status);
@@ -156,6 +169,21 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
     EXPECT_NE(out.find(message), std::string::npos) << args << ": " << out;
   }
   int status = -1;
+  // A robot named on the command line is the option's fault, and nothing is written.
+  const std::string lola =
+      runCommand(bin + " match " + src + "/configs/match_2v2.yaml --lola 2:3 --out " +
+                     (dir / "lola_run").string(),
+                 status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(lola.find("--lola: no robot 2:3 in the match"), std::string::npos) << lola;
+  EXPECT_FALSE(std::filesystem::exists(dir / "lola_run"));
+  // A match authority is not replaced unless asked: the credentials it signed would stop working.
+  std::filesystem::create_directories(dir / "creds");
+  std::ofstream(dir / "creds" / "ca.pem") << "kept\n";
+  EXPECT_NE(runCommand(bin + " credentials " + (dir / "creds").string(), status)
+                .find("holds a match authority (ca.pem)"),
+            std::string::npos);
+  EXPECT_EQ(test::readFile(dir / "creds" / "ca.pem"), "kept\n");
   EXPECT_NE(runCommand(bin + " bench --help", status).find("simsoccer bench NAME --help"),
             std::string::npos);
   EXPECT_EQ(status, 0);

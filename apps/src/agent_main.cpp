@@ -57,6 +57,11 @@ int main(int argc, char** argv) {
       throw apps::UsageError("--mode must be nod, walk, garbage or stall");
     const long stall_after = opt.wholeNumber("stall-after", 50, 0, 1000000000);
     const long max_ticks = opt.wholeNumber("ticks", -1, -1, 2000000000);
+    if (max_ticks == 0) throw apps::UsageError("--ticks must be >= 1 (or -1: no limit)");
+    if (opt.has("stall-after") && mode != "stall")
+      throw apps::UsageError("--stall-after goes with --mode stall");
+    if (opt.has("mode") && opt.has("role"))
+      throw apps::UsageError("--mode and --role exclude each other (--role plays soccer)");
 
     const robots::RobotModel model = robots::loadRobotModel(robot_file);
     // The motions and gaits: a folder per robot model that has its own (motionsFolder).
@@ -132,7 +137,10 @@ int main(int argc, char** argv) {
     if (!client.claim(opt.positive("claim-timeout", 10.0),
                       if_owned == "refuse" ? agents::AgentClient::IfOwned::Refuse
                                            : agents::AgentClient::IfOwned::WaitForRelease)) {
-      std::fprintf(stderr, "simsoccer-agent: robot (%d, %d) not granted\n", team, player);
+      std::fprintf(stderr,
+                   "simsoccer-agent: robot (%d, %d) not granted on DDS domain %u (no simulator "
+                   "there, or another participant owns it)\n",
+                   team, player, dds.domain);
       return 3;
     }
     // Answers run in the DDS receive thread (AgentClient::onFrame): no

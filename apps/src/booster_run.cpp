@@ -44,7 +44,13 @@ int boosterRun(int argc, char** argv, int first) {
   if (opt.help(kBoosterRunHelp)) return 0;
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
+  if (!opt.has("robot")) throw UsageError("--robot T:P is required (the robot to drive)");
   const std::string robot = opt.get("robot", "");
+  // The profile before anything else: checked, and absolute (the program may change folder).
+  const std::filesystem::path profile = std::filesystem::absolute(
+      findConfig(opt.get("profile", ""), "configs/dds/booster_fastdds.xml"));
+  if (!std::filesystem::is_regular_file(profile))
+    throw UsageError("--profile " + profile.string() + ": no such file");
   std::vector<match::LolaPlayer> players;
   try {
     players = match::parseLolaPlayers(robot);
@@ -67,8 +73,6 @@ int boosterRun(int argc, char** argv, int first) {
                      " (needs root)");
   }
   ::close(fd);
-  const std::string profile =
-      findConfig(opt.get("profile", ""), "configs/dds/booster_fastdds.xml").string();
   ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", profile.c_str(), /*overwrite=*/0);
   ::execvp(argv[split + 1], argv + split + 1);
   const int e = errno;

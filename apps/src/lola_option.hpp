@@ -10,13 +10,17 @@ namespace simsoccer::apps {
 
 inline void addLolaRobots(const Options& opt, match::MatchConfig& config) {
   if (opt.flag("lola-net")) config.lola.network = true;
-  if (!opt.has("lola")) return;
-  try {
-    const auto players = match::parseLolaPlayers(opt.get("lola", ""));
-    config.lola.robots.insert(config.lola.robots.end(), players.begin(), players.end());
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(std::string("--lola: ") + e.what());
+  if (opt.has("lola")) {
+    try {
+      const auto players = match::parseLolaPlayers(opt.get("lola", ""));
+      config.lola.robots.insert(config.lola.robots.end(), players.begin(), players.end());
+      config.lola.from_option = players.size();
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--lola: ") + e.what());
+    }
   }
+  if (opt.flag("lola-net") && config.lola.robots.empty())
+    throw UsageError("--lola-net: no LoLA robots (--lola T:P,... or the config's lola.robots)");
 }
 
 }  // namespace simsoccer::apps

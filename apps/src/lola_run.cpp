@@ -80,6 +80,11 @@ int lolaRun(int argc, char** argv, int first) {
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   if (!opt.has("socket") && !opt.has("robot")) throw UsageError("give --socket or --robot");
+  if (opt.has("socket") && opt.has("robot"))
+    throw UsageError("--socket and --robot exclude each other (--robot finds the socket)");
+  if (opt.has("socket") && opt.get("socket", "").empty()) throw UsageError("--socket: empty path");
+  if (!opt.flag("net") && (opt.has("prefix") || opt.has("bridge")))
+    throw UsageError("--prefix and --bridge go with --net");
   if (opt.flag("net") && !opt.has("robot"))
     throw UsageError("--net: give --robot T:P (its address)");
   std::vector<match::LolaPlayer> players;
@@ -96,7 +101,7 @@ int lolaRun(int argc, char** argv, int first) {
                         : match::lolaSocketPath(opt.get("run", "runs/serve"), players[0]);
   socket = std::filesystem::absolute(socket);
   const double wait = opt.number("wait", 60.0);
-  if (!(wait >= 0)) throw UsageError("--wait must be >= 0 s");
+  if (!(wait >= 0 && wait <= 86400)) throw UsageError("--wait must be 0 to 86400 s");
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long>(wait * 1000));
   while (!std::filesystem::is_socket(socket)) {
@@ -112,6 +117,10 @@ int lolaRun(int argc, char** argv, int first) {
     lola::FieldNetwork net;
     net.bridge = opt.get("bridge", net.bridge);
     net.prefix = opt.get("prefix", net.prefix);
+    unsigned a = 256, b = 256;
+    char rest = 0;
+    if (std::sscanf(net.prefix.c_str(), "%u.%u%c", &a, &b, &rest) != 2 || a > 255 || b > 255)
+      throw UsageError("--prefix " + net.prefix + ": the network's first two numbers, A.B");
     if (!std::filesystem::exists("/sys/class/net/" + net.bridge))
       throw std::runtime_error("no field network '" + net.bridge +
                                "': start the simulator with --lola-net first");

@@ -84,6 +84,10 @@ int match(int argc, char** argv, int first) {
   addLolaRobots(opt, config);
   if (opt.has("external-gc"))
     config.external_gc_port = static_cast<uint16_t>(opt.wholeNumber("external-gc", 3838, 1, 65535));
+  if (config.external_gc_port == 3939)
+    throw UsageError(
+        "--external-gc 3939: the GameController's own port (it hears the robots "
+        "there); its packets come on 3838");
   RunOptions o = runOptions(opt, config);
   o.realtime = opt.flag("realtime") || config.external_gc_port.has_value();
   o.external = opt.flag("external-agents");
@@ -113,9 +117,8 @@ int match(int argc, char** argv, int first) {
   }
   const bool tty = !opt.flag("quiet") && isatty(STDOUT_FILENO);
   if (tty) o.progress = printStatus;
+  MatchSession session(config, o.seed);  // (a bad --lola robot stops here, nothing written)
   match::prepareOut(o.out, o.overwrite);
-
-  MatchSession session(config, o.seed);
   std::printf(
       "simsoccer match %s: %zu robots, seed %llu, %s, %s periods, DDS domain %u, output %s\n",
       config.name.c_str(), session.world().robotCount(), static_cast<unsigned long long>(o.seed),

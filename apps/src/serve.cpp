@@ -45,6 +45,8 @@ int serve(int argc, char** argv, int first) {
       (opt.has("booster-domain") || opt.flag("booster-lockstep") || opt.flag("booster-netns")))
     throw UsageError("--booster-domain, --booster-lockstep and --booster-netns go with --booster");
   const std::filesystem::path file = opt.positional()[0];
+  if (opt.flag("lola-net") && !opt.has("lola") && !isMatchConfig(file))
+    throw UsageError("--lola-net goes with --lola");
   net::ServerConfig cfg;
   // Agents started elsewhere are told the domain: it is what it says or refused.
   const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::Fixed);
@@ -53,6 +55,10 @@ int serve(int argc, char** argv, int first) {
   std::optional<uint16_t> external_gc;
   if (opt.has("external-gc")) {
     external_gc = static_cast<uint16_t>(opt.wholeNumber("external-gc", 3838, 1, 65535));
+    if (*external_gc == 3939)
+      throw UsageError(
+          "--external-gc 3939: the GameController's own port (it hears the robots "
+          "there); its packets come on 3838");
     if (opt.has("gc-address"))
       throw UsageError(
           "--external-gc: an external GameController sends the packets, not --gc-address");
@@ -67,6 +73,7 @@ int serve(int argc, char** argv, int first) {
   sim::GameOfficials* officials = nullptr;
   if (isMatchConfig(file)) {
     if (opt.has("rules")) throw UsageError("--rules: a match config names its own rule book");
+    if (opt.has("teams")) throw UsageError("--teams: a match config names its own teams");
     match::MatchConfig mc = match::loadMatchConfig(file);
     if (opt.has("half")) {
       const double h = opt.number("half", 0);
@@ -88,6 +95,13 @@ int serve(int argc, char** argv, int first) {
     own_world = std::make_unique<world::World>(scenario);
     if (opt.has("rules")) {
       const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
+      for (int team = 0; team < 2;
+           ++team)  // the others would be substitutes (match refuses it too)
+        if (std::count_if(scenario.robots.begin(), scenario.robots.end(),
+                          [&](const auto& r) { return r.team == team; }) > rules.players_per_team)
+          throw UsageError("--rules " + opt.get("rules", "") + ": " +
+                           std::to_string(rules.players_per_team) + " players a team, but " +
+                           file.string() + " has more in team " + std::to_string(team));
       const std::vector<int> numbers = opt.intList("teams", {1, 2});
       if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
           numbers[1] > 255 || numbers[0] == numbers[1])
@@ -116,7 +130,7 @@ int serve(int argc, char** argv, int first) {
   std::array<int, 2> team_numbers{1, 2};
   if (session) {
     team_numbers = session->config().team_numbers;
-  } else if (opt.has("teams")) {
+  } else if (opt.has("teams")) {  // (a match config's own teams: refused above)
     const std::vector<int> numbers = opt.intList("teams", {1, 2});
     if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 254 || numbers[1] < 0 ||
         numbers[1] > 254 || numbers[0] == numbers[1])

@@ -33,7 +33,9 @@ ChildProcess::ChildProcess(std::vector<std::string> args, std::vector<std::strin
   envp.push_back(nullptr);
   // During a pipelined run, off the CPU the periods run on (sim/cores.hpp).
   sim::CoreClaim::spawnOnOtherCpus([&] {
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
+    // A program named without a '/' is looked up on PATH, as a shell would.
+    spawn_error_ = posix_spawnp(&pid_, argv[0], nullptr, nullptr, argv.data(), envp.data());
+    if (spawn_error_ != 0) pid_ = -1;
   });
 }
 

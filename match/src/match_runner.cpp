@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -140,7 +141,22 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     }
     lola_clients.push_back(std::make_unique<ChildProcess>(args));
     if (!lola_clients.back()->started())
-      throw std::runtime_error("cannot start the LoLA client " + args[0]);
+      throw std::runtime_error("lola.client: cannot start " + args[0] + " (" +
+                               std::strerror(lola_clients.back()->spawnError()) + ")");
+  }
+  const auto stopRequested = [&] { return o.stop_requested && o.stop_requested(); };
+  // The LoLA clients (started by hand, maybe much later) first: agents started before would
+  // see no frame while this waits, take the simulator for gone and exit.
+  if (lola_robots) {
+    const auto t_lola = Clock::now();
+    while (!stopRequested() && !lola_robots->endpoint().waitForClients(0.5))
+      if (secondsSince(t_lola) > c.lola.connect_timeout) {
+        if (o.notice)
+          o.notice("not every LoLA client connected within " +
+                   fixedNumber(c.lola.connect_timeout, 0) +
+                   " s: the match starts, their robots hold");
+        break;
+      }
   }
   net::SimServer server(simulation, sc);
   // The agents find the game state when they start.
@@ -174,7 +190,6 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     agents.push_back(std::move(a));
   }
   const auto t_wait = Clock::now();
-  const auto stopRequested = [&] { return o.stop_requested && o.stop_requested(); };
   const size_t dds_robots = w.robotCount() - session.lolaRobots().size();
   while (!stopRequested() && !server.waitForOwners(dds_robots, 0.5)) {
     // An agent that exits before it claims its robot exits on its start-up (its message is
@@ -187,16 +202,6 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
                                  ") before it claimed its robot");
     if (secondsSince(t_wait) > 60.0)
       throw std::runtime_error("agents did not claim their robots within 60 s");
-  }
-  if (lola_robots) {
-    const auto t_lola = Clock::now();
-    while (!stopRequested() && !lola_robots->endpoint().waitForClients(0.5))
-      if (secondsSince(t_lola) > c.lola.connect_timeout) {
-        if (o.notice)
-          o.notice("not every LoLA client connected within " +
-                   fixedNumber(c.lola.connect_timeout, 0) + " s: the match starts, their robots hold");
-        break;
-      }
   }
   const auto t0 = Clock::now();
   double last_progress = -1.0;

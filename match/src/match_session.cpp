@@ -270,7 +270,14 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     rec.last = world_->torsoPose(r).translation();
     records_.push_back(rec);
   }
-  for (const LolaPlayer& p : config.lola.robots) {
+  for (size_t i = 0; i < config.lola.robots.size(); ++i) {
+    const LolaPlayer& p = config.lola.robots[i];
+    // A robot named with --lola is the command line's fault, not the file's.
+    const bool option = i >= config.lola.robots.size() - config.lola.from_option;
+    const auto fail = [&](const std::string& reason) {
+      if (option) throw std::invalid_argument("--lola: " + reason);
+      throw engine::ConfigError(config.file, "lola.robots", reason);
+    };
     int team = -1;
     for (int t = 0; t < 2; ++t)
       if (config.team_numbers[static_cast<size_t>(t)] == p.team_number) team = t;
@@ -278,16 +285,13 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     for (world::RobotId r = 0; r < world_->robotCount(); ++r)
       if (world_->robot(r).team == team && world_->robot(r).number == p.player) found = r;
     if (!found)
-      throw engine::ConfigError(config.file, "lola.robots",
-                                "no robot " + std::to_string(p.team_number) + ":" +
-                                    std::to_string(p.player) + " in the match (teams " +
-                                    std::to_string(config.team_numbers[0]) + " and " +
-                                    std::to_string(config.team_numbers[1]) + ")");
+      fail("no robot " + std::to_string(p.team_number) + ":" + std::to_string(p.player) +
+           " in the match (teams " + std::to_string(config.team_numbers[0]) + " and " +
+           std::to_string(config.team_numbers[1]) + ")");
     for (world::RobotId r : lola_robots_)
       if (r == *found)
-        throw engine::ConfigError(config.file, "lola.robots",
-                                  "robot " + std::to_string(p.team_number) + ":" +
-                                      std::to_string(p.player) + " is named twice");
+        fail("robot " + std::to_string(p.team_number) + ":" + std::to_string(p.player) +
+             " is named twice");
     lola_robots_.push_back(*found);
   }
 }

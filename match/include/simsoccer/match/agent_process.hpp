@@ -25,6 +25,7 @@ class ChildProcess {
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
   bool started() const { return pid_ > 0; }
+  int spawnError() const { return spawn_error_; }  // errno of a failed start, else 0
   pid_t pid() const { return pid_; }
   // False once the process has exited (reaped; exitStatus() then tells how).
   bool running();
@@ -34,6 +35,7 @@ class ChildProcess {
  private:
   pid_t pid_ = -1;
   int exit_status_ = -1;
+  int spawn_error_ = 0;
 };
 
 // The simsoccer-agent program beside the running executable.

@@ -38,6 +38,7 @@ std::vector<LolaPlayer> parseLolaPlayers(const std::string& list);
 
 struct LolaSettings {
   std::vector<LolaPlayer> robots;
+  size_t from_option = 0;  // the last ones came from the command line (--lola), not the file
   // Started once per LoLA robot with "{socket}" replaced by its socket path
   // (e.g. `simsoccer lola-run --socket {socket} -- ./team-binary`); empty:
   // the clients are started by hand.
