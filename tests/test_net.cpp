@@ -366,7 +366,7 @@ TEST(Net, TheLanConfigurationFindsTheAgentOnANetworkInterface) {
   cfg.dds.config_file = lan;
   sim::Simulation simulation(w);
   net::SimServer server(simulation, cfg);
-  AgentProcess agent(domain, 0, 1, {"--dds-config", lan});
+  AgentProcess agent(domain, 0, 1, {}, {}, lan);
   ASSERT_TRUE(server.waitForOwners(1, 20.0)) << "the agent did not claim its robot";
   for (int i = 0; i < 100; ++i) simulation.period();
   const auto& st = server.stats(0);

@@ -77,6 +77,35 @@ TEST(Secure, CredentialsAreSignedByTheMatchAuthority) {
   EXPECT_EQ(team0.find("robot_1_"), std::string::npos);
 }
 
+// What a secure match reads is checked before it starts, naming the bad file (Cyclone and
+// OpenSSL name none): another authority's certificate, a key that is not the certificate's,
+// garbage permissions, a folder copied elsewhere (its ID.xml files name the original's files).
+TEST(Secure, ABadCredentialsFolderIsRefusedNamingTheFile) {
+  const Credentials c("secure_check"), other("secure_check_other");
+  EXPECT_NO_THROW(net::checkMatchCredentials(c.dir.path()));
+  const auto refused = [&](const std::filesystem::path& dir, const std::string& said) {
+    try {
+      net::checkMatchCredentials(dir);
+      ADD_FAILURE() << "accepted; expected: " << said;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(said), std::string::npos) << e.what();
+    }
+  };
+  const test::TempDir copy("secure_check_copy");
+  std::filesystem::copy(c.dir.path(), copy.path(), std::filesystem::copy_options::recursive);
+  refused(copy.path(), "simulator.xml: names " + (c / "ca.pem").string());
+  std::filesystem::copy_file(other / "team_0.pem", c / "team_0.pem",
+                             std::filesystem::copy_options::overwrite_existing);
+  refused(c.dir.path(), "team_0.pem: not signed by this folder's ca.pem");
+  std::filesystem::copy_file(c / "team_1.pem", c / "team_0.pem",
+                             std::filesystem::copy_options::overwrite_existing);
+  refused(c.dir.path(), "team_0_key.pem: not the key of");
+  std::filesystem::copy_file(c / "team_0.pem", c / "team_1.pem",
+                             std::filesystem::copy_options::overwrite_existing);  // undo-ish
+  std::ofstream(c / "governance.p7s") << "garbage\n";
+  refused(c.dir.path(), "governance.p7s: not an S/MIME signed document");
+}
+
 // Without this authority's credentials a participant is not even matched;
 // with the other team's, its own DDS refuses it the robot's topics, and with
 // the other team's identity and permissions it signed itself the simulator

@@ -80,8 +80,10 @@ int lolaRun(int argc, char** argv, int first) {
   opt.noPositional();
   if (split + 1 >= argc) throw UsageError("expected -- PROGRAM [ARGS...]");
   if (!opt.has("socket") && !opt.has("robot")) throw UsageError("give --socket or --robot");
-  if (opt.has("socket") && opt.has("robot"))
-    throw UsageError("--socket and --robot exclude each other (--robot finds the socket)");
+  if (opt.has("socket") && opt.has("robot") && !opt.flag("net"))
+    throw UsageError(
+        "--socket and --robot exclude each other (--robot finds the socket; with "
+        "--net it also names the robot's address)");
   if (opt.has("socket") && opt.get("socket", "").empty()) throw UsageError("--socket: empty path");
   if (!opt.flag("net") && (opt.has("prefix") || opt.has("bridge")))
     throw UsageError("--prefix and --bridge go with --net");

@@ -102,11 +102,16 @@ int match(int argc, char** argv, int first) {
                   opt.has("secure") ? secure_max : 232);
   o.domain = domain.domain();
   if (opt.has("secure")) {
+    if (opt.has("dds-config"))
+      throw UsageError(
+          "--secure and --dds-config exclude each other (the credentials' ID.xml "
+          "files are the Cyclone configurations)");
     o.secure = opt.get("secure", "");
     for (const std::string& id : net::credentialIdentities())
       if (!std::filesystem::is_regular_file(net::credentialConfig(o.secure, id)))
         throw UsageError("--secure " + o.secure.string() + ": no " + id + ".xml" +
                          " (make the folder with `simsoccer credentials DIR`)");
+    net::checkMatchCredentials(o.secure);
   }
   o.video = config.video.enabled && !opt.flag("no-video");
   o.max_seconds = opt.nonNegative("max-seconds", 0);

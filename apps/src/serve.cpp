@@ -65,6 +65,9 @@ int serve(int argc, char** argv, int first) {
   }
   cfg.lockstep = !opt.flag("realtime") && !external_gc;
   cfg.hold_on_release = !opt.flag("limp-on-release");
+  cfg.notice = [](const std::string& line) {
+    std::fprintf(stderr, "simsoccer: %s\n", line.c_str());
+  };
 
   // The world and its officials: a match's, or a scenario's with optional rules.
   std::unique_ptr<match::MatchSession> session;

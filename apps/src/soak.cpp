@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "domain_option.hpp"
+#include "simsoccer/world/scenario.hpp"
 
 namespace simsoccer::apps {
 namespace {
@@ -48,6 +49,13 @@ int soak(int argc, char** argv, int first) {
   o.kills_per_game = opt.wholeNumber("kills", 10, 0, 10000);
   o.stops_per_game = opt.wholeNumber("stops", 2, 0, 10000);
   o.stop_seconds = opt.positive("stop-seconds", 3.0);
+  // Each agent is killed at most agents.restart_limit times (more would stop the match).
+  const auto agents = world::loadScenario(config.scenario).robots.size();
+  if (static_cast<size_t>(o.kills_per_game) > agents * static_cast<size_t>(config.restart_limit))
+    throw UsageError("--kills " + std::to_string(o.kills_per_game) + ": at most " +
+                     std::to_string(agents * static_cast<size_t>(config.restart_limit)) +
+                     " a game (" + std::to_string(agents) + " agents, each restarted at most " +
+                     std::to_string(config.restart_limit) + " times: agents.restart_limit)");
   o.seed = opt.seed("seed", config.seed);
   o.run.out = opt.get("out", timestampedRunDir("soak-").string());
   const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::FirstFree);

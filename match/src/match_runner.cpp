@@ -120,6 +120,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   sc.team_message_delay = c.message_delay;
   sc.team_message_loss = c.message_loss;
   sc.not_served = session.lolaRobots();
+  sc.notice = o.notice;
   // The agents this match starts get their robots' keys: nobody else can
   // claim their robots, also while one restarts (net/robot_keys.hpp).
   if (!o.external) sc.reserve = net::newMatchSecret();

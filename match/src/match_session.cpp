@@ -68,6 +68,14 @@ std::vector<LolaPlayer> parseLolaPlayers(const std::string& list) {
 
 MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
+  // Another kind of file (a scenario, say) is named as such before its keys are judged.
+  if (!root.has("match") && !root.has("penalty"))
+    root.fail(
+        "not a match config: needs `match: NAME` (a game) or `penalty: NAME` (a "
+        "penalty-kick scenario)" +
+        std::string(root.has("field") ? "; this looks like a scenario, which a match "
+                                        "config names with `scenario:`"
+                                      : ""));
   root.allowOnly({"match", "penalty", "scenario", "rules", "half_duration", "half_time_break",
                   "teams", "agents", "team_messages", "lockstep", "set_duration", "video", "seed",
                   "kicks", "lola"});

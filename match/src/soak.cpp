@@ -10,10 +10,10 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <random>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <set>
+#include <sstream>
 
 #include "simsoccer/match/outputs.hpp"
 #include "simsoccer/net/robot_keys.hpp"
@@ -157,6 +157,8 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
       std::sort(stops.begin(), stops.end());
       size_t next_kill = 0, next_stop = 0;
       std::map<int, int> killed;  // robot (team * 256 + player) -> kills this game
+      // Killed, maybe not yet reaped: still a child, and SIGKILL to it succeeds again.
+      std::set<int> killed_pids;
       std::vector<std::pair<int, Clock::time_point>> frozen;  // pid, when to continue
       bool first_sample = true;
       const auto sample = [&] {
@@ -193,7 +195,9 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
           std::vector<AgentPid> candidates;
           int fewest = 1 << 30;
           for (const AgentPid& a : agentChildren()) {
-            if (std::any_of(frozen.begin(), frozen.end(), [&](auto& f) { return f.first == a.pid; }))
+            if (std::any_of(frozen.begin(), frozen.end(),
+                            [&](auto& f) { return f.first == a.pid; }) ||
+                killed_pids.count(a.pid))
               continue;
             const int n = killed[a.team * 256 + a.player];
             if (n >= config.restart_limit) continue;
@@ -203,6 +207,7 @@ SoakResult runSoak(const MatchConfig& config, const SoakOptions& o,
           if (candidates.empty()) break;  // restarts still coming up: next time
           const AgentPid& v = candidates[rng() % candidates.size()];
           if (::kill(v.pid, SIGKILL) == 0) {
+            killed_pids.insert(v.pid);
             ++killed[v.team * 256 + v.player];
             ++g.kills;
           }

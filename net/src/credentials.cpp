@@ -290,4 +290,72 @@ void writeMatchCredentials(const CredentialsOptions& o) {
   }
 }
 
+namespace {
+
+Bio readFile(const std::filesystem::path& file) {
+  Bio b(BIO_new_file(file.c_str(), "r"));
+  if (!b) throw std::runtime_error(file.string() + ": cannot be read");
+  return b;
+}
+
+Cert readCert(const std::filesystem::path& file) {
+  Cert c(PEM_read_bio_X509(readFile(file).get(), nullptr, nullptr, nullptr));
+  if (!c) fail(file.string() + ": not a PEM certificate");
+  return c;
+}
+
+// An S/MIME document signed by `ca` alone (the signer looked up among {ca} only).
+void checkSigned(const std::filesystem::path& file, X509* ca) {
+  BIO* content = nullptr;
+  Pkcs7 p7(SMIME_read_PKCS7(readFile(file).get(), &content));
+  Bio content_owner(content);
+  if (!p7) fail(file.string() + ": not an S/MIME signed document");
+  struct FreeStack {  // sk_X509_free is a macro
+    void operator()(STACK_OF(X509) * s) const { sk_X509_free(s); }
+  };
+  std::unique_ptr<STACK_OF(X509), FreeStack> signers(sk_X509_new_null());
+  sk_X509_push(signers.get(), ca);
+  if (PKCS7_verify(p7.get(), signers.get(), nullptr, content, nullptr,
+                   PKCS7_TEXT | PKCS7_NOINTERN | PKCS7_NOVERIFY) != 1)
+    fail(file.string() + ": not signed by this folder's ca.pem");
+}
+
+}  // namespace
+
+void checkMatchCredentials(const std::filesystem::path& given) {
+  const std::filesystem::path dir = std::filesystem::absolute(given);
+  const Cert ca = readCert(dir / "ca.pem");
+  EVP_PKEY* ca_public = X509_get0_pubkey(ca.get());
+  checkSigned(dir / "governance.p7s", ca.get());
+  for (const std::string& id : credentialIdentities()) {
+    const std::filesystem::path cert_file = dir / (id + ".pem"), key_file = dir / (id + "_key.pem");
+    const Cert cert = readCert(cert_file);
+    if (X509_verify(cert.get(), ca_public) != 1)
+      fail(cert_file.string() + ": not signed by this folder's ca.pem");
+    const Key key(PEM_read_bio_PrivateKey(readFile(key_file).get(), nullptr, nullptr, nullptr));
+    if (!key) fail(key_file.string() + ": not a PEM private key");
+    if (X509_check_private_key(cert.get(), key.get()) != 1)
+      fail(key_file.string() + ": not the key of " + cert_file.string());
+    checkSigned(dir / (id + "_permissions.p7s"), ca.get());
+    // The configuration names its files by absolute path: a folder copied elsewhere still
+    // names the original's.
+    std::ifstream in(credentialConfig(dir, id));
+    std::stringstream xml;
+    xml << in.rdbuf();
+    const std::string named = "<IdentityCA>file:";
+    const size_t at = xml.str().find(named);
+    if (!in || at == std::string::npos)
+      throw std::runtime_error(credentialConfig(dir, id).string() +
+                               ": no <IdentityCA>file:...</IdentityCA> (not written by "
+                               "`simsoccer credentials`?)");
+    const size_t start = at + named.size(), end = xml.str().find("</IdentityCA>", start);
+    const std::filesystem::path ca_named = xml.str().substr(start, end - start);
+    std::error_code ec;
+    if (!std::filesystem::equivalent(ca_named, dir / "ca.pem", ec))
+      throw std::runtime_error(credentialConfig(dir, id).string() + ": names " + ca_named.string() +
+                               ", not this folder's ca.pem (the folder was "
+                               "copied or moved: make the credentials here again)");
+  }
+}
+
 }  // namespace simsoccer::net

@@ -508,11 +508,23 @@ void SimServer::handleCommands() {
       return;
     }
     // The one check every command goes through (counted there when refused).
+    sim::CommandFault fault = sim::CommandFault::None;
     const auto checked =
         sim_.gate().check(static_cast<world::RobotId>(ri),
                           std::span<const float>(c.position._buffer, c.position._length),
-                          std::span<const float>(c.stiffness._buffer, c.stiffness._length));
-    if (!checked) return;
+                          std::span<const float>(c.stiffness._buffer, c.stiffness._length), &fault);
+    if (!checked) {
+      if (!s.told_refused && config_.notice) {
+        s.told_refused = true;
+        config_.notice(
+            "robot " + std::to_string(s.team) + ":" + std::to_string(s.player) +
+            ": its owner's command refused (" + sim::faultName(fault) + ", " +
+            std::to_string(c.position._length) + " positions for " +
+            std::to_string(world_.robot(static_cast<world::RobotId>(ri)).model->actuators.size()) +
+            " actuators); later refusals are counted, not told");
+      }
+      return;
+    }
     s.command = *checked;
     s.has_command = true;
     s.last_tick = c.tick;

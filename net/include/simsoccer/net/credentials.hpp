@@ -49,6 +49,13 @@ inline const std::vector<std::string>& credentialIdentities() {
 // std::runtime_error naming the file on failure.
 void writeMatchCredentials(const CredentialsOptions& o);
 
+// What a secure match reads from `dir`, checked before it starts (Cyclone and OpenSSL name no
+// file when one is bad): ca.pem a certificate; per identity its certificate signed by ca.pem,
+// its key the certificate's, its permissions and the governance S/MIME signed by ca.pem, and
+// its ID.xml naming the files of this folder (not of the one it was copied from). Throws
+// std::runtime_error naming the file and what is wrong.
+void checkMatchCredentials(const std::filesystem::path& dir);
+
 // Where Cyclone's security plugins were found at build time ("" if not).
 std::filesystem::path defaultSecurityPluginDir();
 

@@ -55,6 +55,10 @@ struct ServerConfig {
   // owner's status proves the simulator holds it too (robot_keys.hpp).
   // Empty: the first claimant owns a free robot.
   std::optional<MatchSecret> reserve;
+  // Told, once per robot, when its owner's command is refused and why: a driver whose every
+  // command is refused (built for another robot model, say) leaves its robot holding and, in
+  // lockstep, each period waiting its timeout. Empty: not told (the counters still count).
+  std::function<void(const std::string&)> notice;
 };
 
 // accepted, missed: the simulation's count (sim::CommandStats); rejected:
@@ -116,6 +120,7 @@ class SimServer : public sim::CommandSource {
     bool has_command = false;              // a checked command waits to be taken
     uint64_t last_tick = 0;                // tick of the last accepted command
     uint64_t wrong_tick = 0;               // answers to a tick other than the one asked
+    bool told_refused = false;             // config_.notice told of a refused command
     sim::RobotCommand command;             // checked and quantised by the gate
   };
 
