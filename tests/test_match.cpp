@@ -238,6 +238,7 @@ TEST(MatchConfig, RefusesWhatTheAgentsOrTheRefereeWouldStopOn) {
   refused("set_duration: -1\n", "m.yaml", "set_duration");
   refused("video: {position: [1, 2, 3], look_at: [1, 2, 3]}\n", "m.yaml", "video.look_at");
   refused("video: {horizontal_fov: 4}\n", "m.yaml", "video.horizontal_fov");
+  refused("kicks: 3\n", "m.yaml", "kicks");  // a penalty config's, read by nobody in a match
   std::ofstream(dir / "five.yaml")
       << "match: five\nscenario: " << (configs / "scenarios/match_7v7.yaml").string()
       << "\nrules: " << (configs / "rules/spl.yaml").string() << "\n";

@@ -214,7 +214,11 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   }
   if (root.has("seed") && root["seed"].integer() < 0) root["seed"].fail("must be >= 0");
   c.seed = static_cast<uint64_t>(root.integer("seed", 1));
+  if (root.has("match") && root.has("kicks")) root["kicks"].fail("belongs to a penalty config (`penalty: NAME`)");
   if (root.has("penalty")) {
+    // A penalty kick has no halves: these would be read by nobody.
+    for (const char* key : {"half_duration", "half_time_break"})
+      if (root.has(key)) root[key].fail("belongs to a match; a penalty kick lasts the rule book's shot_duration");
     c.penalty_kicks = root.integer("kicks", 5);
     if (c.penalty_kicks < 1) root["kicks"].fail("must be >= 1");
   }
