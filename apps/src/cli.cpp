@@ -75,18 +75,16 @@ Options::Options(int argc, char** argv, int first, const std::vector<std::string
 
 void Options::checkWritable(const std::string& name) const {
   if (!has(name)) return;
-  {
-    const std::filesystem::path file = values_.at(name);
-    const std::string what = std::string("--") + name + " " + file.string() + ": ";
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec)) throw UsageError(what + "is a folder");
-    const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
-    if (!std::filesystem::is_directory(folder, ec))
-      throw UsageError(what + "no such folder " + folder.string());
-    const bool exists = std::filesystem::exists(file, ec);
-    if (exists ? ::access(file.c_str(), W_OK) != 0 : ::access(folder.c_str(), W_OK) != 0)
-      throw UsageError(what + "not writable");
-  }
+  const std::filesystem::path file = values_.at(name);
+  const std::string what = std::string("--") + name + " " + file.string() + ": ";
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw UsageError(what + "is a folder");
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+  if (!std::filesystem::is_directory(folder, ec))
+    throw UsageError(what + "no such folder " + folder.string());
+  const bool exists = std::filesystem::exists(file, ec);
+  if (exists ? ::access(file.c_str(), W_OK) != 0 : ::access(folder.c_str(), W_OK) != 0)
+    throw UsageError(what + "not writable");
 }
 
 bool Options::help(const char* text) const {

@@ -98,8 +98,8 @@ int serve(int argc, char** argv, int first) {
     own_world = std::make_unique<world::World>(scenario);
     if (opt.has("rules")) {
       const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
-      for (int team = 0; team < 2;
-           ++team)  // the others would be substitutes (match refuses it too)
+      // More robots than the rule book's team size would be substitutes (match refuses it too).
+      for (int team = 0; team < 2; ++team)
         if (std::count_if(scenario.robots.begin(), scenario.robots.end(),
                           [&](const auto& r) { return r.team == team; }) > rules.players_per_team)
           throw UsageError("--rules " + opt.get("rules", "") + ": " +

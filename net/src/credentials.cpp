@@ -265,6 +265,14 @@ void writeMatchCredentials(const CredentialsOptions& o) {
     throw std::runtime_error("Cyclone DDS's security plugins are not in '" + plugins.string() +
                              "' (Debian's libddsc0debian package has them)");
   if (o.days < 1) throw std::runtime_error("credentials must be valid for at least one day");
+  {  // the network configuration before anything is written (cycloneConfig reads it again)
+    std::ifstream f(o.network);
+    std::stringstream xml;
+    xml << f.rdbuf();
+    if (!f || xml.str().rfind("</Domain>") == std::string::npos)
+      throw std::runtime_error(o.network.string() +
+                               ": not a Cyclone DDS configuration with a <Domain>");
+  }
   std::error_code made;
   std::filesystem::create_directories(o.dir, made);
   if (made)
