@@ -1,7 +1,10 @@
 #include "simsoccer/engine/config.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <set>
 
 namespace simsoccer::engine {
@@ -41,6 +44,40 @@ void checkKeys(const YAML::Node& node, const std::string& file, const std::strin
       checkKeys(node[i], file, path + "[" + std::to_string(i) + "]", depth + 1, budget);
   }
 }
+// Counts a YAML document's nodes but nulls (an empty document after a trailing --- is one).
+class NodeCounter : public YAML::EventHandler {
+ public:
+  int nodes = 0;
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { ++nodes; }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    ++nodes;
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    ++nodes;
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    ++nodes;
+  }
+  void OnMapEnd() override {}
+};
+
+// A second document with content would be read by nobody: refused rather than ignored. At most
+// two documents are parsed: yaml-cpp 0.7's LoadAll loops for ever on some malformed input
+// (found by fuzz_configs and fuzz_agent_inputs).
+bool secondDocumentHasContent(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  YAML::Parser parser(in);
+  NodeCounter first, second;
+  return parser.HandleNextDocument(first) && parser.HandleNextDocument(second) && second.nodes > 0;
+}
+
 }  // namespace
 
 ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
@@ -48,13 +85,11 @@ ConfigNode ConfigNode::loadFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw ConfigError(name, "", "file not found");
   if (!std::filesystem::is_regular_file(file)) throw ConfigError(name, "", "not a regular file");
   try {
-    // A second document (after ---) would be read by nobody: refused rather than ignored.
-    const std::vector<YAML::Node> documents = YAML::LoadAllFromFile(name);
-    if (documents.size() > 1)
+    YAML::Node root = YAML::LoadFile(name);
+    if (secondDocumentHasContent(file))
       throw ConfigError(name, "",
-                        "holds " + std::to_string(documents.size()) +
-                            " YAML documents (--- lines); a config file is one");
-    YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+                        "holds a second YAML document (after a --- line), which nothing reads; a "
+                        "config file is one document");
     if (!root.IsMap()) throw ConfigError(name, "", "expected a mapping at the top level");
     long budget = 100000;
     checkKeys(root, name, "", 0, budget);
