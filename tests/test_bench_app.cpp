@@ -154,9 +154,6 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
        "--external-gc 3939: the GameController's own port"},
       {"serve " + src + "/configs/match_2v2.yaml --teams 3,4",
        "--teams: a match config names its own teams"},
-      {"serve " + src + "/configs/scenarios/match_11v11.yaml --rules " + src +
-           "/configs/rules/spl.yaml",
-       "5 players a team, but"},
       {"lola-run --socket s --robot 1:1 -- true", "--socket and --robot exclude each other"},
       {"lola-run --robot 1:1 --prefix 10.0 -- true", "--prefix and --bridge go with --net"},
       {"booster-run -- true", "--robot T:P is required"},
@@ -169,6 +166,13 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
     EXPECT_NE(out.find(message), std::string::npos) << args << ": " << out;
   }
   int status = -1;
+  // A rule book whose teams are smaller than the scenario's: the others would be substitutes.
+  const std::string eleven =
+      runCommand(bin + " serve " + src + "/configs/scenarios/match_11v11.yaml --rules " + src +
+                     "/configs/rules/spl.yaml",
+                 status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(eleven.find("spl.yaml: players_per_team: 5, but"), std::string::npos) << eleven;
   // A robot named on the command line is the option's fault, and nothing is written.
   const std::string lola =
       runCommand(bin + " match " + src + "/configs/match_2v2.yaml --lola 2:3 --out " +

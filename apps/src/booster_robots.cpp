@@ -14,7 +14,12 @@ namespace simsoccer::apps {
 std::vector<world::RobotId> boosterRobots(const Options& opt, const world::World& w,
                                           const std::array<int, 2>& team_numbers) {
   std::vector<world::RobotId> out;
-  if (!opt.has("booster")) return out;
+  if (!opt.has("booster")) {
+    if (opt.has("booster-domain") || opt.flag("booster-lockstep") || opt.flag("booster-netns"))
+      throw UsageError(
+          "--booster-domain, --booster-lockstep and --booster-netns go with --booster");
+    return out;
+  }
   const std::string spec = opt.get("booster", "");
   if (spec == "all") {
     for (world::RobotId r = 0; r < w.robotCount(); ++r) out.push_back(r);

@@ -11,6 +11,7 @@
 #include "help_texts.hpp"
 #include "lola_option.hpp"
 #include "serve_report.hpp"
+#include "serve_world.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/match_runner.hpp"
 #include "simsoccer/net/sim_server.hpp"
@@ -26,10 +27,6 @@ void onSignal(int) {
   g_stop = 1;
 }
 
-bool isMatchConfig(const std::filesystem::path& file) {
-  return engine::ConfigNode::loadFile(file).has("match");
-}
-
 }  // namespace
 
 int serve(int argc, char** argv, int first) {
@@ -41,12 +38,7 @@ int serve(int argc, char** argv, int first) {
                      "out", "external-gc", "booster", "booster-domain"});
   if (opt.help(kServeHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
-  if (!opt.has("booster") &&
-      (opt.has("booster-domain") || opt.flag("booster-lockstep") || opt.flag("booster-netns")))
-    throw UsageError("--booster-domain, --booster-lockstep and --booster-netns go with --booster");
   const std::filesystem::path file = opt.positional()[0];
-  if (opt.flag("lola-net") && !opt.has("lola") && !isMatchConfig(file))
-    throw UsageError("--lola-net goes with --lola");
   net::ServerConfig cfg;
   // Agents started elsewhere are told the domain: it is what it says or refused.
   const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::Fixed);
@@ -65,59 +57,11 @@ int serve(int argc, char** argv, int first) {
   }
   cfg.lockstep = !opt.flag("realtime") && !external_gc;
   cfg.hold_on_release = !opt.flag("limp-on-release");
-  cfg.notice = [](const std::string& line) {
-    std::fprintf(stderr, "simsoccer: %s\n", line.c_str());
-  };
+  cfg.notice = [](const std::string& s) { std::fprintf(stderr, "simsoccer: %s\n", s.c_str()); };
 
   // The world and its officials: a match's, or a scenario's with optional rules.
-  std::unique_ptr<match::MatchSession> session;
-  std::unique_ptr<world::World> own_world;
-  std::unique_ptr<sim::GameOfficials> own_officials;
-  sim::GameOfficials* officials = nullptr;
-  if (isMatchConfig(file)) {
-    if (opt.has("rules")) throw UsageError("--rules: a match config names its own rule book");
-    if (opt.has("teams")) throw UsageError("--teams: a match config names its own teams");
-    match::MatchConfig mc = match::loadMatchConfig(file);
-    if (opt.has("half")) {
-      const double h = opt.number("half", 0);
-      if (!(h > 0)) throw UsageError("--half must be > 0 s");
-      mc.half_duration = h;
-    }
-    addLolaRobots(opt, mc);
-    mc.external_gc_port = external_gc;
-    session = std::make_unique<match::MatchSession>(mc, opt.seed("seed", mc.seed));
-    officials = &session->officials();
-    cfg.command_timeout = mc.command_timeout;
-    cfg.team_message_delay = mc.message_delay;
-    cfg.team_message_loss = mc.message_loss;
-  } else {
-    if (opt.has("half") || opt.has("lola"))
-      throw UsageError("--half and --lola go with a match config");
-    world::Scenario scenario = world::loadScenario(file);
-    if (opt.has("seed")) scenario.seed = opt.seed("seed", 0);
-    own_world = std::make_unique<world::World>(scenario);
-    if (opt.has("rules")) {
-      const referee::RuleBook rules = referee::loadRuleBook(findConfig(opt.get("rules", ""), ""));
-      // More robots than the rule book's team size would be substitutes (match refuses it too).
-      for (int team = 0; team < 2; ++team)
-        if (std::count_if(scenario.robots.begin(), scenario.robots.end(),
-                          [&](const auto& r) { return r.team == team; }) > rules.players_per_team)
-          throw UsageError("--rules " + opt.get("rules", "") + ": " +
-                           std::to_string(rules.players_per_team) + " players a team, but " +
-                           file.string() + " has more in team " + std::to_string(team));
-      const std::vector<int> numbers = opt.intList("teams", {1, 2});
-      if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 255 || numbers[1] < 0 ||
-          numbers[1] > 255 || numbers[0] == numbers[1])
-        throw UsageError("--teams: two different team numbers 0..255");
-      sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(static_cast<uint8_t>(numbers[0]),
-                                                               static_cast<uint8_t>(numbers[1]));
-      oc.referee.auto_placement = opt.flag("auto-placement");
-      oc.seed = scenario.seed;
-      oc.external_gc_port = external_gc;
-      own_officials = std::make_unique<sim::GameOfficials>(*own_world, rules, oc);
-      officials = own_officials.get();
-    }
-  }
+  ServedWorld served = openServedWorld(opt, file, external_gc, cfg);
+  sim::GameOfficials* officials = served.officials;
   if (opt.has("timeout")) cfg.command_timeout = opt.positive("timeout", 0.5);
   if (external_gc && !officials)
     throw UsageError("--external-gc needs --rules or a match config (the game it runs)");
@@ -128,18 +72,9 @@ int serve(int argc, char** argv, int first) {
   const auto gc_port = static_cast<uint16_t>(opt.wholeNumber("gc-port", 3838, 1, 65535));
   const auto gc_return_port =
       static_cast<uint16_t>(opt.wholeNumber("gc-return-port", 3939, 0, 65535));
-  world::World& w = session ? session->world() : *own_world;
-  // GameController team numbers of the scenario's teams 0 and 1.
-  std::array<int, 2> team_numbers{1, 2};
-  if (session) {
-    team_numbers = session->config().team_numbers;
-  } else if (opt.has("teams")) {  // (a match config's own teams: refused above)
-    const std::vector<int> numbers = opt.intList("teams", {1, 2});
-    if (numbers.size() != 2 || numbers[0] < 0 || numbers[0] > 254 || numbers[1] < 0 ||
-        numbers[1] > 254 || numbers[0] == numbers[1])
-      throw UsageError("--teams: two different team numbers 0..254");
-    team_numbers = {numbers[0], numbers[1]};
-  }
+  world::World& w = served.world();
+  const std::unique_ptr<match::MatchSession>& session = served.session;
+  const std::array<int, 2> team_numbers = served.team_numbers;
   // Booster SDK clients run on the wall clock: real time unless --booster-lockstep.
   const std::vector<world::RobotId> booster_robots = boosterRobots(opt, w, team_numbers);
   if (!booster_robots.empty() && !opt.flag("booster-lockstep")) cfg.lockstep = false;

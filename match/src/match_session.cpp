@@ -66,6 +66,19 @@ std::vector<LolaPlayer> parseLolaPlayers(const std::string& list) {
   return out;
 }
 
+void checkTeamSizes(const referee::RuleBook& rules, const world::Scenario& scenario) {
+  for (int team = 0; team < 2; ++team) {
+    const auto players =
+        std::count_if(scenario.robots.begin(), scenario.robots.end(),
+                      [&](const world::RobotPlacement& r) { return r.team == team; });
+    if (players > rules.players_per_team)
+      throw engine::ConfigError(rules.source_file, "players_per_team",
+                                std::to_string(rules.players_per_team) + ", but " +
+                                    scenario.source_file + " has " + std::to_string(players) +
+                                    " robots in team " + std::to_string(team));
+  }
+}
+
 MatchConfig loadMatchConfig(const std::filesystem::path& file) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   // Another kind of file (a scenario, say) is named as such before its keys are judged.
@@ -223,18 +236,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (c.penalty_kicks < 1) root["kicks"].fail("must be >= 1");
   }
   // The rule book and scenario must load (their own errors name them).
-  const referee::RuleBook rules = referee::loadRuleBook(c.rules);
   const world::Scenario scenario = world::loadScenario(c.scenario);
-  for (int team = 0; team < 2; ++team) {
-    const auto players =
-        std::count_if(scenario.robots.begin(), scenario.robots.end(),
-                      [&](const world::RobotPlacement& r) { return r.team == team; });
-    if (players > rules.players_per_team)
-      throw engine::ConfigError(c.rules.string(), "players_per_team",
-                                std::to_string(rules.players_per_team) + ", but " +
-                                    c.scenario.string() + " has " + std::to_string(players) +
-                                    " robots in team " + std::to_string(team));
-  }
+  checkTeamSizes(referee::loadRuleBook(c.rules), scenario);
   checkAgentFiles(c, scenario);
   const std::string bytes = fileBytes(file) + fileBytes(c.scenario) + fileBytes(c.rules);
   char hex[17];

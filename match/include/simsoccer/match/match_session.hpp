@@ -82,6 +82,10 @@ struct MatchConfig {
 };
 // Reads a match or penalty config; throws engine::ConfigError (file, key, reason).
 MatchConfig loadMatchConfig(const std::filesystem::path& file);
+// Players numbered beyond the rule book's team size are substitutes (penalised, as GameController
+// 3 starts a game): a scenario with more robots in a team is refused, engine::ConfigError naming
+// the rule book's players_per_team.
+void checkTeamSizes(const referee::RuleBook& rules, const world::Scenario& scenario);
 
 // A robot going down (not a keeper's dive): when, where, and how near the
 // nearest other robot and the ball were (a push, a kick, or on its own).
