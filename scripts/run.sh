@@ -6,4 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
-./build/apps/simsoccer match configs/match_5v5.yaml --half 120 --out runs/latest --overwrite "$@"
+# Given twice, an option's last value counts: the user's --half wins. A run the user sends
+# elsewhere with --out is not overwritten unless the user says --overwrite too.
+defaults=(--half 120 --out runs/latest --overwrite)
+for a in "$@"; do [ "$a" = --out ] && defaults=(--half 120); done
+./build/apps/simsoccer match configs/match_5v5.yaml "${defaults[@]}" "$@"

@@ -102,7 +102,9 @@ TEST(CheckApp, EveryKindOfConfigFile) {
       {"/robots/booster_k1.yaml", "robot 'booster_k1' is valid"},
       {"/configs/rules/spl_champions_cup.yaml", "(7 players a team"},
       {"/configs/agents/soccer_k1.yaml", "agent behaviour file is valid"},
-      {"/configs/motions/booster_k1/gait.yaml", "gait file is valid"}};
+      {"/configs/motions/booster_k1/gait.yaml", "gait file is valid"},
+      {"/configs/bench/physics_k1.yaml", "benchmark scene is valid"},
+      {"/configs/bench/motion_booster_k1.yaml", "motion bench of booster_k1 is valid"}};
   int status = -1;
   for (const auto& [file, said] : kinds) {
     const std::string out = runCommand(std::string(SIMSOCCER_BIN) + " check " + src + file, status);
@@ -142,12 +144,11 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
       {"replay " + (dir / "x.log").string() + " --video out.gif",
        "--video out.gif: .mp4, .avi or .png"},
       {"replay " + (dir / "x.log").string() + " --from -5", "--from must be >= 0"},
-      {"bench physics --seconds 1 --seconds 2", "option --seconds given twice"},
       {"bench physics --robots 1000", "the benchmark's grid holds at most"},
       {"serve " + src + "/configs/scenarios/k1_3v3.yaml --booster-domain 9",
        "--booster-domain, --booster-lockstep and --booster-netns go with --booster"},
       {"serve " + src + "/configs/scenarios/lineup_5v5.yaml --teams 1,1",
-       "--teams: two different team numbers"},
+       "--teams: two different team numbers 1..254"},
       {"bench", "usage: simsoccer bench physics|sensors|net|cameras|motion|scaling"},
       {"match " + src + "/configs/match_2v2.yaml --lola-net", "--lola-net: no LoLA robots"},
       {"match " + src + "/configs/match_2v2.yaml --external-gc 3939",
@@ -197,10 +198,27 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
   EXPECT_EQ(WEXITSTATUS(status), 2) << seed;
   EXPECT_NE(seed.find("--seed goes with --role"), std::string::npos) << seed;
   // A second YAML document would be read by nobody; a behaviour the agents do not have.
-  std::ofstream(dir / "two.yaml") << "field: x\n---\nfield: y\n";
+  std::ofstream(dir / "two.yaml") << "field: x\n---\n---\nfield: y\n";
   EXPECT_NE(runCommand(bin + " check " + (dir / "two.yaml").string(), status)
                 .find("two.yaml: (document): holds a second YAML document"),
             std::string::npos);
+  // A scenario without its `scenario:` key is told so (not judged as a field file).
+  {
+    std::ifstream in(src + "/configs/scenarios/lineup_5v5.yaml");
+    std::ofstream out(dir / "unnamed.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("scenario:", 0) == 0) continue;
+      if (const auto up = line.find("../../"); up != std::string::npos)
+        line.replace(up, 6, src + "/");
+      out << line << "\n";
+    }
+  }
+  EXPECT_NE(runCommand(bin + " check " + (dir / "unnamed.yaml").string(), status)
+                .find("unnamed.yaml: scenario: missing required key"),
+            std::string::npos);
+  EXPECT_NE(runCommand(bin + " replay " + (dir / "x.log").string() + " --video OUT.PNG", status)
+                .find(".mp4, .avi or .png"),
+            std::string::npos);  // the renderer tells them apart by the lower-case name
   {
     std::ifstream in(src + "/configs/agents/soccer.yaml");
     std::ofstream out(dir / "chess.yaml");

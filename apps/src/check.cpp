@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "bench_motion/trial.hpp"
+#include "bench_scene.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 #include "simsoccer/agents/motion/gait.hpp"
@@ -28,6 +30,8 @@ const char* kCheckHelp =
     "                  (nothing is stepped): the robots and the initial state hash\n"
     "  match, penalty  the match config with its scenario (as above), rule book, agent\n"
     "                  behaviour file and every robot's motions and gait\n"
+    "  bench           a benchmark scene (configs/bench/physics*.yaml), its scenario as above\n"
+    "  targets         bench motion's robot file (configs/bench/motion_*.yaml)\n"
     "  field, robot, rules, behaviour, walk/kick (a gait)  that file alone\n";
 
 void printScenario(const std::filesystem::path& file) {
@@ -63,8 +67,14 @@ int check(int argc, char** argv, int first) {
                 c.agent_config.empty() ? "(the agent's default)" : c.agent_config.c_str(),
                 c.role.c_str());
     printScenario(c.scenario);
-  } else if (root.has("scenario")) {
-    printScenario(file);
+  } else if (root.has("bench")) {
+    const BenchConfig b = loadBenchConfig(file);
+    std::printf("%s: benchmark scene is valid (%zu robot counts)\n", f, b.robots.size());
+  } else if (root.has("targets")) {
+    const motion::MotionBench b = motion::loadMotionBench(file);
+    std::printf("%s: motion bench of %s is valid\n", f, b.robot.c_str());
+  } else if (root.has("scenario") || root.has("robot_model") || root.has("robots")) {
+    printScenario(file);  // (one without `scenario:` is told it misses it)
   } else if (root.has("field")) {
     const fields::FieldModel m = fields::loadFieldModel(file);
     std::printf("%s: field '%s' is valid (%.1f x %.1f m)\n", f, m.name.c_str(), m.length, m.width);
@@ -84,8 +94,8 @@ int check(int argc, char** argv, int first) {
     std::printf("%s: gait file is valid\n", f);
   } else {
     root.fail(
-        "not a file `check` knows: its first key names the kind (scenario, match, penalty, "
-        "field, robot, rules, behaviour, or walk/kick for a gait)");
+        "not a file `check` knows: its keys name the kind (scenario, match, penalty, bench, "
+        "targets, field, robot, rules, behaviour, or walk/kick for a gait)");
   }
   return 0;
 }

@@ -60,7 +60,6 @@ Options::Options(int argc, char** argv, int first, const std::vector<std::string
         // was left out.
         if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
           throw UsageError("option --" + name + " needs a value");
-        if (values_.count(name)) throw UsageError("option --" + name + " given twice");
         values_[name] = argv[++i];
       } else {
         throw UsageError("unknown option " + a);

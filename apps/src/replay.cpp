@@ -1,6 +1,5 @@
 // simsoccer replay: what a match log holds, its video, and a re-run of the
 // game through the same period pipeline with the recorded commands.
-#include <cctype>
 #include <cstdio>
 
 #include "cli.hpp"
@@ -39,9 +38,8 @@ int replay(int argc, char** argv, int first) {
   const double from = opt.nonNegative("from", 0.0), to = opt.nonNegative("to", 1e12);
   if (to < from) throw UsageError("--to must not be before --from");
   if (opt.has("video")) {
-    std::string ext = std::filesystem::path(opt.get("video", "")).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".mp4" && ext != ".avi" && ext != ".png")
+    const std::string ext = std::filesystem::path(opt.get("video", "")).extension().string();
+    if (ext != ".mp4" && ext != ".avi" && ext != ".png")  // as renderVideo tells them apart
       throw UsageError("--video " + opt.get("video", "") + ": .mp4, .avi or .png");
     opt.checkWritable("video");
   }

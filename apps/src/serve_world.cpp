@@ -12,7 +12,7 @@ namespace {
 std::array<int, 2> teamNumbers(const Options& opt) {
   const std::vector<int> n = opt.intList("teams", {1, 2});
   if (n.size() != 2 || n[0] < 0 || n[0] > 254 || n[1] < 0 || n[1] > 254 || n[0] == n[1])
-    throw UsageError("--teams: two different team numbers 0..254");
+    throw UsageError("--teams: two different team numbers 1..254");
   return {n[0], n[1]};
 }
 

@@ -190,13 +190,19 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
     }
     agents.push_back(std::move(a));
   }
+  const auto claimed = [&](const AgentSlot& a) {
+    for (world::RobotId r = 0; r < w.robotCount(); ++r)
+      if (w.robot(r).team == a.team && w.robot(r).number == a.number) return server.stats(r).owned;
+    return false;
+  };
   const auto t_wait = Clock::now();
   const size_t dds_robots = w.robotCount() - session.lolaRobots().size();
   while (!stopRequested() && !server.waitForOwners(dds_robots, 0.5)) {
     // An agent that exits before it claims its robot exits on its start-up (its message is
-    // above): restarting it would fail the same way.
+    // above): restarting it would fail the same way. (One that claimed and then exited is
+    // restarted once the game runs, as before.)
     for (AgentSlot& a : agents)
-      if (a.process && !a.process->running())
+      if (a.process && !a.process->running() && !claimed(a))
         throw std::runtime_error("the agent of team " + std::to_string(a.team) + " player " +
                                  std::to_string(a.number) + " exited (status " +
                                  std::to_string(a.process->exitStatus()) +

@@ -1,5 +1,6 @@
 #include "simsoccer/net/credentials.hpp"
 
+#include <fcntl.h>
 #include <openssl/bio.h>
 #include <openssl/err.h>
 #include <openssl/evp.h>
@@ -8,10 +9,10 @@
 #include <openssl/rand.h>
 #include <openssl/x509.h>
 #include <openssl/x509v3.h>
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <ctime>
 #include <fstream>
 #include <memory>
@@ -309,6 +310,20 @@ Bio readFile(const std::filesystem::path& file) {
 Cert readCert(const std::filesystem::path& file) {
   Cert c(PEM_read_bio_X509(readFile(file).get(), nullptr, nullptr, nullptr));
   if (!c) fail(file.string() + ": not a PEM certificate");
+  // Credentials are made for some days (--days): an expired one is the likeliest failure.
+  const auto when = [](const ASN1_TIME* t) {
+    Bio b(BIO_new(BIO_s_mem()));
+    ASN1_TIME_print(b.get(), t);
+    char* text = nullptr;
+    const long n = BIO_get_mem_data(b.get(), &text);
+    return std::string(text, static_cast<size_t>(std::max(n, 0L)));
+  };
+  if (X509_cmp_current_time(X509_get0_notAfter(c.get())) < 0)
+    throw std::runtime_error(file.string() + ": expired on " + when(X509_get0_notAfter(c.get())) +
+                             " (make the credentials again: simsoccer credentials DIR --days N)");
+  if (X509_cmp_current_time(X509_get0_notBefore(c.get())) > 0)
+    throw std::runtime_error(file.string() + ": not valid before " +
+                             when(X509_get0_notBefore(c.get())));
   return c;
 }
 

@@ -516,12 +516,11 @@ void SimServer::handleCommands() {
     if (!checked) {
       if (!s.told_refused && config_.notice) {
         s.told_refused = true;
-        config_.notice(
-            "robot " + std::to_string(s.team) + ":" + std::to_string(s.player) +
-            ": its owner's command refused (" + sim::faultName(fault) + ", " +
-            std::to_string(c.position._length) + " positions for " +
-            std::to_string(world_.robot(static_cast<world::RobotId>(ri)).model->actuators.size()) +
-            " actuators); later refusals are counted, not told");
+        config_.notice("team " + std::to_string(s.team) + " player " + std::to_string(s.player) +
+                       ": its owner's command refused (" + sim::faultName(fault) + "; " +
+                       std::to_string(c.position._length) + " positions of " +
+                       std::to_string(world::kActuators) +
+                       "); later refusals are counted, not told");
       }
       return;
     }
