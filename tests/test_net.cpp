@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -511,6 +512,14 @@ TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   const uint32_t domain = 106;
   world::World w(teams(2));
   net::ServerConfig cfg = serverConfig(domain, 2.0);
+  // The first refusal per robot is told, with its reason (on the DDS receive thread); the
+  // rest are only counted.
+  std::mutex told_mutex;
+  std::vector<std::string> told;
+  cfg.notice = [&](const std::string& line) {
+    const std::lock_guard lock(told_mutex);
+    told.push_back(line);
+  };
   sim::Simulation simulation(w);
   net::SimServer server(simulation, cfg);
   AgentProcess garbage(domain, 0, 1, {"--mode", "garbage"});
@@ -530,6 +539,10 @@ TEST(Net, GarbageCommandsAreRejectedAndCounted) {
   EXPECT_TRUE(w.isStanding(1));
   for (int j = 0; j < static_cast<int>(w.robot(0).model->body->joints.size()); ++j)
     EXPECT_TRUE(std::isfinite(w.jointPosition(0, j)));
+  const std::lock_guard lock(told_mutex);
+  ASSERT_EQ(told.size(), 1u);  // robot 0 alone, once
+  EXPECT_EQ(told[0].rfind("team 0 player 1: its owner's command refused (", 0), 0u) << told[0];
+  EXPECT_NE(told[0].find("); later refusals are counted, not told"), std::string::npos) << told[0];
 }
 
 TEST(Net, LockstepTimeoutBoundsAStalledAgent) {
