@@ -223,15 +223,20 @@ std::string permissions(const CredentialsOptions& o, const std::string& id) {
 }
 
 // The network configuration with a <Security> section for identity `id`.
-std::string cycloneConfig(const CredentialsOptions& o, const std::filesystem::path& dir,
-                          const std::string& id, const std::filesystem::path& plugins) {
+// The network configuration whose settings every ID.xml keeps, read and checked once, before
+// anything is written.
+std::string networkConfig(const CredentialsOptions& o) {
   std::ifstream f(o.network);
   std::stringstream ss;
   ss << f.rdbuf();
-  std::string xml = ss.str();
-  const size_t end = xml.rfind("</Domain>");
-  if (!f || end == std::string::npos)
+  if (!f || ss.str().rfind("</Domain>") == std::string::npos)
     throw std::runtime_error(o.network.string() + ": not a Cyclone DDS configuration with a <Domain>");
+  return ss.str();
+}
+
+std::string cycloneConfig(std::string xml, const std::filesystem::path& dir, const std::string& id,
+                          const std::filesystem::path& plugins) {
+  const size_t end = xml.rfind("</Domain>");
   const auto file = [&](const std::string& name) { return "file:" + (dir / name).string(); };
   const auto library = [&](const char* name, const char* init, const char* fini) {
     return std::string("<Library path=\"") + (plugins / name).string() + "\" initFunction=\"" + init +
@@ -266,14 +271,7 @@ void writeMatchCredentials(const CredentialsOptions& o) {
     throw std::runtime_error("Cyclone DDS's security plugins are not in '" + plugins.string() +
                              "' (Debian's libddsc0debian package has them)");
   if (o.days < 1) throw std::runtime_error("credentials must be valid for at least one day");
-  {  // the network configuration before anything is written (cycloneConfig reads it again)
-    std::ifstream f(o.network);
-    std::stringstream xml;
-    xml << f.rdbuf();
-    if (!f || xml.str().rfind("</Domain>") == std::string::npos)
-      throw std::runtime_error(o.network.string() +
-                               ": not a Cyclone DDS configuration with a <Domain>");
-  }
+  const std::string network = networkConfig(o);
   std::error_code made;
   std::filesystem::create_directories(o.dir, made);
   if (made)
@@ -295,7 +293,7 @@ void writeMatchCredentials(const CredentialsOptions& o) {
     const std::string perm = permissions(o, id);
     writeText(dir / (id + "_permissions.xml"), perm);
     writeSigned(dir / (id + "_permissions.p7s"), perm, ca.get(), ca_key.get());
-    writeText(credentialConfig(dir, id), cycloneConfig(o, dir, id, plugins));
+    writeText(credentialConfig(dir, id), cycloneConfig(network, dir, id, plugins));
   }
 }
 
