@@ -2,8 +2,11 @@
 // this process with its credentials; its agent, strangers and the other team
 // as processes with theirs (a process holds one DDS configuration per domain).
 #include <gtest/gtest.h>
+#include <openssl/pem.h>
+#include <openssl/x509.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <future>
 #include <string>
@@ -104,6 +107,55 @@ TEST(Secure, ABadCredentialsFolderIsRefusedNamingTheFile) {
                              std::filesystem::copy_options::overwrite_existing);  // undo-ish
   std::ofstream(c / "governance.p7s") << "garbage\n";
   refused(c.dir.path(), "governance.p7s: not an S/MIME signed document");
+}
+
+// A certificate out of its validity (made for --days; a clock set wrong) is refused with its
+// dates, though signed by the folder's own authority: `cert` is signed again by ca_key.pem with
+// its validity moved by `not_before_s` and `not_after_s` from now.
+namespace {
+void resign(const std::filesystem::path& dir, const std::string& cert, long not_before_s,
+            long not_after_s) {
+  const auto read = [](const std::filesystem::path& f) {
+    FILE* in = std::fopen(f.c_str(), "r");
+    if (!in) throw std::runtime_error(f.string() + ": cannot be read");
+    return in;
+  };
+  FILE* in = read(dir / cert);
+  X509* c = PEM_read_X509(in, nullptr, nullptr, nullptr);
+  std::fclose(in);
+  in = read(dir / "ca_key.pem");
+  EVP_PKEY* ca_key = PEM_read_PrivateKey(in, nullptr, nullptr, nullptr);
+  std::fclose(in);
+  ASSERT_TRUE(c && ca_key);
+  ASSERT_TRUE(X509_gmtime_adj(X509_getm_notBefore(c), not_before_s));
+  ASSERT_TRUE(X509_gmtime_adj(X509_getm_notAfter(c), not_after_s));
+  ASSERT_GT(X509_sign(c, ca_key, EVP_sha256()), 0);
+  FILE* out = std::fopen((dir / cert).c_str(), "w");
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(PEM_write_X509(out, c));
+  std::fclose(out);
+  X509_free(c);
+  EVP_PKEY_free(ca_key);
+}
+}  // namespace
+
+TEST(Secure, ACertificateOutOfItsValidityIsRefusedWithItsDates) {
+  const Credentials c("secure_validity");
+  const auto refused = [&](const std::string& said) {
+    try {
+      net::checkMatchCredentials(c.dir.path());
+      ADD_FAILURE() << "accepted; expected: " << said;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(said), std::string::npos) << e.what();
+    }
+  };
+  resign(c.dir.path(), "team_1.pem", -2 * 86400, 3600);  // still valid: signed again, accepted
+  EXPECT_NO_THROW(net::checkMatchCredentials(c.dir.path()));
+  resign(c.dir.path(), "team_1.pem", -2 * 86400, -86400);
+  refused((c / "team_1.pem").string() + ": expired on ");
+  refused("simsoccer credentials DIR --days N");
+  resign(c.dir.path(), "team_1.pem", 86400, 2 * 86400);
+  refused((c / "team_1.pem").string() + ": not valid before ");
 }
 
 // Without this authority's credentials a participant is not even matched;
