@@ -12,7 +12,10 @@
 #include <map>
 #include <opencv2/videoio.hpp>
 #include <regex>
+#include <sstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/agent_process.hpp"
@@ -430,6 +433,61 @@ TEST(MatchApp, KilledAndStoppedAgentsNeverStallTheMatch) {
   EXPECT_NE(summary.find("end of the second half"), std::string::npos);
   // The timeout, and a margin for a loaded machine's scheduling.
   EXPECT_LE(std::stod(jsonValue(summary, "longest_wait_seconds")), 0.5 + 0.25) << summary;
+}
+
+// `simsoccer soak`: two short games, eight agents killed in each (of four agents, at most three
+// times each: the restart limit) and one stopped. Each kill is counted once, when its agent is
+// gone (a killed agent not yet reaped is never counted again), every one is restarted, and
+// each game's summary holds the restarts the table reports.
+TEST(SoakApp, EveryKillIsCountedOnceAndEveryKilledAgentIsRestarted) {
+  const test::TempDir dir("soak_kills");
+  int status = -1;
+  const std::string out = test::runCommand(
+      kBin + " soak " + (test::sourceDir() / "configs/match_2v2.yaml").string() +
+          " --games 2 --half 10 --kills 8 --stops 1 --stop-seconds 0.5 --domain 156 --out " +
+          (dir / "soak").string() + " --csv " + (dir / "soak.csv").string() + " 2>&1",
+      status);
+  // The soak's own checks that concern the agents (its memory check is judged over longer soaks).
+  EXPECT_EQ(out.find("did not finish"), std::string::npos) << out;
+  EXPECT_EQ(out.find("kills but"), std::string::npos) << out;
+  EXPECT_EQ(out.find("kills of the"), std::string::npos) << out;
+  EXPECT_EQ(out.find("incomplete"), std::string::npos) << out;
+  std::stringstream csv(test::readFile(dir / "soak.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line)) << out;
+  const auto cells = [](const std::string& row) {
+    std::vector<std::string> c;
+    std::stringstream in(row);
+    for (std::string cell; std::getline(in, cell, ',');) c.push_back(cell);
+    return c;
+  };
+  const std::vector<std::string> header = cells(line);
+  const auto column = [&](const std::vector<std::string>& row, const std::string& name) {
+    for (size_t i = 0; i < header.size() && i < row.size(); ++i)
+      if (header[i] == name) return row[i];
+    ADD_FAILURE() << "no column " << name << " in " << line;
+    return std::string();
+  };
+  int games = 0;
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> row = cells(line);
+    ++games;
+    SCOPED_TRACE("game " + column(row, "game"));
+    EXPECT_EQ(column(row, "kills"), "8");
+    EXPECT_EQ(column(row, "stops"), "1");
+    EXPECT_EQ(column(row, "finished"), "yes");
+    EXPECT_EQ(column(row, "summary_complete"), "yes");
+    const int restarts = std::atoi(column(row, "restarts").c_str());
+    EXPECT_GE(restarts, 8);
+    const std::string summary =
+        test::readFile(dir / "soak" / ("game_" + column(row, "game")) / "summary.json");
+    int told = 0;
+    for (size_t at = summary.find("\"restart\": "); at != std::string::npos;
+         at = summary.find("\"restart\": ", at + 1))
+      ++told;
+    EXPECT_EQ(told, restarts) << summary;
+  }
+  EXPECT_EQ(games, 2) << out;
 }
 
 TEST(MatchApp, CtrlCLeavesAValidTruncatedLogAndSummary) {
