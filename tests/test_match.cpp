@@ -743,7 +743,8 @@ TEST(ServeApp, PlaysTheSameGameAsMatchWithTheSameAgents) {
 // drives through `simsoccer lola-run` (its socket at /tmp/robocup in a
 // private namespace), the others built-in agents over DDS. The robot plays
 // the whole game at LoLA's 12 ms cycle, the summary counts the client's maps
-// (and its unknown keys), and the log keeps the LED colours it set.
+// (and its unknown keys), and the log keeps the LED colours it set. The client comes 7 s late
+// and no DDS agent is lost waiting for it.
 TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
   if (!test::bubblewrapWorks()) GTEST_SKIP() << "bubblewrap cannot make a namespace here";
   BackgroundMatch m("match_lola",
@@ -755,6 +756,9 @@ TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
     up = std::filesystem::is_socket(socket);
   }
   ASSERT_TRUE(up) << "no LoLA socket at " << socket;
+  // A team starts its binary by hand, maybe late: the match waits for it before it starts the
+  // DDS agents (after 5 s without a frame an agent would take the simulator for gone and exit).
+  std::this_thread::sleep_for(std::chrono::seconds(7));
   match::ChildProcess client({kBin, "lola-run", "--robot", "2:1", "--run", m.dir.path().string(),
                               "--", SIMSOCCER_LOLA_CLIENT, "--mode", "unknown", "--joint",
                               "HeadYaw=0.4"});
@@ -767,6 +771,7 @@ TEST(MatchApp, ALolaRobotPlaysThroughItsSocketBesideDdsAgents) {
   EXPECT_NE(m.out.find("LoLA robot 2:1 at"), std::string::npos) << m.out;
   const std::string summary = test::readFile(m.dir / "summary.json");
   EXPECT_EQ(jsonValue(summary, "control_period"), "0.012");
+  EXPECT_EQ(jsonValue(summary, "agent_restarts"), "[]") << summary;
   const std::regex lola(
       "\"lola\": \\[\\s*\\{\"team\": 2, \"player\": 1, \"socket\": \"[^\"]+\", "
       "\"address\": null, \"sessions\": 1, \"packets_sent\": ([0-9]+), "
