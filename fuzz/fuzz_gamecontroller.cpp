@@ -1,6 +1,6 @@
-// The GameController packet decoders (control v18 and v19, return v4) on
+// The GameController packet decoders (control v18, v19 and v20, return v4) on
 // any datagram. A packet that decodes must encode and decode again to the
-// same values (the v19 codes map to the SPL's and back consistently).
+// same values (the HSL codes map to the SPL's and back consistently).
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -1,7 +1,8 @@
 // A reader of GameController control packets written for the tests from the
 // official layouts (GameController3's RoboCupGameControlData.h, version 18,
-// 118 bytes; the HSL GameController's, version 19, 198 bytes), by absolute
-// byte offsets, independent of the simulator's encoder and decoder.
+// 118 bytes; the HSL GameController's, version 19, 198 bytes, and version 20,
+// 158 bytes), by absolute byte offsets, independent of the simulator's encoder
+// and decoder.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +15,7 @@
 namespace simsoccer::test {
 
 struct GcPlayer {
-  int penalty = 0, secs_till_unpenalised = 0, warnings = 0, cautions = 0;
+  int penalty = 0, secs_till_unpenalised = 0, warnings = -1, cautions = -1;  // HSL only
 };
 struct GcTeam {
   int number = 0, field_player_colour = 0, goalkeeper_colour = 0, goalkeeper = 0, score = 0;
@@ -25,7 +26,7 @@ struct GcPacket {
   int version = 0, packet_number = 0, players_per_team = 0;
   int competition_phase = -1;  // v18 only
   int competition_type = 0;
-  int stopped = -1;  // v19 only
+  int stopped = -1;  // HSL (v19, v20) only
   int game_phase = 0, state = 0, set_play = 0, first_half = 0, kicking_team = 0;
   int secs_remaining = 0, secondary_time = 0;
   GcTeam teams[2];
@@ -36,7 +37,10 @@ inline GcPacket readGcPacket(std::span<const uint8_t> b) {
     throw std::runtime_error("not an RGme packet");
   GcPacket p;
   p.version = b[4];
-  const std::size_t size = p.version == 18 ? 118 : p.version == 19 ? 198 : 0;
+  const std::size_t size = p.version == 18   ? 118
+                           : p.version == 19 ? 198
+                           : p.version == 20 ? 158
+                                             : 0;
   if (size == 0) throw std::runtime_error("version " + std::to_string(p.version));
   if (b.size() != size)
     throw std::runtime_error("version " + std::to_string(p.version) + " packet of " +
@@ -59,8 +63,9 @@ inline GcPacket readGcPacket(std::span<const uint8_t> b) {
   p.kicking_team = b[13];
   p.secs_remaining = i16(14);
   p.secondary_time = i16(16);
-  const std::size_t player_size = p.version == 18 ? 2 : 4;
-  const std::size_t team_size = 10 + 20 * player_size;  // 50 or 90
+  // RobotInfo: penalty, secsTillUnpenalised; v19 warnings, cautions; v20 cautions.
+  const std::size_t player_size = p.version == 18 ? 2 : p.version == 19 ? 4 : 3;
+  const std::size_t team_size = 10 + 20 * player_size;  // 50, 90 or 70
   for (int t = 0; t < 2; ++t) {
     const std::size_t at = 18 + static_cast<std::size_t>(t) * team_size;
     GcTeam& team = p.teams[t];
@@ -77,9 +82,11 @@ inline GcPacket readGcPacket(std::span<const uint8_t> b) {
       GcPlayer pl;
       pl.penalty = b[q];
       pl.secs_till_unpenalised = b[q + 1];
-      if (player_size == 4) {
+      if (p.version == 19) {
         pl.warnings = b[q + 2];
         pl.cautions = b[q + 3];
+      } else if (p.version == 20) {
+        pl.cautions = b[q + 2];
       }
       team.players.push_back(pl);
     }

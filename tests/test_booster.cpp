@@ -573,7 +573,7 @@ TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespac
   listener.join();
   ASSERT_GE(received.size(), 8u);
   EXPECT_EQ(received.substr(0, 4), "RGme");
-  EXPECT_EQ(static_cast<uint8_t>(received[4]), 19);  // the HSL's version
+  EXPECT_EQ(static_cast<uint8_t>(received[4]), 20);  // the HSL's version (RoboCup 2026)
   // The team message counts against team 3's budget, the officials' way (up to 3 s: the
   // broadcast crosses the bridge, and in a parallel test run the cores are busy; 0.4 s once
   // was not enough).
@@ -592,6 +592,6 @@ TEST(BoosterEndpoint, OnTheFieldNetworkTheGameControllerReachesTheRobotsNamespac
   const int status = runUntilTheClientEnds(k1.simulation, k1.endpoint, client);
   ASSERT_EQ(status, 0) << client.result().dump();
   EXPECT_NEAR(client.result().at("head_yaw").get<double>(), 0.4, 0.03);
-  std::printf("%s at %s: a %zu-byte RGme v19 packet; the client drove its robot on domain 0\n",
+  std::printf("%s at %s: a %zu-byte RGme v20 packet; the client drove its robot on domain 0\n",
               ns.name().c_str(), ns.address().c_str(), received.size());
 }

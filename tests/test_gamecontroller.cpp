@@ -228,7 +228,7 @@ TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
   d.stopped = 1;
   d.teams[0].players[2].warnings = 1;
   d.teams[0].players[2].cautions = 1;
-  const auto bytes = encodeHsl(d);
+  const auto bytes = encodeHsl(d, 19);
   ASSERT_EQ(bytes.size(), 198u);
   const simsoccer::test::GcPacket p = simsoccer::test::readGcPacket(bytes);
   EXPECT_EQ(p.version, 19);
@@ -260,7 +260,7 @@ TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
   EXPECT_EQ(back.stopped, 1);
   // Standby does not exist in v19: a robot sees Initial.
   d.state = static_cast<uint8_t>(gc::State::Standby);
-  EXPECT_EQ(simsoccer::test::readGcPacket(encodeHsl(d)).state, 0);
+  EXPECT_EQ(simsoccer::test::readGcPacket(encodeHsl(d, 19)).state, 0);
   // A v18 packet is still told apart.
   int version = 0;
   decodeAnyControl(encode(knownState()), &version);
@@ -268,15 +268,95 @@ TEST(GameControllerPacket, HslVersion19AtTheOfficialOffsets) {
   EXPECT_THROW(decodeAnyControl(std::span<const uint8_t>(bytes.data(), 118)), PacketError);
 }
 
-// The link sends the rule book's version, with the message budget going down
-// as the team sends messages.
+// The HSL GameController's packet of RoboCup 2026 (v20, 158 bytes; its Wireshark dissector
+// game_controller_msgs/dissectors/robocup_gc.lua): v19's header part, a 3-byte RobotInfo
+// (penalty, secsTillUnpenalised, cautions), the penalties renumbered (Motion in Stop 3,
+// Cautioned 11 new).
+TEST(GameControllerPacket, HslVersion20AtTheOfficialOffsets) {
+  ControlData d = knownState();
+  d.competition_type = 1;  // MIDDLE
+  d.stopped = 1;
+  d.teams[0].players[2].cautions = 1;
+  d.teams[0].players[3].penalty = static_cast<uint8_t>(gc::Penalty::LocalGameStuck);
+  d.teams[0].players[4].penalty = static_cast<uint8_t>(gc::Penalty::RequestForPickup);
+  d.teams[0].players[5].penalty = static_cast<uint8_t>(gc::Penalty::InactivePlayer);
+  d.teams[0].players[6].penalty = static_cast<uint8_t>(gc::Penalty::LeavingTheField);
+  d.teams[0].players[7].penalty = static_cast<uint8_t>(gc::Penalty::IllegalMotionInSet);
+  d.teams[0].players[8].penalty = static_cast<uint8_t>(gc::Penalty::IllegalBallContact);
+  d.teams[0].players[9].penalty = static_cast<uint8_t>(gc::Penalty::IllegalPosition);
+  const auto bytes = encodeHsl(d);  // the current version
+  ASSERT_EQ(bytes.size(), 158u);
+  const simsoccer::test::GcPacket p = simsoccer::test::readGcPacket(bytes);
+  EXPECT_EQ(p.version, 20);
+  EXPECT_EQ(p.packet_number, 42);
+  EXPECT_EQ(p.competition_type, 1);
+  EXPECT_EQ(p.stopped, 1);
+  EXPECT_EQ(p.game_phase, 1);
+  EXPECT_EQ(p.state, 3);
+  EXPECT_EQ(p.set_play, 6);  // CORNER_KICK (SPL: 3)
+  EXPECT_EQ(p.kicking_team, 13);
+  EXPECT_EQ(p.secs_remaining, 600);
+  EXPECT_EQ(p.secondary_time, -3);
+  EXPECT_EQ(p.teams[0].number, 13);
+  EXPECT_EQ(p.teams[0].goalkeeper_colour, 2);
+  EXPECT_EQ(p.teams[0].single_shots, 0x0105);
+  EXPECT_EQ(p.teams[0].message_budget, 1200);
+  const auto& players = p.teams[0].players;
+  EXPECT_EQ(players[2].penalty, 10);  // PUSHING (v19: 9, SPL: 2)
+  EXPECT_EQ(players[2].secs_till_unpenalised, 45);
+  EXPECT_EQ(players[2].cautions, 1);
+  EXPECT_EQ(players[2].warnings, -1);  // none in v20
+  EXPECT_EQ(players[3].penalty, 4);    // LOCAL_GAME_STUCK (v19: 3)
+  EXPECT_EQ(players[4].penalty, 6);    // PICK_UP (v19: 5)
+  EXPECT_EQ(players[5].penalty, 5);    // INCAPABLE_ROBOT (v19: 4)
+  EXPECT_EQ(players[6].penalty, 8);    // LEAVING_THE_FIELD (v19: 7)
+  EXPECT_EQ(players[7].penalty, 2);    // MOTION_IN_SET
+  EXPECT_EQ(players[8].penalty, 9);    // PLAYING_WITH_ARMS_HANDS (v19: 8)
+  EXPECT_EQ(players[9].penalty, 1);    // ILLEGAL_POSITIONING
+  EXPECT_EQ(p.teams[1].number, 5);
+  EXPECT_EQ(p.teams[1].message_budget, 0x0102);
+  EXPECT_EQ(p.teams[1].players[19].penalty, 13);  // SUBSTITUTE (v19: 11, SPL: 14)
+  // Decoded back into the SPL's codes, told apart from v18 and v19 by the version byte.
+  int version = 0;
+  const ControlData back = decodeAnyControl(bytes, &version);
+  EXPECT_EQ(version, 20);
+  EXPECT_EQ(back.set_play, d.set_play);
+  for (size_t i = 2; i < 10; ++i) EXPECT_EQ(back.teams[0].players[i], d.teams[0].players[i]) << i;
+  EXPECT_EQ(back.teams[1].players[19], d.teams[1].players[19]);
+  EXPECT_EQ(back.stopped, 1);
+  // What v20 has and the SPL has not: Motion in Stop reads as motion in Set, Cautioned and
+  // Sent Off as the GameController's own penalty; past Substitute is no v20 penalty.
+  auto coded = bytes;
+  const size_t player0 = 18 + 10;  // teams[0].players[0].penalty
+  for (const auto& [code, spl] : {std::pair{3, gc::Penalty::IllegalMotionInSet},
+                                  {7, gc::Penalty::IllegalBallContact},
+                                  {11, gc::Penalty::Manual},
+                                  {12, gc::Penalty::Manual}}) {
+    coded[player0] = static_cast<uint8_t>(code);
+    EXPECT_EQ(decodeAnyControl(coded).teams[0].players[0].penalty, static_cast<uint8_t>(spl))
+        << code;
+  }
+  coded[player0] = 14;
+  EXPECT_THROW(decodeAnyControl(coded), PacketError);
+  // Standby does not exist in v20 either: a robot sees Initial.
+  d.state = static_cast<uint8_t>(gc::State::Standby);
+  EXPECT_EQ(simsoccer::test::readGcPacket(encodeHsl(d)).state, 0);
+  // A v19-sized packet that says 20 is refused by its size.
+  std::vector<uint8_t> wrong = encodeHsl(knownState(), 19);
+  wrong[4] = 20;
+  EXPECT_THROW(decodeAnyControl(wrong), PacketError);
+}
+
+// The link sends the rule book's version, with the message budget going down as the team sends
+// messages in Ready, Set and Playing (those sent in Initial, Finished and the shoot-out are
+// free, as GameController3 and the HSL's count them).
 TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
   for (const char* book : {"spl.yaml", "hsl_small_foundation.yaml", "hsl_middle_foundation.yaml",
                            "hsl_middle_advanced.yaml"}) {
     const RuleBook rules =
         loadRuleBook(std::filesystem::path(SIMSOCCER_SOURCE_DIR) / "configs" / "rules" / book);
     const std::string name = book;
-    // HSL divisions on the wire (RoboCupGameControlData.h v19): SMALL 0, MIDDLE 1;
+    // HSL divisions on the wire (RoboCupGameControlData.h v19, v20): SMALL 0, MIDDLE 1;
     // the Middle division plays 3 v 3 (Foundation) and 5 v 5 (Advanced).
     const int division = name.starts_with("hsl_middle") ? 1 : 0;
     if (name.starts_with("hsl_middle")) {
@@ -291,7 +371,9 @@ TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
     GameControllerLink link(c);
     std::array<uint8_t, 512> buf{};
     std::vector<int> budgets;
-    for (uint64_t sent : {0, 10, 25}) {
+    game.setTeamMessagesSent(0, 40);  // in Initial: free
+    game.ready();
+    for (uint64_t sent : {40, 50, 65}) {
       game.setTeamMessagesSent(0, sent);
       link.update(game);
       game.advance(0.5);
@@ -299,7 +381,7 @@ TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
       ASSERT_GT(n, 0u) << book;
       const auto p = simsoccer::test::readGcPacket(std::span<const uint8_t>(buf.data(), n));
       EXPECT_EQ(p.version, rules.gc_version) << book;
-      if (rules.gc_version == 19) {
+      if (rules.gc_version != 18) {
         EXPECT_EQ(p.competition_type, division) << book;
       }
       EXPECT_EQ(p.teams[0].number, 7);
@@ -309,5 +391,10 @@ TEST(GameControllerUdp, TheRuleBooksVersionGoesOutWithTheBudgetLeft) {
     EXPECT_EQ(budgets, (std::vector<int>{rules.message_budget, rules.message_budget - 10,
                                          rules.message_budget - 25}))
         << book;
+    game.timeout(std::nullopt);  // a referee timeout: Initial
+    game.setTeamMessagesSent(0, 100);
+    EXPECT_EQ(game.messageBudget(0), rules.message_budget - 25) << book;
+    game.setTeamMessagesSent(1, 7);
+    EXPECT_EQ(game.messageBudget(1), rules.message_budget) << book;
   }
 }

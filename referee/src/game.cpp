@@ -67,12 +67,14 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   if (auto g = root.optional("gamecontroller")) {
     g->allowOnly({"version", "competition_type"});
     r.gc_version = g->integer("version", 18);
-    if (r.gc_version != 18 && r.gc_version != 19)
-      g->failKey("version", "must be 18 (SPL, GameController3) or 19 (HSL)");
+    if (r.gc_version != 18 && r.gc_version != 19 && r.gc_version != 20)
+      g->failKey("version",
+                 "must be 18 (SPL, GameController3), 19 (HSL, German Open 2026) or 20 (HSL, "
+                 "RoboCup 2026)");
     r.standby = r.gc_version == 18;
     if (g->has("competition_type")) {
       const std::string t = (*g)["competition_type"].string();
-      if (r.gc_version != 19) g->failKey("competition_type", "goes with version 19 (HSL)");
+      if (r.gc_version == 18) g->failKey("competition_type", "goes with version 19 or 20 (HSL)");
       if (t == "small") r.competition_type = 0;
       else if (t == "middle") r.competition_type = 1;
       else if (t == "large") r.competition_type = 2;
@@ -705,11 +707,20 @@ void Game::follow(const ControlData& d) {
 }
 
 void Game::setTeamMessagesSent(int team, uint64_t total) {
-  messages_sent_.at(static_cast<size_t>(team)) = total;
+  const auto t = static_cast<size_t>(team);
+  const uint64_t fresh = total > messages_seen_.at(t) ? total - messages_seen_[t] : 0;
+  messages_seen_[t] = total;
+  // As GameController3 (actions/team_message.rs) and the HSL's: a message counts in Standby,
+  // Ready, Set and Playing outside the shoot-out; in Initial, Finished, a timeout or the
+  // shoot-out it is free.
+  const bool counted = phase_ != gc::GamePhase::PenaltyShoot &&
+                       (state_ == gc::State::Standby || state_ == gc::State::Ready ||
+                        state_ == gc::State::Set || state_ == gc::State::Playing);
+  if (counted) messages_counted_[t] += fresh;
 }
 
 int Game::messageBudget(int team) const {
-  const uint64_t sent = messages_sent_.at(static_cast<size_t>(team));
+  const uint64_t sent = messages_counted_.at(static_cast<size_t>(team));
   const auto budget = static_cast<uint64_t>(rules_.message_budget);
   return static_cast<int>(sent >= budget ? 0 : budget - sent);
 }

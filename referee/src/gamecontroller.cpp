@@ -30,7 +30,7 @@ std::array<uint8_t, kControlSize> encode(const ControlData& d) {
   o.u8(d.kicking_team);
   o.i16(d.secs_remaining);
   o.i16(d.secondary_time);
-  for (const TeamInfo& t : d.teams) writeTeam(o, t, false);
+  for (const TeamInfo& t : d.teams) writeTeam(o, t, gc::kControlVersion);
   return b;
 }
 
@@ -59,7 +59,7 @@ ControlData decodeControl(std::span<const uint8_t> bytes) {
   d.kicking_team = in.u8();
   d.secs_remaining = in.i16();
   d.secondary_time = in.i16();
-  for (TeamInfo& t : d.teams) t = readTeam(in, false);
+  for (TeamInfo& t : d.teams) t = readTeam(in, gc::kControlVersion);
   if (d.game_phase > 3)
     throw PacketError("control packet: gamePhase " + std::to_string(d.game_phase));
   if (d.state > 5) throw PacketError("control packet: state " + std::to_string(d.state));

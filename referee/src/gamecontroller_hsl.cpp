@@ -1,9 +1,13 @@
-// RoboCupGameControlData v19, the HSL GameController's (a fork of
-// GameController3; RoboCup-HumanoidSoccerLeague/GameController,
-// game_controller_msgs/headers/RoboCupGameControlData.h): the same header
-// part as v18 with competitionPhase replaced by competitionType and
-// competitionType's byte by `stopped`; RobotInfo grows warnings and cautions.
+// RoboCupGameControlData v19 and v20, the HSL GameController's (a fork of GameController3;
+// RoboCup-HumanoidSoccerLeague/GameController, game_controller_msgs/headers/
+// RoboCupGameControlData.h and game_controller_msgs/dissectors/robocup_gc.lua): the same header
+// part as v18 with competitionPhase replaced by competitionType and competitionType's byte by
+// `stopped`; RobotInfo is penalty, secsTillUnpenalised, warnings (v19 only) and cautions.
 #include <cstring>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "packet_io.hpp"
 #include "simsoccer/referee/gamecontroller.hpp"
@@ -12,7 +16,7 @@ namespace simsoccer::referee {
 
 namespace hsl {
 namespace {
-// HSL codes (v19 header).
+// HSL codes (the same in v19 and v20).
 enum SetPlay : uint8_t {
   kNone = 0,
   kDirectFreeKick = 1,
@@ -22,20 +26,62 @@ enum SetPlay : uint8_t {
   kGoalKick = 5,
   kCornerKick = 6
 };
-enum Penalty : uint8_t {
-  kNoPenalty = 0,
-  kIllegalPositioning = 1,
-  kMotionInSet = 2,
-  kLocalGameStuck = 3,
-  kIncapableRobot = 4,
-  kPickUp = 5,
-  kBallHolding = 6,
-  kLeavingTheField = 7,
-  kPlayingWithArmsHands = 8,
-  kPushing = 9,
-  kSentOff = 10,
-  kSubstitute = 11
+// The HSL's penalties by name; their codes differ between v19 and v20.
+enum class Penalty {
+  None,
+  IllegalPositioning,
+  MotionInSet,
+  MotionInStop,  // v20 only
+  LocalGameStuck,
+  IncapableRobot,
+  PickUp,
+  BallHolding,
+  LeavingTheField,
+  PlayingWithArmsHands,
+  Pushing,
+  Cautioned,  // v20 only
+  SentOff,
+  Substitute
 };
+// Code -> penalty, per version (v20: RoboCupGameControlData.h v20; v19: its v19).
+constexpr Penalty kPenalties20[] = {Penalty::None,
+                                    Penalty::IllegalPositioning,
+                                    Penalty::MotionInSet,
+                                    Penalty::MotionInStop,
+                                    Penalty::LocalGameStuck,
+                                    Penalty::IncapableRobot,
+                                    Penalty::PickUp,
+                                    Penalty::BallHolding,
+                                    Penalty::LeavingTheField,
+                                    Penalty::PlayingWithArmsHands,
+                                    Penalty::Pushing,
+                                    Penalty::Cautioned,
+                                    Penalty::SentOff,
+                                    Penalty::Substitute};
+constexpr Penalty kPenalties19[] = {Penalty::None,
+                                    Penalty::IllegalPositioning,
+                                    Penalty::MotionInSet,
+                                    Penalty::LocalGameStuck,
+                                    Penalty::IncapableRobot,
+                                    Penalty::PickUp,
+                                    Penalty::BallHolding,
+                                    Penalty::LeavingTheField,
+                                    Penalty::PlayingWithArmsHands,
+                                    Penalty::Pushing,
+                                    Penalty::SentOff,
+                                    Penalty::Substitute};
+
+std::span<const Penalty> penaltyCodes(int version) {
+  if (version == kVersion19) return kPenalties19;
+  return kPenalties20;
+}
+
+uint8_t codeOf(Penalty p, int version) {
+  const auto codes = penaltyCodes(version);
+  for (size_t i = 0; i < codes.size(); ++i)
+    if (codes[i] == p) return static_cast<uint8_t>(i);
+  return 0;  // not reached: every penalty sent has a code in both
+}
 }  // namespace
 
 uint8_t setPlayFromSpl(uint8_t spl) {
@@ -61,51 +107,104 @@ uint8_t setPlayToSpl(uint8_t hsl) {
   }
 }
 
-uint8_t penaltyFromSpl(uint8_t spl) {
+uint8_t penaltyFromSpl(uint8_t spl, int version) {
   using P = gc::Penalty;
+  Penalty h = Penalty::PickUp;
   switch (static_cast<P>(spl)) {
-    case P::None: return kNoPenalty;
-    case P::IllegalBallContact: return kPlayingWithArmsHands;
-    case P::PlayerPushing: return kPushing;
+    case P::None:
+      h = Penalty::None;
+      break;
+    case P::IllegalBallContact:
+      h = Penalty::PlayingWithArmsHands;
+      break;
+    case P::PlayerPushing:
+      h = Penalty::Pushing;
+      break;
     case P::IllegalMotionInSet:
-    case P::IllegalMotionInStandby: return kMotionInSet;
-    case P::InactivePlayer: return kIncapableRobot;
+    case P::IllegalMotionInStandby:
+      h = Penalty::MotionInSet;
+      break;
+    case P::InactivePlayer:
+      h = Penalty::IncapableRobot;
+      break;
     case P::IllegalPosition:
     case P::IllegalPositionInSet:
-    case P::PlayerStance: return kIllegalPositioning;
-    case P::LeavingTheField: return kLeavingTheField;
+    case P::PlayerStance:
+      h = Penalty::IllegalPositioning;
+      break;
+    case P::LeavingTheField:
+      h = Penalty::LeavingTheField;
+      break;
     case P::RequestForPickup:
-    case P::Manual: return kPickUp;
-    case P::LocalGameStuck: return kLocalGameStuck;
-    case P::Substitute: return kSubstitute;
+    case P::Manual:
+      h = Penalty::PickUp;
+      break;
+    case P::LocalGameStuck:
+      h = Penalty::LocalGameStuck;
+      break;
+    case P::Substitute:
+      h = Penalty::Substitute;
+      break;
   }
-  return kPickUp;
+  return codeOf(h, version);
 }
 
-uint8_t penaltyToSpl(uint8_t hsl) {
+uint8_t penaltyToSpl(uint8_t code, int version) {
   using P = gc::Penalty;
-  switch (hsl) {
-    case kNoPenalty: return static_cast<uint8_t>(P::None);
-    case kIllegalPositioning: return static_cast<uint8_t>(P::IllegalPosition);
-    case kMotionInSet: return static_cast<uint8_t>(P::IllegalMotionInSet);
-    case kLocalGameStuck: return static_cast<uint8_t>(P::LocalGameStuck);
-    case kIncapableRobot: return static_cast<uint8_t>(P::InactivePlayer);
-    case kPickUp: return static_cast<uint8_t>(P::RequestForPickup);
-    case kBallHolding:
-    case kPlayingWithArmsHands: return static_cast<uint8_t>(P::IllegalBallContact);
-    case kLeavingTheField: return static_cast<uint8_t>(P::LeavingTheField);
-    case kPushing: return static_cast<uint8_t>(P::PlayerPushing);
-    case kSubstitute: return static_cast<uint8_t>(P::Substitute);
-    default: return static_cast<uint8_t>(P::Manual);  // sent off: out for the game
+  const auto codes = penaltyCodes(version);
+  if (code >= codes.size())
+    throw PacketError("control packet v" + std::to_string(version) + ": penalty " +
+                      std::to_string(code));
+  P p = P::Manual;  // sent off (out for the game), cautioned: the GameController's to lift
+  switch (codes[code]) {
+    case Penalty::None:
+      p = P::None;
+      break;
+    case Penalty::IllegalPositioning:
+      p = P::IllegalPosition;
+      break;
+    case Penalty::MotionInSet:
+    case Penalty::MotionInStop:
+      p = P::IllegalMotionInSet;
+      break;
+    case Penalty::LocalGameStuck:
+      p = P::LocalGameStuck;
+      break;
+    case Penalty::IncapableRobot:
+      p = P::InactivePlayer;
+      break;
+    case Penalty::PickUp:
+      p = P::RequestForPickup;
+      break;
+    case Penalty::BallHolding:
+    case Penalty::PlayingWithArmsHands:
+      p = P::IllegalBallContact;
+      break;
+    case Penalty::LeavingTheField:
+      p = P::LeavingTheField;
+      break;
+    case Penalty::Pushing:
+      p = P::PlayerPushing;
+      break;
+    case Penalty::Substitute:
+      p = P::Substitute;
+      break;
+    case Penalty::Cautioned:
+    case Penalty::SentOff:
+      break;
   }
+  return static_cast<uint8_t>(p);
 }
 }  // namespace hsl
 
-std::array<uint8_t, hsl::kControlSize> encodeHsl(const ControlData& d) {
-  std::array<uint8_t, hsl::kControlSize> b{};
+std::vector<uint8_t> encodeHsl(const ControlData& d, int version) {
+  if (version != hsl::kVersion19 && version != hsl::kVersion20)
+    throw std::invalid_argument("HSL GameController version " + std::to_string(version) +
+                                ": 19 or 20");
+  std::vector<uint8_t> b(hsl::controlSize(version));
   Out o(b);
   o.bytes(d.true_data ? "RGTD" : "RGme", 4);
-  o.u8(hsl::kControlVersion);
+  o.u8(static_cast<uint8_t>(version));
   o.u8(d.packet_number);
   o.u8(d.players_per_team);
   o.u8(d.competition_type);
@@ -119,21 +218,25 @@ std::array<uint8_t, hsl::kControlSize> encodeHsl(const ControlData& d) {
   o.u8(d.kicking_team);
   o.i16(d.secs_remaining);
   o.i16(d.secondary_time);
-  for (const TeamInfo& t : d.teams) writeTeam(o, t, true);
+  for (const TeamInfo& t : d.teams) writeTeam(o, t, version);
   return b;
 }
 
 ControlData decodeHsl(std::span<const uint8_t> bytes) {
-  if (bytes.size() != hsl::kControlSize)
-    throw PacketError("control packet v19: " + std::to_string(bytes.size()) + " bytes, expected " +
-                      std::to_string(hsl::kControlSize));
+  if (bytes.size() < 5)
+    throw PacketError("control packet: " + std::to_string(bytes.size()) + " bytes");
+  const int version = bytes[4];
+  if (version != hsl::kVersion19 && version != hsl::kVersion20)
+    throw PacketError("control packet: version " + std::to_string(version) + ", expected 19 or 20");
+  const std::string v = "control packet v" + std::to_string(version) + ": ";
+  if (bytes.size() != hsl::controlSize(version))
+    throw PacketError(v + std::to_string(bytes.size()) + " bytes, expected " +
+                      std::to_string(hsl::controlSize(version)));
   const bool rgme = std::memcmp(bytes.data(), "RGme", 4) == 0;
   const bool rgtd = std::memcmp(bytes.data(), "RGTD", 4) == 0;
   if (!rgme && !rgtd) throw PacketError("control packet: header is not RGme or RGTD");
   In in(bytes);
-  for (int i = 0; i < 4; ++i) in.u8();
-  if (const uint8_t version = in.u8(); version != hsl::kControlVersion)
-    throw PacketError("control packet: version " + std::to_string(version) + ", expected 19");
+  for (int i = 0; i < 5; ++i) in.u8();
   ControlData d;
   d.true_data = rgtd;
   d.packet_number = in.u8();
@@ -147,21 +250,18 @@ ControlData decodeHsl(std::span<const uint8_t> bytes) {
   d.kicking_team = in.u8();
   d.secs_remaining = in.i16();
   d.secondary_time = in.i16();
-  for (TeamInfo& t : d.teams) t = readTeam(in, true);
+  for (TeamInfo& t : d.teams) t = readTeam(in, version);
   if (d.competition_type > 2)
-    throw PacketError("control packet v19: competitionType " + std::to_string(d.competition_type));
-  if (d.game_phase > 3) throw PacketError("control packet: gamePhase " + std::to_string(d.game_phase));
-  if (d.state > 4) throw PacketError("control packet v19: state " + std::to_string(d.state));
-  if (set_play > 6) throw PacketError("control packet v19: setPlay " + std::to_string(set_play));
+    throw PacketError(v + "competitionType " + std::to_string(d.competition_type));
+  if (d.game_phase > 3) throw PacketError(v + "gamePhase " + std::to_string(d.game_phase));
+  if (d.state > 4) throw PacketError(v + "state " + std::to_string(d.state));
+  if (set_play > 6) throw PacketError(v + "setPlay " + std::to_string(set_play));
   d.set_play = hsl::setPlayToSpl(set_play);
   return d;
 }
 
 std::vector<uint8_t> encodeControl(const ControlData& data, int version) {
-  if (version == hsl::kControlVersion) {
-    const auto b = encodeHsl(data);
-    return {b.begin(), b.end()};
-  }
+  if (version == hsl::kVersion19 || version == hsl::kVersion20) return encodeHsl(data, version);
   const auto b = encode(data);
   return {b.begin(), b.end()};
 }
@@ -170,7 +270,7 @@ ControlData decodeAnyControl(std::span<const uint8_t> bytes, int* version) {
   if (bytes.size() < 5) throw PacketError("control packet: " + std::to_string(bytes.size()) + " bytes");
   const int v = bytes[4];
   if (version) *version = v;
-  return v == hsl::kControlVersion ? decodeHsl(bytes) : decodeControl(bytes);
+  return v == hsl::kVersion19 || v == hsl::kVersion20 ? decodeHsl(bytes) : decodeControl(bytes);
 }
 
 }  // namespace simsoccer::referee

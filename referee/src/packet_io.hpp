@@ -1,6 +1,7 @@
 // The GameController packets' field-by-field serialisation (no struct layout
 // is trusted): a little-endian writer and reader over a fixed buffer, and a
-// TeamInfo in v18's layout (2-byte RobotInfo) or v19's (4 bytes, HSL codes).
+// TeamInfo in v18's layout (2-byte RobotInfo), v19's (4 bytes, HSL codes) or v20's (3 bytes,
+// HSL codes).
 #pragma once
 
 #include <cstddef>
@@ -62,7 +63,9 @@ class In {
   size_t pos_ = 0;
 };
 
-void writeTeam(Out& o, const TeamInfo& t, bool hsl) {
+// `version`: 18 (SPL), 19 or 20 (HSL).
+void writeTeam(Out& o, const TeamInfo& t, int version) {
+  const bool hsl = version != gc::kControlVersion;
   o.u8(t.team_number);
   o.u8(t.field_player_colour);
   o.u8(t.goalkeeper_colour);
@@ -72,16 +75,15 @@ void writeTeam(Out& o, const TeamInfo& t, bool hsl) {
   o.u16(t.single_shots);
   o.u16(t.message_budget);
   for (const RobotInfo& r : t.players) {
-    o.u8(hsl ? hsl::penaltyFromSpl(r.penalty) : r.penalty);
+    o.u8(hsl ? hsl::penaltyFromSpl(r.penalty, version) : r.penalty);
     o.u8(r.secs_till_unpenalised);
-    if (hsl) {
-      o.u8(r.warnings);
-      o.u8(r.cautions);
-    }
+    if (version == hsl::kVersion19) o.u8(r.warnings);
+    if (hsl) o.u8(r.cautions);
   }
 }
 
-TeamInfo readTeam(In& in, bool hsl) {
+TeamInfo readTeam(In& in, int version) {
+  const bool hsl = version != gc::kControlVersion;
   TeamInfo t;
   t.team_number = in.u8();
   t.field_player_colour = in.u8();
@@ -93,16 +95,10 @@ TeamInfo readTeam(In& in, bool hsl) {
   t.message_budget = in.u16();
   for (RobotInfo& r : t.players) {
     r.penalty = in.u8();
-    if (hsl) {
-      if (r.penalty > 11)
-        throw PacketError("control packet v19: penalty " + std::to_string(r.penalty));
-      r.penalty = hsl::penaltyToSpl(r.penalty);
-    }
+    if (hsl) r.penalty = hsl::penaltyToSpl(r.penalty, version);
     r.secs_till_unpenalised = in.u8();
-    if (hsl) {
-      r.warnings = in.u8();
-      r.cautions = in.u8();
-    }
+    if (version == hsl::kVersion19) r.warnings = in.u8();
+    if (hsl) r.cautions = in.u8();
   }
   return t;
 }

@@ -47,7 +47,7 @@ struct RuleBook {
   // GameController3) or 19 (HSL); the HSL has no Standby state.
   int gc_version = 18;
   bool standby = true;
-  uint8_t competition_type = 0;  // v19: 0 SMALL, 1 MIDDLE, 2 LARGE (v18: 0 NORMAL)
+  uint8_t competition_type = 0;  // HSL: 0 SMALL, 1 MIDDLE, 2 LARGE (v18: 0 NORMAL)
 };
 
 // Reads and checks a rule book; throws engine::ConfigError (file, key, reason).
@@ -131,8 +131,9 @@ class Game {
   void timeout(std::optional<int> team);  // a team timeout, or a referee timeout (nullopt)
   void dropBall();  // restart without a kicking team (after a global game stuck)
   void substitute(int team, int player_out, int player_in);
-  // The team messages `team` has sent so far (the GameController counts them
-  // on the team port): its packets' message budget is what is left.
+  // The team messages `team` has sent so far (the GameController counts them on the team
+  // port), called as the total grows: those sent while the game is in Standby, Ready, Set or
+  // Playing outside the shoot-out count, and its packets' message budget is what is left.
   void setTeamMessagesSent(int team, uint64_t total);
   int messageBudget(int team) const;
 
@@ -226,7 +227,8 @@ class Game {
   std::array<int, 2> score_{};
   std::array<int, 2> incremental_{};  // incremental penalties so far, per team
   std::array<int, 2> timeouts_left_{1, 1};
-  std::array<uint64_t, 2> messages_sent_{};
+  std::array<uint64_t, 2> messages_seen_{};     // the sources' totals at the last call
+  std::array<uint64_t, 2> messages_counted_{};  // against the budget
   bool stopped_ = false;  // an external HSL GameController stopped play
   double half_clock_ = 0.0, secondary_ = 0.0, time_ = 0.0;
   // Shoot-out.

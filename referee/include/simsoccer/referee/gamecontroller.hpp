@@ -24,7 +24,8 @@ namespace gc = protocol::gc;
 struct RobotInfo {
   uint8_t penalty = 0;                // gc::Penalty
   uint8_t secs_till_unpenalised = 0;  // rounded up, clamped to 0..255
-  uint8_t warnings = 0, cautions = 0;  // v19 (HSL) only
+  uint8_t warnings = 0;               // HSL v19 only
+  uint8_t cautions = 0;               // HSL v19 and v20
   bool operator==(const RobotInfo&) const = default;
 };
 
@@ -42,15 +43,15 @@ struct TeamInfo {
 };
 
 // RoboCupGameControlData, in the SPL's v18 codes (the simulator's and the
-// agents' vocabulary, also when the game runs under HSL rules: the v19
+// agents' vocabulary, also when the game runs under HSL rules: the HSL
 // functions below map the codes on the wire).
 struct ControlData {
   bool true_data = false;  // "RGTD" (to monitors) instead of "RGme"
   uint8_t packet_number = 0;
   uint8_t players_per_team = 5;
   uint8_t competition_phase = 0;
-  uint8_t competition_type = 0;  // v18: 0 NORMAL, 1 MOST_PASSES; v19: 0 SMALL, 1 MIDDLE, 2 LARGE
-  uint8_t stopped = 0;           // v19 only: play is stopped
+  uint8_t competition_type = 0;  // v18: 0 NORMAL, 1 MOST_PASSES; HSL: 0 SMALL, 1 MIDDLE, 2 LARGE
+  uint8_t stopped = 0;           // HSL (v19, v20) only: play is stopped
   uint8_t game_phase = 0;        // gc::GamePhase
   uint8_t state = 0;       // gc::State
   uint8_t set_play = 0;    // gc::SetPlay
@@ -91,27 +92,44 @@ class PacketError : public std::runtime_error {
 std::array<uint8_t, kControlSize> encode(const ControlData& data);
 ControlData decodeControl(std::span<const uint8_t> bytes);  // throws PacketError
 
-// The HSL GameController's RoboCupGameControlData v19 (2026-; 198 bytes):
-// byte 7 competitionType (SMALL/MIDDLE/LARGE), byte 8 `stopped`, no
-// competitionPhase, no Standby, RobotInfo of 4 bytes (penalty,
-// secsTillUnpenalised, warnings, cautions), the HSL's set-play and penalty
-// codes (mapped from and to the SPL's here; docs/referee.md).
+// The HSL GameController's RoboCupGameControlData (RoboCup-HumanoidSoccerLeague/GameController,
+// game_controller_msgs/headers/RoboCupGameControlData.h and its Wireshark dissector): the same
+// header part as v18 with competitionPhase replaced by competitionType (SMALL/MIDDLE/LARGE) and
+// competitionType's byte by `stopped`, no Standby, the HSL's set-play and penalty codes (mapped
+// from and to the SPL's here; docs/referee.md).
+// - v20 (GameController v7.0.0, RoboCup 2026; 158 bytes): RobotInfo of 3 bytes (penalty,
+//   secsTillUnpenalised, cautions), penalties 1..13 with Motion in Stop and Cautioned.
+// - v19 (GameController v6.0, the German Open 2026; 198 bytes): RobotInfo of 4 bytes (penalty,
+//   secsTillUnpenalised, warnings, cautions), penalties 1..11.
 namespace hsl {
-constexpr uint8_t kControlVersion = 19;
-constexpr size_t kRobotInfoSize = 4;
-constexpr size_t kTeamInfoSize = 6 + 2 + 2 + gc::kMaxPlayers * kRobotInfoSize;
-constexpr size_t kControlSize = kControlHeaderSize + 2 * kTeamInfoSize;
-static_assert(kTeamInfoSize == 90 && kControlSize == 198, "RoboCupGameControlData v19 is 198 bytes");
+constexpr uint8_t kVersion19 = 19;
+constexpr uint8_t kVersion20 = 20;
+constexpr uint8_t kControlVersion = kVersion20;  // the current one
+constexpr size_t robotInfoSize(int version) {
+  return version == kVersion19 ? 4 : 3;
+}
+constexpr size_t teamInfoSize(int version) {
+  return 6 + 2 + 2 + gc::kMaxPlayers * robotInfoSize(version);
+}
+constexpr size_t controlSize(int version) {
+  return kControlHeaderSize + 2 * teamInfoSize(version);
+}
+static_assert(teamInfoSize(kVersion19) == 90 && controlSize(kVersion19) == 198,
+              "RoboCupGameControlData v19 is 198 bytes");
+static_assert(teamInfoSize(kVersion20) == 70 && controlSize(kVersion20) == 158,
+              "RoboCupGameControlData v20 is 158 bytes");
 uint8_t setPlayFromSpl(uint8_t spl);
 uint8_t setPlayToSpl(uint8_t hsl);
-uint8_t penaltyFromSpl(uint8_t spl);
-uint8_t penaltyToSpl(uint8_t hsl);
+// `version` 19 or 20: their penalty codes differ.
+uint8_t penaltyFromSpl(uint8_t spl, int version);
+uint8_t penaltyToSpl(uint8_t hsl, int version);  // throws PacketError for a code out of range
 }  // namespace hsl
-std::array<uint8_t, hsl::kControlSize> encodeHsl(const ControlData& data);
-ControlData decodeHsl(std::span<const uint8_t> bytes);  // throws PacketError
-// The packet as the given GameController version sends it (18 or 19).
+// The packet in HSL version 19 or 20.
+std::vector<uint8_t> encodeHsl(const ControlData& data, int version = hsl::kControlVersion);
+ControlData decodeHsl(std::span<const uint8_t> bytes);  // v19 or v20; throws PacketError
+// The packet as the given GameController version sends it (18, 19 or 20).
 std::vector<uint8_t> encodeControl(const ControlData& data, int version);
-// A v18 or v19 packet, told apart by its version byte (and checked for its size).
+// A v18, v19 or v20 packet, told apart by its version byte (and checked for its size).
 ControlData decodeAnyControl(std::span<const uint8_t> bytes, int* version = nullptr);
 std::array<uint8_t, kReturnSize> encode(const ReturnData& data);
 ReturnData decodeReturn(std::span<const uint8_t> bytes);  // throws PacketError (GC3's checks)

@@ -71,7 +71,7 @@ class GameControllerLink {
   std::map<std::pair<uint8_t, uint8_t>, ReturnData> returns_;  // ordered: deterministic iteration
 };
 
-// An external GameController's packets (v18 or v19) received on its port
+// An external GameController's packets (v18, v19 or v20) received on its port
 // (3838, shared with robot software on the same host: SO_REUSEADDR, and the
 // GameController broadcasts). The simulator then does not bind 3939, so a
 // GameController on the same host can. Malformed packets are counted and
