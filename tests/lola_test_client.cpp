@@ -8,7 +8,7 @@
 //
 //   simsoccer-lola-test-client [--socket P] [--mode M] [--cycles N] [--after K]
 //       [--joint NAME=RAD]... [--stiffness S] [--expect-chest] [--print-id]
-//       [--expect-id BODY_ID] [--ramp]
+//       [--expect-id BODY_ID] [--ramp] [--expect-ticks]
 // modes: hold (answer every map, full), partial (full once, then Position
 // alone, split over two writes, LEDs in a second map), probe (read one map,
 // disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
@@ -16,7 +16,8 @@
 // bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a
 // field network, receive a GameController packet on 3838, send a status packet to
 // --gc-host:3939, broadcast team messages to --broadcast:10000+team until
-// one from a teammate arrives; --team-number, --player).
+// one from a teammate arrives; --team-number, --player). --expect-ticks: Battery[3] carries the
+// cycle counter (the Webots LoLA controller's convention), one more in each map.
 // Exit: 0 done, 1 expectation not met, 2 usage, 3 protocol violation, 4 no server.
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -74,6 +75,7 @@ struct Options {
   std::string expect_id;  // the body id the robot must report
   int team_number = 0, player = 0;
   bool ramp = false;  // HeadYaw = 0.001 rad x the cycle: which cycle a command answers
+  bool expect_ticks = false;
   std::string gc_host, broadcast;
 };
 
@@ -191,6 +193,8 @@ int main(int argc, char** argv) {
       o.print_id = true;
     else if (a == "--ramp")
       o.ramp = true;
+    else if (a == "--expect-ticks")
+      o.expect_ticks = true;
     else if (a == "--expect-id")
       o.expect_id = value();
     else if (a == "--team-number")
@@ -226,6 +230,7 @@ int main(int argc, char** argv) {
   }
   std::vector<float> hold;  // targets: the first map's positions, with --joint overrides
   long cycle = 0, silent_until = -1;
+  float last_tick = -1.0f;  // --expect-ticks: Battery[3] of the last map
   bool probed = false, faulted = false, reconnected = false;
   std::vector<uint8_t> packet(896);
   for (; o.cycles == 0 || cycle < o.cycles; ++cycle) {
@@ -260,6 +265,15 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "lola client: robot %s, expected %s\n", s.robot_config[0].c_str(),
                    o.expect_id.c_str());
       return 1;
+    }
+    if (o.expect_ticks) {
+      const float tick = s["Battery"][3];
+      if (cycle > 0 && tick != std::fmod(last_tick + 1.0f, 65536.0f)) {
+        std::fprintf(stderr, "lola client: map %ld has tick %.0f after %.0f\n", cycle, tick,
+                     last_tick);
+        return 1;
+      }
+      last_tick = tick;
     }
     if (o.expect_chest && s["Touch"][0] == 1.0f) {
       std::printf("lola client: chest button pressed in map %ld\n", cycle);

@@ -95,8 +95,9 @@ lola::EndpointConfig teamFiveConfig(const std::filesystem::path& dir) {
 
 }  // namespace
 
+// Each map carries the next cycle counter in Battery[3], as under the Webots LoLA controller.
 TEST(LolaEndpoint, AJointFollowsItsCommandAndEveryMapPassesTheStrictClient) {
-  Rig rig({"--joint", "HeadYaw=0.6", "--cycles", "150"});
+  Rig rig({"--joint", "HeadYaw=0.6", "--cycles", "150", "--expect-ticks"});
   EXPECT_EQ(rig.finish(), 0) << "the strict client refused a sensor map";
   EXPECT_NEAR(rig.headYaw(), 0.6, 0.03);
   EXPECT_TRUE(rig.world.isStanding(0));

@@ -292,7 +292,9 @@ void Endpoint::observe(const sim::Observation& o) {
   for (Client& c : clients_) {
     const world::SensorFrame& f = o.world->sensorFrame(c.config.robot);
     if (observed_) c.battery.update(f, cycle_seconds_);
-    c.latest = encodeSensorPacket(fromFrame(f, c.battery.reading()), c.config.identity);
+    Battery battery = c.battery.reading();
+    if (c.config.tick_in_battery) battery.temperature = static_cast<float>(o.tick & 0xffff);
+    c.latest = encodeSensorPacket(fromFrame(f, battery), c.config.identity);
     c.has_latest = true;
     c.latest_sent = false;
   }

@@ -53,6 +53,7 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
                       ? own->second
                       : lola::defaultIdentity(c.lola.robots[i].team_number,
                                               c.lola.robots[i].player);
+    rs.tick_in_battery = c.lola.tick_in_battery;
     ec.robots.push_back(rs);
   }
   endpoint_ = std::make_unique<lola::Endpoint>(session.world(), ec);

@@ -182,7 +182,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
           .fail("the camera must look at a point away from its position");
   }
   if (auto l = root.optional("lola")) {
-    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities"});
+    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities",
+                  "tick_in_battery"});
     if (auto ids = l->optional("identities")) {
       for (const auto& [robot, node] : ids->entries()) {
         std::vector<LolaPlayer> players;
@@ -208,6 +209,7 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
       }
     }
     c.lola.network = l->boolean("network", false);
+    c.lola.tick_in_battery = l->boolean("tick_in_battery", true);
     if (l->has("image_port")) {
       const int port = (*l)["image_port"].integer();
       if (port < 1 || port > 65000) (*l)["image_port"].fail("must be 1..65000");

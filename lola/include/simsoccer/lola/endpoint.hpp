@@ -30,6 +30,10 @@ struct RobotSocket {
   std::filesystem::path socket;  // where the endpoint listens (an old file there is replaced)
   RobotIdentity identity;
   double battery_charge = 1.0;  // at the start
+  // The Webots LoLA controller's convention: Battery[3] (the temperature) carries the LoLA
+  // cycle counter (u16, wrapping), which Bembelbots' code takes for the simulated time (tick x
+  // 12 ms) when the head id is the simulator's. False: a constant 30 deg C.
+  bool tick_in_battery = true;
 };
 
 struct EndpointConfig {

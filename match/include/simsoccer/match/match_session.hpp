@@ -53,6 +53,9 @@ struct LolaSettings {
   bool network = false;
   // RobotConfig strings per robot ("T:P") where not lola::defaultIdentity's.
   std::map<std::string, lola::RobotIdentity> identities;
+  // Battery[3] carries the LoLA cycle counter, as under the Webots LoLA controller
+  // (lola::RobotSocket::tick_in_battery); false: the battery's temperature.
+  bool tick_in_battery = true;
 };
 
 struct MatchConfig {
