@@ -8,10 +8,10 @@
 //
 //   simsoccer-lola-test-client [--socket P] [--mode M] [--cycles N] [--after K]
 //       [--joint NAME=RAD]... [--stiffness S] [--expect-chest] [--print-id]
-//       [--expect-id BODY_ID] [--ramp] [--expect-ticks]
+//       [--expect-id BODY_ID] [--ramp] [--expect-ticks] [--probe-gap S]
 // modes: hold (answer every map, full), partial (full once, then Position
 // alone, split over two writes, LEDs in a second map), probe (read one map,
-// disconnect, reconnect, hold), garbage, nan, huge (a 10 MB map), unknown
+// disconnect, reconnect --probe-gap s later, hold), garbage, nan, huge (a 10 MB map), unknown
 // (unknown keys in every map), silent (stop answering for K cycles after K),
 // bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a
 // field network, receive a GameController packet on 3838, send a status packet to
@@ -76,6 +76,7 @@ struct Options {
   int team_number = 0, player = 0;
   bool ramp = false;  // HeadYaw = 0.001 rad x the cycle: which cycle a command answers
   bool expect_ticks = false;
+  double probe_gap = 0.0;  // s between the probe's close and its reconnection
   std::string gc_host, broadcast;
 };
 
@@ -195,6 +196,8 @@ int main(int argc, char** argv) {
       o.ramp = true;
     else if (a == "--expect-ticks")
       o.expect_ticks = true;
+    else if (a == "--probe-gap")
+      o.probe_gap = std::stod(value());
     else if (a == "--expect-id")
       o.expect_id = value();
     else if (a == "--team-number")
@@ -286,6 +289,7 @@ int main(int argc, char** argv) {
     if (o.mode == "probe" && !probed) {  // B-Human reads the body id and reconnects
       probed = true;
       ::close(fd);
+      std::this_thread::sleep_for(std::chrono::duration<double>(o.probe_gap));  // booting
       fd = connectTo(o.socket);
       if (fd < 0) return 4;
       continue;

@@ -46,8 +46,9 @@ struct Rig {
   lola::Endpoint endpoint;
   std::unique_ptr<match::ChildProcess> client;
 
-  explicit Rig(const std::vector<std::string>& client_args, bool lockstep = true)
-      : endpoint(world, config(dir.path(), lockstep)) {
+  explicit Rig(const std::vector<std::string>& client_args, bool lockstep = true,
+               double reconnect_timeout = 0.0)
+      : endpoint(world, config(dir.path(), lockstep, reconnect_timeout)) {
     sim.addSource(endpoint);
     std::vector<std::string> args = {SIMSOCCER_LOLA_CLIENT, "--socket",
                                      (dir.path() / "robot.sock").string()};
@@ -55,7 +56,8 @@ struct Rig {
     client = std::make_unique<match::ChildProcess>(args);
     EXPECT_TRUE(endpoint.waitForClients(10.0)) << "the client never connected";
   }
-  static lola::EndpointConfig config(const std::filesystem::path& dir, bool lockstep) {
+  static lola::EndpointConfig config(const std::filesystem::path& dir, bool lockstep,
+                                     double reconnect_timeout = 0.0) {
     lola::EndpointConfig c;
     lola::RobotSocket r;
     r.robot = 0;
@@ -64,6 +66,7 @@ struct Rig {
     c.robots.push_back(r);
     c.lockstep = lockstep;
     c.answer_timeout = 0.5;
+    c.reconnect_timeout = reconnect_timeout;
     return c;
   }
   void run(int periods) {
@@ -183,6 +186,28 @@ TEST_P(LolaFault, NeverStopsTheSimulationOrMovesTheRobot) {
   } else if (mode == "probe") {
     EXPECT_EQ(s.sessions, 2u);
   }
+}
+
+// B-Human's binary reads one map for the body id, closes the socket and connects again when
+// it has booted (here 1 s later): lockstep waits for it (up to the reconnect timeout), so the
+// robot misses no period of the game; without the wait the simulation ran on at its own speed
+// meanwhile, and the robot stood through the kick-off.
+TEST(LolaEndpoint, LockstepWaitsForABinaryThatReconnectsAsItBoots) {
+  Rig rig({"--mode", "probe", "--probe-gap", "1.0", "--joint", "HeadYaw=0.3", "--cycles", "80"},
+          true, 3.0);
+  rig.run(60);  // the client is there through all of them
+  lola::RobotLolaStats s = rig.endpoint.stats(0);
+  EXPECT_EQ(s.sessions, 2u);
+  EXPECT_EQ(s.no_client, 0u);
+  EXPECT_EQ(s.missed, 0u);
+  EXPECT_GE(s.answered, 58u);
+  EXPECT_NEAR(rig.headYaw(), 0.3, 0.03);
+  EXPECT_EQ(rig.finish(), 0);
+  // Gone for good: waited for once (3 s), then the periods run on without it.
+  const auto before = std::chrono::steady_clock::now();
+  rig.run(20);
+  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(10));
+  EXPECT_GE(rig.endpoint.stats(0).no_client, 19u);
 }
 
 // One answer comes after the lockstep timeout: that period is missed, the

@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 #include "simsoccer/protocol/wire.hpp"
@@ -33,6 +35,8 @@ struct Endpoint::Client {
   bool new_joints = false;  // a map that sets joints was taken since the last collect
   int missed_in_row = 0, answered_in_row = 0;
   bool unresponsive = false;  // lockstep does not wait for it until it answers again
+  // Lockstep waits for it to connect again until then (EndpointConfig::reconnect_timeout).
+  std::optional<std::chrono::steady_clock::time_point> return_by;
   std::array<float, kJoints> accepted_position{}, accepted_stiffness{};
   RobotLolaStats stats;
   Client(const RobotSocket& c) : config(c), battery(c.battery_charge) {}
@@ -148,6 +152,7 @@ void Endpoint::startSession(Client& c, int fd) {
   const int bytes = static_cast<int>(config_.max_unread_packets * kSensorPacketBytes);
   ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &bytes, sizeof bytes);
   c.fd = fd;
+  c.return_by.reset();
   ++c.stats.sessions;
   c.unsent.clear();
   c.owed = 0;
@@ -170,6 +175,9 @@ void Endpoint::endSession(Client& c) {
   ::close(c.fd);
   c.fd = -1;
   c.unsent.clear();  // what the client sent before it went is still taken (parse)
+  if (config_.lockstep && config_.reconnect_timeout > 0.0)
+    c.return_by = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(config_.reconnect_timeout));
 }
 
 void Endpoint::acceptAll() {
@@ -316,13 +324,23 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
     return c.fd >= 0 && c.owed > 0 && !c.unresponsive;
   };
   if (config_.lockstep) {
-    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                             std::chrono::duration<double>(config_.answer_timeout));
+    auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(config_.answer_timeout));
+    // A client that went away: waited for until it is back (its map goes out as it connects,
+    // then its answer is awaited) or its time is up.
+    const auto returning = [&](const Client& c) {
+      return c.fd < 0 && c.return_by && Clock::now() < *c.return_by;
+    };
     for (;;) {
       bool waiting = false;
-      for (const Client& c : clients_) waiting = waiting || awaited(c);
+      for (const Client& c : clients_) {
+        waiting = waiting || awaited(c) || returning(c);
+        if (returning(c)) deadline = std::max(deadline, *c.return_by);  // (also one gone now)
+      }
       if (!waiting || !pollOnce(deadline, true)) break;
     }
+    for (Client& c : clients_)
+      if (c.fd < 0 && c.return_by && !returning(c)) c.return_by.reset();  // not waited for again
   } else {
     for (Client& c : clients_) {  // whatever has arrived
       if (c.fd >= 0) receive(c);

@@ -44,6 +44,7 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
   lola::EndpointConfig ec;
   ec.lockstep = lockstep;
   ec.answer_timeout = c.command_timeout;
+  ec.reconnect_timeout = c.lola.reconnect_timeout;
   for (size_t i = 0; i < session.lolaRobots().size(); ++i) {
     lola::RobotSocket rs;
     rs.robot = session.lolaRobots()[i];

@@ -182,8 +182,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
           .fail("the camera must look at a point away from its position");
   }
   if (auto l = root.optional("lola")) {
-    l->allowOnly({"robots", "client", "connect_timeout", "image_port", "network", "identities",
-                  "tick_in_battery"});
+    l->allowOnly({"robots", "client", "connect_timeout", "reconnect_timeout", "image_port",
+                  "network", "identities", "tick_in_battery"});
     if (auto ids = l->optional("identities")) {
       for (const auto& [robot, node] : ids->entries()) {
         std::vector<LolaPlayer> players;
@@ -226,6 +226,8 @@ MatchConfig loadMatchConfig(const std::filesystem::path& file) {
     if (l->has("client"))
       for (const engine::ConfigNode& a : (*l)["client"].items()) c.lola.client.push_back(a.string());
     if (l->has("connect_timeout")) c.lola.connect_timeout = (*l)["connect_timeout"].positive();
+    if (l->has("reconnect_timeout"))
+      c.lola.reconnect_timeout = (*l)["reconnect_timeout"].nonNegative();
   }
   if (root.has("seed") && root["seed"].integer() < 0) root["seed"].fail("must be >= 0");
   c.seed = static_cast<uint64_t>(root.integer("seed", 1));

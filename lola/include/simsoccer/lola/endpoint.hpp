@@ -43,6 +43,11 @@ struct EndpointConfig {
   // Lockstep stops waiting for a client that missed this many periods in a
   // row (it is hung or stopped), until it answers this many in a row again.
   int unresponsive_after = 3;
+  // Lockstep: s of wall time the periods wait for a client that went away to connect again
+  // (B-Human's binary reads the body id, closes and connects again when it has booted; a
+  // watchdog restarts a crashed one), once per disconnection; 0: not waited for. Without it
+  // the simulation ran on at its own speed meanwhile, and the robot missed the kick-off.
+  double reconnect_timeout = 0.0;
   // Sensor maps a client may leave unread before new ones are dropped
   // (whole, so the stream stays framed), as LoLA ignores a client that does not read.
   std::size_t max_unread_packets = 3;

@@ -44,6 +44,9 @@ struct LolaSettings {
   // the clients are started by hand.
   std::vector<std::string> client;
   double connect_timeout = 60.0;  // s the match waits for every LoLA client before it starts
+  // Lockstep: s a match waits for a client that went away to connect again, once per
+  // disconnection (lola::EndpointConfig::reconnect_timeout).
+  double reconnect_timeout = 10.0;
   // With the scenario's cameras on: the k-th LoLA robot's images on TCP
   // ports image_port + 2k (top) and + 2k + 1 (bottom), as the Webots LoLA
   // controller's 10001/10002 for one robot.
