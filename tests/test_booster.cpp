@@ -11,10 +11,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <thread>
 
@@ -218,6 +220,97 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.3, 0.05);
 }
 
+// What Booster's soccer demo (and the teams built on it) reads besides the low state: the
+// odometry of the walk (rt/odometer_state: x, y, theta since the start or the last
+// ResetOdometry) and the head in the robot's base frame (rt/head_pose, geometry_msgs/Pose:
+// the demo intersects camera rays with its z = 0 plane), both with ROS 2's default QoS
+// (reliable, depth 1 in the demo) as they would subscribe.
+TEST(BoosterEndpoint, OdometryAndTheHeadPoseGoOutAsBoostersDemoReadsThem) {
+  booster::BoosterRobot robot = served(0, 186);
+  robot.motions = test::sourceDir() / "configs/motions/booster_k1";
+  ServedK1 k1(robot, /*lockstep=*/false);
+  auto& [w, simulation, endpoint] = k1;
+  net::Participant participant(loopback(186));
+  net::QosSpec q;
+  q.reliable = true;
+  q.depth = 1;
+  net::Reader<booster_interface_msg_dds__Odometer_> odometer(
+      participant, booster_interface_msg_dds__Odometer__desc, "rt/odometer_state", q);
+  net::Reader<geometry_msgs_msg_dds__Pose_> head_pose(
+      participant, geometry_msgs_msg_dds__Pose__desc, "rt/head_pose", q);
+  net::Writer<booster_msgs_msg_dds__RpcReqMsg_> requests(
+      participant, booster_msgs_msg_dds__RpcReqMsg__desc, "rt/LocoApiTopicReq", [] {
+        net::QosSpec r;
+        r.reliable = true;
+        r.depth = 10;
+        return r;
+      }());
+  const engine::Pose start = w.torsoPose(0);
+  int status = -1;
+  runPacedClient(k1, {"--periods", "300", "--walk", "0.3"}, status);
+  ASSERT_EQ(status, 0);
+  const auto latest = [&](auto& reader, auto& out) {
+    bool got = false;
+    for (int i = 0; i < 100 && !got; ++i) {
+      simulation.period();
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      reader.take([&](const auto& m, const dds_sample_info_t& info) {
+        if (info.valid_data) {
+          out = m;
+          got = true;
+        }
+      });
+    }
+    return got;
+  };
+  booster_interface_msg_dds__Odometer_ odo{};
+  ASSERT_TRUE(latest(odometer, odo)) << "no rt/odometer_state";
+  // The trunk's planar pose since the start, in the start's heading.
+  const engine::Pose now = w.torsoPose(0);
+  const double start_yaw = std::atan2(start.linear()(1, 0), start.linear()(0, 0));
+  const double yaw = std::atan2(now.linear()(1, 0), now.linear()(0, 0));
+  const engine::Vec3 moved = now.translation() - start.translation();
+  const double c = std::cos(start_yaw), s = std::sin(start_yaw);
+  std::printf("odometer %.3f %.3f %.3f; the trunk moved %.3f %.3f, turned %.3f\n", odo.x, odo.y,
+              odo.theta, c * moved.x() + s * moved.y(), -s * moved.x() + c * moved.y(),
+              yaw - start_yaw);
+  EXPECT_GT(odo.x, 0.5);
+  EXPECT_NEAR(odo.x, c * moved.x() + s * moved.y(), 0.02);
+  EXPECT_NEAR(odo.y, -s * moved.x() + c * moved.y(), 0.02);
+  EXPECT_NEAR(odo.theta, std::remainder(yaw - start_yaw, 2 * std::numbers::pi), 0.02);
+  // The head (the client turned it to yaw 0.3): about 0.9 m up, turned 0.3 from the trunk.
+  geometry_msgs_msg_dds__Pose_ head{};
+  ASSERT_TRUE(latest(head_pose, head)) << "no rt/head_pose";
+  const Eigen::Quaterniond hq(head.orientation.w, head.orientation.x, head.orientation.y,
+                              head.orientation.z);
+  const Eigen::Vector3d forward = hq * Eigen::Vector3d::UnitX();
+  std::printf("head at %.3f %.3f %.3f, looking along %.2f %.2f %.2f\n", head.position.x,
+              head.position.y, head.position.z, forward.x(), forward.y(), forward.z());
+  EXPECT_NEAR(hq.norm(), 1.0, 1e-6);
+  EXPECT_GT(head.position.z, 0.6);
+  EXPECT_LT(head.position.z, 1.1);
+  EXPECT_LT(std::abs(head.position.x), 0.15);
+  EXPECT_NEAR(std::atan2(forward.y(), forward.x()), 0.3, 0.08);
+  // ResetOdometry (2031): the origin moves to where the robot stands.
+  const std::string header = R"({"api_id": 2031, "expect_response": true})";
+  booster_msgs_msg_dds__RpcReqMsg_ reset{};
+  reset.uuid = const_cast<char*>("reset-1");
+  reset.header = const_cast<char*>(header.c_str());
+  reset.body = const_cast<char*>("");
+  for (int i = 0; i < 200; ++i) {  // discovery: matched with the robot's request reader
+    dds_publication_matched_status_t matched{};
+    dds_get_publication_matched_status(requests.get(), &matched);
+    if (matched.current_count > 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  requests.write(reset);
+  booster_interface_msg_dds__Odometer_ after{1e9f, 1e9f, 1e9f};
+  for (int i = 0; i < 50 && std::abs(after.x) > 0.05; ++i) latest(odometer, after);
+  EXPECT_NEAR(after.x, 0.0, 0.05);
+  EXPECT_NEAR(after.y, 0.0, 0.05);
+  EXPECT_NEAR(after.theta, 0.0, 0.05);
+}
+
 // A K1 on the HSL M-Field (its size 3 ball) at the centre facing +x, with the simulation's
 // perception (ideal: what its cameras' frustums hold) for its locomotion service's kicks.
 world::Scenario k1KickScenario() {
@@ -367,10 +460,11 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
     std::lock_guard lock(mutex);
     if (image.camera == world::CameraId::Top) rendered[image.tick] = image.data;
   });
-  // A ROS 2 subscriber's reader: best effort, as image subscribers usually are.
+  // A ROS 2 subscriber's default reader: reliable (image_transport's and create_subscription's
+  // default, Booster's own vision node's); a best-effort writer never matched it.
   net::Participant participant(loopback(176));
   net::QosSpec q;
-  q.reliable = false;
+  q.reliable = true;
   q.depth = 64;
   net::Reader<sensor_msgs_msg_dds__Image_> reader(participant, sensor_msgs_msg_dds__Image__desc,
                                                   "rt/StereoNetNode/rectified_image", q);

@@ -58,11 +58,12 @@ TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
   EXPECT_EQ(s.handle(R"({"api_id": 1e300})", "{}").status, kStatusBadRequest);
   EXPECT_EQ(s.handle(R"({"api_id": 2000.5})", "{}").status, kStatusBadRequest);
   EXPECT_EQ(s.handle(R"({"api_id": 9999})", "{}").status, kStatusBadRequest);
+  EXPECT_EQ(s.handle(R"({"api_id": 2014})", "{}").status, kStatusBadRequest);  // not the SDK's
   EXPECT_EQ(call(s, 2000, {{"mode", 7}}).status, kStatusBadRequest);
   EXPECT_EQ(call(s, 2000, {{"mode", "custom"}}).status, kStatusBadRequest);
   EXPECT_EQ(s.handle(R"({"api_id": 2000})", "[1, 2]").status, kStatusBadRequest);
   EXPECT_EQ(call(s, 2004, {{"pitch", 0.1}}).status, kStatusBadRequest);
-  EXPECT_EQ(s.malformed(), 9u);
+  EXPECT_EQ(s.malformed(), 10u);
   EXPECT_EQ(s.mode(), RobotMode::Prepare);
   // A fire-and-forget request gets no answer but is carried out.
   const RpcAnswer quiet = call(s, 2000, {{"mode", 3}}, false);
@@ -70,6 +71,19 @@ TEST(BoosterLoco, MotionCallsAreRefusedAndBadRequestsNamed) {
   EXPECT_EQ(s.mode(), RobotMode::Custom);
   // GetMode may come with an empty body.
   EXPECT_EQ(s.handle(R"({"api_id": 2017, "expect_response": true})", "").status, kStatusSuccess);
+  // The SDK's other calls (hands, dances, sounds, queries): 501 naming the call, not 400 (the
+  // SDK's "request param invalid", which would send a team looking for its own bug).
+  for (int api : {2005, 2022, 2030, 2035, 2044, 2046, 2050}) {
+    const RpcAnswer a = call(s, api, json::object());
+    EXPECT_EQ(a.status, kStatusServerRefused) << api;
+    EXPECT_NE(a.body.find(unservedLocoApiName(api)), std::string::npos) << a.body;
+  }
+  EXPECT_STREQ(unservedLocoApiName(2022), "GetRobotInfo");
+  EXPECT_EQ(unservedLocoApiName(2014), nullptr);
+  // ResetOdometry: answered, counted for the endpoint (which moves the odometry's origin).
+  EXPECT_EQ(call(s, 2031, json::object()).status, kStatusSuccess);
+  EXPECT_EQ(s.odometryResets(), 1u);
+  EXPECT_EQ(s.malformed(), 10u);
 }
 
 // A robot with simsoccer's walk (the K1): Walking and Soccer are served, Move sets the walk's

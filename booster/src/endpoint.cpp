@@ -12,6 +12,7 @@
 #include <exception>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,8 @@ using RpcResp = booster_msgs_msg_dds__RpcRespMsg_;
 using Image = sensor_msgs_msg_dds__Image_;
 using CompressedImage = sensor_msgs_msg_dds__CompressedImage_;
 using KickTarget = brain_msg_dds__Kick_;
+using Odometer = booster_interface_msg_dds__Odometer_;
+using HeadPose = geometry_msgs_msg_dds__Pose_;
 
 namespace {
 net::QosSpec qos(bool reliable, int depth, bool transient_local = false) {
@@ -55,7 +58,13 @@ struct Endpoint::Robot {
   net::Writer<RpcResp> answers;
   net::Writer<FallDown> fall;
   net::Reader<KickTarget> kick_targets;
+  net::Writer<Odometer> odometer;
+  net::Writer<HeadPose> head_pose;
   LocoService loco;
+  // The odometry's origin (the trunk's planar pose at the start or the last ResetOdometry).
+  std::optional<std::array<double, 3>> odometry_origin;  // x, y, yaw in the field
+  uint64_t odometry_resets = 0;
+  int head_link = -1;  // the model's link "Head", if it has one
   RobotBoosterStats stats;
   // Camera images (attachCameras), written from the camera conversion thread.
   std::unique_ptr<net::Writer<Image>> image;
@@ -125,6 +134,11 @@ struct Endpoint::Robot {
              qos(true, 1)),
         // Best effort, as Booster's own readers of it: matches every writer.
         kick_targets(participant, brain_msg_dds__Kick__desc, "rt/kick_ball", qos(false, 4)),
+        // Reliable: matches the SDK's best-effort readers and ROS 2's reliable default ones
+        // (Booster's soccer demo subscribes with depth 1, reliable).
+        odometer(participant, booster_interface_msg_dds__Odometer__desc, "rt/odometer_state",
+                 qos(true, 1)),
+        head_pose(participant, geometry_msgs_msg_dds__Pose__desc, "rt/head_pose", qos(true, 1)),
         loco(c.initial_mode, can),
         pending_pool(kMaxPending,
                      Command{std::vector<float>(n), std::vector<float>(n), std::vector<float>(n),
@@ -194,6 +208,8 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       if (failed) std::rethrow_exception(failed);
     }
     r->stand = &stand;
+    for (size_t l = 0; l < model.body->links.size(); ++l)
+      if (model.body->links[l].name == "Head") r->head_link = static_cast<int>(l);
     // The walk's motions are read here, so a bad motions folder refuses to start (not the
     // first period in WALKING).
     if (walk)
@@ -222,10 +238,10 @@ void Endpoint::attachCameras(sim::Simulation& simulation) {
     if (cameras.encoding == "jpeg")
       r.compressed = std::make_unique<net::Writer<CompressedImage>>(
           r.participant, sensor_msgs_msg_dds__CompressedImage__desc,
-          config_.image_topic + "/compressed", qos(false, 1));
+          config_.image_topic + "/compressed", qos(true, 1));
     else
       r.image = std::make_unique<net::Writer<Image>>(
-          r.participant, sensor_msgs_msg_dds__Image__desc, config_.image_topic, qos(false, 1));
+          r.participant, sensor_msgs_msg_dds__Image__desc, config_.image_topic, qos(true, 1));
   }
   simulation.addImageSink([this](const world::CameraImage& image) { publishImage(image); });
 }
@@ -375,6 +391,7 @@ void Endpoint::observe(const sim::Observation& o) {
     }
     r.state.write(s);
     ++r.stats.states_sent;
+    publishPoses(r, w);
 
     const int fallen = w.isStanding(r.config.robot) ? booster_interface_msg_dds__IS_READY
                                                     : booster_interface_msg_dds__HAS_FALLEN;
@@ -396,6 +413,43 @@ void Endpoint::observe(const sim::Observation& o) {
       r.walk_targets.clear();
     }
   }
+}
+
+void Endpoint::publishPoses(Robot& r, const world::World& w) {
+  // The trunk on the field, planar: the odometry (ground truth since its origin; a real K1's
+  // odometry comes from its gait and drifts) and the base frame of the head pose.
+  const world::Pose trunk = w.torsoPose(r.config.robot);
+  const Eigen::Matrix3d& rot = trunk.linear();
+  const double yaw = std::atan2(rot(1, 0), rot(0, 0));
+  const double x = trunk.translation().x(), y = trunk.translation().y();
+  if (!r.odometry_origin || r.loco.odometryResets() != r.odometry_resets) {
+    r.odometry_origin = std::array<double, 3>{x, y, yaw};
+    r.odometry_resets = r.loco.odometryResets();
+  }
+  const auto& [ox, oy, oyaw] = *r.odometry_origin;
+  const double c = std::cos(oyaw), s = std::sin(oyaw);
+  Odometer odo{};
+  odo.x = static_cast<float>(c * (x - ox) + s * (y - oy));
+  odo.y = static_cast<float>(-s * (x - ox) + c * (y - oy));
+  odo.theta = static_cast<float>(std::remainder(yaw - oyaw, 2.0 * std::numbers::pi));
+  r.odometer.write(odo);
+  if (r.head_link < 0) return;
+  // The head link in the robot's base frame: on the ground under the trunk, x along the trunk's
+  // heading, z up (Booster's demo intersects camera rays with its z = 0 plane).
+  world::Pose base = world::Pose::Identity();
+  base.translation() = Eigen::Vector3d(x, y, 0.0);
+  base.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const world::Pose head = base.inverse() * w.linkPose(r.config.robot, r.head_link);
+  const Eigen::Quaterniond q(head.linear());
+  HeadPose p{};
+  p.position.x = head.translation().x();
+  p.position.y = head.translation().y();
+  p.position.z = head.translation().z();
+  p.orientation.x = q.x();
+  p.orientation.y = q.y();
+  p.orientation.z = q.z();
+  p.orientation.w = q.w();
+  r.head_pose.write(p);
 }
 
 void Endpoint::walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t acts_at) {

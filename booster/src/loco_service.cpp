@@ -2,10 +2,54 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
 
 namespace simsoccer::booster {
 
 using nlohmann::json;
+
+const char* unservedLocoApiName(int api_id) {
+  // The SDK's LocoApiId values (include/booster/robot/b1/b1_loco_api.hpp) that LocoService
+  // does not serve.
+  static constexpr std::pair<int, const char*> kUnserved[] = {
+      {2005, "WaveHand"},
+      {2006, "RotateHeadWithDirection"},
+      {2009, "MoveHandEndEffector"},
+      {2010, "ControlGripper"},
+      {2011, "GetFrameTransform"},
+      {2012, "SwitchHandEndEffectorControlMode"},
+      {2013, "ControlDexterousHand"},
+      {2015, "Handshake"},
+      {2016, "Dance"},
+      {2019, "PushUp"},
+      {2020, "PlaySound"},
+      {2021, "StopSound"},
+      {2022, "GetRobotInfo"},
+      {2023, "StopHandEndEffector"},
+      {2026, "ZeroTorqueDrag"},
+      {2027, "RecordTrajectory"},
+      {2028, "ReplayTrajectory"},
+      {2029, "WholeBodyDance"},
+      {2030, "UpperBodyCustomControl"},
+      {2032, "LoadCustomTrainedTraj"},
+      {2033, "ActivateCustomTrainedTraj"},
+      {2034, "UnloadCustomTrainedTraj"},
+      {2035, "EnterWBCGait"},
+      {2036, "ExitWBCGait"},
+      {2037, "MoveDualHandEndEffector"},
+      {2039, "LionDancePrepare"},
+      {2040, "LionDanceStart"},
+      {2041, "LionDanceMove"},
+      {2044, "GetSensors"},
+      {2045, "GetHands"},
+      {2046, "GetRobotModel"},
+      {2047, "GetTrainedTrajStatus"},
+      {2050, "HandOnChestGreeting"}};
+  for (const auto& [id, name] : kUnserved)
+    if (id == api_id) return name;
+  return nullptr;
+}
 
 const char* modeName(RobotMode m) {
   switch (m) {
@@ -212,6 +256,9 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
       case LocoApi::SwitchGait:
         unavailable("SwitchGait");
         break;
+      case LocoApi::ResetOdometry:
+        ++odometry_resets_;
+        break;
       case LocoApi::GetStatus:
       case LocoApi::RotateHeadWithTime:
         ++refused_;
@@ -222,7 +269,12 @@ RpcAnswer LocoService::handle(std::string_view header_text, std::string_view bod
                       " is not available in simsoccer");
         break;
       default:
-        bad("unknown api_id " + std::to_string(static_cast<long long>(*api)));
+        if (const char* name = unservedLocoApiName(static_cast<int>(*api))) {
+          ++refused_;
+          a = error(kStatusServerRefused, std::string(name) + " is not available in simsoccer");
+        } else {
+          bad("unknown api_id " + std::to_string(static_cast<long long>(*api)));
+        }
     }
   }
   a.respond = respond;

@@ -135,6 +135,8 @@ class Endpoint : public sim::CommandSource {
   // rt/kick_ball: the visual kick's direction.
   void takeKickTargets(Robot& r);
   void publishImage(const world::CameraImage& image);
+  // rt/odometer_state and rt/head_pose from the world's state.
+  void publishPoses(Robot& r, const world::World& w);
   // Walking and Soccer: the walk's targets from the frame just observed,
   // acting from period `acts_at`.
   void walkTargets(Robot& r, const world::SensorFrame& frame, uint64_t acts_at);

@@ -50,10 +50,15 @@ enum class LocoApi : int {
   GetStatus = 2018,
   Shoot = 2024,
   GetUpWithMode = 2025,
+  ResetOdometry = 2031,
   VisualKick = 2038,
   SwitchGait = 2042,
   RotateHeadWithTime = 2043,
 };
+// The name of every other LocoApiId of the SDK (b1_loco_api.hpp: hands, dances, sounds,
+// trajectories, queries), answered 501 (not available in simsoccer); nullptr for an id the SDK
+// does not have (answered 400).
+const char* unservedLocoApiName(int api_id);
 
 struct RpcAnswer {
   bool respond = true;  // false: the request said expect_response false
@@ -101,6 +106,8 @@ class LocoService {
   int visualKickVersion() const { return visual_kick_version_; }
   // True once for each Shoot taken.
   bool takeShoot() { return std::exchange(shoot_, false); }
+  // ResetOdometry requests so far (the odometry's origin moves to the robot at each).
+  uint64_t odometryResets() const { return odometry_resets_; }
   // Whether the robot is down (falling, lying, getting up): kicks answer 502
   // and a running visual kick ends.
   void setDown(bool down);
@@ -114,7 +121,7 @@ class LocoService {
   bool walk_ = false, kicks_ = false, vision_ = false;
   bool down_ = false, visual_kick_ = false, shoot_ = false;
   int visual_kick_version_ = 0;
-  uint64_t visual_kick_starts_ = 0;
+  uint64_t visual_kick_starts_ = 0, odometry_resets_ = 0;
   std::optional<HeadTarget> head_;
   WalkVelocity velocity_;
   uint64_t requests_ = 0, refused_ = 0, malformed_ = 0;
