@@ -192,6 +192,28 @@ TEST(Referee, LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement) {
   EXPECT_EQ(g.penalty(0, 1), gc::Penalty::None);
 }
 
+// Motion in Set (called by a GameController the simulation follows, or an operator) is served
+// in place: the robot stays where it is, unlike every other penalty.
+TEST(Referee, MotionInSetIsServedInPlace) {
+  world::World w(twoVsTwo());
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  run(w, ref, 0.1);
+  if (g.state() == gc::State::Ready) g.set();  // (the referee may call Set itself)
+  ASSERT_EQ(g.state(), gc::State::Set);
+  const Vec3 before = w.torsoPose(1).translation();
+  g.penalise(0, 2, gc::Penalty::IllegalMotionInSet);
+  run(w, ref, 0.5);
+  EXPECT_EQ(g.penalty(0, 2), gc::Penalty::IllegalMotionInSet);
+  EXPECT_LT((w.torsoPose(1).translation() - before).head<2>().norm(), 0.05);
+  // Another penalty takes it off the field.
+  g.unpenalise(0, 2);
+  g.penalise(0, 2, gc::Penalty::RequestForPickup);
+  run(w, ref, 0.1);
+  EXPECT_GT((w.torsoPose(1).translation() - before).head<2>().norm(), 0.5);
+}
+
 TEST(Referee, IllegalPositionInSetOrAutoPlacement) {
   for (const bool auto_place : {false, true}) {
     world::World w(twoVsTwo());

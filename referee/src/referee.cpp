@@ -618,7 +618,9 @@ void Referee::removePenalised() {
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
     const auto& info = world_.robot(r);
     const gc::Penalty pen = game_.penalty(info.team, info.number);
-    const bool out = pen != gc::Penalty::None;
+    // Motion in Set is served in place (spl-rules 2025 and the HSL's rules: the robot stays
+    // where it moved, and the penalty may be revoked while still in Set); the others leave.
+    const bool out = pen != gc::Penalty::None && pen != gc::Penalty::IllegalMotionInSet;
     if (out) {
       if (slot_[r] < 0) {
         // The first free waiting spot of its team; it keeps it while it waits.
