@@ -364,6 +364,73 @@ TEST(Simulation, UnderHslRulesTheOperatorSkipsStandby) {
   EXPECT_EQ(officials.game().messageBudget(0), 12000);
 }
 
+// A followed GameController that hides the kicking side (the Champions Cup: kickingTeam 255 in
+// a penalty kick) is asked for its true data as a monitor asks (RGTr to its monitor port), and
+// its true data (RGTD, unicast to the listener's port) places the ball on the right mark; the
+// robots' packets are not followed while true data comes. Before any true data, the hidden
+// side leaves the ball where it is (it went on the -x mark: the wrong one half the time).
+TEST(Simulation, AFollowedGameControllerIsAskedForItsTrueData) {
+  world::World w(test::scenario(4));
+  const referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl_champions_cup.yaml");
+  referee::UdpReceiver monitor_requests(0, "127.0.0.1");
+  sim::OfficialsConfig oc = sim::OfficialsConfig::forTeams(13, 5);
+  oc.external_gc_port = 0;
+  oc.external_gc_monitor_port = monitor_requests.port();
+  sim::GameOfficials officials(w, rules, oc);
+  sim::Simulation simulation(w);
+  simulation.setOfficials(&officials);
+  referee::UdpSender gc("127.0.0.1", officials.externalGameController()->port());
+  referee::ControlData d;
+  d.players_per_team = 5;
+  d.secs_remaining = 500;
+  d.teams[0].team_number = 13;  // team 13 (index 0) defends the left goal
+  d.teams[1].team_number = 5;
+  for (referee::TeamInfo& t : d.teams)
+    for (size_t n = 5; n < t.players.size(); ++n)
+      t.players[n].penalty = static_cast<uint8_t>(referee::gc::Penalty::Substitute);
+  const auto send = [&](referee::gc::State state, bool true_data, int kicking, int periods) {
+    d.state = static_cast<uint8_t>(state);
+    d.true_data = true_data;
+    d.kicking_team = static_cast<uint8_t>(kicking);
+    gc.send(referee::encode(d));
+    ++d.packet_number;
+    for (int i = 0; i < periods; ++i) simulation.period();
+  };
+  // The game under way, then a penalty kick as the robots see it: the side hidden.
+  d.kicking_team = 13;
+  send(referee::gc::State::Ready, false, 13, 10);
+  send(referee::gc::State::Set, false, 13, 10);
+  send(referee::gc::State::Playing, false, 13, 10);
+  test::putBallOnCarpet(w, 0.7, 0.4);
+  d.set_play = static_cast<uint8_t>(referee::gc::SetPlay::PenaltyKick);
+  send(referee::gc::State::Ready, false, 255, 10);
+  send(referee::gc::State::Set, false, 255, 10);
+  EXPECT_EQ(officials.game().kickingTeam(), -1);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), 0.7, 0.05) << "left where it was";
+  // The listener asked for true data: "RGTr" and version 0.
+  std::array<uint8_t, 64> request{};
+  const size_t n = monitor_requests.receive(request, 2.0);
+  ASSERT_EQ(n, 5u);
+  EXPECT_EQ(std::string(request.begin(), request.begin() + 4), "RGTr");
+  EXPECT_EQ(request[4], 0);
+  EXPECT_GE(officials.externalGameController()->monitorRequests(), 1u);
+  // The true data: team 5 (right half) takes it, at the left goal's penalty mark.
+  send(referee::gc::State::Ready, true, 5, 10);
+  send(referee::gc::State::Set, true, 5, 10);
+  EXPECT_EQ(officials.game().kickingTeam(), 1);
+  const double mark = -(w.field().halfLength() - w.field().penalty_mark_distance.value_or(1.3));
+  EXPECT_NEAR(w.ballState().pose.translation().x(), mark, 0.05);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), 0.0, 0.05);
+  // The robots' copy (hidden side, and Set for 10 s after the whistle) is not followed while
+  // true data comes.
+  send(referee::gc::State::Playing, true, 5, 5);
+  send(referee::gc::State::Set, false, 255, 10);
+  EXPECT_EQ(officials.game().state(), referee::gc::State::Playing);
+  EXPECT_EQ(officials.game().kickingTeam(), 1);
+  EXPECT_GE(officials.externalGameController()->trueData(), 3u);
+}
+
 // An external GameController runs the game: packets sent from the test (as
 // GameController3 would broadcast them) and the simulated game follows its
 // states, scores and penalties; a penalised robot leaves the field and comes

@@ -161,10 +161,19 @@ UdpReceiver::~UdpReceiver() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-size_t UdpReceiver::receive(std::span<uint8_t> buffer, double timeout_seconds) {
+size_t UdpReceiver::receive(std::span<uint8_t> buffer, double timeout_seconds,
+                            std::string* source) {
   pollfd p{fd_, POLLIN, 0};
   if (::poll(&p, 1, static_cast<int>(timeout_seconds * 1000)) <= 0) return 0;
-  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+  sockaddr_in from{};
+  socklen_t from_size = sizeof from;
+  const ssize_t n = ::recvfrom(fd_, buffer.data(), buffer.size(), MSG_TRUNC,
+                               reinterpret_cast<sockaddr*>(&from), &from_size);
+  if (source && n > 0) {
+    char text[INET_ADDRSTRLEN] = {};
+    ::inet_ntop(AF_INET, &from.sin_addr, text, sizeof text);
+    *source = text;
+  }
   // An oversized datagram is cut to the buffer: its size still tells it is not a packet.
   return n > 0 ? std::min(static_cast<size_t>(n), buffer.size()) : 0;
 }

@@ -83,22 +83,50 @@ std::optional<ReturnData> GameControllerLink::lastReturn(uint8_t team_number,
   return it->second;
 }
 
-GameControllerListener::GameControllerListener(uint16_t port, const std::string& bind)
-    : receiver_(std::make_unique<UdpReceiver>(port, bind)) {}
+GameControllerListener::GameControllerListener(uint16_t port, const std::string& bind,
+                                               uint16_t monitor_port)
+    : receiver_(std::make_unique<UdpReceiver>(port, bind)), monitor_port_(monitor_port) {}
 
 std::optional<ControlData> GameControllerListener::poll() {
-  std::optional<ControlData> latest;
+  using Clock = std::chrono::steady_clock;
+  constexpr auto kFresh = std::chrono::seconds(2);
+  std::optional<ControlData> robots, truth;
   std::array<uint8_t, 512> buffer{};
-  for (size_t n; (n = receiver_->receive(buffer, 0.0)) > 0;) {
+  std::string source;
+  for (size_t n; (n = receiver_->receive(buffer, 0.0, &source)) > 0;) {
     try {
-      latest = decodeAnyControl(std::span<const uint8_t>(buffer.data(), n));
+      const ControlData d = decodeAnyControl(std::span<const uint8_t>(buffer.data(), n));
       ++accepted_;
+      if (d.true_data) {
+        truth = d;
+        ++true_data_;
+        last_true_ = Clock::now();
+      } else {
+        robots = d;
+        if (source != gc_address_) monitor_sender_.reset();  // (another GameController host)
+        gc_address_ = source;
+      }
     } catch (const PacketError& e) {
       ++rejected_;
       last_error_ = e.what();
     }
   }
-  return latest;
+  const auto now = Clock::now();
+  const bool fresh = true_data_ > 0 && now - last_true_ < kFresh;
+  if (!fresh && !gc_address_.empty() && monitor_port_ != 0 && now - last_request_ >= kFresh) {
+    try {
+      if (!monitor_sender_)
+        monitor_sender_ = std::make_unique<UdpSender>(gc_address_, monitor_port_);
+      static constexpr std::array<uint8_t, 5> kRequest{'R', 'G', 'T', 'r', 0};
+      monitor_sender_->send(kRequest);
+      ++monitor_requests_;
+    } catch (const std::runtime_error& e) {
+      last_error_ = e.what();
+    }
+    last_request_ = now;
+  }
+  if (truth) return truth;
+  return fresh ? std::nullopt : robots;
 }
 
 }  // namespace simsoccer::referee

@@ -266,6 +266,9 @@ std::vector<char> Referee::legalPositions() const {
   std::vector<char> legal(n, 1);
   const int kicking = game_.kickingTeam();
   const bool penalty_kick = game_.currentSetPlay() == gc::SetPlay::PenaltyKick;
+  // A followed GameController that hides the kicking side (kickingTeam 255, the Champions
+  // Cup, without its true data): which penalty area is whose is not known here.
+  if (penalty_kick && kicking < 0) return legal;
   // The one kicking-team robot allowed in the centre circle (kick-off) or
   // in the penalty area (penalty kick): the one nearest the ball's spot.
   const Vec3 spot = penalty_kick ? Vec3(penaltyMarkX(-teamSign(kicking)), 0.0, 0.0) : Vec3::Zero();
@@ -347,10 +350,10 @@ void Referee::onEnterSet() {
   if (game_.phase() == gc::GamePhase::PenaltyShoot) return;  // placed by startShootoutKick
   // The ball goes to the centre mark for a kick-off or drop ball, to the
   // penalty mark for a penalty kick.
-  if (game_.currentSetPlay() == gc::SetPlay::PenaltyKick)
-    placeBall(penaltyMarkX(-teamSign(game_.kickingTeam())), 0.0);
-  else
+  if (game_.currentSetPlay() != gc::SetPlay::PenaltyKick)
     placeBall(0.0, 0.0);
+  else if (game_.kickingTeam() >= 0)  // (hidden by a followed GameController: left where it is)
+    placeBall(penaltyMarkX(-teamSign(game_.kickingTeam())), 0.0);
   // Illegal positions: penalised (15 s), or moved by auto-placement to the
   // nearest legal spot.
   const std::vector<char> legal = legalPositions();

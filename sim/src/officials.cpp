@@ -22,7 +22,8 @@ GameOfficials::GameOfficials(world::World& world, const referee::RuleBook& rules
   referee_ = std::make_unique<referee::Referee>(world, rules, config.teams, config.kick_off_team,
                                                 config.referee);
   if (config.external_gc_port) {
-    listener_ = std::make_unique<referee::GameControllerListener>(*config.external_gc_port);
+    listener_ = std::make_unique<referee::GameControllerListener>(
+        *config.external_gc_port, "0.0.0.0", config.external_gc_monitor_port);
     return;  // the external GameController's operator starts the game
   }
   if (config.penalty_kick_trial) referee_->game().startShootout(0, 1, config.seed);

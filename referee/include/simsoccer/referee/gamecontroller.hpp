@@ -156,8 +156,9 @@ class UdpReceiver {
   UdpReceiver(const UdpReceiver&) = delete;
   UdpReceiver& operator=(const UdpReceiver&) = delete;
   uint16_t port() const { return port_; }  // the bound port (useful with port 0)
-  // Waits up to `timeout_seconds` for one datagram; returns its size, 0 on timeout.
-  size_t receive(std::span<uint8_t> buffer, double timeout_seconds);
+  // Waits up to `timeout_seconds` for one datagram; returns its size, 0 on timeout. `source`:
+  // the sender's IPv4 address in dotted form.
+  size_t receive(std::span<uint8_t> buffer, double timeout_seconds, std::string* source = nullptr);
 
  private:
   int fd_ = -1;

@@ -6,6 +6,7 @@
 // written against the real GameController runs against the simulator.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -76,19 +77,35 @@ class GameControllerLink {
 // GameController broadcasts). The simulator then does not bind 3939, so a
 // GameController on the same host can. Malformed packets are counted and
 // dropped; never blocks.
+//
+// The simulated world follows the game as it is, not as the robots are told it: the listener
+// asks the GameController for its true data as a monitor does (`RGTr` to `monitor_port`, 3636,
+// every 2 s until `RGTD` packets come to this port) and prefers them while they come. The
+// robots' packets hide the kicking side of free kicks and penalty kicks in the Champions Cup
+// (kickingTeam 255) and show Set up to 10 s after the whistle; true data does neither. A host
+// that sent status packets gets no monitor service (GameController3): then the robots' packets
+// are followed, and a penalty kick whose side is hidden leaves the ball where it is.
 class GameControllerListener {
  public:
-  explicit GameControllerListener(uint16_t port = 3838, const std::string& bind = "0.0.0.0");
+  explicit GameControllerListener(uint16_t port = 3838, const std::string& bind = "0.0.0.0",
+                                  uint16_t monitor_port = 3636);
   uint16_t port() const { return receiver_->port(); }
-  // The newest valid packet received since the last call, if any.
+  // The newest valid packet to follow received since the last call, if any: true data while it
+  // comes (for 2 s after the last), else the robots' packets.
   std::optional<ControlData> poll();
   uint64_t accepted() const { return accepted_; }
   uint64_t rejected() const { return rejected_; }
+  uint64_t trueData() const { return true_data_; }                // RGTD packets received
+  uint64_t monitorRequests() const { return monitor_requests_; }  // RGTr sent
   const std::string& lastError() const { return last_error_; }
 
  private:
   std::unique_ptr<UdpReceiver> receiver_;
-  uint64_t accepted_ = 0, rejected_ = 0;
+  uint16_t monitor_port_;
+  std::string gc_address_;  // where the robots' packets come from
+  std::unique_ptr<UdpSender> monitor_sender_;
+  std::chrono::steady_clock::time_point last_true_{}, last_request_{};
+  uint64_t accepted_ = 0, rejected_ = 0, true_data_ = 0, monitor_requests_ = 0;
   std::string last_error_;
 };
 

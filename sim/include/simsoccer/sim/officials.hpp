@@ -32,6 +32,9 @@ struct OfficialsConfig {
   // this UDP port (0: any free one, for tests), the operator does nothing,
   // and the referee's own calls are reported only (referee::Referee::follow).
   std::optional<uint16_t> external_gc_port;
+  // Where that GameController takes monitor requests (its true data;
+  // referee::GameControllerListener).
+  uint16_t external_gc_monitor_port = 3636;
   // With an external GameController the game is over this many seconds
   // after the GameController finished it and said nothing new (it may still
   // start a shoot-out).
