@@ -116,7 +116,7 @@ int match(int argc, char** argv, int first) {
   o.video = config.video.enabled && !opt.flag("no-video");
   o.max_seconds = opt.nonNegative("max-seconds", 0);
   try {
-    o.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
+    o.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::defaultMode(!o.realtime))));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }

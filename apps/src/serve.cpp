@@ -82,7 +82,7 @@ int serve(int argc, char** argv, int first) {
   sim::SimulationConfig simc;
   simc.lockstep = cfg.lockstep;
   try {
-    simc.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::kDefaultMode)));
+    simc.mode = sim::parseMode(opt.get("mode", sim::modeName(sim::defaultMode(cfg.lockstep))));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--mode: ") + e.what());
   }

@@ -39,6 +39,14 @@ enum class Mode : uint8_t { Serial, Pipelined };
 // pipelined, as on a real robot, where a command computed from one sensor packet acts in a
 // later cycle; physics and agents overlap on two cores.
 inline constexpr Mode kDefaultMode = Mode::Pipelined;
+// The default of a run in lockstep (kDefaultMode) or paced to the wall clock: serial there. A
+// paced period collects right after observe the answers that came during the last period's
+// wait, the same one period of delay as pipelined lockstep; pipelined, it collected them right
+// after the step, about 1 ms after the frames went out, and an answer waited a period more (a
+// LoLA client's answer to sensor map N showed in map N + 3, not N + 2 as in lockstep).
+constexpr Mode defaultMode(bool lockstep) {
+  return lockstep ? kDefaultMode : Mode::Serial;
+}
 const char* modeName(Mode m);
 // "serial" or "pipelined"; throws std::invalid_argument naming the value.
 Mode parseMode(const std::string& name);
