@@ -389,33 +389,18 @@ TEST(LolaRun, TeamBinariesOnTheFieldNetworkGetTheGameAndTalk) {
   gc.address = net.broadcast();
   gc.return_bind = net.hostAddress();
   gc.team_message_bind = net.broadcast();
+  gc.team_message_device = net.bridge;  // as a match has it
   referee::GameControllerLink link(gc);
   std::vector<std::unique_ptr<match::ChildProcess>> binaries;
   for (int player = 1; player <= 2; ++player)
-    binaries.push_back(std::make_unique<match::ChildProcess>(
-        std::vector<std::string>{SIMSOCCER_BIN,
-                                 "lola-run",
-                                 "--robot",
-                                 "5:" + std::to_string(player),
-                                 "--socket",
-                                 c.robots[static_cast<size_t>(player - 1)].socket.string(),
-                                 "--net",
-                                 "--bridge",
-                                 net.bridge,
-                                 "--prefix",
-                                 net.prefix,
-                                 "--",
-                                 SIMSOCCER_LOLA_CLIENT,
-                                 "--mode",
-                                 "gc",
-                                 "--team-number",
-                                 "5",
-                                 "--player",
-                                 std::to_string(player),
-                                 "--gc-host",
-                                 net.hostAddress(),
-                                 "--broadcast",
-                                 net.broadcast()}));
+    binaries.push_back(std::make_unique<match::ChildProcess>(std::vector<std::string>{
+        SIMSOCCER_BIN, "lola-run", "--robot", "5:" + std::to_string(player), "--socket",
+        c.robots[static_cast<size_t>(player - 1)].socket.string(), "--net", "--bridge", net.bridge,
+        "--prefix", net.prefix, "--", SIMSOCCER_LOLA_CLIENT, "--mode", "gc", "--team-number", "5",
+        "--player", std::to_string(player), "--gc-host", net.hostAddress(), "--broadcast",
+        // The limited broadcast, as some teams send: counted too (a
+        // socket bound to the subnet's broadcast address never got it).
+        "255.255.255.255"}));
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while ((binaries[0]->running() || binaries[1]->running()) &&
          std::chrono::steady_clock::now() < until) {

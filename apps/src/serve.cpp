@@ -121,6 +121,7 @@ int serve(int argc, char** argv, int first) {
       if (field) {
         gcfg.return_bind = booster->bridge->network().hostAddress();
         gcfg.team_message_bind = booster->bridge->network().broadcast();
+        gcfg.team_message_device = booster->bridge->network().bridge;
       }
       gcfg.control_port = gc_port;
       gcfg.return_port = gc_return_port;

@@ -35,6 +35,7 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
       gc.address = net.broadcast();
       gc.return_bind = net.hostAddress();
       gc.team_message_bind = net.broadcast();
+      gc.team_message_device = net.bridge;
       link_ = std::make_unique<referee::GameControllerLink>(gc);
       link_->update(session.game());  // binds every port now, and sends the first packet
       // The binaries' team messages count against each team's budget.

@@ -132,7 +132,8 @@ void UdpSender::send(std::span<const uint8_t> bytes) {
            sizeof(sockaddr_in));
 }
 
-UdpReceiver::UdpReceiver(uint16_t port, const std::string& bind_address) {
+UdpReceiver::UdpReceiver(uint16_t port, const std::string& bind_address,
+                         const std::string& device) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
   if (fd_ < 0) throw std::runtime_error("UDP: socket: " + std::string(std::strerror(errno)));
   // A well-known port (the GameController's 3838, a team port) is shared by
@@ -142,6 +143,13 @@ UdpReceiver::UdpReceiver(uint16_t port, const std::string& bind_address) {
   if (port != 0) {
     const int yes = 1;
     ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  }
+  if (!device.empty() && ::setsockopt(fd_, SOL_SOCKET, SO_BINDTODEVICE, device.c_str(),
+                                      static_cast<socklen_t>(device.size())) != 0) {
+    const std::string why = std::strerror(errno);
+    ::close(fd_);
+    throw std::runtime_error("UDP: cannot bind port " + std::to_string(port) + " to " + device +
+                             ": " + why);
   }
   sockaddr_in a{};
   a.sin_family = AF_INET;

@@ -39,8 +39,10 @@ void GameControllerLink::bindTeamPorts(const Game& game) {
   for (int t = 0; t < 2; ++t) {
     TeamPort p;
     p.team_number = game.teamNumber(t);
-    p.receiver = std::make_unique<UdpReceiver>(static_cast<uint16_t>(10000 + p.team_number),
-                                               config_.team_message_bind);
+    p.receiver = std::make_unique<UdpReceiver>(
+        static_cast<uint16_t>(10000 + p.team_number),
+        config_.team_message_device.empty() ? config_.team_message_bind : std::string("0.0.0.0"),
+        config_.team_message_device);
     team_ports_.push_back(std::move(p));
   }
 }

@@ -151,7 +151,10 @@ class UdpSender {
 
 class UdpReceiver {
  public:
-  explicit UdpReceiver(uint16_t port, const std::string& bind_address = "0.0.0.0");
+  // `device`: only datagrams that arrive on this network interface (SO_BINDTODEVICE, needs
+  // CAP_NET_RAW), with bind_address 0.0.0.0 both the subnet's and the limited broadcast.
+  explicit UdpReceiver(uint16_t port, const std::string& bind_address = "0.0.0.0",
+                       const std::string& device = "");
   ~UdpReceiver();
   UdpReceiver(const UdpReceiver&) = delete;
   UdpReceiver& operator=(const UdpReceiver&) = delete;

@@ -30,6 +30,11 @@ struct GameControllerLinkConfig {
   // team ports (10000 + team number) at this address (the field's broadcast
   // address; empty: not counted).
   std::string team_message_bind;
+  // With it, on any address of this interface (the field network's bridge): the subnet's
+  // broadcast and the limited one (255.255.255.255, which some teams send to and which a
+  // socket bound to the subnet's broadcast address never gets). GameController3 listens on any
+  // address.
+  std::string team_message_device;
 };
 
 class GameControllerLink {
