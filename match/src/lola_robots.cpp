@@ -60,14 +60,18 @@ LolaRobots::LolaRobots(const MatchSession& session, sim::Simulation& sim,
   }
   endpoint_ = std::make_unique<lola::Endpoint>(session.world(), ec);
   if (session.world().scenario().cameras.enabled) {
+    // On a field network the binaries run in namespaces of their own, whose loopback is not
+    // this one: the servers listen on the host's address on the bridge, which they reach (and
+    // programs on this host too).
+    const std::string host = bridge_ ? bridge_->network().hostAddress() : "127.0.0.1";
     std::vector<lola::ImagePorts> ports;
     for (size_t k = 0; k < ec.robots.size(); ++k) {
       const auto top = static_cast<uint16_t>(c.lola.image_port + 2 * k);
       ports.push_back({ec.robots[k].robot, top, static_cast<uint16_t>(top + 1)});
-      say("LoLA robot " + name(k) + " images on TCP ports " + std::to_string(top) + " (top) and " +
-          std::to_string(top + 1) + " (bottom)");
+      say("LoLA robot " + name(k) + " images on TCP " + host + " ports " + std::to_string(top) +
+          " (top) and " + std::to_string(top + 1) + " (bottom)");
     }
-    images_ = std::make_unique<lola::ImageStreams>(sim, ports);  // joins sim last of all
+    images_ = std::make_unique<lola::ImageStreams>(sim, ports, host);  // joins sim last of all
   }
   sim.addSource(*endpoint_);
   if (team_messages_) sim.addSource(*team_messages_);
