@@ -220,6 +220,63 @@ TEST(BoosterEndpoint, MoveWalksTheK1WithSimsoccersWalk) {
   EXPECT_NEAR(w.physics().jointPosition(w.robot(0).body, head), 0.3, 0.05);
 }
 
+// rt/fall_down as a client watching its K1 in WALKING mode sees a fall: on its front, the robot
+// is reported fallen, then getting up (the walk's own recovery), then ready again, with
+// recovery available throughout (the robot gets up by itself in WALKING and SOCCER).
+TEST(BoosterEndpoint, FallDownReportsTheFallAndTheGetUp) {
+  booster::BoosterRobot robot = served(0, 187);
+  robot.motions = test::sourceDir() / "configs/motions/booster_k1";
+  robot.initial_mode = booster::RobotMode::Walking;
+  ServedK1 k1(robot, /*lockstep=*/false);
+  auto& [w, simulation, endpoint] = k1;
+  net::Participant participant(loopback(187));
+  net::QosSpec q;
+  q.reliable = true;
+  q.depth = 64;
+  net::Reader<booster_interface_msg_dds__FallDownState_> fall(
+      participant, booster_interface_msg_dds__FallDownState__desc, "rt/fall_down", q);
+  std::vector<int> states;  // each change, in order
+  bool recovery = true;
+  const auto look = [&] {
+    fall.take([&](const booster_interface_msg_dds__FallDownState_& m, const dds_sample_info_t& i) {
+      if (!i.valid_data) return;
+      recovery = recovery && m.is_recovery_available;
+      if (states.empty() || states.back() != static_cast<int>(m.fall_down_state))
+        states.push_back(static_cast<int>(m.fall_down_state));
+    });
+  };
+  for (int i = 0; i < 100; ++i) {  // standing in WALKING mode; the reader matched meanwhile
+    simulation.period();
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    look();
+  }
+  engine::Pose lying = engine::Pose::Identity();
+  lying.linear() = Eigen::AngleAxisd(M_PI / 2, engine::Vec3::UnitY()).toRotationMatrix();
+  lying.translation() = engine::Vec3(-2.0, 0.0, 0.2);
+  w.placeRobot(0, lying, "stand");
+  for (int i = 0;
+       i < 2000 && !(states.size() > 2 && states.back() == booster_interface_msg_dds__IS_READY);
+       ++i) {
+    simulation.period();
+    if (i % 10 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    look();
+  }
+  std::string seen;
+  for (int s : states) seen += std::to_string(s) + " ";
+  std::printf("rt/fall_down states: %s(0 ready, 1 falling, 2 fallen, 3 getting up)\n",
+              seen.c_str());
+  const auto at = [&](int s) { return std::find(states.begin(), states.end(), s); };
+  ASSERT_FALSE(states.empty());
+  EXPECT_EQ(states.front(), booster_interface_msg_dds__IS_READY) << seen;
+  EXPECT_NE(at(booster_interface_msg_dds__HAS_FALLEN), states.end()) << seen;
+  EXPECT_NE(at(booster_interface_msg_dds__IS_GETTING_UP), states.end()) << seen;
+  EXPECT_LT(at(booster_interface_msg_dds__HAS_FALLEN), at(booster_interface_msg_dds__IS_GETTING_UP))
+      << seen;
+  EXPECT_EQ(states.back(), booster_interface_msg_dds__IS_READY) << seen;
+  EXPECT_TRUE(recovery);
+  EXPECT_TRUE(w.isStanding(0));
+}
+
 // What Booster's soccer demo (and the teams built on it) reads besides the low state: the
 // odometry of the walk (rt/odometer_state: x, y, theta since the start or the last
 // ResetOdometry) and the head in the robot's base frame (rt/head_pose, geometry_msgs/Pose:

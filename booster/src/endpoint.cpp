@@ -393,8 +393,25 @@ void Endpoint::observe(const sim::Observation& o) {
     ++r.stats.states_sent;
     publishPoses(r, w);
 
-    const int fallen = w.isStanding(r.config.robot) ? booster_interface_msg_dds__IS_READY
-                                                    : booster_interface_msg_dds__HAS_FALLEN;
+    int fallen = w.isStanding(r.config.robot) ? booster_interface_msg_dds__IS_READY
+                                              : booster_interface_msg_dds__HAS_FALLEN;
+    // Walking and Soccer: the walk's fall detector and get-up tell the phases between (the
+    // SDK's IS_FALLING and IS_GETTING_UP), as the robot's own recovery does.
+    if (r.motion && r.loco.walking() && r.was_walking) {
+      switch (r.motion->state()) {
+        case agents::MotionState::Falling:
+          fallen = booster_interface_msg_dds__IS_FALLING;
+          break;
+        case agents::MotionState::Lying:
+          fallen = booster_interface_msg_dds__HAS_FALLEN;
+          break;
+        case agents::MotionState::GettingUp:
+          fallen = booster_interface_msg_dds__IS_GETTING_UP;
+          break;
+        default:
+          break;
+      }
+    }
     if (fallen != r.fall_state || o.time - r.fall_sent_at >= config_.fall_down_interval) {
       FallDown fd{};
       fd.fall_down_state = static_cast<booster_interface_msg_dds__FallDownStateType>(fallen);
