@@ -364,6 +364,73 @@ TEST(Simulation, UnderHslRulesTheOperatorSkipsStandby) {
   EXPECT_EQ(officials.game().messageBudget(0), 12000);
 }
 
+// A drawn game under a rule book with a shoot-out: the operator pauses as GameController3's
+// would be seen, so robots get each state: the second half's Finished, the shoot-out's Initial,
+// then each kick's Set and Playing and a Finished between kicks (they went from Playing
+// straight to the next kick's Set, and from the game's end straight into the shoot-out).
+TEST(Simulation, TheOperatorTakesADrawnGameThroughEveryShootoutState) {
+  world::World w(test::scenario(4));
+  referee::RuleBook rules =
+      referee::loadRuleBook(test::sourceDir() / "configs" / "rules" / "spl.yaml");
+  rules.half_duration = 2.0;
+  rules.half_time_break = 2.0;
+  rules.half_time_to_initial = 1.0;
+  rules.shootout_shot_duration = 2.0;
+  rules.shootout_kicks = 2;
+  rules.sudden_death = false;  // (a coin after the kicks)
+  sim::GameOfficials officials(w, rules, sim::OfficialsConfig::forTeams(1, 2));
+  sim::Simulation simulation(w);
+  simulation.setOfficials(&officials);
+  using referee::gc::GamePhase;
+  using referee::gc::State;
+  struct Seen {
+    GamePhase phase;
+    State state;
+    double since;
+  };
+  std::vector<Seen> seen;
+  for (int i = 0; i < 20000 && !officials.over(); ++i) {
+    simulation.period();
+    const auto& g = officials.game();
+    if (seen.empty() || seen.back().phase != g.phase() || seen.back().state != g.state())
+      seen.push_back({g.phase(), g.state(), g.time()});
+  }
+  std::string trace;
+  for (const Seen& k : seen)
+    trace += std::to_string(static_cast<int>(k.phase)) + "/" +
+             std::to_string(static_cast<int>(k.state)) + "@" + std::to_string(k.since) + " ";
+  ASSERT_TRUE(officials.over()) << trace;
+  const auto at = [&](GamePhase phase, State state, size_t from = 0) {
+    for (size_t k = from; k < seen.size(); ++k)
+      if (seen[k].phase == phase && seen[k].state == state) return k;
+    return seen.size();
+  };
+  const size_t start = at(GamePhase::PenaltyShoot, State::Initial);
+  ASSERT_LT(start, seen.size()) << "no shoot-out";
+  ASSERT_GT(start, 0u);
+  // Before it: the game's Finished, for the operator's pause.
+  EXPECT_EQ(seen[start - 1].phase, GamePhase::Normal);
+  EXPECT_EQ(seen[start - 1].state, State::Finished);
+  EXPECT_GE(seen[start].since - seen[start - 1].since, 1.0 - 1e-9);
+  // Then Initial for the pause, then kicks: Set, Playing, Finished, and Set again after a pause.
+  ASSERT_LT(start + 3, seen.size());
+  EXPECT_EQ(seen[start + 1].state, State::Set);
+  EXPECT_GE(seen[start + 1].since - seen[start].since, 1.0 - 1e-9);
+  int kicks = 0;
+  for (size_t k = start + 1; k < seen.size(); ++k) {
+    EXPECT_EQ(seen[k].phase, GamePhase::PenaltyShoot) << k;
+    if (seen[k].state == State::Set) {
+      ++kicks;
+      EXPECT_EQ(seen[k - 1].state, kicks == 1 ? State::Initial : State::Finished) << k;
+      EXPECT_GE(seen[k].since - seen[k - 1].since, 1.0 - 1e-9) << k;
+      ASSERT_LT(k + 1, seen.size());
+      EXPECT_EQ(seen[k + 1].state, State::Playing) << k;
+    }
+  }
+  EXPECT_EQ(kicks, 4);  // 2 a side, none scores (no agents)
+  EXPECT_EQ(seen.back().state, State::Finished);
+}
+
 // A followed GameController that hides the kicking side (the Champions Cup: kickingTeam 255 in
 // a penalty kick) is asked for its true data as a monitor asks (RGTr to its monitor port), and
 // its true data (RGTD, unicast to the listener's port) places the ball on the right mark; the

@@ -56,13 +56,22 @@ void GameOfficials::operatorPart() {
   } else {
     standby_since_.reset();
   }
-  // A drawn game goes to the shoot-out when the rule book calls for it.
-  if (g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
-      g.rules().shootout && !config_.penalty_kick_trial)
+  // A drawn game goes to the shoot-out when the rule book calls for it, after the operator's
+  // pause in Finished; each kick after one in Initial (the shoot-out's start) or Finished (the
+  // last kick's end), so that robots see those states as GameController3 sends them (they
+  // went from Playing straight to the next kick's Set). A penalty-kick trial has no pauses.
+  const bool pause = !config_.penalty_kick_trial;
+  const bool drawn = g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
+                     g.rules().shootout && !config_.penalty_kick_trial;
+  const bool between_kicks =
+      g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished);
+  if (!drawn && !between_kicks) shootout_since_.reset();
+  if (drawn && (!pause || waited(shootout_since_, config_.initial_seconds)))
     g.startShootout(0, std::nullopt, world_.scenario().seed);
   // The next shoot-out kick: the kicking team's field players in turn against
   // the other team's goalkeeper.
-  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished)) {
+  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished) &&
+      (!pause || waited(shootout_since_, config_.initial_seconds))) {
     const int team = g.shotsTaken(0) <= g.shotsTaken(1) ? 0 : 1;
     std::vector<int> strikers;
     for (world::RobotId r = 0; r < world_.robotCount(); ++r)

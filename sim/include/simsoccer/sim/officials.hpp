@@ -69,6 +69,7 @@ class GameOfficials : public Officials {
   size_t events_seen_ = 0;
   std::array<int, 2> next_striker_{0, 0};
   std::optional<double> initial_since_, standby_since_;  // game time the state began
+  std::optional<double> shootout_since_;  // the shoot-out's Finished or Initial began
   std::unique_ptr<referee::GameControllerListener> listener_;
   double last_change_ = 0.0;  // game time of the external GameController's last new state
 };
