@@ -11,7 +11,8 @@
 //       [--expect-id BODY_ID] [--ramp] [--expect-ticks] [--probe-gap S]
 // modes: hold (answer every map, full), partial (full once, then Position
 // alone, split over two writes, LEDs in a second map), probe (read one map,
-// disconnect, reconnect --probe-gap s later, hold), garbage, nan, huge (a 10 MB map), unknown
+// disconnect, reconnect --probe-gap s later, hold), flap (read one map, disconnect,
+// reconnect, for ever: a crash loop), garbage, nan, huge (a 10 MB map), unknown
 // (unknown keys in every map), silent (stop answering for K cycles after K),
 // bump (hold, chest LEDs changing each cycle), late (one answer 0.8 s late), gc (no LoLA: on a
 // field network, receive a GameController packet on 3838, send a status packet to
@@ -285,6 +286,12 @@ int main(int argc, char** argv) {
     if (hold.empty()) {
       hold = s["Position"];
       for (auto [j, rad] : o.joints) hold[static_cast<std::size_t>(j)] = rad;
+    }
+    if (o.mode == "flap") {  // a binary in a crash loop: reads one map, goes, comes back
+      ::close(fd);
+      fd = connectTo(o.socket);
+      if (fd < 0) break;
+      continue;
     }
     if (o.mode == "probe" && !probed) {  // B-Human reads the body id and reconnects
       probed = true;

@@ -178,6 +178,18 @@ TEST(MatchConfig, TheAgentsGetTheMotionsFolderBesideTheMatchConfig) {
   ASSERT_NE(at, command.end());
   ASSERT_NE(at + 1, command.end());
   EXPECT_EQ(*(at + 1), mc.agent_motions.string());
+  EXPECT_EQ(std::find(command.begin(), command.end(), "--gone-after"), command.end());
+  // Beside a LoLA robot, whose client lockstep may wait for (reconnect_timeout), the agents
+  // take the simulator for gone only after that wait and a lockstep timeout more.
+  match::MatchConfig with_lola = mc;
+  with_lola.lola.robots = match::parseLolaPlayers("2:1");
+  const match::MatchSession lola_session(with_lola, 1);
+  const auto lola_command = match::agentCommand(lola_session, match::RunOptions{}, 0, 1);
+  const auto gone = std::find(lola_command.begin(), lola_command.end(), "--gone-after");
+  ASSERT_NE(gone, lola_command.end());
+  ASSERT_NE(gone + 1, lola_command.end());
+  EXPECT_NEAR(std::stod(*(gone + 1)), 5.0 + with_lola.lola.reconnect_timeout + mc.command_timeout,
+              1e-6);
 
   test::TempDir dir("agent_motions");
   const std::string head =

@@ -28,12 +28,13 @@
 int main(int argc, char** argv) {
   using namespace simsoccer;
   try {
-    const apps::Options opt(argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
-                            {"team",    "player", "domain",      "dds-config", "lease",
-                             "robot",   "mode",   "stall-after", "ticks",      "claim-timeout",
-                             "vx",      "vy",     "turn",        "role",       "config",
-                             "motions", "field",  "team-number", "seed",       "game-state-wait",
-                             "if-owned"});
+    const apps::Options opt(
+        argc, argv, 1, {"help", "get-up", "no-get-up", "verbose"},
+        {"team",     "player",    "domain",      "dds-config", "lease",
+         "robot",    "mode",      "stall-after", "ticks",      "claim-timeout",
+         "vx",       "vy",        "turn",        "role",       "config",
+         "motions",  "field",     "team-number", "seed",       "game-state-wait",
+         "if-owned", "gone-after"});
     if (opt.help(simsoccer::apps::kAgentHelp)) return 0;
     opt.noPositional();
     if (!opt.has("team") || !opt.has("player"))
@@ -129,6 +130,7 @@ int main(int argc, char** argv) {
     // it would have arrived (otherwise the first periods may be played
     // without it, and the same seed gives another game).
     const double game_wait = opt.nonNegative("game-state-wait", 0.0);
+    const double gone_after = opt.positive("gone-after", 5.0);
     if (soccer && game_wait > 0.0 && !client.waitForGameState(game_wait))
       std::fprintf(stderr,
                    "simsoccer-agent: robot (%d, %d): no GameState within %g s; playing without "
@@ -188,9 +190,10 @@ int main(int argc, char** argv) {
         client.onFrame(nullptr);
         return 0;
       }
-      if (now_ns() - last_frame_ns > 5'000'000'000LL) {
+      if (static_cast<double>(now_ns() - last_frame_ns) > gone_after * 1e9) {
         client.onFrame(nullptr);
-        std::fprintf(stderr, "simsoccer-agent: no frame for 5 s, the simulator is gone\n");
+        std::fprintf(stderr, "simsoccer-agent: no frame for %g s, the simulator is gone\n",
+                     gone_after);
         return 4;
       }
     }

@@ -127,7 +127,7 @@ int match(int argc, char** argv, int first) {
   std::printf(
       "simsoccer match %s: %zu robots, seed %llu, %s, %s periods, DDS domain %u, output %s\n",
       config.name.c_str(), session.world().robotCount(), static_cast<unsigned long long>(o.seed),
-      o.realtime ? "real time" : "lockstep", sim::modeName(o.mode), o.domain,
+      o.realtime ? "real time" : "lockstep", sim::modeName(*o.mode), o.domain,
       o.out.string().c_str());
   std::fflush(stdout);
   const match::RunResult r = match::playMatch(session, o);

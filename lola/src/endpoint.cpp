@@ -37,12 +37,19 @@ struct Endpoint::Client {
   bool unresponsive = false;  // lockstep does not wait for it until it answers again
   // Lockstep waits for it to connect again until then (EndpointConfig::reconnect_timeout).
   std::optional<std::chrono::steady_clock::time_point> return_by;
+  // Waits for it granted since it last answered a period: a binary that crashes and is
+  // restarted over and over (or connects and closes without answering) is not waited for
+  // beyond kReconnectWaits of them.
+  int reconnect_waits = 0;
   std::array<float, kJoints> accepted_position{}, accepted_stiffness{};
   RobotLolaStats stats;
   Client(const RobotSocket& c) : config(c), battery(c.battery_charge) {}
 };
 
 namespace {
+// Reconnection waits granted to a client between two periods it answers.
+constexpr int kReconnectWaits = 3;
+
 std::string errnoText() {
   return std::strerror(errno);
 }
@@ -175,9 +182,11 @@ void Endpoint::endSession(Client& c) {
   ::close(c.fd);
   c.fd = -1;
   c.unsent.clear();  // what the client sent before it went is still taken (parse)
-  if (config_.lockstep && config_.reconnect_timeout > 0.0)
+  if (config_.lockstep && config_.reconnect_timeout > 0.0 && c.reconnect_waits < kReconnectWaits) {
+    ++c.reconnect_waits;
     c.return_by = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                      std::chrono::duration<double>(config_.reconnect_timeout));
+  }
 }
 
 void Endpoint::acceptAll() {
@@ -272,7 +281,10 @@ bool Endpoint::pollOnce(Clock::time_point deadline, bool wait) {
     if (left.count() <= 0) return false;
     timeout_ms = static_cast<int>((left.count() + 999) / 1000);
   }
-  if (::poll(fds.data(), fds.size(), timeout_ms) <= 0) return wait && Clock::now() < deadline;
+  const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
+  // Interrupted by a signal (Ctrl-C): the wait ends, and the run loop sees the stop.
+  if (ready < 0 && errno == EINTR) return false;
+  if (ready <= 0) return wait && Clock::now() < deadline;
   for (std::size_t i = 0; i < clients_.size(); ++i) {
     Client& c = clients_[i];
     if (fds[2 * i].revents & POLLIN) acceptAll();
@@ -324,8 +336,13 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
     return c.fd >= 0 && c.owed > 0 && !c.unresponsive;
   };
   if (config_.lockstep) {
-    auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                       std::chrono::duration<double>(config_.answer_timeout));
+    const auto start = Clock::now();
+    const auto seconds = [](double s) {
+      return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+    };
+    auto deadline = start + seconds(config_.answer_timeout);
+    // However often clients go and come back, one period waits at most this long.
+    const auto latest = deadline + seconds(config_.reconnect_timeout);
     // A client that went away: waited for until it is back (its map goes out as it connects,
     // then its answer is awaited) or its time is up.
     const auto returning = [&](const Client& c) {
@@ -335,7 +352,8 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
       bool waiting = false;
       for (const Client& c : clients_) {
         waiting = waiting || awaited(c) || returning(c);
-        if (returning(c)) deadline = std::max(deadline, *c.return_by);  // (also one gone now)
+        if (returning(c))
+          deadline = std::min(std::max(deadline, *c.return_by), latest);  // (also one gone now)
       }
       if (!waiting || !pollOnce(deadline, true)) break;
     }
@@ -366,6 +384,7 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
       continue;
     }
     ++c.stats.answered;
+    c.reconnect_waits = 0;
     c.missed_in_row = 0;
     if (++c.answered_in_row >= config_.unresponsive_after) c.unresponsive = false;
     const ActuatorValues& v = c.stream.values();

@@ -92,6 +92,7 @@ std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o) {
   if (!o.motions.empty()) a.insert(a.end(), {"--motions", o.motions.string()});
   if (!o.dds_config.empty()) a.insert(a.end(), {"--dds-config", o.dds_config.string()});
   if (!o.get_up) a.push_back("--no-get-up");
+  if (o.gone_after != 5.0) a.insert(a.end(), {"--gone-after", std::to_string(o.gone_after)});
   return a;
 }
 

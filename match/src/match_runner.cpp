@@ -98,6 +98,10 @@ std::vector<std::string> agentCommand(const MatchSession& session, const RunOpti
   ao.team_number = c.team_numbers[static_cast<size_t>(team)];
   ao.seed = o.seed * 1000 + static_cast<uint64_t>(team * 100 + number);
   ao.get_up = c.get_up;
+  // A lockstep period may wait for a LoLA robot's client to connect again (up to
+  // reconnect_timeout, then the lockstep timeout for its answer) with no frame going out.
+  if (!session.lolaRobots().empty() && !o.realtime)
+    ao.gone_after = 5.0 + c.lola.reconnect_timeout + c.command_timeout;
   return soccerAgentCommand(ao);
 }
 
@@ -106,7 +110,7 @@ RunResult play(MatchSession& session, const RunOptions& o, world::MatchLogWriter
   world::World& w = session.world();
   const MatchConfig& c = session.config();
   sim::SimulationConfig simc;
-  simc.mode = o.mode;
+  simc.mode = o.mode.value_or(sim::defaultMode(!o.realtime));
   simc.lockstep = !o.realtime;
   sim::Simulation simulation(w, simc);
   session.attach(simulation);

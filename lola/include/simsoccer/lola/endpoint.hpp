@@ -45,8 +45,11 @@ struct EndpointConfig {
   int unresponsive_after = 3;
   // Lockstep: s of wall time the periods wait for a client that went away to connect again
   // (B-Human's binary reads the body id, closes and connects again when it has booted; a
-  // watchdog restarts a crashed one), once per disconnection; 0: not waited for. Without it
-  // the simulation ran on at its own speed meanwhile, and the robot missed the kick-off.
+  // watchdog restarts a crashed one), once per disconnection and at most three times between
+  // two periods it answers (a binary in a crash loop is then not waited for); one period
+  // waits at most answer_timeout + reconnect_timeout. 0: not waited for. Without it the
+  // simulation ran on at its own speed meanwhile, and the robot missed the kick-off. (DDS
+  // agents beside it get no frame meanwhile: a match gives them --gone-after beyond it.)
   double reconnect_timeout = 0.0;
   // Sensor maps a client may leave unread before new ones are dropped
   // (whole, so the stream stays framed), as LoLA ignores a client that does not read.

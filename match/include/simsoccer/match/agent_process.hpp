@@ -56,6 +56,7 @@ struct SoccerAgentOptions {
   std::optional<uint64_t> seed;      // the agent's own random numbers
   bool get_up = true;                // after a fall
   double game_state_wait = 10.0;     // s
+  double gone_after = 5.0;  // s without a frame before the agent takes the simulator for gone
 };
 std::vector<std::string> soccerAgentCommand(const SoccerAgentOptions& o);
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,8 @@ struct RunOptions {
   // (replacing dds_config). Empty: no DDS Security.
   std::filesystem::path secure;
   double max_seconds = 0.0;          // > 0: stop after this much simulated time
-  sim::Mode mode = sim::kDefaultMode;  // of the control period
+  // Of the control period; unset: sim::defaultMode (pipelined in lockstep, serial in real time).
+  std::optional<sim::Mode> mode;
   // Asked after every period: true stops the run (Ctrl-C), keeping what was recorded.
   std::function<bool()> stop_requested;
   // Called about every 0.25 s of wall time with the wall seconds so far.

@@ -43,8 +43,8 @@ struct RuleBook {
   bool sudden_death = true;
   int sudden_death_rounds = 3;  // then a coin decides
   int message_budget = 1200;    // team messages per team per game (GameController: messagesPerTeam)
-  // The GameController whose packets the game goes out as: 18 (SPL,
-  // GameController3) or 19 (HSL); the HSL has no Standby state.
+  // The GameController whose packets the game goes out as: 18 (SPL, GameController3), 20 (HSL,
+  // RoboCup 2026) or 19 (HSL, the German Open 2026); the HSL has no Standby state.
   int gc_version = 18;
   bool standby = true;
   uint8_t competition_type = 0;  // HSL: 0 SMALL, 1 MIDDLE, 2 LARGE (v18: 0 NORMAL)

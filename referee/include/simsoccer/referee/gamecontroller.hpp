@@ -151,8 +151,9 @@ class UdpSender {
 
 class UdpReceiver {
  public:
-  // `device`: only datagrams that arrive on this network interface (SO_BINDTODEVICE, needs
-  // CAP_NET_RAW), with bind_address 0.0.0.0 both the subnet's and the limited broadcast.
+  // `device`: only datagrams that arrive on this network interface (SO_BINDTODEVICE; before
+  // Linux 5.7 it needs CAP_NET_RAW), with bind_address 0.0.0.0 both the subnet's and the
+  // limited broadcast.
   explicit UdpReceiver(uint16_t port, const std::string& bind_address = "0.0.0.0",
                        const std::string& device = "");
   ~UdpReceiver();
