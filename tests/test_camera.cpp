@@ -260,7 +260,19 @@ TEST(Camera, CapsuleAndItsCoarseStandInWherePredicted) {
   }
 }
 
-TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
+namespace {
+// BT.601 full-range YCbCr in Y, Cb, Cr order (OpenCV's YCrCb has Y, Cr, Cb), as the Nao's
+// camera delivers it.
+cv::Mat ycbcr(const cv::Mat& rgb) {
+  cv::Mat ycrcb, out(rgb.size(), CV_8UC3);
+  cv::cvtColor(rgb, ycrcb, cv::COLOR_RGB2YCrCb);
+  const int from_to[] = {0, 0, 1, 2, 2, 1};
+  cv::mixChannels(&ycrcb, 1, &out, 1, from_to, 3);
+  return out;
+}
+}  // namespace
+
+TEST(Camera, YuyvIsTheCamerasYCbCrWithinRounding) {
   cv::Mat rgb(480, 640, CV_8UC3);
   cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
   // Every 8-bit value of each channel appears: the extremes are where rounding differs.
@@ -270,8 +282,7 @@ TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
     rgb.at<cv::Vec3b>(2, i) = {0, 255, static_cast<uint8_t>(i)};
   }
   const cv::Mat yuyv = engine::rgbToYuyv(rgb);
-  cv::Mat yuv;
-  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  const cv::Mat yuv = ycbcr(rgb);
   ASSERT_EQ(yuyv.type(), CV_8UC2);
   for (int r = 0; r < rgb.rows; ++r)
     for (int c = 0; c < rgb.cols; c += 2) {
@@ -286,21 +297,25 @@ TEST(Camera, YuyvMatchesOpenCvYuvWithinRounding) {
   cv::Mat rgba;
   cv::cvtColor(rgb, rgba, cv::COLOR_RGB2RGBA);
   EXPECT_EQ(cv::norm(engine::rgbToYuyv(rgba), yuyv, cv::NORM_INF), 0.0);
-  // And back (chroma shared by each pair, OpenCV's YUV -> RGB): a flat colour survives.
-  cv::Mat flat(4, 4, CV_8UC3, cv::Scalar(30, 140, 40)), unpacked(4, 4, CV_8UC3), back;
+  // And back as team code decodes it (B-Human's ColorModelConversions: R = Y + 1.402 (Cr - 128),
+  // G = Y - 0.344 (Cb - 128) - 0.714 (Cr - 128), B = Y + 1.772 (Cb - 128)): a flat colour
+  // survives (chroma shared by each pair).
+  const cv::Vec3b colour(30, 140, 40);
+  cv::Mat flat(4, 4, CV_8UC3, cv::Scalar(colour[0], colour[1], colour[2]));
   const cv::Mat packed = engine::rgbToYuyv(flat);
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) {
       const uint8_t* q = packed.ptr<uint8_t>(r) + 4 * (c / 2);
-      unpacked.at<cv::Vec3b>(r, c) = {q[c % 2 == 0 ? 0 : 2], q[1], q[3]};
+      const double y = q[c % 2 == 0 ? 0 : 2], cb = q[1] - 128.0, cr = q[3] - 128.0;
+      EXPECT_NEAR(y + 1.402 * cr, colour[0], 2.0);
+      EXPECT_NEAR(y - 0.344 * cb - 0.714 * cr, colour[1], 2.0);
+      EXPECT_NEAR(y + 1.772 * cb, colour[2], 2.0);
     }
-  cv::cvtColor(unpacked, back, cv::COLOR_YUV2RGB);
-  EXPECT_LE(cv::norm(flat, back, cv::NORM_INF), 2.0);
   EXPECT_THROW(engine::rgbToYuyv(cv::Mat(2, 3, CV_8UC3)), std::invalid_argument);
 }
 
 TEST(Camera, AYuvViewHoldsTheRgbViewsYuvWhicheverFormatTheOthersUse) {
-  // A view drawn in YUV is OpenCV's RGB -> YUV of the same view drawn in RGB,
+  // A view drawn in YUV is the YCbCr of the same view drawn in RGB,
   // within the rounding of two 8-bit conversions, ball patches and the hall
   // behind the field included, whether the framebuffer was cleared for YUV
   // views (most of them) or for RGB ones.
@@ -324,8 +339,8 @@ TEST(Camera, AYuvViewHoldsTheRgbViewsYuvWhicheverFormatTheOthersUse) {
         views.begin();
     const size_t y = &views.back() == &views[r] ? 0 : views.size() - 1;
     ASSERT_EQ(views[y].format, engine::PixelFormat::Yuv);
-    cv::Mat expected, diff;
-    cv::cvtColor(images[r], expected, cv::COLOR_RGB2YUV);
+    cv::Mat diff;
+    const cv::Mat expected = ycbcr(images[r]);
     cv::absdiff(expected, images[y], diff);
     double worst = 0;
     cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
@@ -346,8 +361,8 @@ TEST(Camera, AYuvViewHoldsTheRgbViewsYuvWhicheverFormatTheOthersUse) {
 TEST(Camera, YuvPacksAsYuyvAsTheRgbConversionDoes) {
   cv::Mat rgb(48, 66, CV_8UC3);  // a width that leaves pairs after the 32-pixel blocks
   cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
-  cv::Mat yuv, yuva, a, b;
-  cv::cvtColor(rgb, yuv, cv::COLOR_RGB2YUV);
+  cv::Mat yuva, a, b;
+  const cv::Mat yuv = ycbcr(rgb);
   cv::cvtColor(yuv, yuva, cv::COLOR_RGB2RGBA);  // a fourth channel of 255, as a Yuv view has
   const cv::Mat expected = engine::rgbToYuyv(rgb);
   engine::yuvToYuyv(yuv, a);

@@ -12,6 +12,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 
 namespace simsoccer::engine {
 namespace {
@@ -133,9 +134,12 @@ constexpr size_t levelOfDetail(size_t batch, float radius_px) {
 constexpr float kIcosahedronScale = 2.0f / (1.0f + 0.7946545f);
 
 // A view's colours from the scene's linear RGB (0..1): out = transform * rgb
-// + offset. Yuv is OpenCV's RGB -> YUV (BT.601 luma, U = 0.492 (B - Y) and
-// V = 0.877 (R - Y), both offset by 128 of 255), so that a Yuv view holds
-// what rgbToYuyv would compute from the Rgb view, up to rounding.
+// + offset. Yuv is BT.601 full-range YCbCr, as the Nao's camera delivers it and team code
+// decodes it (B-Human: R = Y + 1.402 (Cr - 128), B = Y + 1.772 (Cb - 128)): BT.601 luma,
+// Cb = 0.564 (B - Y) and Cr = 0.713 (R - Y), both offset by 128 of 255 (OpenCV's YCrCb, in
+// Y, Cb, Cr order), so that a Yuv view holds what rgbToYuyv would compute from the Rgb view,
+// up to rounding. (Until 2026-12-07 it was OpenCV's analogue YUV, U = 0.492 (B - Y), V =
+// 0.877 (R - Y): chroma 0.87 and 1.23 times a camera's.)
 struct ColourTransform {
   Eigen::Matrix3f transform = Eigen::Matrix3f::Identity();
   Eigen::Vector3f offset = Eigen::Vector3f::Zero();
@@ -147,8 +151,8 @@ ColourTransform colourTransform(PixelFormat format) {
   if (format == PixelFormat::Rgb) return t;
   const Eigen::RowVector3f y(0.299f, 0.587f, 0.114f);
   t.transform.row(0) = y;
-  t.transform.row(1) = 0.492f * (Eigen::RowVector3f(0, 0, 1) - y);
-  t.transform.row(2) = 0.877f * (Eigen::RowVector3f(1, 0, 0) - y);
+  t.transform.row(1) = 0.564f * (Eigen::RowVector3f(0, 0, 1) - y);
+  t.transform.row(2) = 0.713f * (Eigen::RowVector3f(1, 0, 0) - y);
   t.offset = Eigen::Vector3f(0.0f, 128.0f / 255.0f, 128.0f / 255.0f);
   return t;
 }
@@ -812,9 +816,11 @@ namespace {
 // when kChannels is 4) as YUYV: each pixel pair keeps its two Y and shares
 // the rounded means of its U and of its V. 32 pixels at a time with OpenCV's
 // universal intrinsics, the rest one pair at a time.
-template <int kChannels>
+// `in`: Y, U (Cb), V (Cr) per pixel, or Y, V, U with kVFirst (OpenCV's YCrCb order).
+template <int kChannels, bool kVFirst = false>
 void packYuyv(const uint8_t* in, uint8_t* out, int cols) {
   static_assert(kChannels == 3 || kChannels == 4);
+  constexpr int kU = kVFirst ? 2 : 1, kV = kVFirst ? 1 : 2;
   int c = 0;
 #if CV_SIMD128
   const cv::v_uint16x8 low_byte = cv::v_setall_u16(0x00ff);
@@ -830,6 +836,10 @@ void packYuyv(const uint8_t* in, uint8_t* out, int cols) {
       cv::v_load_deinterleave(in, y0, u0, v0, a0);
       cv::v_load_deinterleave(in + 64, y1, u1, v1, a1);
     }
+    if constexpr (kVFirst) {
+      std::swap(u0, v0);
+      std::swap(u1, v1);
+    }
     const cv::v_uint8x16 y_even = cv::v_pack(even(y0), even(y1));
     const cv::v_uint8x16 y_odd = cv::v_pack(odd(y0), odd(y1));
     const cv::v_uint8x16 u = cv::v_rshr_pack<1>(even(u0) + odd(u0), even(u1) + odd(u1));
@@ -839,9 +849,9 @@ void packYuyv(const uint8_t* in, uint8_t* out, int cols) {
 #endif
   for (; c < cols; c += 2, in += 2 * kChannels, out += 4) {
     out[0] = in[0];
-    out[1] = static_cast<uint8_t>((in[1] + in[kChannels + 1] + 1) >> 1);
+    out[1] = static_cast<uint8_t>((in[kU] + in[kChannels + kU] + 1) >> 1);
     out[2] = in[kChannels];
-    out[3] = static_cast<uint8_t>((in[2] + in[kChannels + 2] + 1) >> 1);
+    out[3] = static_cast<uint8_t>((in[kV] + in[kChannels + kV] + 1) >> 1);
   }
 }
 
@@ -870,9 +880,9 @@ void rgbToYuyv(const cv::Mat& rgb, cv::Mat& out) {
     cv::Mat yuv;
     for (int s = strips.start; s < strips.end; ++s) {
       const int r0 = s * strip, r1 = std::min(r0 + strip, rgb.rows);
-      cv::cvtColor(rgb.rowRange(r0, r1), yuv, cv::COLOR_RGB2YUV);  // reads 3 or 4 channels
+      cv::cvtColor(rgb.rowRange(r0, r1), yuv, cv::COLOR_RGB2YCrCb);  // reads 3 or 4 channels
       for (int r = r0; r < r1; ++r)
-        packYuyv<3>(yuv.ptr<uint8_t>(r - r0), out.ptr<uint8_t>(r), rgb.cols);
+        packYuyv<3, true>(yuv.ptr<uint8_t>(r - r0), out.ptr<uint8_t>(r), rgb.cols);
     }
   };
   cv::parallel_for_(cv::Range(0, (rgb.rows + strip - 1) / strip), body);

@@ -47,8 +47,9 @@ struct DrawItem {
 };
 
 // The colour space a view is drawn in. Rgb: the scene's colours, as R, G, B,
-// 255 in the four 8-bit channels. Yuv: OpenCV's RGB -> YUV of them (Y, U, V,
-// 255), computed with the lighting per vertex: a camera that delivers YUV
+// 255 in the four 8-bit channels. Yuv: their BT.601 full-range YCbCr, as the Nao's camera
+// delivers it (Y, Cb, Cr, 255; OpenCV's RGB -> YCrCb with the chroma in that order),
+// computed with the lighting per vertex: a camera that delivers YUV
 // 4:2:2 then only packs pixel pairs (yuvToYuyv) instead of converting every
 // pixel on the CPU, and the rasteriser's cost per pixel stays the same.
 enum class PixelFormat : uint8_t { Rgb, Yuv };
@@ -111,8 +112,8 @@ class OffscreenRenderer {
   RenderTiming timing_;
 };
 
-// The Nao's image format: YUV 4:2:2 as Y0 U Y1 V (YUYV), from 8-bit RGB or RGBA,
-// using OpenCV's RGB -> YUV conversion; each pixel pair shares the mean of
+// The Nao's image format: YCbCr 4:2:2 as Y0 Cb Y1 Cr (YUYV), from 8-bit RGB or RGBA,
+// BT.601 full range (OpenCV's RGB -> YCrCb); each pixel pair shares the mean of
 // its two chroma values. `width` must be even.
 cv::Mat rgbToYuyv(const cv::Mat& rgb);
 // The same into `out` (written in place when it already is rows x cols CV_8UC2).
