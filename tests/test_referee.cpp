@@ -193,7 +193,7 @@ TEST(Referee, LeavingTheFieldRemovesAndReturnsTheRobotWithTheIncrement) {
 }
 
 // Motion in Set (called by a GameController the simulation follows, or an operator) is served
-// in place: the robot stays where it is, unlike every other penalty.
+// in place under the SPL's rules: the robot stays where it is, unlike every other penalty.
 TEST(Referee, MotionInSetIsServedInPlace) {
   world::World w(twoVsTwo());
   Referee ref(w, test::splRules(), test::twoTeams(), 0);
@@ -212,6 +212,19 @@ TEST(Referee, MotionInSetIsServedInPlace) {
   g.penalise(0, 2, gc::Penalty::RequestForPickup);
   run(w, ref, 0.1);
   EXPECT_GT((w.torsoPose(1).translation() - before).head<2>().norm(), 0.5);
+  // Under the HSL's rules Motion in Set is a standard removal penalty.
+  world::World hsl_world(twoVsTwo());
+  Referee hsl(hsl_world,
+              loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_small_foundation.yaml"),
+              test::twoTeams(), 0);
+  EXPECT_FALSE(hsl.game().rules().motion_in_set_in_place);
+  hsl.game().ready();
+  run(hsl_world, hsl, 0.1);
+  if (hsl.game().state() == gc::State::Ready) hsl.game().set();
+  const Vec3 at = hsl_world.torsoPose(1).translation();
+  hsl.game().penalise(0, 2, gc::Penalty::IllegalMotionInSet);
+  run(hsl_world, hsl, 0.1);
+  EXPECT_GT((hsl_world.torsoPose(1).translation() - at).head<2>().norm(), 0.5);
 }
 
 TEST(Referee, IllegalPositionInSetOrAutoPlacement) {

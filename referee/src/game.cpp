@@ -49,11 +49,13 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   r.game_stuck_duration = root["game_stuck_duration"].positive();
   r.goal_area_max_robots = root["goal_area_max_robots"].integer();
   const ConfigNode p = root["penalties"];
-  p.allowOnly({"base", "increment", "illegal_position_in_set", "motion_in_set"});
+  p.allowOnly(
+      {"base", "increment", "illegal_position_in_set", "motion_in_set", "motion_in_set_in_place"});
   r.penalty_base = p["base"].positive();
   r.penalty_increment = p["increment"].nonNegative();
   r.illegal_position_in_set = p["illegal_position_in_set"].positive();
   r.motion_in_set = p["motion_in_set"].positive();
+  r.motion_in_set_in_place = p.boolean("motion_in_set_in_place", true);
   const ConfigNode s = root["shootout"];
   s.allowOnly(
       {"enabled", "kicks_per_team", "shot_duration", "sudden_death", "sudden_death_rounds"});

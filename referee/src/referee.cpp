@@ -621,9 +621,11 @@ void Referee::removePenalised() {
   for (RobotId r = 0; r < world_.robotCount(); ++r) {
     const auto& info = world_.robot(r);
     const gc::Penalty pen = game_.penalty(info.team, info.number);
-    // Motion in Set is served in place (spl-rules 2025 and the HSL's rules: the robot stays
-    // where it moved, and the penalty may be revoked while still in Set); the others leave.
-    const bool out = pen != gc::Penalty::None && pen != gc::Penalty::IllegalMotionInSet;
+    // Motion in Set is served in place where the rule book says so (the SPL's 2025 rules: the
+    // robot stays where it moved, and the penalty may be revoked while still in Set; the HSL
+    // removes it); the others leave.
+    const bool out = pen != gc::Penalty::None && !(pen == gc::Penalty::IllegalMotionInSet &&
+                                                   game_.rules().motion_in_set_in_place);
     if (out) {
       if (slot_[r] < 0) {
         // The first free waiting spot of its team; it keeps it while it waits.

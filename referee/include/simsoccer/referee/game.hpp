@@ -37,6 +37,7 @@ struct RuleBook {
   int timeouts_per_team = 1;
   double penalty_base = 45, penalty_increment = 10;
   double illegal_position_in_set = 15, motion_in_set = 15;
+  bool motion_in_set_in_place = true;  // SPL 2025; the HSL removes the robot
   bool shootout = true;
   int shootout_kicks = 3;
   double shootout_shot_duration = 30;
