@@ -71,4 +71,14 @@ TEST(Field, HslMiddleDivisionFields) {
   EXPECT_NEAR(s.marks[0].x(), -3.0, 1e-12);
   EXPECT_DOUBLE_EQ(s.goal.inner_width, 1.8);
   EXPECT_DOUBLE_EQ(s.ball.radius, m.ball.radius);
+  // The Small division's (Naos): the S-Field's markings and goals, the SPL's ball.
+  const auto small = fields::loadFieldModel(test::sourceDir() / "fields" / "hsl_s_small.yaml");
+  const auto spl = fields::loadFieldModel(test::sourceDir() / "fields" / "spl.yaml");
+  EXPECT_DOUBLE_EQ(small.length, s.length);
+  EXPECT_DOUBLE_EQ(small.goal.inner_width, s.goal.inner_width);
+  EXPECT_DOUBLE_EQ(small.goal.clear_height, s.goal.clear_height);
+  EXPECT_DOUBLE_EQ(small.goal_area->length, s.goal_area->length);
+  EXPECT_DOUBLE_EQ(small.marks[0].x(), s.marks[0].x());
+  EXPECT_DOUBLE_EQ(small.ball.radius, spl.ball.radius);
+  EXPECT_DOUBLE_EQ(small.ball.mass, spl.ball.mass);
 }
