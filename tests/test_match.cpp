@@ -162,6 +162,23 @@ TEST(MatchApp, ShortMatchWritesAConsistentSummaryLogVideoAndHeatmap) {
   EXPECT_GT(std::filesystem::file_size(m.dir / "heatmap.png"), 1000u);
 }
 
+// Each shipped match plays on its league's field: the SPL's on the SPL field, the HSL Small
+// division's on the S-Field with the SPL ball, the Middle division's K1s on the M-Field (the
+// Champions Cup 7 v 7 and the HSL Small 7 v 7 shared a scenario, and one field).
+TEST(MatchConfig, EachShippedMatchPlaysOnItsLeaguesField) {
+  const auto configs = test::sourceDir() / "configs";
+  for (const auto& [config, field] : {std::pair{"match_5v5.yaml", "spl.yaml"},
+                                      {"match_7v7.yaml", "spl.yaml"},
+                                      {"match_2v2.yaml", "spl.yaml"},
+                                      {"match_hsl_small_4v4.yaml", "hsl_s_small.yaml"},
+                                      {"match_hsl_small_7v7.yaml", "hsl_s_small.yaml"},
+                                      {"match_k1_5v5.yaml", "hsl_m.yaml"}}) {
+    const match::MatchConfig mc = match::loadMatchConfig(configs / config);
+    const match::MatchSession session(mc, 1);
+    EXPECT_EQ(session.world().scenario().field_file.filename().string(), field) << config;
+  }
+}
+
 // A match's agents read the motions and gaits beside its config (a copied configs tree plays its
 // own gaits; before, every agent read the ones in its working directory or the source tree), or
 // the folder agents.motions names; a folder that is not there is refused, naming the key, and the

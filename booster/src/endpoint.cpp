@@ -393,10 +393,19 @@ void Endpoint::observe(const sim::Observation& o) {
     ++r.stats.states_sent;
     publishPoses(r, w);
 
+    // The walk runs at its own period, on the state of its period's start.
+    if (r.loco.walking()) {
+      if (o.tick % walk_periods_ == 0) walkTargets(r, f, o.tick + walk_periods_);
+    } else {
+      // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
+      r.was_walking = r.shooting = false;
+      r.walk_targets.clear();
+    }
     int fallen = w.isStanding(r.config.robot) ? booster_interface_msg_dds__IS_READY
                                               : booster_interface_msg_dds__HAS_FALLEN;
     // Walking and Soccer: the walk's fall detector and get-up tell the phases between (the
-    // SDK's IS_FALLING and IS_GETTING_UP), as the robot's own recovery does.
+    // SDK's IS_FALLING and IS_GETTING_UP), as the robot's own recovery does (read after this
+    // period's walk update).
     if (r.motion && r.loco.walking() && r.was_walking) {
       switch (r.motion->state()) {
         case agents::MotionState::Falling:
@@ -420,14 +429,6 @@ void Endpoint::observe(const sim::Observation& o) {
       r.fall.write(fd);
       r.fall_state = fallen;
       r.fall_sent_at = o.time;
-    }
-    // The walk runs at its own period, on the state of its period's start.
-    if (r.loco.walking()) {
-      if (o.tick % walk_periods_ == 0) walkTargets(r, f, o.tick + walk_periods_);
-    } else {
-      // Out of walking (any other mode, CUSTOM included), the walk starts over on its next use.
-      r.was_walking = r.shooting = false;
-      r.walk_targets.clear();
     }
   }
 }

@@ -66,7 +66,7 @@ void GameOfficials::operatorPart() {
   const bool between_kicks =
       g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished);
   if (!drawn && !between_kicks) shootout_since_.reset();
-  if (drawn && (!pause || waited(shootout_since_, config_.initial_seconds)))
+  if (drawn && waited(shootout_since_, config_.initial_seconds))
     g.startShootout(0, std::nullopt, world_.scenario().seed);
   // The next shoot-out kick: the kicking team's field players in turn against
   // the other team's goalkeeper.

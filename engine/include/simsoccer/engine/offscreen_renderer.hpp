@@ -97,9 +97,9 @@ class OffscreenRenderer {
   // Must be called on the thread that created the renderer.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views);
   // View i of the last render as 8-bit RGBA (CV_8UC4, R first, top row
-  // first; Y, U, V, 255 for a Yuv view): a region of the readback. Two readback buffers alternate,
-  // so the pixels stay valid until the second render after this one: one frame's images can be
-  // converted on another thread while the next is drawn.
+  // first; Y, Cb, Cr, 255 for a Yuv view): a region of the readback. Two readback buffers
+  // alternate, so the pixels stay valid until the second render after this one: one frame's images
+  // can be converted on another thread while the next is drawn.
   cv::Mat image(size_t view) const;
   // The same, with `images[i]` a three-channel copy (CV_8UC3: RGB, or YUV) of view i.
   void render(std::span<const DrawItem> scene, std::span<const RenderView> views,

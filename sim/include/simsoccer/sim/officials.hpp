@@ -26,7 +26,8 @@ struct OfficialsConfig {
   uint64_t seed = 1;  // the shoot-out's coin toss
   // The operator's pauses before each half: Initial, then Standby (in
   // leagues that have it), then Ready; long enough for robots to see each
-  // state in the 2 Hz GameController packets.
+  // state in the 2 Hz GameController packets. initial_seconds is also the pause in a drawn
+  // game's Finished before the shoot-out, in its Initial and in Finished between kicks.
   double initial_seconds = 1.0, standby_seconds = 1.0;
   // An external GameController runs the game: its packets are received on
   // this UDP port (0: any free one, for tests), the operator does nothing,
