@@ -40,9 +40,6 @@ int serve(int argc, char** argv, int first) {
   if (opt.positional().size() != 1) throw UsageError("expected one scenario or match config file");
   const std::filesystem::path file = opt.positional()[0];
   net::ServerConfig cfg;
-  // Agents started elsewhere are told the domain: it is what it says or refused.
-  const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::Fixed);
-  cfg.dds.domain = domain.domain();
   cfg.dds.config_file = findConfig(opt.get("dds-config", ""), "configs/dds/loopback.xml");
   std::optional<uint16_t> external_gc;
   if (opt.has("external-gc")) {
@@ -104,6 +101,15 @@ int serve(int argc, char** argv, int first) {
   const auto booster = openBoosterRobots(opt, w, simulation, booster_robots, cfg.dds.config_file,
                                          cfg.command_timeout, team_numbers);
   cfg.not_served.insert(cfg.not_served.end(), booster_robots.begin(), booster_robots.end());
+  const double sim_seconds = opt.positive("seconds", 60.0);
+  if (sim_seconds > 1e7) throw UsageError("--seconds: at most 10000000 (115 days)");
+  const int servable = static_cast<int>(w.robotCount() - cfg.not_served.size());
+  const auto wanted = static_cast<size_t>(opt.wholeNumber("agents", servable, 0, servable));
+  // Agents started elsewhere are told the domain: it is what it says or refused. Claimed once
+  // the config and the options are known good: a bad config is told as such, not as a domain
+  // another run holds (CI ran a test's serve beside a match on domain 0).
+  const net::DomainClaim domain = claimDomain(opt, 0, DomainDefault::Fixed);
+  cfg.dds.domain = domain.domain();
   net::SimServer server(simulation, cfg);
   // Images still on their way reach the transports (their sinks) before those
   // go, also when the run ends with an exception.
@@ -135,10 +141,6 @@ int serve(int argc, char** argv, int first) {
     }
   }
 
-  const double sim_seconds = opt.positive("seconds", 60.0);
-  if (sim_seconds > 1e7) throw UsageError("--seconds: at most 10000000 (115 days)");
-  const int servable = static_cast<int>(w.robotCount() - cfg.not_served.size());
-  const auto wanted = static_cast<size_t>(opt.wholeNumber("agents", servable, 0, servable));
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::printf(
