@@ -62,7 +62,7 @@ struct Endpoint::Robot {
   net::Writer<HeadPose> head_pose;
   LocoService loco;
   // The odometry's origin (the trunk's planar pose at the start or the last ResetOdometry).
-  std::optional<std::array<double, 3>> odometry_origin;  // x, y, yaw in the field
+  std::optional<world::Pose> odometry_origin;
   uint64_t odometry_resets = 0;
   int head_link = -1;  // the model's link "Head", if it has one
   RobotBoosterStats stats;
@@ -208,8 +208,7 @@ Endpoint::Endpoint(const world::World& world, EndpointConfig config)
       if (failed) std::rethrow_exception(failed);
     }
     r->stand = &stand;
-    for (size_t l = 0; l < model.body->links.size(); ++l)
-      if (model.body->links[l].name == "Head") r->head_link = static_cast<int>(l);
+    r->head_link = model.body->linkIndex("Head");
     // The walk's motions are read here, so a bad motions folder refuses to start (not the
     // first period in WALKING).
     if (walk)
@@ -434,29 +433,27 @@ void Endpoint::observe(const sim::Observation& o) {
 }
 
 void Endpoint::publishPoses(Robot& r, const world::World& w) {
-  // The trunk on the field, planar: the odometry (ground truth since its origin; a real K1's
-  // odometry comes from its gait and drifts) and the base frame of the head pose.
+  // The robot's base frame: on the ground under the trunk, x along the trunk's heading, z up.
+  // It is the odometry's frame (its pose since the origin; ground truth, where a real K1's
+  // odometry comes from its gait and drifts) and the head pose's (Booster's demo intersects
+  // camera rays with its z = 0 plane).
   const world::Pose trunk = w.torsoPose(r.config.robot);
-  const Eigen::Matrix3d& rot = trunk.linear();
-  const double yaw = std::atan2(rot(1, 0), rot(0, 0));
-  const double x = trunk.translation().x(), y = trunk.translation().y();
+  world::Pose base = world::Pose::Identity();
+  base.translation() = Eigen::Vector3d(trunk.translation().x(), trunk.translation().y(), 0.0);
+  base.linear() = Eigen::AngleAxisd(std::atan2(trunk.linear()(1, 0), trunk.linear()(0, 0)),
+                                    Eigen::Vector3d::UnitZ())
+                      .toRotationMatrix();
   if (!r.odometry_origin || r.loco.odometryResets() != r.odometry_resets) {
-    r.odometry_origin = std::array<double, 3>{x, y, yaw};
+    r.odometry_origin = base;
     r.odometry_resets = r.loco.odometryResets();
   }
-  const auto& [ox, oy, oyaw] = *r.odometry_origin;
-  const double c = std::cos(oyaw), s = std::sin(oyaw);
+  const world::Pose moved = r.odometry_origin->inverse() * base;
   Odometer odo{};
-  odo.x = static_cast<float>(c * (x - ox) + s * (y - oy));
-  odo.y = static_cast<float>(-s * (x - ox) + c * (y - oy));
-  odo.theta = static_cast<float>(std::remainder(yaw - oyaw, 2.0 * std::numbers::pi));
+  odo.x = static_cast<float>(moved.translation().x());
+  odo.y = static_cast<float>(moved.translation().y());
+  odo.theta = static_cast<float>(std::atan2(moved.linear()(1, 0), moved.linear()(0, 0)));
   r.odometer.write(odo);
   if (r.head_link < 0) return;
-  // The head link in the robot's base frame: on the ground under the trunk, x along the trunk's
-  // heading, z up (Booster's demo intersects camera rays with its z = 0 plane).
-  world::Pose base = world::Pose::Identity();
-  base.translation() = Eigen::Vector3d(x, y, 0.0);
-  base.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const world::Pose head = base.inverse() * w.linkPose(r.config.robot, r.head_link);
   const Eigen::Quaterniond q(head.linear());
   HeadPose p{};

@@ -351,9 +351,10 @@ void Endpoint::collect(uint64_t, sim::CommandGate& gate, std::span<sim::CommandS
     for (;;) {
       bool waiting = false;
       for (const Client& c : clients_) {
-        waiting = waiting || awaited(c) || returning(c);
-        if (returning(c))
-          deadline = std::min(std::max(deadline, *c.return_by), latest);  // (also one gone now)
+        const bool back_soon = returning(c);
+        waiting = waiting || awaited(c) || back_soon;
+        if (back_soon)  // (also one gone during this wait)
+          deadline = std::min(std::max(deadline, *c.return_by), latest);
       }
       if (!waiting || !pollOnce(deadline, true)) break;
     }

@@ -63,15 +63,15 @@ void GameOfficials::operatorPart() {
   const bool pause = !config_.penalty_kick_trial;
   const bool drawn = g.gameOver() && !g.winner() && g.phase() == referee::gc::GamePhase::Normal &&
                      g.rules().shootout && !config_.penalty_kick_trial;
-  const bool between_kicks =
-      g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished);
-  if (!drawn && !between_kicks) shootout_since_.reset();
+  const auto between_kicks = [&] {
+    return g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished);
+  };
+  if (!drawn && !between_kicks()) shootout_since_.reset();
   if (drawn && waited(shootout_since_, config_.initial_seconds))
     g.startShootout(0, std::nullopt, world_.scenario().seed);
   // The next shoot-out kick: the kicking team's field players in turn against
   // the other team's goalkeeper.
-  if (g.shootoutOpen() && (g.state() == State::Initial || g.state() == State::Finished) &&
-      (!pause || waited(shootout_since_, config_.initial_seconds))) {
+  if (between_kicks() && (!pause || waited(shootout_since_, config_.initial_seconds))) {
     const int team = g.shotsTaken(0) <= g.shotsTaken(1) ? 0 : 1;
     std::vector<int> strikers;
     for (world::RobotId r = 0; r < world_.robotCount(); ++r)
