@@ -14,6 +14,7 @@
 #include "simsoccer/agents/behaviour/soccer_behaviour.hpp"
 #include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
+#include "simsoccer/protocol/gamecontroller.hpp"
 #include "simsoccer/world/match_log.hpp"
 #include "simsoccer/world/scenario.hpp"
 #include "test_support.hpp"
@@ -213,6 +214,74 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("clear_max_angle: 1.6"), "clear_max_angle");       // cleared backwards
   EXPECT_EQ(refusedAt("clear_max_angle: -0.1"), "clear_max_angle");
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
+}
+
+TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
+  // The HSL Small division's Naos: the SPL's behaviour with the HSL's goal-kick rule.
+  const auto spl = soccerConfig();
+  const auto hsl =
+      agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_hsl_small.yaml");
+  EXPECT_FALSE(spl.goal_kick_clears_penalty_area);
+  EXPECT_TRUE(hsl.goal_kick_clears_penalty_area);
+  EXPECT_EQ(hsl.ready_positions.size(), spl.ready_positions.size());
+  EXPECT_EQ(hsl.keep_clear, spl.keep_clear);
+  EXPECT_EQ(hsl.kick_ball_x, spl.kick_ball_x);
+  EXPECT_EQ(hsl.sit_when_finished, spl.sit_when_finished);
+  // A bad key in the file or its base is refused naming that file; a loop ends.
+  const test::TempDir dir("behaviour_base");
+  std::ofstream(dir / "base.yaml") << "ready_positions: [[0, 0, 0]]\nkeep_clear: 0.5\n";
+  std::ofstream(dir / "top.yaml") << "base: base.yaml\nkeep_clear: 1.2\n";
+  const auto top = agents::loadBehaviourConfig(dir / "top.yaml");
+  EXPECT_EQ(top.keep_clear, 1.2);
+  EXPECT_EQ(top.ready_positions.size(), 1u);
+  std::ofstream(dir / "base.yaml") << "ready_positions: [[0, 0, 0]]\nkeep_cler: 0.5\n";
+  try {
+    agents::loadBehaviourConfig(dir / "top.yaml");
+    ADD_FAILURE() << "a typo in the base accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_NE(e.file().find("base.yaml"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "top.yaml") << "base: top.yaml\n";
+  EXPECT_THROW(agents::loadBehaviourConfig(dir / "top.yaml"), engine::ConfigError);
+  std::ofstream(dir / "base.yaml") << "ready_positions: [[0, 0, 0]]\n";
+  std::ofstream(dir / "top.yaml") << "base: base.yaml\ngoal_kick_avoidance: goal_area\n";
+  try {
+    agents::loadBehaviourConfig(dir / "top.yaml");
+    ADD_FAILURE() << "a bad goal_kick_avoidance accepted";
+  } catch (const engine::ConfigError& e) {
+    EXPECT_EQ(e.key(), "goal_kick_avoidance");
+  }
+}
+
+TEST(SoccerBehaviour, UnderTheHslRulesItLeavesThePenaltyAreaAtTheOpponentsGoalKick) {
+  const auto f = field();
+  const double front = f.halfLength() - f.penalty_area->length;
+  // Team 0's striker in the opponents' penalty area, 0.67 m from their goal kick's ball (the
+  // goal-area corner), nearer their goal line.
+  const double bx = f.halfLength() - f.goal_area->length, by = 0.5 * f.goal_area->width;
+  for (const bool hsl : {false, true}) {
+    agents::SoccerBehaviour b(hsl ? agents::loadBehaviourConfig(
+                                        test::sourceDir() / "configs/agents/soccer_hsl_small.yaml")
+                                  : soccerConfig(),
+                              f, 0, 1, 4, Role::Striker, 1);
+    auto g = gameState(3);
+    g.kicking_team = 2;  // the opponents
+    g.set_play = static_cast<uint8_t>(protocol::gc::SetPlay::GoalKick);
+    g.secondary_time = 30;
+    auto p = seeing(bx + 0.3, by - 0.6, 0.0, bx, by, 0.5);
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    const MotionRequest r = updateSeeing(b, in);
+    EXPECT_EQ(r.kind, MotionRequest::Kind::Walk) << hsl;
+    // The SPL's: straight away from the ball, deeper into the area; the HSL's: out of it.
+    if (hsl) {
+      EXPECT_LT(b.target().x, front) << b.target().x;
+    } else {
+      EXPECT_GT(b.target().x, front) << b.target().x;
+    }
+  }
 }
 
 TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {

@@ -236,6 +236,45 @@ TEST(Game, RuleBookErrorsNameTheKey) {
     EXPECT_EQ(e.key(), "half_duration");
   }
   EXPECT_NO_THROW(loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"));
+  // The restarts' and the fallen robots' rules: a bad value names its key.
+  const auto refusedAt = [&](const std::string& from, const std::string& to) -> std::string {
+    std::ifstream hsl(test::sourceDir() / "configs" / "rules" / "hsl_middle_advanced.yaml");
+    std::string t((std::istreambuf_iterator<char>(hsl)), std::istreambuf_iterator<char>());
+    EXPECT_NE(t.find(from), std::string::npos) << from;
+    t.replace(t.find(from), from.size(), to);
+    std::ofstream(dir / "bad.yaml") << t;
+    try {
+      loadRuleBook(dir / "bad.yaml");
+    } catch (const engine::ConfigError& e) {
+      return e.key();
+    }
+    return "";
+  };
+  EXPECT_EQ(refusedAt("free_kick_distance: centre_circle", "free_kick_distance: centre"),
+            "restarts.free_kick_distance");
+  EXPECT_EQ(refusedAt("free_kick_distance: centre_circle", "free_kick_distance: -1"),
+            "restarts.free_kick_distance");
+  EXPECT_EQ(refusedAt("goal_kick_avoidance: penalty_area", "goal_kick_avoidance: goal_area"),
+            "restarts.goal_kick_avoidance");
+  EXPECT_EQ(refusedAt("free_kick_own_goal: corner_kick", "free_kick_own_goal: corner"),
+            "restarts.free_kick_own_goal");
+  EXPECT_EQ(refusedAt("get_up_attempts: 3", "get_up_attempts: 0"), "fallen.get_up_attempts");
+  EXPECT_EQ(refusedAt("fallen: {time: 20", "fallen: {time: 0"), "fallen.time");
+  EXPECT_EQ(refusedAt("free_kick_distance: centre_circle", "free_kick_distance: 1.5"), "");
+  const RuleBook hsl =
+      loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_middle_advanced.yaml");
+  EXPECT_FALSE(hsl.kick_off_direct_goal);
+  EXPECT_TRUE(hsl.kick_in_indirect && hsl.free_kick_own_goal_corner &&
+              hsl.free_kick_distance_centre_circle && hsl.goal_kick_clears_penalty_area);
+  EXPECT_EQ(hsl.fallen_time, 20.0);
+  EXPECT_EQ(hsl.get_up_attempts, 3);
+  const RuleBook spl = test::splRules();
+  EXPECT_TRUE(spl.kick_off_direct_goal);
+  EXPECT_FALSE(spl.kick_in_indirect || spl.free_kick_own_goal_corner ||
+               spl.free_kick_distance_centre_circle || spl.goal_kick_clears_penalty_area);
+  EXPECT_EQ(spl.free_kick_distance, 0.75);
+  EXPECT_EQ(spl.fallen_time, 10.0);
+  EXPECT_EQ(spl.get_up_attempts, 2);
 }
 
 namespace {

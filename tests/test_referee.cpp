@@ -846,3 +846,200 @@ TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
   run(w2, ref2, 0.02);
   EXPECT_EQ(ref2.game().score(0), 1);
 }
+
+namespace {
+
+RuleBook hslRules() {
+  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_small_foundation.yaml");
+}
+
+// 3 v 3: twoVsTwo's robots 0-3 and a third of each team (robots 4 and 5).
+world::Scenario threeVsThree() {
+  world::Scenario s = twoVsTwo();
+  for (int team = 0; team < 2; ++team) {
+    world::RobotPlacement p;
+    p.team = team;
+    p.number = 3;
+    p.x = team == 0 ? -2.0 : 2.0;
+    p.y = -1.0;
+    p.yaw = team == 0 ? 0.0 : M_PI;
+    s.robots.push_back(p);
+  }
+  return s;
+}
+
+std::string lastDetail(const Game& g, EventType type) {
+  std::string d;
+  for (const auto& e : g.events())
+    if (e.type == type) d = e.detail;
+  return d;
+}
+
+}  // namespace
+
+TEST(Referee, HslKickOffScoresOnlyAfterASecondTouchOrTheKickerOutsideTheCircle) {
+  // Two robots a team: the kicker must play the ball outside the centre circle before a goal.
+  for (const bool outside : {false, true}) {
+    world::World w(twoVsTwo());
+    Referee ref(w, hslRules(), test::twoTeams(), 0);
+    Game& g = ref.game();
+    g.ready();
+    kickOff(w, ref);
+    w.placeRobot(1, -0.35, 0.0, 0.0);  // team 0 player 2 at the centre mark takes the kick-off
+    touchBall(w, ref, 1);
+    if (outside) {
+      w.placeRobot(1, -1.5, 1.0, 0.0);  // ... and plays the ball again outside the circle
+      touchBall(w, ref, 1);
+    }
+    putBall(w, w.field().halfLength() + 0.3, -0.3);
+    run(w, ref, 0.02);
+    EXPECT_EQ(g.score(0), outside ? 1 : 0) << outside;
+    if (outside) continue;
+    EXPECT_EQ(count(g, "goal_disallowed"), 1);
+    EXPECT_NE(lastDetail(g, EventType::GoalDisallowed).find("outside the centre circle"),
+              std::string::npos);
+    EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::GoalKick);
+    EXPECT_EQ(g.kickingTeam(), 1);
+  }
+  // Three robots a team: two different robots must touch the ball.
+  for (const bool second : {false, true}) {
+    world::World w(threeVsThree());
+    Referee ref(w, hslRules(), test::twoTeams(), 0);
+    Game& g = ref.game();
+    g.ready();
+    kickOff(w, ref);
+    touchBall(w, ref, 1);              // outside the circle, but alone
+    if (second) touchBall(w, ref, 4);  // team 0 player 3
+    putBall(w, w.field().halfLength() + 0.3, 0.3);
+    run(w, ref, 0.02);
+    EXPECT_EQ(g.score(0), second ? 1 : 0) << second;
+    if (!second) {
+      EXPECT_NE(lastDetail(g, EventType::GoalDisallowed).find("two different robots"),
+                std::string::npos);
+    }
+  }
+  // The SPL's rule books leave the kick-off to their own rule (two of the scoring team's).
+  world::World w(twoVsTwo());
+  Referee ref(w, loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"),
+              test::twoTeams(), 0);
+  ref.game().ready();
+  kickOff(w, ref);
+  w.placeRobot(1, -0.35, 0.0, 0.0);
+  touchBall(w, ref, 1);
+  putBall(w, w.field().halfLength() + 0.3, 0.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(ref.game().score(0), 1);  // the 3D league scores straight from the kick-off
+}
+
+TEST(Referee, HslKickInIsIndirectAndAFreeKickIntoTheOwnGoalIsACorner) {
+  world::World w(twoVsTwo());
+  Referee ref(w, hslRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  const auto& f = w.field();
+  openPlay(w, ref);
+  touchBall(w, ref, 2);  // team 1 plays the ball last over the touchline: team 0's kick-in
+  putBall(w, 1.2, f.halfWidth() + 0.2);
+  run(w, ref, 0.02);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  ASSERT_EQ(g.kickingTeam(), 0);
+  touchBall(w, ref, 1);  // team 0 takes it and scores straight from it
+  putBall(w, f.halfLength() + 0.3, 0.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 0);
+  EXPECT_NE(lastDetail(g, EventType::GoalDisallowed).find("kick-in"), std::string::npos);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::GoalKick);  // for the defenders
+  ASSERT_EQ(g.kickingTeam(), 1);
+  // Team 1 takes its goal kick straight into its own goal (+x): a corner kick for team 0.
+  touchBall(w, ref, 3);
+  putBall(w, f.halfLength() + 0.3, 0.5);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 0);
+  EXPECT_NE(lastDetail(g, EventType::GoalDisallowed).find("own goal straight from a free kick"),
+            std::string::npos);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::CornerKick);
+  EXPECT_EQ(g.kickingTeam(), 0);
+  EXPECT_NEAR(w.ballState().pose.translation().x(), f.halfLength(), 1e-3);
+  EXPECT_NEAR(w.ballState().pose.translation().y(), f.halfWidth(), 1e-3);
+  // A corner kick is direct.
+  touchBall(w, ref, 0);
+  putBall(w, f.halfLength() + 0.3, -0.2);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 1);
+  // After team 1's kick-off, a kick-in for team 1 touched by another robot (an opponent) scores.
+  kickOff(w, ref);
+  g.ballFree();
+  touchBall(w, ref, 0);
+  putBall(w, -1.0, -f.halfWidth() - 0.2);
+  run(w, ref, 0.02);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+  ASSERT_EQ(g.kickingTeam(), 1);
+  touchBall(w, ref, 3);
+  touchBall(w, ref, 1);  // team 0's robot deflects it ...
+  touchBall(w, ref, 3);  // ... and team 1 scores
+  putBall(w, -f.halfLength() - 0.3, 0.0);
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(1), 1);
+}
+
+TEST(Referee, HslFreeKickDistanceIsTheCentreCircleAndAGoalKickClearsThePenaltyArea) {
+  world::Scenario s = twoVsTwo();
+  s.field_file = test::sourceDir() / "fields" / "hsl_m.yaml";  // centre circle 1.475 m
+  for (const bool hsl : {true, false}) {
+    world::World w(s);
+    Referee ref(w, hsl ? hslRules() : test::splRules(), test::twoTeams(), 0);
+    Game& g = ref.game();
+    const auto& f = w.field();
+    openPlay(w, ref);
+    putBall(w, 2.0, -2.0);
+    run(w, ref, 0.02);
+    g.setPlay(gc::SetPlay::PushingFreeKick, 0);
+    w.placeRobot(2, 3.2, -2.0, M_PI);  // team 1 player 1, 1.2 m from the ball
+    run(w, ref, 5.1);
+    EXPECT_EQ(g.penalty(1, 1), hsl ? gc::Penalty::IllegalPosition : gc::Penalty::None) << hsl;
+    g.ballFree();
+    // Team 1's goal kick at its goal-area corner; team 0 player 2 in team 1's penalty area,
+    // 2.9 m from the ball.
+    const double corner_x = f.halfLength() - f.goal_area->length;
+    putBall(w, corner_x, 0.5 * f.goal_area->width);
+    run(w, ref, 0.02);
+    g.setPlay(gc::SetPlay::GoalKick, 1);
+    w.placeRobot(1, corner_x - 0.6, -0.9, 0.0);
+    run(w, ref, 5.1);
+    EXPECT_EQ(g.penalty(0, 2), hsl ? gc::Penalty::IllegalPosition : gc::Penalty::None) << hsl;
+    if (hsl) {
+      EXPECT_NE(lastDetail(g, EventType::IllegalPosition).find("penalty area"), std::string::npos);
+    }
+  }
+}
+
+TEST(Referee, HslFallenRobotHasTwentySeconds) {
+  world::World w(twoVsTwo());
+  Referee ref(w, hslRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  g.ready();
+  kickOff(w, ref);
+  const auto& joints = w.robot(3).model->body->joints;
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
+  run(w, ref, 18.0);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);  // the SPL's rule book: penalised at 10 s
+  run(w, ref, 4.0);
+  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
+  EXPECT_NE(lastDetail(g, EventType::Inactive).find("down for 20 s"), std::string::npos);
+}
+
+TEST(Referee, AnInGamePenaltyKickScoresDirectlyUnderTheTwoTouchRule) {
+  world::World w(twoVsTwo());
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  g.setPlay(gc::SetPlay::PenaltyKick, 0);
+  kickOff(w, ref);  // Ready, Set, the whistle
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::PenaltyKick);
+  touchBall(w, ref, 1);  // the kick: the ball moves, the set play is over ...
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::None);
+  putBall(w, w.field().halfLength() + 0.3, 0.0);  // ... and it goes in
+  run(w, ref, 0.02);
+  EXPECT_EQ(g.score(0), 1);
+  EXPECT_EQ(count(g, "goal_disallowed"), 0);
+}

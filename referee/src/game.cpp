@@ -12,15 +12,64 @@ using engine::ConfigNode;
 
 RuleBook loadRuleBook(const std::filesystem::path& file) {
   const ConfigNode root = ConfigNode::loadFile(file);
-  root.allowOnly({"rules", "players_per_team", "halves", "half_duration", "half_time_break",
-                  "half_time_to_initial", "clock_in_ready_and_set", "ready_duration",
-                  "ready_penalty_kick_duration", "kick_off_ball_free", "set_play_duration",
-                  "penalty_kick_duration", "mercy_goal_difference", "game_stuck_duration",
-                  "goal_area_max_robots", "indirect_kick", "timeouts", "penalties", "shootout",
-                  "message_budget", "gamecontroller"});
+  root.allowOnly({"rules",
+                  "players_per_team",
+                  "halves",
+                  "half_duration",
+                  "half_time_break",
+                  "half_time_to_initial",
+                  "clock_in_ready_and_set",
+                  "ready_duration",
+                  "ready_penalty_kick_duration",
+                  "kick_off_ball_free",
+                  "set_play_duration",
+                  "penalty_kick_duration",
+                  "mercy_goal_difference",
+                  "game_stuck_duration",
+                  "goal_area_max_robots",
+                  "indirect_kick",
+                  "restarts",
+                  "fallen",
+                  "timeouts",
+                  "penalties",
+                  "shootout",
+                  "message_budget",
+                  "gamecontroller"});
   RuleBook r;
   r.name = root["rules"].string();
   r.indirect_kick = root["indirect_kick"].boolean();
+  if (auto rs = root.optional("restarts")) {
+    rs->allowOnly({"kick_off_direct_goal", "kick_in_indirect", "free_kick_own_goal",
+                   "free_kick_distance", "goal_kick_avoidance"});
+    r.kick_off_direct_goal = rs->boolean("kick_off_direct_goal", r.kick_off_direct_goal);
+    r.kick_in_indirect = rs->boolean("kick_in_indirect", r.kick_in_indirect);
+    if (rs->has("free_kick_own_goal")) {
+      const std::string v = (*rs)["free_kick_own_goal"].string();
+      if (v != "goal" && v != "corner_kick")
+        rs->failKey("free_kick_own_goal", "must be goal or corner_kick");
+      r.free_kick_own_goal_corner = v == "corner_kick";
+    }
+    if (rs->has("free_kick_distance")) {
+      const ConfigNode d = (*rs)["free_kick_distance"];
+      if (d.raw().IsScalar() && d.raw().Scalar() == "centre_circle")
+        r.free_kick_distance_centre_circle = true;
+      else
+        r.free_kick_distance = d.positive();  // metres, or the error names the key
+    }
+    if (rs->has("goal_kick_avoidance")) {
+      const std::string v = (*rs)["goal_kick_avoidance"].string();
+      if (v != "free_kick_distance" && v != "penalty_area")
+        rs->failKey("goal_kick_avoidance", "must be free_kick_distance or penalty_area");
+      r.goal_kick_clears_penalty_area = v == "penalty_area";
+    }
+  }
+  if (auto fl = root.optional("fallen")) {
+    fl->allowOnly({"time", "get_up_attempts"});
+    r.fallen_time = fl->number("time", r.fallen_time);
+    if (r.fallen_time <= 0) fl->failKey("time", "must be > 0");
+    r.get_up_attempts = fl->integer("get_up_attempts", r.get_up_attempts);
+    if (r.get_up_attempts < 1) fl->failKey("get_up_attempts", "must be >= 1");
+  }
   const ConfigNode to = root["timeouts"];
   to.allowOnly({"team", "referee", "per_team"});
   r.team_timeout = to["team"].positive();

@@ -93,6 +93,11 @@ fields::AreaSize Referee::goalArea() const {
   return world_.field().goal_area.value_or(fields::AreaSize{0.6, 2.2});
 }
 
+double Referee::freeKickDistance() const {
+  return game_.rules().free_kick_distance_centre_circle ? world_.field().centre_circle_radius
+                                                        : game_.rules().free_kick_distance;
+}
+
 double Referee::penaltyMarkX(int side) const {
   const auto& f = world_.field();
   return side * (f.halfLength() - f.penalty_mark_distance.value_or(1.3));
@@ -391,7 +396,7 @@ bool Referee::getUpsFailed(RobotId r, bool standing) {
     }
   }
   g.was_standing = standing;
-  return g.failed >= config_.failed_get_ups + (g.disturbed ? 1 : 0);
+  return g.failed >= game_.rules().get_up_attempts + (g.disturbed ? 1 : 0);
 }
 
 // The teams' handlers put their robots in their own halves before a half's
@@ -435,16 +440,18 @@ void Referee::checkBall() {
     const int defender = defenderOfSide(side);
     const int attacker = 1 - defender;
     if (ballInGoal(f, p) == side) {
-      // Indirect kick: after a restart a goal needs two robots of the scoring
-      // team to have played the ball (own goals always count; a penalty kick
-      // may score directly). A direct goal becomes a goal kick.
+      // A goal straight from a restart the rule book calls indirect becomes a goal kick; a
+      // free kick straight into the kicker's own goal a corner kick (HSL).
       const bool own_goal = last_team == defender;
-      const bool direct = std::popcount(touched_since_restart_[static_cast<size_t>(attacker)]) < 2;
-      if (game_.rules().indirect_kick && !own_goal && direct &&
-          game_.currentSetPlay() != gc::SetPlay::PenaltyKick) {
-        game_.recordEvent(EventType::GoalDisallowed, attacker, 0,
-                          "indirect kick: fewer than two of its robots played the ball");
+      const std::string refused = directGoalRefused(attacker, own_goal);
+      if (!refused.empty()) {
+        game_.recordEvent(EventType::GoalDisallowed, attacker, 0, refused);
         awardGoalKick(defender, side, p.y());
+      } else if (own_goal && ownGoalFromFreeKick(defender)) {
+        game_.recordEvent(EventType::GoalDisallowed, attacker, 0,
+                          "own goal straight from a free kick: corner kick");
+        game_.setPlay(gc::SetPlay::CornerKick, attacker);
+        placeBall(side * f.halfLength(), (p.y() >= 0 ? 1.0 : -1.0) * f.halfWidth());
       } else {
         game_.goal(attacker);  // a goal for the team attacking this goal (own goals too)
         placeBall(0.0, 0.0);
@@ -468,6 +475,65 @@ void Referee::checkBall() {
   }
   set_play_ball_ = world_.ballState().pose.translation();
   set_play_step_ = world_.stepCount();
+}
+
+std::string Referee::directGoalRefused(int attacker, bool own_goal) const {
+  if (own_goal) return {};  // own goals always count (but see ownGoalFromFreeKick)
+  const RuleBook& rules = game_.rules();
+  const size_t a = static_cast<size_t>(attacker);
+  const int robots_touched = std::popcount(touched_since_restart_[0] | touched_since_restart_[1]);
+  // The SPL (2025): after any restart but a penalty kick (a saved one, touched by another
+  // robot, is a failed penalty kick: the rule holds again), two robots of the scoring team.
+  const bool penalty_kick = restart_.play == gc::SetPlay::PenaltyKick && robots_touched <= 1;
+  if (rules.indirect_kick && std::popcount(touched_since_restart_[a]) < 2 && !penalty_kick)
+    return "indirect kick: fewer than two of its robots played the ball";
+  if (restart_.team != attacker) return {};
+  // The HSL: not straight from the kick-off ...
+  if (restart_.kick_off && !rules.kick_off_direct_goal) {
+    if (restart_.robots >= 3 && robots_touched < 2)
+      return "kick-off: two different robots must touch the ball before a goal";
+    if (restart_.robots < 3 && !restart_.kicker_outside_circle && robots_touched < 2)
+      return "kick-off: its kicker must touch the ball outside the centre circle before a goal";
+  }
+  // ... nor straight from a kick-in: another robot, of either team, must touch it.
+  if (!restart_.kick_off && restart_.play == gc::SetPlay::KickIn && rules.kick_in_indirect &&
+      robots_touched < 2)
+    return "kick-in: another robot must touch the ball before a goal";
+  return {};
+}
+
+bool Referee::ownGoalFromFreeKick(int defender) const {
+  // Straight in: the team that took the free kick scores into its own goal, its kicker the
+  // only robot that touched the ball since.
+  if (!game_.rules().free_kick_own_goal_corner || restart_.kick_off || restart_.team != defender ||
+      restart_.play == gc::SetPlay::None || restart_.play == gc::SetPlay::PenaltyKick)
+    return false;
+  return std::popcount(touched_since_restart_[0] | touched_since_restart_[1]) == 1 &&
+         touched_since_restart_[static_cast<size_t>(defender)] != 0;
+}
+
+void Referee::beginRestart(bool kick_off) {
+  touched_since_restart_ = {0, 0};
+  restart_ = Restart{};
+  restart_.kick_off = kick_off;
+  restart_.play = game_.currentSetPlay();
+  restart_.team = game_.kickingTeam();
+  if (restart_.team < 0) return;
+  for (RobotId r = 0; r < world_.robotCount(); ++r) {
+    const auto& info = world_.robot(r);
+    restart_.robots +=
+        info.team == restart_.team && game_.penalty(info.team, info.number) == gc::Penalty::None;
+  }
+}
+
+void Referee::noteRestartTouch(RobotId r) {
+  const int team = world_.robot(r).team;
+  if (r < 64) touched_since_restart_[static_cast<size_t>(team)] |= uint64_t{1} << r;
+  if (team != restart_.team) return;
+  if (restart_.kicker < 0) restart_.kicker = static_cast<int>(r);
+  if (restart_.kicker == static_cast<int>(r) &&
+      world_.ballState().pose.translation().head<2>().norm() > world_.field().centre_circle_radius)
+    restart_.kicker_outside_circle = true;
 }
 
 void Referee::checkSetPlayOver() {
@@ -502,9 +568,9 @@ void Referee::checkPenalties() {
     // Fallen / inactive: down for longer than the rule's time, or its get-ups failed.
     const bool standing = world_.isStanding(r);
     fallen_for_[r] = standing ? 0.0 : fallen_for_[r] + dt;
-    if (fallen_for_[r] >= config_.inactive_time) {
+    if (fallen_for_[r] >= game_.rules().fallen_time) {
       game_.recordEvent(EventType::Inactive, info.team, info.number,
-                        "down for " + engine::formatNumber(config_.inactive_time) + " s");
+                        "down for " + engine::formatNumber(game_.rules().fallen_time) + " s");
       game_.penalise(info.team, info.number, gc::Penalty::InactivePlayer);
       fallen_for_[r] = 0.0;
       continue;
@@ -528,14 +594,19 @@ void Referee::checkPenalties() {
       if (play == gc::SetPlay::None)  // kick-off
         illegal =
             teamSign(info.team) * p.x() < 0.0 || std::hypot(p.x(), p.y()) < f.centre_circle_radius;
-      else if (play != gc::SetPlay::PenaltyKick)
-        illegal = clock_ - set_play_since_ >= config_.free_kick_clear_time &&
-                  (ball - p).head<2>().norm() < config_.free_kick_distance;
+      else if (play != gc::SetPlay::PenaltyKick &&
+               clock_ - set_play_since_ >= config_.free_kick_clear_time)
+        illegal = play == gc::SetPlay::GoalKick && game_.rules().goal_kick_clears_penalty_area
+                      ? inOwnArea(kicking, p, penaltyArea())
+                      : (ball - p).head<2>().norm() < freeKickDistance();
       if (illegal) {
         game_.penalise(info.team, info.number, gc::Penalty::IllegalPosition);
-        game_.recordEvent(EventType::IllegalPosition, info.team, info.number,
-                          play == gc::SetPlay::None ? "entered at the opponents' kick-off"
-                                                    : "too close to the ball at a free kick");
+        game_.recordEvent(
+            EventType::IllegalPosition, info.team, info.number,
+            play == gc::SetPlay::None ? "entered at the opponents' kick-off"
+            : play == gc::SetPlay::GoalKick && game_.rules().goal_kick_clears_penalty_area
+                ? "in the penalty area at the opponents' goal kick"
+                : "too close to the ball at a free kick");
         continue;
       }
     }
@@ -777,7 +848,8 @@ void Referee::enterState(gc::State s) {
   if (normal && !placed_for_second_half_ && (break_begins || second_half_begins))
     placeForTheSecondHalf();
   if (s == gc::State::Playing) {
-    touched_since_restart_ = {0, 0};  // kick-off, drop ball or penalty kick
+    // A kick-off (a kicking team and no set play), a dropped ball or a penalty kick.
+    beginRestart(game_.kickingTeam() >= 0 && game_.currentSetPlay() == gc::SetPlay::None);
     restart_seen_touch_step_ = world_.stepCount();
     set_play_ball_ = world_.ballState().pose.translation();
     set_play_step_ = world_.stepCount();
@@ -830,7 +902,7 @@ void Referee::judge(double dt) {
   clock_ += dt;
   if (game_.currentSetPlay() != last_set_play_) {
     set_play_since_ = clock_;
-    if (game_.currentSetPlay() != gc::SetPlay::None) touched_since_restart_ = {0, 0};  // a restart
+    if (game_.currentSetPlay() != gc::SetPlay::None) beginRestart(false);  // a free kick
   }
   last_set_play_ = game_.currentSetPlay();
   const gc::State s = game_.state();
@@ -870,9 +942,7 @@ void Referee::judge(double dt) {
     } else if (s == gc::State::Playing) {
       if (const auto t = world_.lastBallTouch(); t && t->step > restart_seen_touch_step_) {
         restart_seen_touch_step_ = t->step;
-        if (t->robot < 64)
-          touched_since_restart_[static_cast<size_t>(world_.robot(t->robot).team)] |= uint64_t{1}
-                                                                                      << t->robot;
+        noteRestartTouch(t->robot);
       }
       checkArmContact();
       checkBall();

@@ -108,9 +108,12 @@ std::optional<Role> roleFromName(const std::string& name) {
   return std::nullopt;
 }
 
-BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
+namespace {
+
+BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth) {
   const engine::ConfigNode root = engine::ConfigNode::loadFile(file);
   root.allowOnly({"behaviour",
+                  "base",
                   "ready_positions",
                   "kick_off_position",
                   "max_forward",
@@ -141,15 +144,25 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
                   "defender_goal_distance",
                   "supporter_deepest",
                   "clear_max_angle",
-                  "sit_when_finished"});
+                  "sit_when_finished",
+                  "goal_kick_avoidance"});
   if (root.has("behaviour") && root["behaviour"].string() != "soccer")
     root["behaviour"].fail("must be soccer (the one behaviour the built-in agents play)");
+  // A file may start from another (its path relative to this one) and change some keys.
   BehaviourConfig c;
+  if (root.has("base")) {
+    if (depth >= 4) root["base"].fail("bases nest more than 4 deep (a loop?)");
+    c = loadBehaviourConfig(file.parent_path() / root["base"].string(), depth + 1);
+  }
   auto pose = [](const engine::ConfigNode& n) {
     const auto v = n.numbers(3);
     return Pose2{v[0], v[1], v[2]};
   };
-  for (const auto& item : root["ready_positions"].items()) c.ready_positions.push_back(pose(item));
+  if (!root.has("base") || root.has("ready_positions")) {
+    c.ready_positions.clear();
+    for (const auto& item : root["ready_positions"].items())
+      c.ready_positions.push_back(pose(item));
+  }
   if (auto n = root.optional("kick_off_position")) c.kick_off_position = pose(*n);
   readKickApproach(root, c);
   c.ball_lost_time = root.number("ball_lost_time", c.ball_lost_time);
@@ -181,6 +194,12 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   if (root.has("clear_max_angle") && !(c.clear_max_angle >= 0 && c.clear_max_angle < 0.5 * kPi))
     root["clear_max_angle"].fail("must be from 0 (off) to under pi/2 rad");
   c.sit_when_finished = root.boolean("sit_when_finished", c.sit_when_finished);
+  if (root.has("goal_kick_avoidance")) {
+    const std::string v = root["goal_kick_avoidance"].string();
+    if (v != "keep_clear" && v != "penalty_area")
+      root["goal_kick_avoidance"].fail("must be keep_clear or penalty_area");
+    c.goal_kick_clears_penalty_area = v == "penalty_area";
+  }
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
         "ball_velocity_window", "ball_outlier_distance", "avoid_near", "avoid_far"})
@@ -188,13 +207,20 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
   // Three sightings at the least at 100 Hz over half the window.
   if (root.has("ball_velocity_window") && !(c.ball_velocity_window >= 0.05))
     root["ball_velocity_window"].fail("must be >= 0.05 s");
-  if (!(c.avoid_far > c.avoid_near))
-    (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
-        .fail("avoid_far must be greater than avoid_near");
+  if (!(c.avoid_far > c.avoid_near)) {
+    if (root.has("avoid_far")) root["avoid_far"].fail("avoid_far must be greater than avoid_near");
+    root["avoid_near"].fail("avoid_far must be greater than avoid_near");
+  }
   for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory",
                         "defender_spacing", "defender_goal_distance"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
   return c;
+}
+
+}  // namespace
+
+BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file) {
+  return loadBehaviourConfig(file, 0);
 }
 
 BehaviourConfig loadKickApproach(const std::filesystem::path& file) {
@@ -845,6 +871,24 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       const Vec2 away{self_.x + (self_.x - ball_.x), self_.y + (self_.y - ball_.y)};
       r = walkTo({away.x, away.y, 0.0}, true);
     } else if (std::hypot(target_.x - ball_.x, target_.y - ball_.y) < config_.keep_clear) {
+      r = MotionRequest{};
+    }
+  }
+  if (theirs && config_.goal_kick_clears_penalty_area && field_.penalty_area &&
+      set_play_ == static_cast<uint8_t>(gc::SetPlay::GoalKick) &&
+      r.kind != MotionRequest::Kind::Stand) {
+    // Their goal kick (HSL): out of their whole penalty area, by its nearer edge, with a margin
+    // for the torso the referee judges by.
+    constexpr double kMargin = 0.3;  // m
+    const double front = field_.halfLength() - field_.penalty_area->length - kMargin;
+    const double side = 0.5 * field_.penalty_area->width + kMargin;
+    const auto inside = [&](double x, double y) { return x > front && std::abs(y) < side; };
+    if (inside(self_.x, self_.y)) {
+      const bool by_front = self_.x - front < side - std::abs(self_.y);
+      r = walkTo(by_front ? Pose2{front - 0.1, self_.y, 0.0}
+                          : Pose2{self_.x, (self_.y >= 0 ? 1.0 : -1.0) * (side + 0.1), 0.0},
+                 true);
+    } else if (inside(target_.x, target_.y)) {
       r = MotionRequest{};
     }
   }

@@ -31,8 +31,26 @@ struct RuleBook {
   int mercy_goal_difference = 10;
   double game_stuck_duration = 30;
   int goal_area_max_robots = 3;
-  // After a restart two robots of a team must play the ball before it scores.
+  // After a restart two robots of a team must play the ball before it scores (the SPL's 2025 rule).
   bool indirect_kick = true;
+  // The HSL's restarts (rules/game.tex): a goal straight from a kick-off does not count (with
+  // three or more of the kicking team's robots on the field two different robots must have
+  // touched the ball, else its kicker outside the centre circle); a kick-in is indirect (another
+  // robot, of either team, must touch the ball); a free kick straight into the kicker's own goal
+  // is a corner kick. Each direct goal the rules refuse becomes a goal kick.
+  bool kick_off_direct_goal = true;
+  bool kick_in_indirect = false;
+  bool free_kick_own_goal_corner = false;
+  // Opponents keep this far from the ball at a free kick (m); the field's centre-circle radius
+  // where free_kick_distance_centre_circle (HSL). At a goal kick, where
+  // goal_kick_clears_penalty_area (HSL), they keep out of the kicking team's penalty area instead.
+  double free_kick_distance = 0.75;
+  bool free_kick_distance_centre_circle = false;
+  bool goal_kick_clears_penalty_area = false;
+  // A fallen robot is Inactive when down this long (s; the referee's stand-in for "no get-up
+  // attempt started in time") or after this many failed get-ups (one more when disturbed).
+  double fallen_time = 10;
+  int get_up_attempts = 2;
   double team_timeout = 300, referee_timeout = 600;  // s
   int timeouts_per_team = 1;
   double penalty_base = 45, penalty_increment = 10;

@@ -21,18 +21,19 @@ struct RefereeConfig {
   double set_duration = 5.0;      // s in Set before the referee whistles (Playing); <= 0: never
   double ready_still_time = 1.0;  // Ready ends early when all stand still in legal places this long
   double still_speed = 0.05;      // m/s: a robot slower than this stands still
-  double inactive_time = 10.0;  // s fallen, or standing idle near the ball, before Inactive Player
-  // The rules' other Fallen call: failed get-ups. A get-up failed when the robot stood for
-  // less than get_up_hold_time before it was down again; failed_get_ups in a row are
-  // Inactive Player, one more when another robot's torso was within get_up_disturbed_distance
-  // (torso to torso, on the ground) as one of them failed (the rules: "3 if disturbed").
-  int failed_get_ups = 2;
+  double inactive_time = 10.0;    // s standing idle near the ball before Inactive Player
+  // A fallen robot's time and failed get-ups are the rule book's (fallen_time, get_up_attempts).
+  // A get-up failed when the robot stood for less than get_up_hold_time before it was down
+  // again; the rule book's attempts in a row are Inactive Player, one more when another robot's
+  // torso was within get_up_disturbed_distance (torso to torso, on the ground) as one of them
+  // failed (the rules: "3 if disturbed" in the SPL, 4 in the HSL).
   double get_up_hold_time = 3.0;           // s
   double get_up_disturbed_distance = 0.6;  // m
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
-  double free_kick_distance = 0.75;   // m: defenders keep this far from the ball at a free kick ...
-  double free_kick_clear_time = 5.0;  // s ... once this long after it was awarded (time to leave)
+  // Defenders keep the rule book's distance from the ball at a free kick (or out of the penalty
+  // area at a goal kick) once this long after it was awarded (time to leave).
+  double free_kick_clear_time = 5.0;  // s
   double ball_moved = 0.05;           // m: the kicking team moved the ball clearly
   double stuck_progress = 0.3;        // m the ball must move within the game-stuck time
   double stuck_radius = 0.5;          // m: a robot this close to a stuck ball is penalised (local)
@@ -119,6 +120,7 @@ class Referee {
   engine::Vec3 nearestLegalPosition(world::RobotId r, const std::vector<engine::Vec3>& taken) const;
   fields::AreaSize penaltyArea() const;  // the field's, or the SPL's
   fields::AreaSize goalArea() const;
+  double freeKickDistance() const;      // the rule book's, or the field's centre-circle radius
   double penaltyMarkX(int side) const;  // the mark in front of the goal at x = side * length / 2
   bool inOwnArea(int team, const engine::Vec3& p, const fields::AreaSize& area) const;
   bool inOwnArea(world::RobotId r, const fields::AreaSize& area) const;  // by its torso
@@ -156,6 +158,25 @@ class Referee {
   std::vector<double> in_goal_area_since_;  // game time of entering the own goal area; <0 outside
   // Robots of each team (bit = RobotId) that played the ball since the last restart.
   std::array<uint64_t, 2> touched_since_restart_{};
+  // The last restart, for the rules on goals straight from it: a kick-off (set play None with a
+  // kicking team), a free kick (its set play), a dropped ball (no team); the team that took it,
+  // its robots on the field then, and whether its kicker touched the ball outside the centre
+  // circle (the HSL's kick-off with two robots or fewer).
+  struct Restart {
+    bool kick_off = false;
+    gc::SetPlay play = gc::SetPlay::None;
+    int team = -1;
+    int robots = 0;
+    int kicker = -1;  // RobotId of the kicking team's first touch
+    bool kicker_outside_circle = false;
+  };
+  Restart restart_;
+  void beginRestart(bool kick_off);
+  void noteRestartTouch(world::RobotId r);
+  // Why a goal straight from the last restart does not count under the rule book (empty: it
+  // counts), and whether an own goal straight from a free kick is a corner kick instead.
+  std::string directGoalRefused(int attacker, bool own_goal) const;
+  bool ownGoalFromFreeKick(int defender) const;
   uint64_t restart_seen_touch_step_ = 0;
   gc::SetPlay last_set_play_ = gc::SetPlay::None;
   double set_play_since_ = 0.0;  // clock_ when the current set play was awarded

@@ -74,6 +74,8 @@ struct BehaviourConfig {
   int ball_new_sightings = 3;
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
+  // At the opponents' goal kick, out of their whole penalty area as well (the HSL's rule).
+  bool goal_kick_clears_penalty_area = false;
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
   // Where the goalkeeper stands: this far in front of its goal line (m), in
   // play and as the shoot-out's keeper (the rules keep it on the line).
