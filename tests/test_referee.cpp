@@ -771,11 +771,12 @@ TEST(Referee, DefendersKeepOutAtKickOffAndAwayAtFreeKicks) {
   run(w, ref, 0.02);
   g.setPlay(gc::SetPlay::PushingFreeKick, 0);
   w.placeRobot(2, 2.4, -2.0, M_PI);  // team 1 player 1, 0.4 m from the ball
-  run(w, ref, 4.9);                  // it has 5 s to leave
+  // It has 5 s to leave, and 0.35 m at 0.2 m/s more: 6.75 s.
+  run(w, ref, 6.6);
   EXPECT_EQ(g.penalty(1, 1), gc::Penalty::None);
-  run(w, ref, 0.2);
+  run(w, ref, 0.3);
   EXPECT_EQ(g.penalty(1, 1), gc::Penalty::IllegalPosition);
-  EXPECT_NEAR(g.penaltyTime(1, 1), 55.0, 0.1);  // the team's second: +10 s
+  EXPECT_NEAR(g.penaltyTime(1, 1), 55.0, 0.3);  // the team's second: +10 s
 }
 
 TEST(Referee, RefereedRunsAreBitForBitRepeatable) {
@@ -993,7 +994,8 @@ TEST(Referee, HslFreeKickDistanceIsTheCentreCircleAndAGoalKickClearsThePenaltyAr
     putBall(w, 2.0, -2.0);
     run(w, ref, 0.02);
     g.setPlay(gc::SetPlay::PushingFreeKick, 0);
-    w.placeRobot(2, 3.2, -2.0, M_PI);  // team 1 player 1, 1.2 m from the ball
+    run(w, ref, 0.02);                 // awarded, then
+    w.placeRobot(2, 3.2, -2.0, M_PI);  // team 1 player 1 walks to 1.2 m from the ball
     run(w, ref, 5.1);
     EXPECT_EQ(g.penalty(1, 1), hsl ? gc::Penalty::IllegalPosition : gc::Penalty::None) << hsl;
     g.ballFree();
@@ -1002,9 +1004,12 @@ TEST(Referee, HslFreeKickDistanceIsTheCentreCircleAndAGoalKickClearsThePenaltyAr
     const double corner_x = f.halfLength() - f.goal_area->length;
     putBall(w, corner_x, 0.5 * f.goal_area->width);
     run(w, ref, 0.02);
-    g.setPlay(gc::SetPlay::GoalKick, 1);
     w.placeRobot(1, corner_x - 0.6, -0.9, 0.0);
-    run(w, ref, 5.1);
+    g.setPlay(gc::SetPlay::GoalKick, 1);
+    // Inside when it was awarded, 1.4 m from the area's front edge: 5 s and 1.4 m at 0.2 m/s.
+    run(w, ref, 11.9);
+    EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
+    run(w, ref, 0.2);
     EXPECT_EQ(g.penalty(0, 2), hsl ? gc::Penalty::IllegalPosition : gc::Penalty::None) << hsl;
     if (hsl) {
       EXPECT_NE(lastDetail(g, EventType::IllegalPosition).find("penalty area"), std::string::npos);

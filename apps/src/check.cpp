@@ -86,7 +86,7 @@ int check(int argc, char** argv, int first) {
     const referee::RuleBook r = referee::loadRuleBook(file);
     std::printf("%s: rule book '%s' is valid (%d players a team, %d halves of %.0f s)\n", f,
                 r.name.c_str(), r.players_per_team, r.halves, r.half_duration);
-  } else if (root.has("behaviour")) {
+  } else if (root.has("behaviour") || root.has("base")) {
     agents::loadBehaviourConfig(file);
     std::printf("%s: agent behaviour file is valid\n", f);
   } else if (root.has("walk") || root.has("kick")) {

@@ -20,6 +20,7 @@ Referee::Referee(world::World& world, const RuleBook& rules, const std::array<Te
   idle_for_.assign(world.robotCount(), 0.0);
   idle_anchor_.assign(world.robotCount(), Vec3::Zero());
   in_goal_area_since_.assign(world.robotCount(), -1.0);
+  clear_by_.assign(world.robotCount(), 0.0);
   parked_.assign(world.robotCount(), false);
   slot_.assign(world.robotCount(), -1);
   contact_for_.assign(world.robotCount() * world.robotCount(), 0.0);
@@ -96,6 +97,22 @@ fields::AreaSize Referee::goalArea() const {
 double Referee::freeKickDistance() const {
   return game_.rules().free_kick_distance_centre_circle ? world_.field().centre_circle_radius
                                                         : game_.rules().free_kick_distance;
+}
+
+double Referee::depthInAvoidance(RobotId r) const {
+  const int kicking = game_.kickingTeam();
+  const gc::SetPlay play = game_.currentSetPlay();
+  if (kicking < 0 || play == gc::SetPlay::None || play == gc::SetPlay::PenaltyKick ||
+      world_.robot(r).team == kicking)
+    return 0.0;
+  const Vec3 p = world_.torsoPose(r).translation();
+  if (play == gc::SetPlay::GoalKick && game_.rules().goal_kick_clears_penalty_area) {
+    if (!inOwnArea(kicking, p, penaltyArea())) return 0.0;
+    const double x = teamSign(kicking) * p.x();  // towards the kicking team's goal
+    const fields::AreaSize a = penaltyArea();
+    return std::min(x - (world_.field().halfLength() - a.length), 0.5 * a.width - std::abs(p.y()));
+  }
+  return freeKickDistance() - (world_.ballState().pose.translation() - p).head<2>().norm();
 }
 
 double Referee::penaltyMarkX(int side) const {
@@ -594,11 +611,8 @@ void Referee::checkPenalties() {
       if (play == gc::SetPlay::None)  // kick-off
         illegal =
             teamSign(info.team) * p.x() < 0.0 || std::hypot(p.x(), p.y()) < f.centre_circle_radius;
-      else if (play != gc::SetPlay::PenaltyKick &&
-               clock_ - set_play_since_ >= config_.free_kick_clear_time)
-        illegal = play == gc::SetPlay::GoalKick && game_.rules().goal_kick_clears_penalty_area
-                      ? inOwnArea(kicking, p, penaltyArea())
-                      : (ball - p).head<2>().norm() < freeKickDistance();
+      else if (play != gc::SetPlay::PenaltyKick)
+        illegal = clock_ >= clear_by_[r] && depthInAvoidance(r) > 0.0;
       if (illegal) {
         game_.penalise(info.team, info.number, gc::Penalty::IllegalPosition);
         game_.recordEvent(
@@ -902,6 +916,9 @@ void Referee::judge(double dt) {
   clock_ += dt;
   if (game_.currentSetPlay() != last_set_play_) {
     set_play_since_ = clock_;
+    for (RobotId r = 0; r < world_.robotCount(); ++r)
+      clear_by_[r] = clock_ + config_.free_kick_clear_time +
+                     std::max(0.0, depthInAvoidance(r)) / config_.leave_speed;
     if (game_.currentSetPlay() != gc::SetPlay::None) beginRestart(false);  // a free kick
   }
   last_set_play_ = game_.currentSetPlay();

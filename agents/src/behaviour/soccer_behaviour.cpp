@@ -875,8 +875,7 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
     }
   }
   if (theirs && config_.goal_kick_clears_penalty_area && field_.penalty_area &&
-      set_play_ == static_cast<uint8_t>(gc::SetPlay::GoalKick) &&
-      r.kind != MotionRequest::Kind::Stand) {
+      set_play_ == static_cast<uint8_t>(gc::SetPlay::GoalKick)) {
     // Their goal kick (HSL): out of their whole penalty area, by its nearer edge, with a margin
     // for the torso the referee judges by.
     constexpr double kMargin = 0.3;  // m

@@ -32,8 +32,11 @@ struct RefereeConfig {
   double inactive_ball_distance = 1.0;  // m: "near the ball"
   double inactive_motion = 0.05;        // m the torso must move to count as active
   // Defenders keep the rule book's distance from the ball at a free kick (or out of the penalty
-  // area at a goal kick) once this long after it was awarded (time to leave).
+  // area at a goal kick) once this long after it was awarded (time to leave), and as long again
+  // as walking out at leave_speed takes a robot that was inside then (the HSL's whole penalty
+  // area is 3 m deep on the M-Field).
   double free_kick_clear_time = 5.0;  // s
+  double leave_speed = 0.2;           // m/s
   double ball_moved = 0.05;           // m: the kicking team moved the ball clearly
   double stuck_progress = 0.3;        // m the ball must move within the game-stuck time
   double stuck_radius = 0.5;          // m: a robot this close to a stuck ball is penalised (local)
@@ -120,7 +123,10 @@ class Referee {
   engine::Vec3 nearestLegalPosition(world::RobotId r, const std::vector<engine::Vec3>& taken) const;
   fields::AreaSize penaltyArea() const;  // the field's, or the SPL's
   fields::AreaSize goalArea() const;
-  double freeKickDistance() const;      // the rule book's, or the field's centre-circle radius
+  double freeKickDistance() const;  // the rule book's, or the field's centre-circle radius
+  // How far robot r stands inside the region the opponents of the kicking team keep out of at
+  // the current free kick (m to its border; <= 0: outside).
+  double depthInAvoidance(world::RobotId r) const;
   double penaltyMarkX(int side) const;  // the mark in front of the goal at x = side * length / 2
   bool inOwnArea(int team, const engine::Vec3& p, const fields::AreaSize& area) const;
   bool inOwnArea(world::RobotId r, const fields::AreaSize& area) const;  // by its torso
@@ -180,6 +186,7 @@ class Referee {
   uint64_t restart_seen_touch_step_ = 0;
   gc::SetPlay last_set_play_ = gc::SetPlay::None;
   double set_play_since_ = 0.0;  // clock_ when the current set play was awarded
+  std::vector<double> clear_by_;  // per robot: clock_ by which it is out of the avoidance region
   double clock_ = 0.0;           // seconds of referee updates, for entry order
   std::vector<bool> parked_;
   std::vector<int> slot_;  // a penalised robot's waiting spot index (kept while it waits), -1 none
