@@ -32,6 +32,10 @@ world::Scenario twoVsTwo() {
   return s;
 }
 
+RuleBook hslRules() {
+  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_small_foundation.yaml");
+}
+
 void run(world::World& w, Referee& ref, double seconds) {
   const int periods = static_cast<int>(std::lround(seconds / w.scenario().physics.control_period));
   for (int i = 0; i < periods; ++i) {
@@ -298,27 +302,32 @@ TEST(Referee, TooManyDefendersInTheGoalArea) {
 }
 
 TEST(Referee, FallenRobotIsPenalisedAsInactive) {
-  world::World w(twoVsTwo());
-  Referee ref(w, test::splRules(), test::twoTeams(), 0);
-  Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  const auto& joints = w.robot(3).model->body->joints;
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
-    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
-  run(w, ref, 9.0);
-  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);
-  EXPECT_EQ(count(g, "inactive"), 0);
-  run(w, ref, 3.0);
-  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
-  // The call is in the game's record, as every other penalty's reason.
-  ASSERT_EQ(count(g, "inactive"), 1);
-  for (const auto& e : g.events())
-    if (e.type == EventType::Inactive) {
-      EXPECT_EQ(e.team, 1);
-      EXPECT_EQ(e.player, 2);
-      EXPECT_NE(e.detail.find("down for 10 s"), std::string::npos) << e.detail;
-    }
+  // Down for the rule book's time: 10 s in the SPL's, 20 s in the HSL's.
+  for (const bool hsl : {false, true}) {
+    const double limit = hsl ? 20.0 : 10.0;
+    world::World w(twoVsTwo());
+    Referee ref(w, hsl ? hslRules() : test::splRules(), test::twoTeams(), 0);
+    Game& g = ref.game();
+    g.ready();
+    kickOff(w, ref);
+    const auto& joints = w.robot(3).model->body->joints;
+    for (int j = 0; j < static_cast<int>(joints.size()); ++j)
+      if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
+    run(w, ref, limit - 1.0);
+    EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None) << hsl;
+    EXPECT_EQ(count(g, "inactive"), 0);
+    run(w, ref, 3.0);
+    EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer) << hsl;
+    // The call is in the game's record, as every other penalty's reason.
+    ASSERT_EQ(count(g, "inactive"), 1);
+    for (const auto& e : g.events())
+      if (e.type == EventType::Inactive) {
+        EXPECT_EQ(e.team, 1);
+        EXPECT_EQ(e.player, 2);
+        EXPECT_NE(e.detail.find(hsl ? "down for 20 s" : "down for 10 s"), std::string::npos)
+            << e.detail;
+      }
+  }
 }
 
 namespace {
@@ -850,10 +859,6 @@ TEST(Referee, IndirectKickDirectGoalBecomesAGoalKickOwnGoalsCount) {
 
 namespace {
 
-RuleBook hslRules() {
-  return loadRuleBook(test::sourceDir() / "configs" / "rules" / "hsl_small_foundation.yaml");
-}
-
 // 3 v 3: twoVsTwo's robots 0-3 and a third of each team (robots 4 and 5).
 world::Scenario threeVsThree() {
   world::Scenario s = twoVsTwo();
@@ -1015,22 +1020,6 @@ TEST(Referee, HslFreeKickDistanceIsTheCentreCircleAndAGoalKickClearsThePenaltyAr
       EXPECT_NE(lastDetail(g, EventType::IllegalPosition).find("penalty area"), std::string::npos);
     }
   }
-}
-
-TEST(Referee, HslFallenRobotHasTwentySeconds) {
-  world::World w(twoVsTwo());
-  Referee ref(w, hslRules(), test::twoTeams(), 0);
-  Game& g = ref.game();
-  g.ready();
-  kickOff(w, ref);
-  const auto& joints = w.robot(3).model->body->joints;
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j)
-    if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
-  run(w, ref, 18.0);
-  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::None);  // the SPL's rule book: penalised at 10 s
-  run(w, ref, 4.0);
-  EXPECT_EQ(g.penalty(1, 2), gc::Penalty::InactivePlayer);
-  EXPECT_NE(lastDetail(g, EventType::Inactive).find("down for 20 s"), std::string::npos);
 }
 
 TEST(Referee, AnInGamePenaltyKickScoresDirectlyUnderTheTwoTouchRule) {
