@@ -224,7 +224,8 @@ TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
   EXPECT_FALSE(spl.goal_kick_clears_penalty_area);
   EXPECT_TRUE(hsl.goal_kick_clears_penalty_area);
   EXPECT_EQ(hsl.ready_positions.size(), spl.ready_positions.size());
-  EXPECT_EQ(hsl.keep_clear, spl.keep_clear);
+  EXPECT_EQ(hsl.keep_clear, 0.95);  // the S-Field's free-kick distance and a margin
+  EXPECT_EQ(hsl.avoid_near, spl.avoid_near);
   EXPECT_EQ(hsl.kick_ball_x, spl.kick_ball_x);
   EXPECT_EQ(hsl.sit_when_finished, spl.sit_when_finished);
   // A bad key in the file or its base is refused naming that file; a loop ends.

@@ -65,8 +65,7 @@ RuleBook loadRuleBook(const std::filesystem::path& file) {
   }
   if (auto fl = root.optional("fallen")) {
     fl->allowOnly({"time", "get_up_attempts"});
-    r.fallen_time = fl->number("time", r.fallen_time);
-    if (r.fallen_time <= 0) fl->failKey("time", "must be > 0");
+    if (fl->has("time")) r.fallen_time = (*fl)["time"].positive();
     r.get_up_attempts = fl->integer("get_up_attempts", r.get_up_attempts);
     if (r.get_up_attempts < 1) fl->failKey("get_up_attempts", "must be >= 1");
   }
@@ -602,6 +601,7 @@ void Game::setPlay(gc::SetPlay play, int team) {
   if (play == gc::SetPlay::None) return ballFree();
   kicking_team_ = team;
   set_play_ = play;
+  ++set_plays_awarded_;
   log(EventType::SetPlay, team, 0, setPlayName(play));
   if (play == gc::SetPlay::PenaltyKick) {
     // Ready (30 s) and Set before the kick, which then has 30 s in Playing.
@@ -718,8 +718,11 @@ void Game::follow(const ControlData& d) {
   half_ = half;
   phase_ = phase;
   const int kicking = d.kicking_team == gc::kKickingTeamNone ? -1 : index(d.kicking_team);
-  if (set_play != set_play_ && set_play != gc::SetPlay::None)
+  // (A GameController's packets do not tell a set play awarded again to the same team.)
+  if ((set_play != set_play_ || kicking != kicking_team_) && set_play != gc::SetPlay::None) {
     log(EventType::SetPlay, kicking, 0, std::string(setPlayName(set_play)) + " (GameController)");
+    ++set_plays_awarded_;
+  }
   set_play_ = set_play;
   kicking_team_ = kicking;
   if (state != state_) enter(state, "GameController");

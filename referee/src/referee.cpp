@@ -914,14 +914,19 @@ void Referee::update() {
 void Referee::judge(double dt) {
   game_.advance(dt);
   clock_ += dt;
-  if (game_.currentSetPlay() != last_set_play_) {
-    set_play_since_ = clock_;
+  if (game_.setPlaysAwarded() != last_set_play_award_ &&
+      game_.currentSetPlay() != gc::SetPlay::None) {
+    beginRestart(false);  // a free kick (or a penalty kick's award)
     for (RobotId r = 0; r < world_.robotCount(); ++r)
       clear_by_[r] = clock_ + config_.free_kick_clear_time +
                      std::max(0.0, depthInAvoidance(r)) / config_.leave_speed;
-    if (game_.currentSetPlay() != gc::SetPlay::None) beginRestart(false);  // a free kick
   }
-  last_set_play_ = game_.currentSetPlay();
+  last_set_play_award_ = game_.setPlaysAwarded();
+  // A kick-off or free kick the kicking team never took (its time ran out): no goal comes
+  // straight from it.
+  if (restart_.team >= 0 && restart_.kicker < 0 && game_.kickingTeam() < 0 &&
+      game_.state() == gc::State::Playing)
+    restart_ = Restart{};
   const gc::State s = game_.state();
   if (s != last_state_)
     enterState(s);

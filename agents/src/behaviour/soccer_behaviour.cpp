@@ -883,10 +883,24 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
     const double side = 0.5 * field_.penalty_area->width + kMargin;
     const auto inside = [&](double x, double y) { return x > front && std::abs(y) < side; };
     if (inside(self_.x, self_.y)) {
-      const bool by_front = self_.x - front < side - std::abs(self_.y);
-      r = walkTo(by_front ? Pose2{front - 0.1, self_.y, 0.0}
-                          : Pose2{self_.x, (self_.y >= 0 ? 1.0 : -1.0) * (side + 0.1), 0.0},
-                 true);
+      // By the nearer edge, unless the way there passes the ball (it lies at the goal area's
+      // corner, inside the area) nearer than keep_clear.
+      const Pose2 out_front{front - 0.1, self_.y, 0.0};
+      const Pose2 out_side{self_.x, (self_.y >= 0 ? 1.0 : -1.0) * (side + 0.1), 0.0};
+      const auto passes_ball = [&](const Pose2& to) {
+        const double dx = to.x - self_.x, dy = to.y - self_.y;
+        const double len2 = dx * dx + dy * dy;
+        const double u =
+            len2 > 0.0
+                ? std::clamp(((ball_.x - self_.x) * dx + (ball_.y - self_.y) * dy) / len2, 0.0, 1.0)
+                : 0.0;
+        return std::hypot(self_.x + u * dx - ball_.x, self_.y + u * dy - ball_.y) <
+               config_.keep_clear;
+      };
+      const bool front_nearer = self_.x - front < side - std::abs(self_.y);
+      const bool by_front =
+          passes_ball(out_front) != passes_ball(out_side) ? !passes_ball(out_front) : front_nearer;
+      r = walkTo(by_front ? out_front : out_side, true);
     } else if (inside(target_.x, target_.y)) {
       r = MotionRequest{};
     }

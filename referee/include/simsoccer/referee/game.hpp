@@ -182,6 +182,8 @@ class Game {
   gc::State state() const { return state_; }
   gc::GamePhase phase() const { return phase_; }
   gc::SetPlay currentSetPlay() const { return set_play_; }
+  // Set plays awarded so far: a new award of the same set play to the same team changes it.
+  uint32_t setPlaysAwarded() const { return set_plays_awarded_; }
   Half half() const { return half_; }
   int kickingTeam() const { return kicking_team_; }  // -1 none
   int score(int team) const { return score_[static_cast<size_t>(team)]; }
@@ -236,6 +238,7 @@ class Game {
   gc::State state_ = gc::State::Initial;
   gc::GamePhase phase_ = gc::GamePhase::Normal;
   gc::SetPlay set_play_ = gc::SetPlay::None;
+  uint32_t set_plays_awarded_ = 0;
   Half half_ = Half::First;
   int first_half_kick_off_ = 0;
   int kicking_team_ = -1;

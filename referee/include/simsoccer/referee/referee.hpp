@@ -184,8 +184,7 @@ class Referee {
   std::string directGoalRefused(int attacker, bool own_goal) const;
   bool ownGoalFromFreeKick(int defender) const;
   uint64_t restart_seen_touch_step_ = 0;
-  gc::SetPlay last_set_play_ = gc::SetPlay::None;
-  double set_play_since_ = 0.0;  // clock_ when the current set play was awarded
+  uint32_t last_set_play_award_ = 0;  // Game::setPlaysAwarded() at the last look
   std::vector<double> clear_by_;  // per robot: clock_ by which it is out of the avoidance region
   double clock_ = 0.0;           // seconds of referee updates, for entry order
   std::vector<bool> parked_;
