@@ -159,7 +159,14 @@ TEST(Game, HalfTimeSwapsSidesAndTheOtherTeamKicksOff) {
   EXPECT_EQ(d.teams[0].team_number, 5);  // swapped
   EXPECT_EQ(d.teams[1].team_number, 13);
   EXPECT_EQ(d.secs_remaining, 600);
+  // The break's timer runs on in the second half's Initial (GameController3), and past 0.
+  EXPECT_EQ(d.secondary_time, 300);  // 600 - 300.15 s, rounded up
+  run(g, 100.0);
+  EXPECT_EQ(g.packet(2).secondary_time, 200);
+  run(g, 250.0);
+  EXPECT_EQ(g.packet(3).secondary_time, -50);  // the break is over: counting below 0
   g.ready();
+  EXPECT_EQ(g.packet(4).secondary_time, 45);  // Ready's countdown
   g.set();
   g.playing();
   run(g, 600.05);

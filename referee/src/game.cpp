@@ -321,7 +321,9 @@ void Game::advance(double dt) {
           half_started_ = false;
           kicking_team_ = 1 - first_half_kick_off_;
           kick_off_pending_ = true;
-          secondary_ = 0.0;
+          // The break's timer runs on into the second half's Initial (GameController3's
+          // SwitchHalf leaves it, counting below 0 when the break is over).
+          break_timer_ = true;
           for (int t = 0; t < 2; ++t)
             for (int n = 1; n <= static_cast<int>(gc::kMaxPlayers); ++n)
               if (player(t, n).penalty != gc::Penalty::Substitute) player(t, n) = Player{};
@@ -332,6 +334,7 @@ void Game::advance(double dt) {
       break;
     case gc::State::Initial:
     case gc::State::Standby:
+      if (break_timer_ && phase_ != gc::GamePhase::Timeout) secondary_ -= dt;
       break;
   }
   if (phase_ == gc::GamePhase::Timeout) secondary_ = std::max(0.0, secondary_ - dt);
@@ -518,6 +521,7 @@ void Game::startKickOff(int team, const std::string& why) {
   kick_off_pending_ = true;
   set_play_ = gc::SetPlay::None;
   secondary_ = rules_.ready_duration;
+  break_timer_ = false;
   enter(gc::State::Ready, why);
 }
 
@@ -671,6 +675,7 @@ void Game::timeout(std::optional<int> team) {
   } else {
     secondary_ = rules_.referee_timeout;
   }
+  break_timer_ = false;
   phase_ = gc::GamePhase::Timeout;
   set_play_ = gc::SetPlay::None;
   log(EventType::Timeout, team ? *team : -1, 0, team ? "team timeout" : "referee timeout");

@@ -243,6 +243,7 @@ class Game {
   int first_half_kick_off_ = 0;
   int kicking_team_ = -1;
   bool kick_off_pending_ = true;  // kick-off set play when Playing starts
+  bool break_timer_ = false;      // secondary_ is the half-time break's, run on into Initial
   bool half_started_ = false;     // the half's first kick-off has happened (clock runs)
   bool sides_swapped_ = false;
   bool game_over_ = false;
