@@ -74,6 +74,19 @@ void kickOff(world::World& w, Referee& ref) {
   ASSERT_EQ(ref.game().state(), gc::State::Playing);
 }
 
+// The scenario (2 v 2 unless told) right after team 0's kick-off under the rule book.
+struct KickedOff {
+  world::World w;
+  Referee ref;
+  Game& g = ref.game();
+  explicit KickedOff(const RuleBook& rules = test::splRules(),
+                     const world::Scenario& scenario = twoVsTwo())
+      : w(scenario), ref(w, rules, test::twoTeams(), 0) {
+    g.ready();
+    kickOff(w, ref);
+  }
+};
+
 // From the first kick-off to open play (the ball free).
 void openPlay(world::World& w, Referee& ref) {
   ref.game().ready();
@@ -305,11 +318,8 @@ TEST(Referee, FallenRobotIsPenalisedAsInactive) {
   // Down for the rule book's time: 10 s in the SPL's, 20 s in the HSL's.
   for (const bool hsl : {false, true}) {
     const double limit = hsl ? 20.0 : 10.0;
-    world::World w(twoVsTwo());
-    Referee ref(w, hsl ? hslRules() : test::splRules(), test::twoTeams(), 0);
-    Game& g = ref.game();
-    g.ready();
-    kickOff(w, ref);
+    KickedOff game(hsl ? hslRules() : test::splRules());
+    auto& [w, ref, g] = game;
     const auto& joints = w.robot(3).model->body->joints;
     for (int j = 0; j < static_cast<int>(joints.size()); ++j)
       if (joints[static_cast<size_t>(j)].mimic_of < 0) w.setJointTarget(3, j, 0.0, 0.0);  // limp
@@ -341,18 +351,6 @@ void tipOver(world::World& w, world::RobotId r) {
         joints[static_cast<size_t>(j)].name.find("AnklePitch") != std::string::npos)
       w.setJointTarget(r, j, 0.9, 1.0);
 }
-
-// 2 v 2 right after team 0's kick-off.
-struct KickedOff {
-  world::World w{twoVsTwo()};
-  Referee ref;
-  Game& g = ref.game();
-  explicit KickedOff(const RuleBook& rules = test::splRules())
-      : ref(w, rules, test::twoTeams(), 0) {
-    g.ready();
-    kickOff(w, ref);
-  }
-};
 
 }  // namespace
 
@@ -888,11 +886,8 @@ std::string lastDetail(const Game& g, EventType type) {
 TEST(Referee, HslKickOffScoresOnlyAfterASecondTouchOrTheKickerOutsideTheCircle) {
   // Two robots a team: the kicker must play the ball outside the centre circle before a goal.
   for (const bool outside : {false, true}) {
-    world::World w(twoVsTwo());
-    Referee ref(w, hslRules(), test::twoTeams(), 0);
-    Game& g = ref.game();
-    g.ready();
-    kickOff(w, ref);
+    KickedOff game(hslRules());
+    auto& [w, ref, g] = game;
     w.placeRobot(1, -0.35, 0.0, 0.0);  // team 0 player 2 at the centre mark takes the kick-off
     touchBall(w, ref, 1);
     if (outside) {
@@ -911,11 +906,8 @@ TEST(Referee, HslKickOffScoresOnlyAfterASecondTouchOrTheKickerOutsideTheCircle) 
   }
   // Three robots a team: two different robots must touch the ball.
   for (const bool second : {false, true}) {
-    world::World w(threeVsThree());
-    Referee ref(w, hslRules(), test::twoTeams(), 0);
-    Game& g = ref.game();
-    g.ready();
-    kickOff(w, ref);
+    KickedOff game(hslRules(), threeVsThree());
+    auto& [w, ref, g] = game;
     touchBall(w, ref, 1);              // outside the circle, but alone
     if (second) touchBall(w, ref, 4);  // team 0 player 3
     putBall(w, w.field().halfLength() + 0.3, 0.3);
@@ -927,11 +919,8 @@ TEST(Referee, HslKickOffScoresOnlyAfterASecondTouchOrTheKickerOutsideTheCircle) 
     }
   }
   // A rule book without the HSL's kick-off rule (the 3D league's) scores straight from it.
-  world::World w(twoVsTwo());
-  Referee ref(w, loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"),
-              test::twoTeams(), 0);
-  ref.game().ready();
-  kickOff(w, ref);
+  KickedOff game(loadRuleBook(test::sourceDir() / "configs" / "rules" / "simleague.yaml"));
+  auto& [w, ref, g] = game;
   w.placeRobot(1, -0.35, 0.0, 0.0);
   touchBall(w, ref, 1);
   putBall(w, w.field().halfLength() + 0.3, 0.0);

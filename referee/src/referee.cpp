@@ -506,15 +506,14 @@ std::string Referee::directGoalRefused(int attacker, bool own_goal) const {
     return "indirect kick: fewer than two of its robots played the ball";
   if (restart_.team != attacker) return {};
   // The HSL: not straight from the kick-off ...
-  if (restart_.kick_off && !rules.kick_off_direct_goal) {
+  if (restart_.kickOff() && !rules.kick_off_direct_goal) {
     if (restart_.robots >= 3 && robots_touched < 2)
       return "kick-off: two different robots must touch the ball before a goal";
     if (restart_.robots < 3 && !restart_.kicker_outside_circle && robots_touched < 2)
       return "kick-off: its kicker must touch the ball outside the centre circle before a goal";
   }
   // ... nor straight from a kick-in: another robot, of either team, must touch it.
-  if (!restart_.kick_off && restart_.play == gc::SetPlay::KickIn && rules.kick_in_indirect &&
-      robots_touched < 2)
+  if (restart_.play == gc::SetPlay::KickIn && rules.kick_in_indirect && robots_touched < 2)
     return "kick-in: another robot must touch the ball before a goal";
   return {};
 }
@@ -522,17 +521,16 @@ std::string Referee::directGoalRefused(int attacker, bool own_goal) const {
 bool Referee::ownGoalFromFreeKick(int defender) const {
   // Straight in: the team that took the free kick scores into its own goal, its kicker the
   // only robot that touched the ball since.
-  if (!game_.rules().free_kick_own_goal_corner || restart_.kick_off || restart_.team != defender ||
+  if (!game_.rules().free_kick_own_goal_corner || restart_.team != defender ||
       restart_.play == gc::SetPlay::None || restart_.play == gc::SetPlay::PenaltyKick)
     return false;
   return std::popcount(touched_since_restart_[0] | touched_since_restart_[1]) == 1 &&
          touched_since_restart_[static_cast<size_t>(defender)] != 0;
 }
 
-void Referee::beginRestart(bool kick_off) {
+void Referee::beginRestart() {
   touched_since_restart_ = {0, 0};
   restart_ = Restart{};
-  restart_.kick_off = kick_off;
   restart_.play = game_.currentSetPlay();
   restart_.team = game_.kickingTeam();
   if (restart_.team < 0) return;
@@ -862,8 +860,7 @@ void Referee::enterState(gc::State s) {
   if (normal && !placed_for_second_half_ && (break_begins || second_half_begins))
     placeForTheSecondHalf();
   if (s == gc::State::Playing) {
-    // A kick-off (a kicking team and no set play), a dropped ball or a penalty kick.
-    beginRestart(game_.kickingTeam() >= 0 && game_.currentSetPlay() == gc::SetPlay::None);
+    beginRestart();  // a kick-off, a dropped ball or a penalty kick
     restart_seen_touch_step_ = world_.stepCount();
     set_play_ball_ = world_.ballState().pose.translation();
     set_play_step_ = world_.stepCount();
@@ -916,7 +913,7 @@ void Referee::judge(double dt) {
   clock_ += dt;
   if (game_.setPlaysAwarded() != last_set_play_award_ &&
       game_.currentSetPlay() != gc::SetPlay::None) {
-    beginRestart(false);  // a free kick (or a penalty kick's award)
+    beginRestart();  // a free kick (or a penalty kick's award)
     for (RobotId r = 0; r < world_.robotCount(); ++r)
       clear_by_[r] = clock_ + config_.free_kick_clear_time +
                      std::max(0.0, depthInAvoidance(r)) / config_.leave_speed;

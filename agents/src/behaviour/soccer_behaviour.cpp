@@ -207,10 +207,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
   // Three sightings at the least at 100 Hz over half the window.
   if (root.has("ball_velocity_window") && !(c.ball_velocity_window >= 0.05))
     root["ball_velocity_window"].fail("must be >= 0.05 s");
-  if (!(c.avoid_far > c.avoid_near)) {
-    if (root.has("avoid_far")) root["avoid_far"].fail("avoid_far must be greater than avoid_near");
-    root["avoid_near"].fail("avoid_far must be greater than avoid_near");
-  }
+  if (!(c.avoid_far > c.avoid_near))
+    (root.has("avoid_far") ? root["avoid_far"] : root["avoid_near"])
+        .fail("avoid_far must be greater than avoid_near");
   for (const char* k : {"keeper_line", "shootout_keeper_line", "avoid_ball", "obstacle_memory",
                         "defender_spacing", "defender_goal_distance"})
     if (root.has(k) && !(root[k].number() >= 0)) root[k].fail("must be >= 0");
@@ -897,9 +896,10 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
         return std::hypot(self_.x + u * dx - ball_.x, self_.y + u * dy - ball_.y) <
                config_.keep_clear;
       };
-      const bool front_nearer = self_.x - front < side - std::abs(self_.y);
-      const bool by_front =
-          passes_ball(out_front) != passes_ball(out_side) ? !passes_ball(out_front) : front_nearer;
+      const bool front_passes = passes_ball(out_front);
+      const bool by_front = front_passes != passes_ball(out_side)
+                                ? !front_passes
+                                : self_.x - front < side - std::abs(self_.y);  // the nearer
       r = walkTo(by_front ? out_front : out_side, true);
     } else if (inside(target_.x, target_.y)) {
       r = MotionRequest{};

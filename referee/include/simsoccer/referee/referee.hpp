@@ -34,7 +34,7 @@ struct RefereeConfig {
   // Defenders keep the rule book's distance from the ball at a free kick (or out of the penalty
   // area at a goal kick) once this long after it was awarded (time to leave), and as long again
   // as walking out at leave_speed takes a robot that was inside then (the HSL's whole penalty
-  // area is 3 m deep on the M-Field).
+  // area is 2.95 m deep on the M-Field).
   double free_kick_clear_time = 5.0;  // s
   double leave_speed = 0.2;           // m/s
   double ball_moved = 0.05;           // m: the kicking team moved the ball clearly
@@ -169,15 +169,15 @@ class Referee {
   // its robots on the field then, and whether its kicker touched the ball outside the centre
   // circle (the HSL's kick-off with two robots or fewer).
   struct Restart {
-    bool kick_off = false;
     gc::SetPlay play = gc::SetPlay::None;
     int team = -1;
     int robots = 0;
     int kicker = -1;  // RobotId of the kicking team's first touch
     bool kicker_outside_circle = false;
+    bool kickOff() const { return play == gc::SetPlay::None && team >= 0; }
   };
   Restart restart_;
-  void beginRestart(bool kick_off);
+  void beginRestart();  // from the game's set play and kicking team now
   void noteRestartTouch(world::RobotId r);
   // Why a goal straight from the last restart does not count under the rule book (empty: it
   // counts), and whether an own goal straight from a free kick is a corner kick instead.
