@@ -18,10 +18,10 @@
 
 #include "agent_help.hpp"
 #include "agent_modes.hpp"
+#include "agent_soccer.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
 #include "simsoccer/agents/motion/walk_engine.hpp"
-#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 
@@ -72,40 +72,13 @@ int main(int argc, char** argv) {
       throw apps::UsageError("--motions: no such folder: " + motions.string());
     const std::filesystem::path robot_motions = agents::motionsFolder(motions, model);
 
-    // Soccer (--role): behaviour and motion, loaded before claiming so a bad
-    // file stops here.
-    std::unique_ptr<agents::SoccerAgent> soccer;
-    if (!opt.has("role"))
-      for (const char* soccer_only : {"seed", "config", "team-number"})
-        if (opt.has(soccer_only))
-          throw apps::UsageError(std::string("--") + soccer_only + " goes with --role");
-    if (!opt.has("role") && opt.flag("no-get-up"))
-      throw apps::UsageError("--no-get-up goes with --role");
-    if (opt.has("role")) {
-      const auto role = agents::roleFromName(opt.get("role", ""));
-      if (!role)
-        throw apps::UsageError(
-            "--role must be auto, striker, supporter, defender, goalkeeper, penalty-kicker or "
-            "penalty-goalkeeper");
-      agents::SoccerAgentSetup setup;
-      setup.team = team;
-      setup.team_number = opt.wholeNumber("team-number", team + 1, 0, 254);
-      setup.player = player;
-      setup.role = *role;
-      setup.seed = opt.seed("seed", 1);
-      setup.get_up = !opt.flag("no-get-up");
-      soccer = std::make_unique<agents::SoccerAgent>(
-          model,
-          agents::loadBehaviourConfig(
-              apps::findConfig(opt.get("config", ""), "configs/agents/soccer.yaml")),
-          fields::loadFieldModel(apps::findConfig(opt.get("field", ""), "fields/spl.yaml")),
-          robot_motions, setup);
-    }
+    // Soccer (--role): behaviour and motion, loaded before claiming so a bad file stops here.
+    apps::SoccerPlayer::refuseWithoutRole(opt);
+    std::optional<apps::SoccerPlayer> soccer;
+    if (opt.has("role")) soccer.emplace(opt, model, robot_motions, team, player);
     const bool verbose = opt.flag("verbose");
-    std::vector<float> position(protocol::kActuators, 0.0f), stiffness(protocol::kActuators, 1.0f);
     apps::SimpleModes simple(model, robot_motions, mode, opt.number("vx", 0.2),
                              opt.number("vy", 0.0), opt.number("turn", 0.0));
-    double last_time = 0.0;
 
     // Started by a match (which names itself): go when it goes, also when it
     // was killed with SIGKILL and could not stop its agents.
@@ -124,7 +97,6 @@ int main(int argc, char** argv) {
       ::unsetenv(net::kRobotKeyVariable);  // not inherited by anything this starts
     }
     agents::AgentClient client(dds, team, player, key);
-    simsoccer_msg_GameState game{};
     // The referee's state before claiming: the simulator starts once every
     // robot is claimed, so the first frame is answered with it however late
     // it would have arrived (otherwise the first periods may be played
@@ -155,33 +127,14 @@ int main(int argc, char** argv) {
           .count();
     };
     last_frame_ns = now_ns();
-    agents::PerceptionIn seen;
     client.onFrame([&](const simsoccer_msg_SensorFrame& frame) {
       last_frame_ns = now_ns();
       if (mode == "stall" && answered >= stall_after) return;
       if (max_ticks >= 0 && answered >= max_ticks) return;
-      if (soccer) {
-        // The soccer agent: this tick's perception (in the frame), the
-        // game, teammates' messages, then behaviour and motion.
-        const double dt = last_time > 0 ? frame.sim_time - last_time : 0.01;
-        last_time = frame.sim_time;
-        const bool have_seen = agents::perceptionFromFrame(frame, seen);
-        const bool have_game = client.gameState(game);
-        for (const auto& m : client.receiveTeamMessages()) soccer->receive(m, frame.sim_time);
-        if (auto out =
-                soccer->step(frame.sim_time, dt > 0 ? dt : 0.01, agents::motionSensors(frame),
-                             have_seen ? &seen : nullptr,
-                             have_game ? &game : nullptr, position, stiffness))
-          client.sendTeamMessage(*out);
-        if (verbose && frame.tick % 100 == 0)
-          std::fprintf(stderr, "agent %d/%d t %.1f %s %s\n", team, player, frame.sim_time,
-                       agents::motionStateName(soccer->motion().state()),
-                       soccer->behaviour().status().c_str());
-        client.send(frame.tick, position, stiffness);
-        ++answered;
-        return;
-      }
-      simple.answer(frame, client, team, player);
+      if (soccer)
+        soccer->answer(frame, client, verbose);
+      else
+        simple.answer(frame, client, team, player);
       ++answered;
     });
     for (;;) {
