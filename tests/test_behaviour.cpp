@@ -214,6 +214,10 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("clear_max_angle: 1.6"), "clear_max_angle");       // cleared backwards
   EXPECT_EQ(refusedAt("clear_max_angle: -0.1"), "clear_max_angle");
   EXPECT_EQ(refusedAt("avoid_ball: 0"), "");  // none: never give way at the ball
+  EXPECT_EQ(refusedAt("pass_after_restart: sometimes"), "pass_after_restart");
+  EXPECT_EQ(refusedAt("pass_distance: [2, 1]"), "pass_distance");  // nearest beyond farthest
+  EXPECT_EQ(refusedAt("pass_distance: [0, 3]"), "pass_distance");
+  EXPECT_EQ(refusedAt("pass_distance: [1, 3]"), "");
 }
 
 TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
@@ -283,6 +287,90 @@ TEST(SoccerBehaviour, UnderTheHslRulesItLeavesThePenaltyAreaAtTheOpponentsGoalKi
       EXPECT_GT(b.target().x, front) << b.target().x;
     }
   }
+}
+
+// Where the rules refuse a goal straight from a restart, the striker passes: the SPL's two-touch
+// rule after any restart but a penalty kick, the HSL's after the own kick-off and kick-in. It
+// aims at the teammate furthest up the field within reach (not one too near, too far or in the
+// own penalty area), and at the goal again once a teammate has taken the striker role since.
+TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
+  const auto f = field();
+  const double bx = 1.0, by = 2.9;  // the ball at a kick-in, near the left touchline
+  // A teammate's message: its pose, role and striker bid.
+  const auto message = [](int player, double x, double y, Role role) {
+    agents::TeamMessageData d;
+    d.player = player;
+    d.x = x;
+    d.y = y;
+    d.role = role;
+    d.cost = 3.0;
+    return agents::TeamMessageIn{player, 0, agents::encodeTeamMessage(d)};
+  };
+  // The striker's aim (its target's yaw) at `play` taken by `kicking` (a team number), after
+  // the teammates' messages; with `mate_strikes`, teammate 5 claims the striker role 2 s later.
+  const auto aim = [&](const agents::BehaviourConfig& cfg, protocol::gc::SetPlay play, int kicking,
+                       bool mate_strikes) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+    b.receive(message(3, 0.5, 0.5, Role::Supporter), 0.4);   // 2.45 m away: the pass
+    b.receive(message(4, 1.5, 2.2, Role::Defender), 0.4);    // 0.86 m: too near
+    b.receive(message(5, -3.5, 2.0, Role::Defender), 0.4);   // in the own penalty area
+    b.receive(message(6, 4.2, -1.5, Role::Supporter), 0.4);  // 5.5 m: too far
+    auto g = gameState(3);
+    g.kicking_team = static_cast<uint8_t>(kicking);
+    g.set_play = static_cast<uint8_t>(play);
+    g.secondary_time = 30;
+    auto p = seeing(0.2, 2.3, 0.0, bx, by, 0.5);
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    updateSeeing(b, in);
+    if (mate_strikes) {
+      b.receive(message(5, -3.5, 2.0, Role::Striker), 2.5);
+      in.time = 2.6;
+      p = seeing(0.2, 2.3, 0.0, bx, by, 2.6);
+      b.update(in);
+    }
+    return b.target().yaw;
+  };
+  const double to_mate = std::atan2(0.5 - by, 0.5 - bx);  // -1.78 rad
+  const double inside = 0.5 * f.goal.inner_width - 2.0 * f.ball.radius;
+  const double to_line = f.halfLength() - bx;
+  const double at_goal =
+      0.5 * (std::atan2(inside - by, to_line) + std::atan2(-inside - by, to_line));  // -0.69
+  using protocol::gc::SetPlay;
+  const auto spl = soccerConfig();
+  const auto hsl =
+      agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_hsl_small.yaml");
+  agents::BehaviourConfig direct = spl;
+  direct.pass_after_restart = agents::BehaviourConfig::PassRule::None;
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, false), to_mate, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::GoalKick, 1, false), to_mate, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::CornerKick, 2, false), to_mate, 1e-6);  // theirs: both teams
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, true), at_goal, 1e-6);       // a teammate played it
+  EXPECT_NEAR(aim(spl, SetPlay::PenaltyKick, 1, false), at_goal, 1e-6);
+  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 1, false), to_mate, 1e-6);
+  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 2, false), at_goal,
+              1e-6);  // their kick-in: the rule is theirs
+  EXPECT_NEAR(aim(hsl, SetPlay::GoalKick, 1, false), at_goal, 1e-6);
+  EXPECT_NEAR(aim(direct, SetPlay::KickIn, 1, false), at_goal, 1e-6);
+  // The own kick-off under the HSL's rules, as Playing follows Set: the pass.
+  agents::SoccerBehaviour b(hsl, f, 0, 1, 2, Role::Striker, 1);
+  b.receive(message(3, -1.2, -1.0, Role::Supporter), 0.4);
+  auto g = gameState(2);  // Set
+  g.kicking_team = 1;
+  auto p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.5);
+  agents::SoccerBehaviour::Input in;
+  in.time = 0.5;
+  in.perception = &p;
+  in.game = &g;
+  updateSeeing(b, in);
+  g.state = 3;
+  g.secondary_time = 10;
+  in.time = 0.6;
+  p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.6);
+  b.update(in);
+  EXPECT_NEAR(b.target().yaw, std::atan2(-1.0, -1.2), 1e-6);
 }
 
 TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {

@@ -145,7 +145,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
                   "supporter_deepest",
                   "clear_max_angle",
                   "sit_when_finished",
-                  "goal_kick_avoidance"});
+                  "goal_kick_avoidance",
+                  "pass_after_restart",
+                  "pass_distance"});
   if (root.has("behaviour") && root["behaviour"].string() != "soccer")
     root["behaviour"].fail("must be soccer (the one behaviour the built-in agents play)");
   // A file may start from another (its path relative to this one) and change some keys.
@@ -199,6 +201,24 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
     if (v != "keep_clear" && v != "penalty_area")
       root["goal_kick_avoidance"].fail("must be keep_clear or penalty_area");
     c.goal_kick_clears_penalty_area = v == "penalty_area";
+  }
+  if (root.has("pass_after_restart")) {
+    const std::string v = root["pass_after_restart"].string();
+    if (v == "none")
+      c.pass_after_restart = BehaviourConfig::PassRule::None;
+    else if (v == "every_restart")
+      c.pass_after_restart = BehaviourConfig::PassRule::EveryRestart;
+    else if (v == "own_kick_off_and_kick_in")
+      c.pass_after_restart = BehaviourConfig::PassRule::OwnKickOffAndKickIn;
+    else
+      root["pass_after_restart"].fail("must be none, every_restart or own_kick_off_and_kick_in");
+  }
+  if (auto n = root.optional("pass_distance")) {
+    const auto v = n->numbers(2);
+    if (!(v[0] > 0 && v[1] > v[0]))
+      n->fail("must be [nearest, farthest] with 0 < nearest < farthest");
+    c.pass_min = v[0];
+    c.pass_max = v[1];
   }
   for (const char* k :
        {"message_interval", "block_speed", "block_time", "block_reach", "dive_time", "dive_reach",
@@ -331,8 +351,55 @@ void SoccerBehaviour::readGame(const Input& in) {
     forgetBallTrack();
     obstacles_.clear();
   }
+  // A restart starts the pass rule over (BehaviourConfig::pass_after_restart): a kick-off or a
+  // drop ball as Playing follows Set, a set play as it is awarded. A penalty kick scores directly.
+  const int kicking = g.kicking_team == kNoTeam ? -1 : g.kicking_team;
+  const bool kick_off = state_ == kPlaying && last_state_ == kSet && phase_ != kPhasePenaltyShoot;
+  const bool set_play = state_ == kPlaying && set_play_ != 0 &&
+                        (set_play_ != last_set_play_ || kicking != last_kicking_team_);
+  if (kick_off || set_play) {
+    using PassRule = BehaviourConfig::PassRule;
+    const bool own_kick_off_or_kick_in =
+        our_kick_ && (set_play_ == 0 || set_play_ == static_cast<int>(gc::SetPlay::KickIn));
+    const bool holds =
+        set_play_ != static_cast<int>(gc::SetPlay::PenaltyKick) &&
+        (config_.pass_after_restart == PassRule::EveryRestart ||
+         (config_.pass_after_restart == PassRule::OwnKickOffAndKickIn && own_kick_off_or_kick_in));
+    pass_rule_since_ = holds ? now_ : -1.0;
+  }
+  last_set_play_ = set_play_;
+  last_kicking_team_ = kicking;
   was_penalised_ = penalised_;
   last_state_ = state_;
+}
+
+bool SoccerBehaviour::passRequired() const {
+  // A teammate's claim in the restart's first second may be the role it held before.
+  constexpr double kRolesSettle = 1.0;  // s
+  return pass_rule_since_ >= 0.0 && mate_struck_at_ < pass_rule_since_ + kRolesSettle;
+}
+
+std::optional<SoccerBehaviour::Vec2> SoccerBehaviour::passTarget() {
+  const double own_area =
+      -field_.halfLength() + (field_.penalty_area ? field_.penalty_area->length : 0.0);
+  std::optional<Vec2> best, kept;
+  int best_player = 0;
+  for (const Teammate& m : mates_) {
+    if (m.data.player == goalkeeper_number_ || penalisedInGame(m.data.player) || m.data.fallen ||
+        !heardRecently(m.received, now_, config_))
+      continue;
+    const Vec2 t = toOwn(m.data.x, m.data.y);
+    const double d = std::hypot(t.x - ball_.x, t.y - ball_.y);
+    if (d < config_.pass_min || d > config_.pass_max || t.x < own_area) continue;
+    if (m.data.player == pass_to_) kept = t;
+    if (!best || t.x > best->x) {
+      best = t;
+      best_player = m.data.player;
+    }
+  }
+  if (kept) return kept;
+  pass_to_ = best_player;
+  return best;
 }
 
 bool SoccerBehaviour::takeMotionRestart() {
@@ -424,6 +491,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
 void SoccerBehaviour::receive(const TeamMessageIn& message, double time) {
   const auto d = decodeTeamMessage(message.data);
   if (!d || d->player == player_) return;
+  if (d->role == Role::Striker) mate_struck_at_ = std::max(mate_struck_at_, time);
   for (Teammate& m : mates_)
     if (m.data.player == d->player) {
       m.data = *d;
@@ -579,6 +647,10 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
     const double to_line = field_.halfLength() - ball_.x;
     aim = 0.5 * (std::atan2(inside - ball_.y, to_line) + std::atan2(-inside - ball_.y, to_line));
   }
+  // After a restart whose goal the rules refuse unless another robot of the team played the
+  // ball: to a teammate (without one in reach, at the goal all the same).
+  if (!penalty && passRequired())
+    if (const auto to = passTarget()) aim = std::atan2(to->y - ball_.y, to->x - ball_.x);
   // A ball near the own goal line: aimed at the opponent goal, the place behind it to line up
   // from lay inside the own goal. A K1 goalkeeper clearing a ball 4 cm before its line went
   // in there and, with its sightings of the ball 0.2 m either side of the line, turned round

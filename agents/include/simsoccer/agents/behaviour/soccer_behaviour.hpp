@@ -124,6 +124,16 @@ struct BehaviourConfig {
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
   // down at the whistle fell again and again through the half-time).
   bool sit_when_finished = true;
+  // After which restarts a goal counts only once another robot of the team has played the ball
+  // (the rule book's; agents cannot read it from the GameState): then the striker passes to a
+  // teammate instead of shooting, until a teammate has taken the striker role since its own
+  // kick (the agents' sign that the teammate played the ball). EveryRestart: the SPL's
+  // two-touch rule (after any restart but a penalty kick, both teams); OwnKickOffAndKickIn: the
+  // HSL's (no goal straight from the own kick-off or kick-in); None: shoot at once.
+  enum class PassRule : uint8_t { None, EveryRestart, OwnKickOffAndKickIn };
+  PassRule pass_after_restart = PassRule::None;
+  // m: a pass goes to a teammate this far from the ball (the nearest and the farthest).
+  double pass_min = 1.0, pass_max = 4.0;
 };
 // Reads configs/agents/*.yaml; throws engine::ConfigError (file, key, reason).
 BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file);
@@ -294,6 +304,18 @@ class SoccerBehaviour {
   double penalty_aim_ = 0.5;  // -1..1: right post .. left post
   Pose2 target_;
   bool arrived_ = false;  // at the walk target: standing
+  // The pass rule (BehaviourConfig::pass_after_restart): since when it holds for this team
+  // (-1: it does not), when a teammate last said it strikes (its message's time).
+  double pass_rule_since_ = -1.0, mate_struck_at_ = -1e9;
+  int last_set_play_ = 0, last_kicking_team_ = -1;
+  int pass_to_ = 0;  // the teammate the last pass was aimed at (player number; 0: none)
+  // The rule holds and no teammate has said it strikes since the restart (with this robot's
+  // touch, that teammate's makes two).
+  bool passRequired() const;
+  // Where a pass goes (own frame): the teammate in play furthest up the field among those
+  // pass_min to pass_max from the ball and outside the own penalty area (the one aimed at
+  // before while it still is one); none if there is none.
+  std::optional<Vec2> passTarget();
 };
 
 }  // namespace simsoccer::agents
