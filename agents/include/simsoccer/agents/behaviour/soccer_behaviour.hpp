@@ -15,8 +15,10 @@
 // The GameState rules: stand in Initial, Standby, Set and while penalised;
 // sit in Finished (not in the penalty shoot-out, where Finished is between
 // kicks); walk to the kick-off formation in Ready; play in Playing, keeping
-// clear of the ball while the opponents take a kick-off or set play.
-// Without a GameState (a simulator without a referee publishes none) it plays.
+// clear of the ball while the opponents take a kick-off or set play, and passing after a
+// restart whose goal the rules refuse until another robot of the team played the ball
+// (BehaviourConfig::pass_after_restart). Without a GameState (a simulator without a referee
+// publishes none) it plays.
 //
 // Frames: "own" is the field frame turned so that this team attacks +x.
 #pragma once
