@@ -163,6 +163,12 @@ TEST(TeamMessage, RoundTripsWithinTheSplBudgetSize) {
   EXPECT_EQ(back->player, 4);
   EXPECT_EQ(back->role, Role::Defender);
   EXPECT_TRUE(back->fallen && back->ball_seen);
+  EXPECT_FALSE(back->kicked);
+  d.kicked = true;
+  d.fallen = false;
+  const auto kicked = agents::decodeTeamMessage(agents::encodeTeamMessage(d));
+  ASSERT_TRUE(kicked);
+  EXPECT_TRUE(kicked->kicked && kicked->ball_seen && !kicked->fallen);
   EXPECT_NEAR(back->x, d.x, 1e-3);
   EXPECT_NEAR(back->yaw, d.yaw, 1e-3);
   EXPECT_NEAR(back->ball_y, d.ball_y, 1e-3);
@@ -217,6 +223,7 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("pass_after_restart: sometimes"), "pass_after_restart");
   EXPECT_EQ(refusedAt("pass_distance: [2, 1]"), "pass_distance");  // nearest beyond farthest
   EXPECT_EQ(refusedAt("pass_distance: [0, 3]"), "pass_distance");
+  EXPECT_EQ(refusedAt("pass_distance: [1]"), "pass_distance");
   EXPECT_EQ(refusedAt("pass_distance: [1, 3]"), "");
 }
 
@@ -291,44 +298,52 @@ TEST(SoccerBehaviour, UnderTheHslRulesItLeavesThePenaltyAreaAtTheOpponentsGoalKi
 
 // Where the rules refuse a goal straight from a restart, the striker passes: the SPL's two-touch
 // rule after any restart but a penalty kick, the HSL's after the own kick-off and kick-in. It
-// aims at the teammate furthest up the field within reach (not one too near, too far or in the
-// own penalty area), and at the goal again once a teammate has taken the striker role since.
+// aims at the teammate furthest up the field within reach (not one too near, too far, deeper
+// than the own penalty area or the goalkeeper), and at the goal again once a teammate has said
+// it kicked the ball since the restart (a message about the restart before does not count).
 TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   const auto f = field();
-  const double bx = 1.0, by = 2.9;  // the ball at a kick-in, near the left touchline
-  // A teammate's message: its pose, role and striker bid.
-  const auto message = [](int player, double x, double y, Role role) {
+  const double bx = 1.0, by = 2.9;  // the ball at a kick-in, near the left touchline (own frame)
+  // A teammate's message: its pose (own frame, turned into the field's by `sign`), role, kick.
+  const auto message = [](int player, double x, double y, Role role, bool kicked, double sign) {
     agents::TeamMessageData d;
     d.player = player;
-    d.x = x;
-    d.y = y;
+    d.x = sign * x;
+    d.y = sign * y;
     d.role = role;
+    d.kicked = kicked;
     d.cost = 3.0;
     return agents::TeamMessageIn{player, 0, agents::encodeTeamMessage(d)};
   };
-  // The striker's aim (its target's yaw) at `play` taken by `kicking` (a team number), after
-  // the teammates' messages; with `mate_strikes`, teammate 5 claims the striker role 2 s later.
+  enum class Mate { None, KickedBefore, KickedSince };
+  // The striker's aim (its target's yaw, own frame) at `play` taken by `kicking` (a team
+  // number), attacking +x (team 0's number first) or -x; `mate`: teammate 3 says it kicked,
+  // 0.3 s before the restart or 1.5 s after it.
   const auto aim = [&](const agents::BehaviourConfig& cfg, protocol::gc::SetPlay play, int kicking,
-                       bool mate_strikes) {
+                       Mate mate, bool attack_minus_x = false) {
+    const double sign = attack_minus_x ? -1.0 : 1.0;
     agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
-    b.receive(message(3, 0.5, 0.5, Role::Supporter), 0.4);   // 2.45 m away: the pass
-    b.receive(message(4, 1.5, 2.2, Role::Defender), 0.4);    // 0.86 m: too near
-    b.receive(message(5, -3.5, 2.0, Role::Defender), 0.4);   // in the own penalty area
-    b.receive(message(6, 4.2, -1.5, Role::Supporter), 0.4);  // 5.5 m: too far
-    auto g = gameState(3);
+    b.receive(message(3, 0.5, 0.5, Role::Supporter, false, sign), 0.2);   // 2.45 m: the pass
+    b.receive(message(4, 1.5, 2.2, Role::Defender, false, sign), 0.2);    // 0.86 m: too near
+    b.receive(message(5, -2.9, 2.6, Role::Defender, false, sign), 0.2);   // 3.91 m: in the area
+    b.receive(message(6, 4.2, -1.5, Role::Supporter, false, sign), 0.2);  // 5.5 m: too far
+    b.receive(message(1, 2.0, 1.0, Role::Goalkeeper, false, sign), 0.2);  // the goalkeeper
+    if (mate == Mate::KickedBefore)
+      b.receive(message(3, 0.5, 0.5, Role::Supporter, true, sign), 0.2);
+    auto g = gameState(3, attack_minus_x ? 2 : 1);
     g.kicking_team = static_cast<uint8_t>(kicking);
     g.set_play = static_cast<uint8_t>(play);
     g.secondary_time = 30;
-    auto p = seeing(0.2, 2.3, 0.0, bx, by, 0.5);
+    auto p = seeing(sign * 0.2, sign * 2.3, attack_minus_x ? M_PI : 0.0, sign * bx, sign * by, 0.5);
     agents::SoccerBehaviour::Input in;
     in.time = 0.5;
     in.perception = &p;
     in.game = &g;
     updateSeeing(b, in);
-    if (mate_strikes) {
-      b.receive(message(5, -3.5, 2.0, Role::Striker), 2.5);
-      in.time = 2.6;
-      p = seeing(0.2, 2.3, 0.0, bx, by, 2.6);
+    if (mate == Mate::KickedSince) {
+      b.receive(message(3, 0.5, 0.5, Role::Supporter, true, sign), 2.0);
+      in.time = 2.1;
+      p = seeing(sign * 0.2, sign * 2.3, attack_minus_x ? M_PI : 0.0, sign * bx, sign * by, 2.1);
       b.update(in);
     }
     return b.target().yaw;
@@ -344,19 +359,66 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
       agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_hsl_small.yaml");
   agents::BehaviourConfig direct = spl;
   direct.pass_after_restart = agents::BehaviourConfig::PassRule::None;
-  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, false), to_mate, 1e-6);
-  EXPECT_NEAR(aim(spl, SetPlay::GoalKick, 1, false), to_mate, 1e-6);
-  EXPECT_NEAR(aim(spl, SetPlay::CornerKick, 2, false), to_mate, 1e-6);  // theirs: both teams
-  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, true), at_goal, 1e-6);       // a teammate played it
-  EXPECT_NEAR(aim(spl, SetPlay::PenaltyKick, 1, false), at_goal, 1e-6);
-  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 1, false), to_mate, 1e-6);
-  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 2, false), at_goal,
-              1e-6);  // their kick-in: the rule is theirs
-  EXPECT_NEAR(aim(hsl, SetPlay::GoalKick, 1, false), at_goal, 1e-6);
-  EXPECT_NEAR(aim(direct, SetPlay::KickIn, 1, false), at_goal, 1e-6);
-  // The own kick-off under the HSL's rules, as Playing follows Set: the pass.
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::None), to_mate, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::None, true), to_mate, 1e-6);  // attacking -x
+  EXPECT_NEAR(aim(spl, SetPlay::GoalKick, 1, Mate::None), to_mate, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::CornerKick, 2, Mate::None), to_mate, 1e-6);  // theirs: both teams
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::KickedSince), at_goal, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::KickedBefore), to_mate, 1e-6);
+  EXPECT_NEAR(aim(spl, SetPlay::PenaltyKick, 1, Mate::None), at_goal, 1e-6);
+  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 1, Mate::None), to_mate, 1e-6);
+  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 2, Mate::None), at_goal, 1e-6);  // theirs: their rule
+  EXPECT_NEAR(aim(hsl, SetPlay::GoalKick, 1, Mate::None), at_goal, 1e-6);
+  EXPECT_NEAR(aim(direct, SetPlay::KickIn, 1, Mate::None), at_goal, 1e-6);
+
+  // A robot that kicks after the restart says so at once, and only then.
+  {
+    agents::SoccerBehaviour b(spl, f, 0, 1, 2, Role::Striker, 1);
+    auto g = gameState(3);
+    g.kicking_team = 1;
+    g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
+    g.secondary_time = 30;
+    // Lined up on the pass: the ball before its left foot, facing teammate 3.
+    const double c = std::cos(to_mate), s = std::sin(to_mate);
+    const double x = bx - (c * 0.17 - s * 0.05), y = by - (s * 0.17 + c * 0.05);
+    b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 0.2);
+    auto p = seeing(x - 0.5, y, to_mate, bx, by, 0.5);  // 0.5 m short of it first
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    const auto decoded = [&](double t) {
+      in.time = t;
+      const auto out = b.outgoing(in);
+      return out ? agents::decodeTeamMessage(*out) : std::nullopt;
+    };
+    EXPECT_NE(updateSeeing(b, in).kind, MotionRequest::Kind::Kick);
+    const auto first = decoded(0.5);
+    ASSERT_TRUE(first);
+    EXPECT_FALSE(first->kicked);
+    EXPECT_FALSE(decoded(0.51));  // paced
+    p = seeing(x, y, to_mate, bx, by, 0.6);
+    in.time = 0.6;
+    EXPECT_EQ(b.update(in).kind, MotionRequest::Kind::Kick);
+    const auto news = decoded(0.85);  // 0.35 s after the last: news goes out at once
+    ASSERT_TRUE(news);
+    EXPECT_TRUE(news->kicked);
+    // A set play given again (its time starts over) is a new restart: not kicked since.
+    g.secondary_time = 20;
+    in.time = 0.9;
+    b.update(in);
+    g.secondary_time = 30;
+    in.time = 1.0;
+    b.update(in);
+    const auto again = decoded(1.2);
+    ASSERT_TRUE(again);
+    EXPECT_FALSE(again->kicked);
+  }
+
+  // The own kick-off under the HSL's rules, as Playing follows Set: the pass, back to a
+  // teammate (from the own half beyond the centre circle, never back towards the own goal).
   agents::SoccerBehaviour b(hsl, f, 0, 1, 2, Role::Striker, 1);
-  b.receive(message(3, -1.2, -1.0, Role::Supporter), 0.4);
+  b.receive(message(3, -1.2, -1.0, Role::Supporter, false, 1.0), 0.4);
   auto g = gameState(2);  // Set
   g.kicking_team = 1;
   auto p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.5);
@@ -371,6 +433,16 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.6);
   b.update(in);
   EXPECT_NEAR(b.target().yaw, std::atan2(-1.0, -1.2), 1e-6);
+  agents::SoccerBehaviour deep(spl, f, 0, 1, 2, Role::Striker, 1);
+  deep.receive(message(3, -2.2, 1.5, Role::Supporter, false, 1.0), 0.4);  // behind the ball
+  g = gameState(3);
+  g.kicking_team = 1;
+  g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
+  g.secondary_time = 30;
+  p = seeing(-1.8, 2.3, 0.0, -1.0, 2.9, 0.6);
+  updateSeeing(deep, in);
+  EXPECT_NEAR(deep.target().yaw,
+              0.5 * (std::atan2(inside - 2.9, 5.5) + std::atan2(-inside - 2.9, 5.5)), 1e-6);
 }
 
 TEST(SoccerBehaviour, TheNearestFieldPlayerStrikesTheOthersDefendAndSupport) {

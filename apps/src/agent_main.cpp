@@ -8,20 +8,19 @@
 
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <thread>
-#include <vector>
 
 #include "agent_help.hpp"
 #include "agent_modes.hpp"
 #include "agent_soccer.hpp"
 #include "cli.hpp"
 #include "simsoccer/agents/agent_client.hpp"
-#include "simsoccer/agents/motion/walk_engine.hpp"
+#include "simsoccer/agents/soccer_agent.hpp"
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/robots/robot_model.hpp"
 

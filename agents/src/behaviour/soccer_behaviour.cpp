@@ -252,12 +252,13 @@ BehaviourConfig loadKickApproach(const std::filesystem::path& file) {
 }
 
 std::vector<uint8_t> encodeTeamMessage(const TeamMessageData& d) {
-  std::vector<uint8_t> b{'S',
-                         'S',
-                         1,
-                         static_cast<uint8_t>(d.player),
-                         static_cast<uint8_t>(d.role),
-                         static_cast<uint8_t>((d.fallen ? 1 : 0) | (d.ball_seen ? 2 : 0))};
+  std::vector<uint8_t> b{
+      'S',
+      'S',
+      1,
+      static_cast<uint8_t>(d.player),
+      static_cast<uint8_t>(d.role),
+      static_cast<uint8_t>((d.fallen ? 1 : 0) | (d.ball_seen ? 2 : 0) | (d.kicked ? 4 : 0))};
   put16(b, static_cast<int>(std::lround(d.x * 1000)));
   put16(b, static_cast<int>(std::lround(d.y * 1000)));
   put16(b, static_cast<int>(std::lround(wrap(d.yaw) * 1000)));
@@ -275,6 +276,7 @@ std::optional<TeamMessageData> decodeTeamMessage(const std::vector<uint8_t>& b) 
   d.role = static_cast<Role>(b[4]);
   d.fallen = b[5] & 1;
   d.ball_seen = b[5] & 2;
+  d.kicked = b[5] & 4;
   d.x = get16s(b, 6) / 1000.0;
   d.y = get16s(b, 8) / 1000.0;
   d.yaw = get16s(b, 10) / 1000.0;
@@ -352,11 +354,13 @@ void SoccerBehaviour::readGame(const Input& in) {
     obstacles_.clear();
   }
   // A restart starts the pass rule over (BehaviourConfig::pass_after_restart): a kick-off or a
-  // drop ball as Playing follows Set, a set play as it is awarded. A penalty kick scores directly.
+  // drop ball as Playing follows Set, a set play as it is awarded (another set play or team, or
+  // the same again: its time to take it starts over). A penalty kick scores directly.
   const int kicking = g.kicking_team == kNoTeam ? -1 : g.kicking_team;
   const bool kick_off = state_ == kPlaying && last_state_ == kSet && phase_ != kPhasePenaltyShoot;
   const bool set_play = state_ == kPlaying && set_play_ != 0 &&
-                        (set_play_ != last_set_play_ || kicking != last_kicking_team_);
+                        (set_play_ != last_set_play_ || kicking != last_kicking_team_ ||
+                         g.secondary_time > last_secondary_time_);
   if (kick_off || set_play) {
     using PassRule = BehaviourConfig::PassRule;
     const bool own_kick_off_or_kick_in =
@@ -366,17 +370,20 @@ void SoccerBehaviour::readGame(const Input& in) {
         (config_.pass_after_restart == PassRule::EveryRestart ||
          (config_.pass_after_restart == PassRule::OwnKickOffAndKickIn && own_kick_off_or_kick_in));
     pass_rule_since_ = holds ? now_ : -1.0;
+    pass_to_ = 0;
   }
   last_set_play_ = set_play_;
   last_kicking_team_ = kicking;
+  last_secondary_time_ = g.secondary_time;
   was_penalised_ = penalised_;
   last_state_ = state_;
 }
 
 bool SoccerBehaviour::passRequired() const {
-  // A teammate's claim in the restart's first second may be the role it held before.
-  constexpr double kRolesSettle = 1.0;  // s
-  return pass_rule_since_ >= 0.0 && mate_struck_at_ < pass_rule_since_ + kRolesSettle;
+  // A message sent before its sender read the restart tells of the restart before: the
+  // simulator relays messages within a period or two.
+  constexpr double kRelay = 0.1;  // s
+  return pass_rule_since_ >= 0.0 && mate_kicked_at_ < pass_rule_since_ + kRelay;
 }
 
 std::optional<SoccerBehaviour::Vec2> SoccerBehaviour::passTarget() {
@@ -391,6 +398,7 @@ std::optional<SoccerBehaviour::Vec2> SoccerBehaviour::passTarget() {
     const Vec2 t = toOwn(m.data.x, m.data.y);
     const double d = std::hypot(t.x - ball_.x, t.y - ball_.y);
     if (d < config_.pass_min || d > config_.pass_max || t.x < own_area) continue;
+    if (ball_.x < -field_.centre_circle_radius && t.x < ball_.x) continue;  // back to the goal
     if (m.data.player == pass_to_) kept = t;
     if (!best || t.x > best->x) {
       best = t;
@@ -491,7 +499,7 @@ void SoccerBehaviour::updateBall(const Input& in) {
 void SoccerBehaviour::receive(const TeamMessageIn& message, double time) {
   const auto d = decodeTeamMessage(message.data);
   if (!d || d->player == player_) return;
-  if (d->role == Role::Striker) mate_struck_at_ = std::max(mate_struck_at_, time);
+  if (d->kicked) mate_kicked_at_ = std::max(mate_kicked_at_, time);
   for (Teammate& m : mates_)
     if (m.data.player == d->player) {
       m.data = *d;
@@ -579,14 +587,18 @@ std::optional<std::vector<uint8_t>> SoccerBehaviour::outgoing(const Input& in) {
   // message every second, a team spent a fifth of its play with no striker
   // or with two.
   constexpr double kRoleNewsGap = 0.25;  // s
-  const bool news = (role_ == Role::Striker) != (last_sent_role_ == Role::Striker);
+  // So is a kick after a restart under the pass rule: the teammates pass until they hear of it.
+  const bool news = (role_ == Role::Striker) != (last_sent_role_ == Role::Striker) ||
+                    kickedSinceRestart() != last_sent_kicked_;
   if (in.time - last_sent_ < (news ? kRoleNewsGap : interval)) return std::nullopt;
   last_sent_ = in.time;
   last_sent_role_ = role_;
+  last_sent_kicked_ = kickedSinceRestart();
   TeamMessageData d;
   d.player = player_;
   d.role = role_;
   d.fallen = in.fallen();
+  d.kicked = last_sent_kicked_;
   const Vec2 f = fromOwn(self_.x, self_.y);
   d.x = f.x;
   d.y = f.y;
@@ -703,6 +715,7 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
                                   wrap(aim - self_.yaw), penalty ? 0.1 : 0.15, kick_foot_);
   if (r.kind == MotionRequest::Kind::Kick) {
     kick_commit_until_ = now_ + 1.5;
+    kicked_at_ = now_;
     return r;
   }
   target_ = {ball_.x, ball_.y, aim};

@@ -1,7 +1,7 @@
 // simsoccer bench motion: the agents' motion on an empty field, in this
 // process on the real physics, through the same period pipeline as a match.
-// The options; the trials are one file each,
-// the table is motion_table.cpp, the one-trial modes single_trial.cpp.
+// The options; the trials are one file each, the table is motion_table.cpp, the one-trial
+// modes single_trial.cpp.
 #include <cstdio>
 
 #include "cli.hpp"

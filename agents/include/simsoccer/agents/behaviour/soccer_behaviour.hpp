@@ -128,10 +128,10 @@ struct BehaviourConfig {
   bool sit_when_finished = true;
   // After which restarts a goal counts only once another robot of the team has played the ball
   // (the rule book's; agents cannot read it from the GameState): then the striker passes to a
-  // teammate instead of shooting, until a teammate has taken the striker role since its own
-  // kick (the agents' sign that the teammate played the ball). EveryRestart: the SPL's
-  // two-touch rule (after any restart but a penalty kick, both teams); OwnKickOffAndKickIn: the
-  // HSL's (no goal straight from the own kick-off or kick-in); None: shoot at once.
+  // teammate instead of shooting, until a teammate says (TeamMessageData::kicked) that it kicked
+  // the ball since the restart. EveryRestart: the SPL's two-touch rule (after any restart but a
+  // penalty kick, both teams); OwnKickOffAndKickIn: the HSL's (no goal straight from the own
+  // kick-off or kick-in); None: shoot at once.
   enum class PassRule : uint8_t { None, EveryRestart, OwnKickOffAndKickIn };
   PassRule pass_after_restart = PassRule::None;
   // m: a pass goes to a teammate this far from the ball (the nearest and the farthest).
@@ -149,6 +149,8 @@ struct TeamMessageData {
   int player = 0;
   Role role = Role::Auto;
   bool fallen = false, ball_seen = false;
+  // It kicked the ball since the last restart under the pass rule (pass_after_restart).
+  bool kicked = false;
   double x = 0, y = 0, yaw = 0;   // m, m, rad
   double ball_x = 0, ball_y = 0;  // m
   double ball_age = 0;            // s since seen
@@ -307,16 +309,22 @@ class SoccerBehaviour {
   Pose2 target_;
   bool arrived_ = false;  // at the walk target: standing
   // The pass rule (BehaviourConfig::pass_after_restart): since when it holds for this team
-  // (-1: it does not), when a teammate last said it strikes (its message's time).
-  double pass_rule_since_ = -1.0, mate_struck_at_ = -1e9;
-  int last_set_play_ = 0, last_kicking_team_ = -1;
+  // (-1: it does not); when this robot last kicked; when a message last came from a teammate
+  // that kicked since (the time it was received).
+  double pass_rule_since_ = -1.0, kicked_at_ = -1e9, mate_kicked_at_ = -1e9;
+  int last_set_play_ = 0, last_kicking_team_ = -1, last_secondary_time_ = 0;
   int pass_to_ = 0;  // the teammate the last pass was aimed at (player number; 0: none)
-  // The rule holds and no teammate has said it strikes since the restart (with this robot's
-  // touch, that teammate's makes two).
+  bool last_sent_kicked_ = false;  // TeamMessageData::kicked in the last message sent
+  bool kickedSinceRestart() const {
+    return pass_rule_since_ >= 0.0 && kicked_at_ >= pass_rule_since_;
+  }
+  // The rule holds and no teammate has said it kicked the ball since the restart (with this
+  // robot's touch, that teammate's makes two).
   bool passRequired() const;
   // Where a pass goes (own frame): the teammate in play furthest up the field among those
-  // pass_min to pass_max from the ball and outside the own penalty area (the one aimed at
-  // before while it still is one); none if there is none.
+  // pass_min to pass_max from the ball, not deeper than the own penalty area and, from a ball in
+  // the own half beyond the centre circle, not behind the ball (the one aimed at before while it
+  // still is one); none if there is none.
   std::optional<Vec2> passTarget();
 };
 
