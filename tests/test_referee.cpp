@@ -94,6 +94,16 @@ void openPlay(world::World& w, Referee& ref) {
   ref.game().ballFree();
 }
 
+// From open play, team 1 (robot 2) plays the ball last over the left touchline: team 0's kick-in.
+void kickInForTeam0(world::World& w, Referee& ref) {
+  openPlay(w, ref);
+  touchBall(w, ref, 2);
+  putBall(w, 1.2, w.field().halfWidth() + 0.2);
+  run(w, ref, 0.02);
+  ASSERT_EQ(ref.game().currentSetPlay(), gc::SetPlay::KickIn);
+  ASSERT_EQ(ref.game().kickingTeam(), 0);
+}
+
 // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other
 // 0.35 m apart, the ball 0.3 m to their side.
 void faceOff(world::World& w) {
@@ -933,12 +943,8 @@ TEST(Referee, HslKickInIsIndirectAndAFreeKickIntoTheOwnGoalIsACorner) {
   Referee ref(w, hslRules(), test::twoTeams(), 0);
   Game& g = ref.game();
   const auto& f = w.field();
-  openPlay(w, ref);
-  touchBall(w, ref, 2);  // team 1 plays the ball last over the touchline: team 0's kick-in
-  putBall(w, 1.2, f.halfWidth() + 0.2);
-  run(w, ref, 0.02);
-  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
-  ASSERT_EQ(g.kickingTeam(), 0);
+  kickInForTeam0(w, ref);
+  if (HasFatalFailure()) return;
   touchBall(w, ref, 1);  // team 0 takes it and scores straight from it
   putBall(w, f.halfLength() + 0.3, 0.0);
   run(w, ref, 0.02);
@@ -1036,11 +1042,8 @@ TEST(Referee, HslRestartsEndWithTheirKickAndStartAgainWithEachAward) {
     Referee ref(w, hslRules(), test::twoTeams(), 0);
     Game& g = ref.game();
     const auto& f = w.field();
-    openPlay(w, ref);
-    touchBall(w, ref, 2);
-    putBall(w, 1.2, f.halfWidth() + 0.2);
-    run(w, ref, 0.02);
-    ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::KickIn);
+    kickInForTeam0(w, ref);
+    if (HasFatalFailure()) return;
     run(w, ref, 45.1);
     ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::None);
     touchBall(w, ref, 1);

@@ -107,9 +107,9 @@ double Referee::depthInAvoidance(RobotId r) const {
     return 0.0;
   const Vec3 p = world_.torsoPose(r).translation();
   if (play == gc::SetPlay::GoalKick && game_.rules().goal_kick_clears_penalty_area) {
-    if (!inOwnArea(kicking, p, penaltyArea())) return 0.0;
-    const double x = teamSign(kicking) * p.x();  // towards the kicking team's goal
     const fields::AreaSize a = penaltyArea();
+    if (!inOwnArea(kicking, p, a)) return 0.0;
+    const double x = teamSign(kicking) * p.x();  // towards the kicking team's goal
     return std::min(x - (world_.field().halfLength() - a.length), 0.5 * a.width - std::abs(p.y()));
   }
   return freeKickDistance() - (world_.ballState().pose.translation() - p).head<2>().norm();
