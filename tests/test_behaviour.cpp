@@ -225,6 +225,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("pass_distance: [0, 3]"), "pass_distance");
   EXPECT_EQ(refusedAt("pass_distance: [1]"), "pass_distance");
   EXPECT_EQ(refusedAt("pass_distance: [1, 3]"), "");
+  EXPECT_EQ(refusedAt("back_off_speed: 0"), "back_off_speed");
+  EXPECT_EQ(refusedAt("back_off_speed: 0.2"), "");
 }
 
 TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
@@ -293,6 +295,88 @@ TEST(SoccerBehaviour, UnderTheHslRulesItLeavesThePenaltyAreaAtTheOpponentsGoalKi
     } else {
       EXPECT_GT(b.target().x, front) << b.target().x;
     }
+  }
+  // A K1 on the M-Field by its goal line, 2.1 m from the ball: the nearer edge (the side) lies
+  // past the ball, within keep_clear of it; it leaves by the front, 0.3 m out, as it stands.
+  const auto m = fields::loadFieldModel(test::sourceDir() / "fields/hsl_m.yaml");
+  const auto k1 = agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_k1.yaml");
+  const double mx = m.halfLength() - m.goal_area->length, my = 0.5 * m.goal_area->width;
+  const double x = m.halfLength() - 0.025, y = 0.1;
+  ASSERT_GT(std::hypot(x - mx, y - my), k1.keep_clear);
+  ASSERT_LT(0.5 * m.penalty_area->width - y, x - (m.halfLength() - m.penalty_area->length));
+  agents::SoccerBehaviour b(k1, m, 0, 1, 4, Role::Striker, 1);
+  auto g = gameState(3);
+  g.kicking_team = 2;
+  g.set_play = static_cast<uint8_t>(protocol::gc::SetPlay::GoalKick);
+  g.secondary_time = 30;
+  auto p = seeing(x, y, M_PI, mx, my, 0.5);
+  agents::SoccerBehaviour::Input in;
+  in.time = 0.5;
+  in.perception = &p;
+  in.game = &g;
+  EXPECT_EQ(updateSeeing(b, in).kind, MotionRequest::Kind::Walk);
+  EXPECT_NEAR(b.target().x, m.halfLength() - m.penalty_area->length - 0.4, 1e-6);
+  EXPECT_NEAR(b.target().y, y, 1e-6);
+}
+
+// At the opponents' free kick a robot inside keep_clear steps backwards out of it, facing the ball,
+// at back_off_speed, to just beyond it straight away from the ball; from beyond it, it stands
+// where its role would take it inside. (Walking to a place as far again from the ball turned a
+// K1 1.2 m from it round for 5 s, and stepped one 0.4 m from it back at 0.1 m/s.)
+TEST(SoccerBehaviour, AtTheOpponentsFreeKickItStepsBackOutOfTheCircleFacingTheBall) {
+  const auto f = field();
+  for (const bool k1 : {false, true}) {
+    const auto cfg =
+        k1 ? agents::loadBehaviourConfig(test::sourceDir() / "configs/agents/soccer_k1.yaml")
+           : soccerConfig();
+    EXPECT_EQ(cfg.back_off_speed, k1 ? 0.25 : 0.1);
+    const double out = cfg.keep_clear + 0.1;
+    auto g = gameState(3);
+    g.kicking_team = 2;  // the opponents
+    g.set_play = static_cast<uint8_t>(protocol::gc::SetPlay::PushingFreeKick);
+    g.secondary_time = 30;
+    // (distance from the ball, the robot's yaw, the side it stands on): facing the ball, or
+    // turned away from it, from in front of it and from beside it.
+    struct Case {
+      double distance, yaw_off_ball;
+      int side;
+    };
+    for (const Case c : {Case{0.4, 0.0, 0}, Case{0.75 * cfg.keep_clear, 0.0, 0}, Case{0.6, 0.0, 1},
+                         Case{0.5, 2.5, 0}}) {
+      agents::SoccerBehaviour b(cfg, f, 0, 1, 4, Role::Striker, 1);
+      const double bx = 1.0, by = 0.5;
+      const double dir = c.side == 0 ? M_PI : -0.5 * M_PI;  // from the ball to the robot
+      const double x = bx + c.distance * std::cos(dir), y = by + c.distance * std::sin(dir);
+      const double yaw = dir + M_PI + c.yaw_off_ball;
+      auto p = seeing(x, y, yaw, bx, by, 0.5);
+      agents::SoccerBehaviour::Input in;
+      in.time = 0.5;
+      in.perception = &p;
+      in.game = &g;
+      const MotionRequest r = updateSeeing(b, in);
+      const std::string what = std::to_string(k1) + " " + std::to_string(c.distance) + " " +
+                               std::to_string(c.yaw_off_ball) + " " + std::to_string(c.side);
+      ASSERT_EQ(r.kind, MotionRequest::Kind::Walk) << what;
+      EXPECT_NEAR(b.target().x, bx + out * std::cos(dir), 1e-6) << what;
+      EXPECT_NEAR(b.target().y, by + out * std::sin(dir), 1e-6) << what;
+      if (c.yaw_off_ball == 0.0) {
+        // Facing the ball: straight backwards at the back-off speed, no turning round.
+        EXPECT_NEAR(r.forward, -cfg.back_off_speed, 1e-6) << what;
+        EXPECT_NEAR(r.left, 0.0, 1e-6) << what;
+        EXPECT_NEAR(r.turn, 0.0, 1e-6) << what;
+      } else {
+        EXPECT_GT(r.forward, 0.0) << what;  // the way out lies ahead of it
+        EXPECT_LT(r.turn, 0.0) << what;     // turning back to the ball
+      }
+    }
+    // Beyond keep_clear, with its role's place (behind the ball) inside: it stands.
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 4, Role::Striker, 1);
+    auto p = seeing(1.0 - cfg.keep_clear - 0.2, 0.5, 0.0, 1.0, 0.5, 0.5);
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    EXPECT_EQ(updateSeeing(b, in).kind, MotionRequest::Kind::Stand) << k1;
   }
 }
 

@@ -76,6 +76,9 @@ struct BehaviourConfig {
   int ball_new_sightings = 3;
   double team_ball_time = 4.0;         // s: a teammate's sighting counts this long
   double keep_clear = 0.8;             // m from the ball at the opponents' kick-off / set play
+  // m/s: stepping backwards, facing the ball, out of keep_clear (the rules' referee allows 0.2
+  // m/s after the first 5 s; other walks step back at 0.1 at the most).
+  double back_off_speed = 0.1;
   // At the opponents' goal kick, out of their whole penalty area as well (the HSL's rule).
   bool goal_kick_clears_penalty_area = false;
   double message_interval = 1.0;       // s, the fastest; slower when the budget asks
@@ -226,8 +229,11 @@ class SoccerBehaviour {
   std::optional<Crossing> ballCrossing(double x, double speed) const;
   // Beyond turn_beyond (m) the robot turns towards the target and walks; nearer it steps there
   // as it faces (target.yaw, or the ball).
+  // Nearer, it steps backwards at max_backward (m/s) at the most.
   static constexpr double kTurnToWalkBeyond = 0.5;  // m
-  MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = kTurnToWalkBeyond);
+  static constexpr double kMaxBackward = 0.1;       // m/s
+  MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = kTurnToWalkBeyond,
+                       double max_backward = kMaxBackward);
   void avoidRobots(MotionRequest& r) const;
   // The head's angles into r; `planned` is the walk before avoidRobots.
   void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
