@@ -535,6 +535,32 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   EXPECT_EQ(g.kickingTeam(), 1);
 }
 
+// At a pushing free kick the ball stays where it is: one still rolling at the call (kicked just
+// before it) is stopped there, not left to roll on to the opponents.
+TEST(Referee, APushingFreeKickIsTakenWhereTheRollingBallWasAtTheFoul) {
+  world::World w(twoVsTwo());
+  Referee ref(w, test::splRules(), test::twoTeams(), 0);
+  Game& g = ref.game();
+  openPlay(w, ref);
+  faceOff(w);
+  run(w, ref, 0.5);
+  engine::RigidBodyState rolling = w.ballState();
+  rolling.linear_velocity = Vec3(0.0, 1.5, 0.0);  // along the touchline, away from the two
+  const Vec3 start = rolling.pose.translation();
+  for (int i = 0; i < 200 && g.penalty(0, 2) == gc::Penalty::None; ++i) {
+    w.setBallState(rolling);  // kicked again and again from the same place
+    w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
+    run(w, ref, 0.01);
+  }
+  ASSERT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
+  ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
+  run(w, ref, 1.0);
+  EXPECT_LT(w.ballState().linear_velocity.norm(), 0.05);
+  EXPECT_LT((w.ballState().pose.translation() - start).head<2>().norm(), 0.05)
+      << w.ballState().pose.translation().transpose();
+  EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
+}
+
 // Robot 1 is driven at `velocity` (world frame), and robot 3 at `other_velocity`, for
 // up to `seconds`, until robot 1 is penalised.
 void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double seconds,

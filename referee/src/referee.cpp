@@ -12,6 +12,11 @@ namespace simsoccer::referee {
 using engine::Vec3;
 using world::RobotId;
 
+namespace {
+// m/s: a slower ball lies still (a resting ball's contact jitter is far below it).
+constexpr double kBallAtRest = 0.05;
+}  // namespace
+
 Referee::Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,
                  int kick_off_team, const RefereeConfig& config)
     : world_(world), config_(config), game_(rules, teams, kick_off_team) {
@@ -255,6 +260,12 @@ void Referee::checkPushing() {
         const bool in_area =
             inOwnArea(ip.team, world_.torsoPose(victim).translation(), penaltyArea());
         game_.setPlay(in_area ? gc::SetPlay::PenaltyKick : gc::SetPlay::PushingFreeKick, iv.team);
+        // The ball stays where it is; one still rolling (kicked just before the call) is stopped
+        // there. Left rolling, a K1's kick just before the call carried it 6 m on to two
+        // opponents, who were called too close to it while the kicking team's touch, before the
+        // award, could not end the free kick (K1 5 v 5 seed 57).
+        if (!in_area && world_.ballState().linear_velocity.head<2>().norm() > kBallAtRest)
+          placeBall(ball.x(), ball.y());
         set_play_ball_ = ball;
         set_play_step_ = world_.stepCount();
       }
