@@ -228,8 +228,7 @@ class SoccerBehaviour {
   // `speed` m/s, crosses the line at own-frame x; nothing if it does not.
   std::optional<Crossing> ballCrossing(double x, double speed) const;
   // Beyond turn_beyond (m) the robot turns towards the target and walks; nearer it steps there
-  // as it faces (target.yaw, or the ball).
-  // Nearer, it steps backwards at max_backward (m/s) at the most.
+  // as it faces (target.yaw, or the ball), backwards at max_backward (m/s) at the most.
   static constexpr double kTurnToWalkBeyond = 0.5;  // m
   static constexpr double kMaxBackward = 0.1;       // m/s
   MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = kTurnToWalkBeyond,
