@@ -499,6 +499,30 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
     EXPECT_FALSE(again->kicked);
   }
 
+  // After its own kick (the pass) the kicker passes again under the SPL's rule (two of the team's
+  // robots), and plays on under the HSL's (any other robot's touch counts, an opponent's too).
+  for (const bool under_hsl : {false, true}) {
+    agents::SoccerBehaviour b(under_hsl ? hsl : spl, f, 0, 1, 2, Role::Striker, 1);
+    auto g = gameState(3);
+    g.kicking_team = 1;
+    g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
+    g.secondary_time = 30;
+    const double c = std::cos(to_mate), s = std::sin(to_mate);
+    const double x = bx - (c * 0.17 - s * 0.05), y = by - (s * 0.17 + c * 0.05);
+    b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 0.2);
+    auto p = seeing(x, y, to_mate, bx, by, 0.5);
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    ASSERT_EQ(updateSeeing(b, in).kind, MotionRequest::Kind::Kick) << under_hsl;
+    b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 2.0);  // it did not kick
+    p = seeing(x - 0.5, y, to_mate, bx, by, 2.5);  // after the kick, 0.5 m short of the ball
+    in.time = 2.5;
+    b.update(in);
+    EXPECT_NEAR(b.target().yaw, under_hsl ? at_goal : to_mate, 1e-6) << under_hsl;
+  }
+
   // The own kick-off under the HSL's rules, as Playing follows Set: the pass, back to a
   // teammate (from the own half beyond the centre circle, never back towards the own goal).
   agents::SoccerBehaviour b(hsl, f, 0, 1, 2, Role::Striker, 1);

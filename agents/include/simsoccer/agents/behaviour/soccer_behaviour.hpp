@@ -134,7 +134,9 @@ struct BehaviourConfig {
   // teammate instead of shooting, until a teammate says (TeamMessageData::kicked) that it kicked
   // the ball since the restart. EveryRestart: the SPL's two-touch rule (after any restart but a
   // penalty kick, both teams); OwnKickOffAndKickIn: the HSL's (no goal straight from the own
-  // kick-off or kick-in); None: shoot at once.
+  // kick-off or kick-in: another robot of either team must touch the ball), where the restart's
+  // kick itself is the pass (an opponent's touch counts, and the agents see no touches); None:
+  // shoot at once.
   enum class PassRule : uint8_t { None, EveryRestart, OwnKickOffAndKickIn };
   PassRule pass_after_restart = PassRule::None;
   // m: a pass goes to a teammate this far from the ball (the nearest and the farthest).
@@ -324,7 +326,7 @@ class SoccerBehaviour {
     return pass_rule_since_ >= 0.0 && kicked_at_ >= pass_rule_since_;
   }
   // The rule holds and no teammate has said it kicked the ball since the restart (with this
-  // robot's touch, that teammate's makes two).
+  // robot's touch, that teammate's makes two); under the HSL's rule, nor has this robot.
   bool passRequired() const;
   // Where a pass goes (own frame): the teammate in play furthest up the field among those
   // pass_min to pass_max from the ball, not deeper than the own penalty area and, from a ball in
