@@ -455,16 +455,22 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   EXPECT_NEAR(aim(hsl, SetPlay::GoalKick, 1, Mate::None), at_goal, 1e-6);
   EXPECT_NEAR(aim(direct, SetPlay::KickIn, 1, Mate::None), at_goal, 1e-6);
 
-  // A robot that kicks after the restart says so at once, and only then.
-  {
-    agents::SoccerBehaviour b(spl, f, 0, 1, 2, Role::Striker, 1);
+  // The own kick-in; lined up on the pass at (x, y): the ball before its left foot, facing
+  // teammate 3.
+  const auto ourKickIn = [] {
     auto g = gameState(3);
     g.kicking_team = 1;
     g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
     g.secondary_time = 30;
-    // Lined up on the pass: the ball before its left foot, facing teammate 3.
-    const double c = std::cos(to_mate), s = std::sin(to_mate);
-    const double x = bx - (c * 0.17 - s * 0.05), y = by - (s * 0.17 + c * 0.05);
+    return g;
+  };
+  const double x = bx - (std::cos(to_mate) * 0.17 - std::sin(to_mate) * 0.05);
+  const double y = by - (std::sin(to_mate) * 0.17 + std::cos(to_mate) * 0.05);
+
+  // A robot that kicks after the restart says so at once, and only then.
+  {
+    agents::SoccerBehaviour b(spl, f, 0, 1, 2, Role::Striker, 1);
+    auto g = ourKickIn();
     b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 0.2);
     auto p = seeing(x - 0.5, y, to_mate, bx, by, 0.5);  // 0.5 m short of it first
     agents::SoccerBehaviour::Input in;
@@ -503,12 +509,7 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   // robots), and plays on under the HSL's (any other robot's touch counts, an opponent's too).
   for (const bool under_hsl : {false, true}) {
     agents::SoccerBehaviour b(under_hsl ? hsl : spl, f, 0, 1, 2, Role::Striker, 1);
-    auto g = gameState(3);
-    g.kicking_team = 1;
-    g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
-    g.secondary_time = 30;
-    const double c = std::cos(to_mate), s = std::sin(to_mate);
-    const double x = bx - (c * 0.17 - s * 0.05), y = by - (s * 0.17 + c * 0.05);
+    auto g = ourKickIn();
     b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 0.2);
     auto p = seeing(x, y, to_mate, bx, by, 0.5);
     agents::SoccerBehaviour::Input in;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "referee_support.hpp"
 #include "simsoccer/referee/referee.hpp"
@@ -110,6 +111,14 @@ void faceOff(world::World& w) {
   w.placeRobot(1, 0.45, -2.0, 0.0);
   w.placeRobot(3, 0.8, -2.0, M_PI);
   putBall(w, 0.7, -1.7);
+}
+
+// In open play, team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other, the
+// ball beside them, for 0.5 s.
+void faceOffInOpenPlay(world::World& w, Referee& ref) {
+  openPlay(w, ref);
+  faceOff(w);
+  run(w, ref, 0.5);
 }
 
 }  // namespace
@@ -513,10 +522,7 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   world::World w(twoVsTwo());
   Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
-  openPlay(w, ref);
-  // Team 0 player 2 (robot 1) and team 1 player 2 (robot 3) face each other.
-  faceOff(w);
-  run(w, ref, 0.5);
+  faceOffInOpenPlay(w, ref);
   // Standing face to face without driving: nothing.
   EXPECT_EQ(g.penalty(0, 2), gc::Penalty::None);
   // Robot 1 drives into robot 3.
@@ -535,23 +541,34 @@ TEST(Referee, PushingAnOpponentNearTheBallIsAFoul) {
   EXPECT_EQ(g.kickingTeam(), 1);
 }
 
+// Robot 1 is driven at `velocity` (world frame), and robot 3 at `other_velocity`, for
+// up to `seconds`, until robot 1 is penalised.
+// `each_period` runs before each period's drive.
+void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double seconds,
+               const Vec3& other_velocity = Vec3::Zero(),
+               const std::function<void()>& each_period = {}) {
+  for (int i = 0;
+       i < static_cast<int>(seconds / 0.01) && ref.game().penalty(0, 2) == gc::Penalty::None; ++i) {
+    if (each_period) each_period();
+    w.physics().setRootVelocity(w.robot(1).body, velocity, Vec3::Zero());
+    if (!other_velocity.isZero())
+      w.physics().setRootVelocity(w.robot(3).body, other_velocity, Vec3::Zero());
+    run(w, ref, 0.01);
+  }
+}
+
 // At a pushing free kick the ball stays where it is: one still rolling at the call (kicked just
 // before it) is stopped there, not left to roll on to the opponents.
 TEST(Referee, APushingFreeKickIsTakenWhereTheRollingBallWasAtTheFoul) {
   world::World w(twoVsTwo());
   Referee ref(w, test::splRules(), test::twoTeams(), 0);
   Game& g = ref.game();
-  openPlay(w, ref);
-  faceOff(w);
-  run(w, ref, 0.5);
+  faceOffInOpenPlay(w, ref);
   engine::RigidBodyState rolling = w.ballState();
   rolling.linear_velocity = Vec3(0.0, 1.5, 0.0);  // along the touchline, away from the two
   const Vec3 start = rolling.pose.translation();
-  for (int i = 0; i < 200 && g.penalty(0, 2) == gc::Penalty::None; ++i) {
-    w.setBallState(rolling);  // kicked again and again from the same place
-    w.physics().setRootVelocity(w.robot(1).body, Vec3(0.3, 0.0, 0.0), Vec3::Zero());
-    run(w, ref, 0.01);
-  }
+  // Kicked again and again from the same place while robot 1 drives into robot 3.
+  driveInto(w, ref, Vec3(0.3, 0.0, 0.0), 2.0, Vec3::Zero(), [&] { w.setBallState(rolling); });
   ASSERT_EQ(g.penalty(0, 2), gc::Penalty::PlayerPushing);
   ASSERT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
   run(w, ref, 1.0);
@@ -559,19 +576,6 @@ TEST(Referee, APushingFreeKickIsTakenWhereTheRollingBallWasAtTheFoul) {
   EXPECT_LT((w.ballState().pose.translation() - start).head<2>().norm(), 0.05)
       << w.ballState().pose.translation().transpose();
   EXPECT_EQ(g.currentSetPlay(), gc::SetPlay::PushingFreeKick);
-}
-
-// Robot 1 is driven at `velocity` (world frame), and robot 3 at `other_velocity`, for
-// up to `seconds`, until robot 1 is penalised.
-void driveInto(world::World& w, Referee& ref, const Vec3& velocity, double seconds,
-               const Vec3& other_velocity = Vec3::Zero()) {
-  for (int i = 0;
-       i < static_cast<int>(seconds / 0.01) && ref.game().penalty(0, 2) == gc::Penalty::None; ++i) {
-    w.physics().setRootVelocity(w.robot(1).body, velocity, Vec3::Zero());
-    if (!other_velocity.isZero())
-      w.physics().setRootVelocity(w.robot(3).body, other_velocity, Vec3::Zero());
-    run(w, ref, 0.01);
-  }
 }
 
 // Robots 1 and 3 placed at (x, y, yaw), the ball at `ball`, robot 1 driven at
