@@ -450,7 +450,12 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::KickedSince), at_goal, 1e-6);
   EXPECT_NEAR(aim(spl, SetPlay::KickIn, 1, Mate::KickedBefore), to_mate, 1e-6);
   EXPECT_NEAR(aim(spl, SetPlay::PenaltyKick, 1, Mate::None), at_goal, 1e-6);
-  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 1, Mate::None), to_mate, 1e-6);
+  // The HSL's rule counts an opponent's touch: with the goal beyond the farthest pass (4.55 m
+  // away, 4 m) a pass back (teammate 3 is behind the ball) does not pay: up the field.
+  EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 1, Mate::None), at_goal, 1e-6);
+  agents::BehaviourConfig hsl_far = hsl;
+  hsl_far.pass_max = 5.0;
+  EXPECT_NEAR(aim(hsl_far, SetPlay::KickIn, 1, Mate::None), to_mate, 1e-6);
   EXPECT_NEAR(aim(hsl, SetPlay::KickIn, 2, Mate::None), at_goal, 1e-6);  // theirs: their rule
   EXPECT_NEAR(aim(hsl, SetPlay::GoalKick, 1, Mate::None), at_goal, 1e-6);
   EXPECT_NEAR(aim(direct, SetPlay::KickIn, 1, Mate::None), at_goal, 1e-6);
@@ -508,7 +513,7 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
   // After its own kick (the pass) the kicker passes again under the SPL's rule (two of the team's
   // robots), and plays on under the HSL's (any other robot's touch counts, an opponent's too).
   for (const bool under_hsl : {false, true}) {
-    agents::SoccerBehaviour b(under_hsl ? hsl : spl, f, 0, 1, 2, Role::Striker, 1);
+    agents::SoccerBehaviour b(under_hsl ? hsl_far : spl, f, 0, 1, 2, Role::Striker, 1);
     auto g = ourKickIn();
     b.receive(message(3, 0.5, 0.5, Role::Supporter, false, 1.0), 0.2);
     auto p = seeing(x, y, to_mate, bx, by, 0.5);
@@ -524,31 +529,41 @@ TEST(SoccerBehaviour, AfterARestartWhoseGoalNeedsASecondRobotTheStrikerPasses) {
     EXPECT_NEAR(b.target().yaw, under_hsl ? at_goal : to_mate, 1e-6) << under_hsl;
   }
 
-  // The own kick-off under the HSL's rules, as Playing follows Set: the pass, back to a
-  // teammate (from the own half beyond the centre circle, never back towards the own goal).
-  agents::SoccerBehaviour b(hsl, f, 0, 1, 2, Role::Striker, 1);
-  b.receive(message(3, -1.2, -1.0, Role::Supporter, false, 1.0), 0.4);
-  auto g = gameState(2);  // Set
-  g.kicking_team = 1;
-  auto p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.5);
+  // The own kick-off under the HSL's rules, as Playing follows Set: the goal is 4.5 m away,
+  // beyond the farthest pass: to the teammate ahead of the ball, or with none, at the goal; with
+  // a farther pass, back to the teammate behind it.
+  const auto kickOffAim = [&](const agents::BehaviourConfig& cfg, double mate_x) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+    b.receive(message(3, mate_x, -1.0, Role::Supporter, false, 1.0), 0.4);
+    auto g = gameState(2);  // Set
+    g.kicking_team = 1;
+    auto p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.5);
+    agents::SoccerBehaviour::Input in;
+    in.time = 0.5;
+    in.perception = &p;
+    in.game = &g;
+    updateSeeing(b, in);
+    g.state = 3;
+    g.secondary_time = 10;
+    in.time = 0.6;
+    p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.6);
+    b.update(in);
+    return b.target().yaw;
+  };
+  EXPECT_NEAR(kickOffAim(hsl, 1.5), std::atan2(-1.0, 1.5), 1e-6);
+  EXPECT_NEAR(kickOffAim(hsl, -1.2), 0.0, 1e-6);
+  EXPECT_NEAR(kickOffAim(hsl_far, -1.2), std::atan2(-1.0, -1.2), 1e-6);
+  auto g = gameState(3);
   agents::SoccerBehaviour::Input in;
-  in.time = 0.5;
+  auto p = seeing(-1.8, 2.3, 0.0, -1.0, 2.9, 0.6);
+  in.time = 0.6;
   in.perception = &p;
   in.game = &g;
-  updateSeeing(b, in);
-  g.state = 3;
-  g.secondary_time = 10;
-  in.time = 0.6;
-  p = seeing(-0.3, 0.0, 0.0, 0.0, 0.0, 0.6);
-  b.update(in);
-  EXPECT_NEAR(b.target().yaw, std::atan2(-1.0, -1.2), 1e-6);
   agents::SoccerBehaviour deep(spl, f, 0, 1, 2, Role::Striker, 1);
   deep.receive(message(3, -2.2, 1.5, Role::Supporter, false, 1.0), 0.4);  // behind the ball
-  g = gameState(3);
   g.kicking_team = 1;
   g.set_play = static_cast<uint8_t>(SetPlay::KickIn);
   g.secondary_time = 30;
-  p = seeing(-1.8, 2.3, 0.0, -1.0, 2.9, 0.6);
   updateSeeing(deep, in);
   EXPECT_NEAR(deep.target().yaw,
               0.5 * (std::atan2(inside - 2.9, 5.5) + std::atan2(-inside - 2.9, 5.5)), 1e-6);

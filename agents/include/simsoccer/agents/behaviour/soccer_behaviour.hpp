@@ -330,7 +330,8 @@ class SoccerBehaviour {
   bool passRequired() const;
   // Where a pass goes (own frame): the teammate in play furthest up the field among those
   // pass_min to pass_max from the ball, not deeper than the own penalty area and, from a ball in
-  // the own half beyond the centre circle, not behind the ball (the one aimed at before while it
+  // the own half beyond the centre circle, not behind the ball; under the HSL's rule with the
+  // goal beyond pass_max from the ball, only one ahead of it (the one aimed at before while it
   // still is one); none if there is none.
   std::optional<Vec2> passTarget();
 };
