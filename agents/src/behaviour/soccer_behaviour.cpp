@@ -390,9 +390,7 @@ bool SoccerBehaviour::passRequired() const {
   constexpr double kRelay = 0.1;  // s
   if (pass_rule_since_ < 0.0 || mate_kicked_at_ >= pass_rule_since_ + kRelay) return false;
   // The HSL's rule counts any other robot's touch, an opponent's too, which the agents do not
-  // see: the restart's kick is the pass, and after it the team plays on. Passing until a
-  // teammate kicked, the K1s scored 3 goals in play in 64 games (K1 5 v 5, --half 60), 12 before
-  // they passed, none of them refused.
+  // see: the restart's kick is the pass (passTarget), and after it the team plays on.
   return !(config_.pass_after_restart == BehaviourConfig::PassRule::OwnKickOffAndKickIn &&
            kickedSinceRestart());
 }
@@ -404,7 +402,7 @@ std::optional<SoccerBehaviour::Vec2> SoccerBehaviour::passTarget() {
   // kick might go straight in: with the goal beyond the farthest pass the ball goes up the field
   // instead, to a teammate ahead of it or at the goal. From the kick-off spot, where all
   // teammates stand behind the ball, K1s passing back scored 3 goals in play in 64 games (K1
-  // 5 v 5, --half 60), kicking at the goal 12, none refused.
+  // 5 v 5, --half 60); kicking at the goal, 9 and 12 own goals, one refused.
   const bool ahead_only =
       config_.pass_after_restart == BehaviourConfig::PassRule::OwnKickOffAndKickIn &&
       std::hypot(field_.halfLength() - ball_.x, ball_.y) > config_.pass_max;
