@@ -507,7 +507,9 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   world::World w(sc);
   sim::Simulation simulation(w, sim::SimulationConfig{});
   booster::EndpointConfig ec;
-  ec.robots = {served(0, 176)};
+  // A domain of its own: on ShootKicksTheBallInFrontOfTheK1's (176), which ctest may run beside
+  // it, this endpoint (in prepare mode) answered that test's GetMode once.
+  ec.robots = {served(0, 180)};
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
   booster::Endpoint endpoint(w, ec);
   simulation.addSource(endpoint);
@@ -520,7 +522,7 @@ TEST(BoosterEndpoint, HeadCameraImagesGoOutAsRos2Images) {
   });
   // A ROS 2 subscriber's default reader: reliable (image_transport's and create_subscription's
   // default, Booster's own vision node's); a best-effort writer never matched it.
-  net::Participant participant(loopback(176));
+  net::Participant participant(loopback(180));
   net::QosSpec q;
   q.reliable = true;
   q.depth = 64;
