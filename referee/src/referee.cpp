@@ -12,11 +12,6 @@ namespace simsoccer::referee {
 using engine::Vec3;
 using world::RobotId;
 
-namespace {
-// m/s: a slower ball lies still (a resting ball's contact jitter is far below it).
-constexpr double kBallAtRest = 0.05;
-}  // namespace
-
 Referee::Referee(world::World& world, const RuleBook& rules, const std::array<TeamSetup, 2>& teams,
                  int kick_off_team, const RefereeConfig& config)
     : world_(world), config_(config), game_(rules, teams, kick_off_team) {
@@ -264,7 +259,7 @@ void Referee::checkPushing() {
         // there. Left rolling, a K1's kick just before the call carried it 6 m on to two
         // opponents, who were called too close to it while the kicking team's touch, before the
         // award, could not end the free kick (K1 5 v 5 seed 57).
-        if (!in_area && world_.ballState().linear_velocity.head<2>().norm() > kBallAtRest)
+        if (!in_area && world_.ballState().linear_velocity.head<2>().norm() >= config_.ball_stopped_speed)
           placeBall(ball.x(), ball.y());
         set_play_ball_ = ball;
         set_play_step_ = world_.stepCount();
