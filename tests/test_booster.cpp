@@ -458,11 +458,11 @@ TEST(BoosterEndpoint, OneRobotPerDomain) {
   world::World w(s);
   booster::EndpointConfig ec;
   ec.dds_config = test::sourceDir() / "configs/dds/loopback.xml";
-  ec.robots = {served(0, 171), served(1, 171)};
+  ec.robots = {served(0, 181), served(1, 181)};
   EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
-  ec.robots = {served(0, 171), served(0, 172)};
+  ec.robots = {served(0, 181), served(0, 182)};
   EXPECT_THROW(booster::Endpoint(w, ec), std::invalid_argument);
-  ec.robots = {served(0, 171), served(1, 172)};
+  ec.robots = {served(0, 181), served(1, 182)};
   EXPECT_NO_THROW(booster::Endpoint(w, ec));
 }
 
