@@ -157,3 +157,27 @@ TEST(Ball, BouncesOnTheCarpet) {
   EXPECT_GT(rebound, 0.06);
   EXPECT_LT(rebound, 0.2);
 }
+
+// The field's estimate of how far a rolled ball goes (the match records judge by it whether a
+// shot was going in when a defender touched it) against the real roll: within 5 %.
+TEST(Ball, TheFieldsRollingEstimateMatchesTheRealRoll) {
+  const world::World w(emptyField());
+  const fields::FieldModel& f = w.field();
+  for (const double speed : {1.0, 2.0, 3.0}) {
+    const double estimate = f.ballRollingDistance(speed);
+    const double real = rollDistance(speed);
+    std::printf("ball rolled at %.0f m/s: stops after %.2f m, estimated %.2f m\n", speed, real,
+                estimate);
+    EXPECT_NEAR(estimate, real, 0.05 * real);
+  }
+  // At the goal at +x from 2 m out: in at 2 m/s (rolls about 4.5 m), short at 1 m/s; wide of
+  // the posts, away from the goal, or at rest, no goal; the other way, the goal at -x.
+  const double x = f.halfLength() - 2.0;
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, 2.0, 0.0), 1);
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, 1.0, 0.0), 0);
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, 2.0, 0.8), 0);  // crosses the line 0.83 m aside
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, 2.0, 0.6), 1);  // 0.62 m aside: inside the posts
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, -2.0, 0.0), 0);
+  EXPECT_EQ(f.goalReachedByRollingBall(x, 0.0, 0.0, 0.0), 0);
+  EXPECT_EQ(f.goalReachedByRollingBall(-x, 0.2, -2.0, 0.0), -1);
+}

@@ -144,6 +144,7 @@ TEST(CliApp, BadOptionsAreRefusedBeforeAnythingRuns) {
       {"replay " + (dir / "x.log").string() + " --video out.gif",
        "--video out.gif: .mp4, .avi or .png"},
       {"replay " + (dir / "x.log").string() + " --from -5", "--from must be >= 0"},
+      {"replay " + (dir / "x.log").string() + " --touches", "--touches goes with --physics"},
       {"bench physics --robots 1000", "the benchmark's grid holds at most"},
       {"serve " + src + "/configs/scenarios/k1_3v3.yaml --booster-domain 9",
        "--booster-domain, --booster-lockstep and --booster-netns go with --booster"},

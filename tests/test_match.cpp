@@ -20,6 +20,8 @@
 #include "simsoccer/engine/config.hpp"
 #include "simsoccer/match/agent_process.hpp"
 #include "simsoccer/match/match_runner.hpp"
+#include "simsoccer/match/match_session.hpp"
+#include "simsoccer/sim/simulation.hpp"
 #include "simsoccer/world/match_log.hpp"
 #include "test_support.hpp"
 
@@ -177,6 +179,72 @@ TEST(MatchConfig, EachShippedMatchPlaysOnItsLeaguesField) {
     const match::MatchSession session(mc, 1);
     EXPECT_EQ(session.world().scenario().field_file.filename().string(), field) << config;
   }
+}
+
+// Who a goal is credited to, as football counts it. A shot going in that a defender touches on
+// its way is the shooter's goal, in off that defender (the summary's deflected_by); a ball the
+// defender sends into its own goal is an own goal. The referee's own rules keep the last touch.
+// Real physics and contacts: the attacker touches the ball with its toe, the ball rolls at the
+// goal (or lies still), and the defender's toe touches it as it goes in.
+TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) {
+  auto play = [](double speed_before) {
+    match::MatchConfig mc = match::loadMatchConfig(test::sourceDir() / "configs/match_2v2.yaml");
+    match::MatchSession session(mc, 1);
+    sim::Simulation sim(session.world());
+    session.attach(sim);
+    world::World& w = session.world();
+    for (int i = 0; i < 20000 && session.game().state() != referee::gc::State::Playing; ++i) sim.period();
+    EXPECT_EQ(session.game().state(), referee::gc::State::Playing);
+    const int defender = 1;  // its robots are ids 2 and 3; the attacker is team 0's player 2
+    const double side = defender == session.game().leftTeam() ? -1.0 : 1.0;
+    const double line = side * w.field().halfLength();
+    auto toe = [&](world::RobotId r) {
+      const int foot = w.robot(r).model->body->linkIndex("LFoot");
+      return engine::Vec3(w.linkPose(r, foot) * engine::Vec3(0.12, 0.0075, -0.02));
+    };
+    auto putBall = [&](const engine::Vec3& at, double vx) {
+      engine::RigidBodyState b;
+      b.pose = engine::Pose::Identity();
+      b.pose.translation() = engine::Vec3(at.x(), at.y(), 0.05);
+      b.linear_velocity = engine::Vec3(vx, 0, 0);
+      w.setBallState(b);
+    };
+    // The attacker 2.5 m out, the defender 0.6 m from its line, both facing the goal; the
+    // goalkeeper out of the way.
+    w.placeRobot(1, line - side * 2.5, 1.0, side > 0 ? 0.0 : M_PI);
+    w.placeRobot(2, line - side * 2.5, -2.0, side > 0 ? 0.0 : M_PI);
+    w.placeRobot(3, line - side * 0.6, 0.0, side > 0 ? 0.0 : M_PI);
+    putBall(toe(1), 0.0);
+    for (int i = 0; i < 5; ++i) sim.period();
+    EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 1u);
+    // The ball 1.5 m out, rolling at the goal (or lying still) for a period...
+    putBall(engine::Vec3(line - side * 1.5, 0.0, 0.0), side * speed_before);
+    sim.period();
+    // ...then at the defender's toe, going in at 2 m/s.
+    putBall(toe(3), side * 2.0);
+    for (int i = 0; i < 200 && session.goals().empty(); ++i) sim.period();
+    EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 3u);
+    EXPECT_EQ(session.game().score(0), 1);
+    return session.goals();
+  };
+  const auto shot = play(3.0);
+  ASSERT_EQ(shot.size(), 1u);
+  EXPECT_EQ(shot[0].team, 0);
+  EXPECT_EQ(shot[0].scorer, 2);
+  EXPECT_FALSE(shot[0].own_goal);
+  EXPECT_EQ(shot[0].deflected_by, 2);
+  // Too slow to reach the line (the SPL ball slows at about 0.45 m/s^2): the defender's goal.
+  const auto slow = play(0.8);
+  ASSERT_EQ(slow.size(), 1u);
+  EXPECT_TRUE(slow[0].own_goal);
+  EXPECT_EQ(slow[0].scorer, 2);
+  EXPECT_EQ(slow[0].deflected_by, 0);
+  const auto still = play(0.0);
+  ASSERT_EQ(still.size(), 1u);
+  EXPECT_EQ(still[0].team, 0);
+  EXPECT_EQ(still[0].scorer, 2);
+  EXPECT_TRUE(still[0].own_goal);
+  EXPECT_EQ(still[0].deflected_by, 0);
 }
 
 // A match's agents read the motions and gaits beside its config (a copied configs tree plays its
@@ -387,6 +455,20 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
     EXPECT_NE(out.find("every state hash equal"), std::string::npos) << out;
   }
   EXPECT_TRUE(std::filesystem::exists(still));
+  // The re-run's ball touches: the kick-off's first, each by a robot of the game, in time order.
+  const std::string touches = test::runCommand(
+      kBin + " replay " + (m.dir / "match.log").string() + " --physics --touches", status);
+  ASSERT_EQ(status, 0) << touches;
+  const std::regex touch_line(R"(\s+([0-9.]+) s  touch  team ([01]) player ([12])  (\w+))");
+  int count = 0;
+  double last = 0;
+  for (std::sregex_iterator i(touches.begin(), touches.end(), touch_line), end; i != end; ++i) {
+    const double at = std::stod((*i)[1].str());
+    EXPECT_GE(at, last) << touches;
+    last = at;
+    ++count;
+  }
+  EXPECT_GE(count, 1) << touches;
   // A part of the log as a video: 2 s at 25 fps.
   const auto part = m.dir / "part.mp4";
   test::runCommand(kBin + " replay " + (m.dir / "match.log").string() + " --video " +

@@ -139,9 +139,14 @@ int match(int argc, char** argv, int first) {
               session.world().time() / std::max(r.wall, 1e-9),
               static_cast<double>(r.log_bytes) / 1e6);
   if (r.aborted) std::printf("stopped: %s\n", r.abort_reason.c_str());
-  for (const auto& goal : session.goals())
+  for (const auto& goal : session.goals()) {
+    std::string how = goal.own_goal ? " (own goal)" : "";
+    if (goal.deflected_by > 0)
+      how = " (in off team " + std::to_string(1 - goal.team) + " player " +
+            std::to_string(goal.deflected_by) + ")";
     std::printf("  goal %7.1f s  team %d  player %d%s\n", goal.time, goal.team, goal.scorer,
-                goal.own_goal ? " (own goal)" : "");
+                how.c_str());
+  }
   if (r.video_frames > 0)
     std::printf("video: %s, %d frames\n", (o.out / "match.mp4").string().c_str(), r.video_frames);
   for (const match::LolaResult& l : r.lola)

@@ -1,6 +1,8 @@
 // simsoccer replay: what a match log holds, its video, and a re-run of the
 // game through the same period pipeline with the recorded commands.
+#include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "cli.hpp"
 #include "simsoccer/match/match_session.hpp"
@@ -12,8 +14,8 @@ namespace simsoccer::apps {
 namespace {
 
 const char* kReplayHelp =
-    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics [--threads N]]\n"
-    "                            [--events]\n"
+    "usage: simsoccer replay LOG [--video FILE] [--from T] [--to T] [--physics [--threads N]\n"
+    "                            [--touches]] [--events]\n"
     "\n"
     "Reads a match log: prints what it holds (--events: every referee event); --video renders the "
     "spectator camera over\n"
@@ -21,14 +23,16 @@ const char* kReplayHelp =
     "--from); --physics re-runs the\n"
     "game through the physics and the referee with the recorded commands and checks every\n"
     "period's state hash against the log (exit status 1 on the first difference); --threads:\n"
-    "with N solver threads instead of the scenario's (the hashes must not change). A log cut\n"
+    "with N solver threads instead of the scenario's (the hashes must not change); --touches:\n"
+    "every touch of the ball in [--from, --to] s as the re-run finds it (who, with which link,\n"
+    "where the ball was), as the referee judges who touched it last. A log cut\n"
     "inside a block (its writer was killed) is read up to the cut, with a warning and exit\n"
     "status 4.\n";
 
 }  // namespace
 
 int replay(int argc, char** argv, int first) {
-  const Options opt(argc, argv, first, {"help", "physics", "events"},
+  const Options opt(argc, argv, first, {"help", "physics", "events", "touches"},
                     {"video", "from", "to", "threads"});
   if (opt.help(kReplayHelp)) return 0;
   if (opt.positional().size() != 1) throw UsageError("expected one match log");
@@ -46,6 +50,8 @@ int replay(int argc, char** argv, int first) {
   const int threads = opt.wholeNumber("threads", 0, 1, world::PhysicsConfig::kMaxThreads);
   if (opt.has("threads") && !opt.flag("physics"))
     throw UsageError("--threads goes with --physics (the solver threads of the re-run)");
+  if (opt.flag("touches") && !opt.flag("physics"))
+    throw UsageError("--touches goes with --physics (the touches are the re-run's contacts)");
   world::MatchLogReader reader(file);
   const auto& h = reader.header().values;
   int frames = 0;
@@ -95,6 +101,28 @@ int replay(int argc, char** argv, int first) {
     sim::LogSource recorded(file);
     simulation.addSource(recorded);
     int checked = 0;
+    const world::World& world = session.world();
+    // A touch is a robot's contact with the ball after 0.1 s without one of its own (or after
+    // another robot's): the referee's last touch, period by period.
+    const auto gap = static_cast<uint64_t>(std::lround(0.1 / world.scenario().physics.dt));
+    std::optional<world::BallTouch> shown;
+    auto printTouch = [&] {
+      const auto& touch = world.lastBallTouch();
+      if (!opt.flag("touches") || !touch) return;
+      const double at = static_cast<double>(touch->step) * world.scenario().physics.dt;
+      const bool fresh = !shown || touch->robot != shown->robot || touch->step > shown->step + gap;
+      if (shown && touch->step == shown->step) return;
+      if (fresh && at >= from && at <= to) {
+        const world::RobotInfo& r = world.robot(touch->robot);
+        const engine::RigidBodyState ball_state = world.ballState();
+        const auto& ball = ball_state.pose.translation();
+        std::printf("  %8.2f s  touch  team %d player %d  %-16s  ball at %.2f %.2f m\n",
+                    at, r.team, r.number,
+                    r.model->body->links.at(static_cast<size_t>(touch->link)).name.c_str(),
+                    ball.x(), ball.y());
+      }
+      shown = touch;
+    };
     // Period after period as long as the log has one and every hash agrees.
     sim::RunLoop(simulation, sim::Pacing::Lockstep)
         .run([&] { return (status != 0 && status != 4) || !recorded.next(); }, -1,
@@ -105,6 +133,7 @@ int replay(int argc, char** argv, int first) {
                  status = 1;
                  return;
                }
+               printTouch();
                ++checked;
              });
     if (recorded.refused() > 0)

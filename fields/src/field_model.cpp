@@ -1,5 +1,6 @@
 #include "simsoccer/fields/field_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "simsoccer/engine/config.hpp"
@@ -39,6 +40,33 @@ void buildMarkings(FieldModel& f) {
 }
 
 }  // namespace
+
+double FieldModel::ballRollingDeceleration() const {
+  const double g = 9.81;
+  return 5.0 * ball.material.rolling_friction * carpet.friction * g / (7.0 * ball.radius);
+}
+
+int FieldModel::goalReachedByRollingBall(double x, double y, double vx, double vy) const {
+  if (vx == 0.0) return 0;
+  const int side = vx > 0 ? 1 : -1;
+  // Wholly over the goal line: the line's far edge plus the radius (as the referee counts).
+  const double line_x = side * (halfLength() + 0.5 * line_width + ball.radius);
+  const double to_line = (line_x - x) / vx;  // s at the present speed, along the path
+  if (to_line < 0) return 0;
+  const double y_at_line = y + vy * to_line;
+  if (std::abs(y_at_line) > 0.5 * goal.inner_width - ball.radius) return 0;
+  const double speed = std::hypot(vx, vy);
+  const double path = speed * to_line;
+  return ballRollingDistance(speed) >= path ? side : 0;
+}
+
+double FieldModel::ballRollingDistance(double speed) const {
+  const double a = ballRollingDeceleration();
+  const double k = -std::log(1.0 - std::clamp(ball.linear_damping, 0.0, 0.999));
+  if (k < 1e-9) return speed * speed / (2.0 * a);
+  if (a <= 0.0) return speed / k;
+  return speed / k - a / (k * k) * std::log1p(k * speed / a);
+}
 
 bool FieldModel::onCarpet(double x, double y) const {
   return std::abs(x) <= halfLength() + border && std::abs(y) <= halfWidth() + border;

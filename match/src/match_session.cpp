@@ -370,19 +370,38 @@ void MatchSession::record(const sim::PeriodRecord& p) {
   // Possession: the team with a robot nearest the ball, within 0.5 m.
   const int team = nearest[0] <= nearest[1] ? 0 : 1;
   if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
+  // A touch by the other team's robot than the last toucher's: was the ball, just before it
+  // (at the end of the period before), rolling into a goal?
+  const auto& touch = world_->lastBallTouch();
+  if (touch && (!seen_touch_ || touch->step != seen_touch_->step)) {
+    const auto& info = world_->robot(touch->robot);
+    if (last_toucher_.team >= 0 && info.team != last_toucher_.team) {
+      before_other_team_ = last_toucher_;
+      const engine::Vec3 b = ball_before_.pose.translation();
+      heading_for_goal_ = world_->field().goalReachedByRollingBall(
+          b.x(), b.y(), ball_before_.linear_velocity.x(), ball_before_.linear_velocity.y());
+    }
+    last_toucher_ = {info.team, info.number};
+    seen_touch_ = touch;
+  }
   for (const sim::Event& e : *p.events) {
     if (e.type != sim::EventType::Goal) continue;
     Goal goal{world_->time(), e.team, e.player, false};
-    if (goal.scorer == 0 && e.team >= 0) {
-      // The last robot to touch the ball: the scorer, or an own goal.
-      if (const auto& touch = world_->lastBallTouch()) {
-        const auto& info = world_->robot(touch->robot);
-        goal.scorer = info.number;
-        goal.own_goal = info.team != e.team;
+    if (goal.scorer == 0 && e.team >= 0 && last_toucher_.team >= 0) {
+      // The last robot to touch the ball, or the shooter whose shot it deflected.
+      goal.scorer = last_toucher_.number;
+      goal.own_goal = last_toucher_.team != e.team;
+      // The goal's side: where the ball was the period before (the referee has placed it since).
+      const int side = ball_before_.pose.translation().x() > 0 ? 1 : -1;
+      if (goal.own_goal && before_other_team_.team == e.team && heading_for_goal_ == side) {
+        goal.deflected_by = goal.scorer;
+        goal.scorer = before_other_team_.number;
+        goal.own_goal = false;
       }
     }
     goals_.push_back(goal);
   }
+  ball_before_ = world_->ballState();
 }
 
 std::array<double, 2> MatchSession::possession() const {

@@ -68,7 +68,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
     const auto& goal = s.goals()[i];
     out << (i ? ", " : "") << "{\"time\": " << fixedNumber(goal.time, 2) << ", \"team\": " << goal.team
         << ", \"scorer\": " << goal.scorer
-        << ", \"own_goal\": " << (goal.own_goal ? "true" : "false") << "}";
+        << ", \"own_goal\": " << (goal.own_goal ? "true" : "false")
+        << ", \"deflected_by\": " << goal.deflected_by << "}";
   }
   out << "],\n";
   out << "  \"referee_events\": [\n";

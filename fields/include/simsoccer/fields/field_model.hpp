@@ -66,6 +66,17 @@ struct FieldModel {
   double halfWidth() const { return 0.5 * width; }
   // Inside the carpet (field plus border).
   bool onCarpet(double x, double y) const;
+  // The ball's deceleration rolling on the carpet, m/s^2: a solid sphere with Bullet's
+  // rolling friction c (the ball's times the carpet's: Bullet multiplies them) slows at
+  // 5 c g / (7 r). The ball's linear damping (turf drag) comes on top.
+  double ballRollingDeceleration() const;
+  // How far a ball rolling at `speed` m/s goes before it stops, m: slowed at that deceleration
+  // a and by its linear damping d (Bullet scales the velocity by (1 - d)^dt: dv/dt = -a - k v,
+  // k = -ln(1 - d)), v/k - a/k^2 ln(1 + k v / a); v^2 / (2a) without damping.
+  double ballRollingDistance(double speed) const;
+  // The goal (+1 or -1, 0: neither) whose mouth a ball rolling from (x, y) at (vx, vy) m/s
+  // would cross, all of it between the posts, before rolling to a stop.
+  int goalReachedByRollingBall(double x, double y, double vx, double vy) const;
   // Collision primitives of the goal behind the goal line at x = side * length / 2
   // (side = +1 or -1), in the field frame.
   std::vector<engine::Shape> goalShapes(int side) const;

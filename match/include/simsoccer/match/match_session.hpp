@@ -142,10 +142,16 @@ class MatchSession : public sim::Recorder {
   std::array<double, 2> possession() const;  // share of the time each team had the ball
   struct Goal {
     double time;
-    // scorer: player number of the last robot to touch the ball, of either team (0: unknown);
-    // own_goal: that robot was the other team's.
+    // scorer: player number of the robot the goal is the work of, of either team (0: unknown);
+    // own_goal: that robot was the other team's. As football counts goals, a shot that
+    // a defender (or more) touched on its way in is the shooter's, not an own goal, if it
+    // was going in before the first of them touched it (rolling over the goal line between
+    // the posts before stopping); deflected_by: then the last of them (0: none). The referee
+    // judges the rules (a goal straight from an indirect restart, the HSL's own goal from a
+    // free kick) by the last touch alone.
     int team, scorer;
     bool own_goal;
+    int deflected_by = 0;
   };
   const std::vector<Goal>& goals() const { return goals_; }
   referee::ControlData controlData() const { return officials_->controlData(); }
@@ -163,6 +169,16 @@ class MatchSession : public sim::Recorder {
   std::optional<size_t> diving_keeper_;
   std::array<double, 2> possession_{};
   std::vector<Goal> goals_;
+  // Ball touches seen at the end of each period: the last toucher, and who touched it before
+  // the other team's robots did, with where the ball was heading (a goal's side, 0 none).
+  struct Toucher {
+    int team = -1, number = 0;
+  };
+  std::optional<world::BallTouch> seen_touch_;
+  Toucher last_toucher_;
+  Toucher before_other_team_;
+  int heading_for_goal_ = 0;
+  engine::RigidBodyState ball_before_;  // at the end of the period before
   std::vector<world::RobotId> lola_robots_;
 };
 
