@@ -227,6 +227,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("pass_distance: [1, 3]"), "");
   EXPECT_EQ(refusedAt("back_off_speed: 0"), "back_off_speed");
   EXPECT_EQ(refusedAt("back_off_speed: 0.2"), "");
+  EXPECT_EQ(refusedAt("keeper_lane: -0.1"), "keeper_lane");
+  EXPECT_EQ(refusedAt("keeper_lane: 0"), "");
 }
 
 TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
@@ -635,7 +637,8 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
   const auto f = field();  // SPL: goal area 0.6 m deep from x = -4.5, 2.2 m wide
   const auto game = gameState(3);
   // Player 2 strikes (3 is far away); the ball lies in the own goal area.
-  const auto strikerTarget = [&](std::optional<bool> keeper_fallen) {
+  const auto strikerTarget = [&](std::optional<bool> keeper_fallen, double self_y = 0.5,
+                                  double ball_y = 0.3) {
     agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Auto, 1);
     b.receive(mate(3, 2.0, 0.0, 9.0), 0.0);
     if (keeper_fallen) {
@@ -645,17 +648,27 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
       d.fallen = *keeper_fallen;
       b.receive(agents::TeamMessageIn{.from_player = 1, .data = agents::encodeTeamMessage(d)}, 0.0);
     }
-    auto p = seeing(-3.2, 0.5, M_PI, -4.2, 0.3, 0.01);
+    auto p = seeing(-3.2, self_y, M_PI, -4.2, ball_y, 0.01);
     agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
     updateSeeing(b, in);
     EXPECT_EQ(b.role(), Role::Striker);
     return b.target();
   };
   // The goalkeeper plays: the striker waits outside the area (avoid_near in front of it),
-  // facing the ball, instead of going round the ball between it and the goal line.
+  // facing the ball, instead of going round the ball between it and the goal line; keeper_lane
+  // beside the keeper's clearance (the line from the ball to the opponent goal at (4.5, 0)), on
+  // its own side of it, or on the other where its own would be beyond the area's width.
+  const double wait_x = -3.9 + cfg.avoid_near;
+  const auto lane = [&](double ball_y) { return ball_y * (4.5 - wait_x) / (4.5 + 4.2); };
+  ASSERT_GT(cfg.keeper_lane, 0.3);
   auto t = strikerTarget(false);
-  EXPECT_NEAR(t.x, -3.9 + cfg.avoid_near, 1e-6);
-  EXPECT_NEAR(t.y, 0.3, 1e-6);
+  EXPECT_NEAR(t.x, wait_x, 1e-6);
+  EXPECT_NEAR(t.y, lane(0.3) + cfg.keeper_lane, 1e-6);
+  t = strikerTarget(false, -0.5);
+  EXPECT_NEAR(t.x, wait_x, 1e-6);
+  EXPECT_NEAR(t.y, lane(0.3) - cfg.keeper_lane, 1e-6);
+  t = strikerTarget(false, 1.0, 0.9);  // its own side: 1.4 m out, beyond the area's 1.1
+  EXPECT_NEAR(t.y, lane(0.9) - cfg.keeper_lane, 1e-6);
   // No goalkeeper heard from, or a fallen one: the striker plays the ball itself, from
   // behind it.
   for (const auto keeper : {std::optional<bool>{}, std::optional<bool>{true}}) {

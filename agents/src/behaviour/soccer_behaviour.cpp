@@ -146,6 +146,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
                   "defender_goal_distance",
                   "supporter_deepest",
                   "clear_max_angle",
+                  "keeper_lane",
                   "sit_when_finished",
                   "goal_kick_avoidance",
                   "pass_after_restart",
@@ -198,6 +199,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
   if (root.has("supporter_deepest") && !(c.supporter_deepest >= -1.0 && c.supporter_deepest <= 1.0))
     root["supporter_deepest"].fail("must be a share of the half-length, from -1 to 1");
   c.clear_max_angle = root.number("clear_max_angle", c.clear_max_angle);
+  c.keeper_lane = root.number("keeper_lane", c.keeper_lane);
+  if (root.has("keeper_lane") && !(c.keeper_lane >= 0))
+    root["keeper_lane"].fail("must be >= 0 m (0: in front of the ball)");
   if (root.has("clear_max_angle") && !(c.clear_max_angle >= 0 && c.clear_max_angle < 0.5 * kPi))
     root["clear_max_angle"].fail("must be from 0 (off) to under pi/2 rad");
   c.sit_when_finished = root.boolean("sit_when_finished", c.sit_when_finished);
@@ -903,10 +907,19 @@ MotionRequest SoccerBehaviour::play(const Input& in) {
       if (inOwnGoalArea(ball_) && keeperInPlay(in.time)) {
         // The ball in the own goal area is the goalkeeper's: going round it to kick it
         // away, the striker walked in between the ball and the goal line, where the
-        // keeper stands, and both played it at once. Wait outside the area, facing it.
+        // keeper stands, and both played it at once. Wait outside the area, facing it, beside
+        // the keeper's clearance (from the ball to the opponent goal), on the side the striker
+        // is on: in front of the ball, 3 of the K1s' 12 own goals in 64 games came back into
+        // the goal off it.
         const double front = -field_.halfLength() + field_.goal_area->length;
         const double half = 0.5 * field_.goal_area->width;
-        r = walkTo({front + config_.avoid_near, std::clamp(ball_.y, -half, half), 0.0}, true);
+        const double wait_x = front + config_.avoid_near;
+        const double along = (wait_x - ball_.x) / std::max(field_.halfLength() - ball_.x, 1.0);
+        const double lane_y = ball_.y * (1.0 - along);
+        double side = self_.y >= lane_y ? 1.0 : -1.0;
+        if (std::abs(lane_y + side * config_.keeper_lane) > half) side = -side;
+        r = walkTo({wait_x, std::clamp(lane_y + side * config_.keeper_lane, -half, half), 0.0},
+                   true);
         break;
       }
       r = striker(0.0, false);

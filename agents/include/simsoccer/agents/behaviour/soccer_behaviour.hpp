@@ -125,6 +125,10 @@ struct BehaviourConfig {
   // keeps the place there, at most this far (rad) off the field's length, to the side whose
   // place is nearer. 0: off (lined up towards the goal, from inside the own goal if need be).
   double clear_max_angle = 0.0;
+  // The striker waiting in front of the own goal area while the goalkeeper plays the ball there
+  // stands this far (m) beside the line from the ball to the opponent goal, the keeper's
+  // clearance: in front of the ball it stopped the clearances, and some came back into the goal.
+  double keeper_lane = 0.6;
   // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
   // down at the whistle fell again and again through the half-time).
