@@ -183,11 +183,12 @@ TEST(MatchConfig, EachShippedMatchPlaysOnItsLeaguesField) {
 
 // Who a goal is credited to, as football counts it. A shot going in that a defender touches on
 // its way is the shooter's goal, in off that defender (the summary's deflected_by); a ball the
-// defender sends into its own goal is an own goal. The referee's own rules keep the last touch.
+// defender sends into its own goal is an own goal, and so is a shot that goes in more than 2 s
+// after the defender's touch. The referee's own rules keep the last touch.
 // Real physics and contacts: the attacker touches the ball with its toe, the ball rolls at the
 // goal (or lies still), and the defender's toe touches it as it goes in.
 TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) {
-  auto play = [](double speed_before) {
+  auto play = [](double speed_before, double seconds_after = 0.0) {
     match::MatchConfig mc = match::loadMatchConfig(test::sourceDir() / "configs/match_2v2.yaml");
     match::MatchSession session(mc, 1);
     sim::Simulation sim(session.world());
@@ -222,6 +223,13 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
     sim.period();
     // ...then at the defender's toe, going in at 2 m/s.
     putBall(toe(3), side * 2.0);
+    if (seconds_after > 0) {
+      // Or stopped after the touch, and rolled in untouched `seconds_after` later.
+      sim.period();
+      putBall(engine::Vec3(line - side * 0.3, -0.5, 0.0), 0.0);
+      for (int i = 0; i < static_cast<int>(seconds_after * 100); ++i) sim.period();
+      putBall(engine::Vec3(line - side * 0.3, -0.5, 0.0), side * 1.5);
+    }
     for (int i = 0; i < 200 && session.goals().empty(); ++i) sim.period();
     EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 3u);
     EXPECT_EQ(session.game().score(0), 1);
@@ -239,6 +247,16 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
   EXPECT_TRUE(slow[0].own_goal);
   EXPECT_EQ(slow[0].scorer, 2);
   EXPECT_EQ(slow[0].deflected_by, 0);
+  // The shot going in, but the ball in only 2.5 s after the defender's touch: the defenders had
+  // it meanwhile (a save, then their own clearance), so the goal is theirs.
+  const auto late = play(3.0, 2.5);
+  ASSERT_EQ(late.size(), 1u);
+  EXPECT_TRUE(late[0].own_goal);
+  EXPECT_EQ(late[0].deflected_by, 0);
+  const auto soon = play(3.0, 1.0);
+  ASSERT_EQ(soon.size(), 1u);
+  EXPECT_FALSE(soon[0].own_goal);
+  EXPECT_EQ(soon[0].deflected_by, 2);
   const auto still = play(0.0);
   ASSERT_EQ(still.size(), 1u);
   EXPECT_EQ(still[0].team, 0);

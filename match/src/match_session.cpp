@@ -377,6 +377,7 @@ void MatchSession::record(const sim::PeriodRecord& p) {
     const auto& info = world_->robot(touch->robot);
     if (last_toucher_.team >= 0 && info.team != last_toucher_.team) {
       before_other_team_ = last_toucher_;
+      other_team_since_ = world_->time();
       const engine::Vec3 b = ball_before_.pose.translation();
       heading_for_goal_ = world_->field().goalReachedByRollingBall(
           b.x(), b.y(), ball_before_.linear_velocity.x(), ball_before_.linear_velocity.y());
@@ -393,7 +394,8 @@ void MatchSession::record(const sim::PeriodRecord& p) {
       goal.own_goal = last_toucher_.team != e.team;
       // The goal's side: where the ball was the period before (the referee has placed it since).
       const int side = ball_before_.pose.translation().x() > 0 ? 1 : -1;
-      if (goal.own_goal && before_other_team_.team == e.team && heading_for_goal_ == side) {
+      if (goal.own_goal && before_other_team_.team == e.team && heading_for_goal_ == side &&
+          world_->time() - other_team_since_ <= kDeflectedShotSeconds) {
         goal.deflected_by = goal.scorer;
         goal.scorer = before_other_team_.number;
         goal.own_goal = false;

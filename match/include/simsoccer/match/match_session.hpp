@@ -146,7 +146,8 @@ class MatchSession : public sim::Recorder {
     // own_goal: that robot was the other team's. As football counts goals, a shot that
     // a defender (or more) touched on its way in is the shooter's, not an own goal, if it
     // was going in before the first of them touched it (rolling over the goal line between
-    // the posts before stopping); deflected_by: then the last of them (0: none). The referee
+    // the posts before stopping) and went in within 2 s of that touch; deflected_by: then the
+    // last of them (0: none). The referee
     // judges the rules (a goal straight from an indirect restart, the HSL's own goal from a
     // free kick) by the last touch alone.
     int team, scorer;
@@ -178,6 +179,11 @@ class MatchSession : public sim::Recorder {
   Toucher last_toucher_;
   Toucher before_other_team_;
   int heading_for_goal_ = 0;
+  double other_team_since_ = 0.0;  // s: the other team's first touch
+  // A shot in off a defender goes in within this many seconds of the defender's first touch
+  // (in the K1 games traced, 0.2-1.5 s): later, the defending team had the ball meanwhile
+  // (a save, then a clearance of its own into its goal) and the goal is its own.
+  static constexpr double kDeflectedShotSeconds = 2.0;
   engine::RigidBodyState ball_before_;  // at the end of the period before
   std::vector<world::RobotId> lola_robots_;
 };
