@@ -638,7 +638,7 @@ TEST(SoccerBehaviour, TheBallInTheOwnGoalAreaIsTheGoalkeepers) {
   const auto game = gameState(3);
   // Player 2 strikes (3 is far away); the ball lies in the own goal area.
   const auto strikerTarget = [&](std::optional<bool> keeper_fallen, double self_y = 0.5,
-                                  double ball_y = 0.3) {
+                                 double ball_y = 0.3) {
     agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Auto, 1);
     b.receive(mate(3, 2.0, 0.0, 9.0), 0.0);
     if (keeper_fallen) {

@@ -194,7 +194,8 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
     sim::Simulation sim(session.world());
     session.attach(sim);
     world::World& w = session.world();
-    for (int i = 0; i < 20000 && session.game().state() != referee::gc::State::Playing; ++i) sim.period();
+    for (int i = 0; i < 20000 && session.game().state() != referee::gc::State::Playing; ++i)
+      sim.period();
     EXPECT_EQ(session.game().state(), referee::gc::State::Playing);
     const int defender = 1;  // its robots are ids 2 and 3; the attacker is team 0's player 2
     const double side = defender == session.game().leftTeam() ? -1.0 : 1.0;
@@ -210,11 +211,11 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
       b.linear_velocity = engine::Vec3(vx, 0, 0);
       w.setBallState(b);
     };
-    // The attacker 2.5 m out, the defender 0.6 m from its line, both facing the goal; the
-    // goalkeeper out of the way.
+    // The attacker (team 0's player 2) 2.5 m out, the defender (team 1's player 1) 0.6 m from
+    // its line, both facing the goal; team 1's player 2 out of the way.
     w.placeRobot(1, line - side * 2.5, 1.0, side > 0 ? 0.0 : M_PI);
-    w.placeRobot(2, line - side * 2.5, -2.0, side > 0 ? 0.0 : M_PI);
-    w.placeRobot(3, line - side * 0.6, 0.0, side > 0 ? 0.0 : M_PI);
+    w.placeRobot(3, line - side * 2.5, -2.0, side > 0 ? 0.0 : M_PI);
+    w.placeRobot(2, line - side * 0.6, 0.0, side > 0 ? 0.0 : M_PI);
     putBall(toe(1), 0.0);
     for (int i = 0; i < 5; ++i) sim.period();
     EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 1u);
@@ -222,47 +223,40 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
     putBall(engine::Vec3(line - side * 1.5, 0.0, 0.0), side * speed_before);
     sim.period();
     // ...then at the defender's toe, going in at 2 m/s.
-    putBall(toe(3), side * 2.0);
+    putBall(toe(2), side * 2.0);
     if (seconds_after > 0) {
       // Or stopped after the touch, and rolled in untouched `seconds_after` later.
       sim.period();
       putBall(engine::Vec3(line - side * 0.3, -0.5, 0.0), 0.0);
-      for (int i = 0; i < static_cast<int>(seconds_after * 100); ++i) sim.period();
+      const double period = w.scenario().physics.control_period;
+      for (int i = 0; i < static_cast<int>(std::lround(seconds_after / period)); ++i) sim.period();
       putBall(engine::Vec3(line - side * 0.3, -0.5, 0.0), side * 1.5);
     }
     for (int i = 0; i < 200 && session.goals().empty(); ++i) sim.period();
-    EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 3u);
+    EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 2u);
     EXPECT_EQ(session.game().score(0), 1);
     return session.goals();
   };
-  const auto shot = play(3.0);
-  ASSERT_EQ(shot.size(), 1u);
-  EXPECT_EQ(shot[0].team, 0);
-  EXPECT_EQ(shot[0].scorer, 2);
-  EXPECT_FALSE(shot[0].own_goal);
-  EXPECT_EQ(shot[0].deflected_by, 2);
-  // Too slow to reach the line (the SPL ball slows at about 0.45 m/s^2): the defender's goal.
-  const auto slow = play(0.8);
-  ASSERT_EQ(slow.size(), 1u);
-  EXPECT_TRUE(slow[0].own_goal);
-  EXPECT_EQ(slow[0].scorer, 2);
-  EXPECT_EQ(slow[0].deflected_by, 0);
-  // The shot going in, but the ball in only 2.5 s after the defender's touch: the defenders had
-  // it meanwhile (a save, then their own clearance), so the goal is theirs.
-  const auto late = play(3.0, 2.5);
-  ASSERT_EQ(late.size(), 1u);
-  EXPECT_TRUE(late[0].own_goal);
-  EXPECT_EQ(late[0].deflected_by, 0);
-  const auto soon = play(3.0, 1.0);
-  ASSERT_EQ(soon.size(), 1u);
-  EXPECT_FALSE(soon[0].own_goal);
-  EXPECT_EQ(soon[0].deflected_by, 2);
-  const auto still = play(0.0);
-  ASSERT_EQ(still.size(), 1u);
-  EXPECT_EQ(still[0].team, 0);
-  EXPECT_EQ(still[0].scorer, 2);
-  EXPECT_TRUE(still[0].own_goal);
-  EXPECT_EQ(still[0].deflected_by, 0);
+  // Rolling at the goal at 3 m/s before the touch: the shooter's goal, in off player 1. Too slow
+  // to reach the line at 0.8 m/s (the SPL ball slows at about 0.45 m/s^2), or at rest: player 1's
+  // own goal. Going in, but only 2.5 s after the defender's touch: the defenders had it meanwhile
+  // (a save, then their own clearance), so the goal is theirs; 1 s after, still the shot's.
+  struct Case {
+    double speed_before, seconds_after;
+    int scorer;
+    bool own_goal;
+    int deflected_by;
+  };
+  for (const Case c :
+       {Case{3.0, 0.0, 2, false, 1}, Case{0.8, 0.0, 1, true, 0}, Case{0.0, 0.0, 1, true, 0},
+        Case{3.0, 2.5, 1, true, 0}, Case{3.0, 1.0, 2, false, 1}}) {
+    const auto goals = play(c.speed_before, c.seconds_after);
+    ASSERT_EQ(goals.size(), 1u) << c.speed_before << " " << c.seconds_after;
+    EXPECT_EQ(goals[0].team, 0);
+    EXPECT_EQ(goals[0].scorer, c.scorer) << c.speed_before << " " << c.seconds_after;
+    EXPECT_EQ(goals[0].own_goal, c.own_goal) << c.speed_before << " " << c.seconds_after;
+    EXPECT_EQ(goals[0].deflected_by, c.deflected_by) << c.speed_before << " " << c.seconds_after;
+  }
 }
 
 // A match's agents read the motions and gaits beside its config (a copied configs tree plays its

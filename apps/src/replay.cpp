@@ -116,8 +116,8 @@ int replay(int argc, char** argv, int first) {
         const world::RobotInfo& r = world.robot(touch->robot);
         const engine::RigidBodyState ball_state = world.ballState();
         const auto& ball = ball_state.pose.translation();
-        std::printf("  %8.2f s  touch  team %d player %d  %-16s  ball at %.2f %.2f m\n",
-                    at, r.team, r.number,
+        std::printf("  %8.2f s  touch  team %d player %d  %-16s  ball at %.2f %.2f m\n", at, r.team,
+                    r.number,
                     r.model->body->links.at(static_cast<size_t>(touch->link)).name.c_str(),
                     ball.x(), ball.y());
       }
