@@ -181,6 +181,23 @@ TEST(MatchConfig, EachShippedMatchPlaysOnItsLeaguesField) {
   }
 }
 
+// A touch of the ball as a spectator counts it: a robot's contact after 0.1 s without one of its
+// own, or after another robot's (the world reports the last contact's step after each period).
+TEST(MatchSession, BallTouchesAreCountedAsASpectatorCountsThem) {
+  match::BallTouchCounter touches(0.005);  // 0.1 s: 20 steps
+  auto at = [&](world::RobotId robot, uint64_t step) {
+    return touches.next(world::BallTouch{robot, 0, step}).has_value();
+  };
+  EXPECT_FALSE(touches.next(std::nullopt).has_value());
+  EXPECT_TRUE(at(1, 100));   // the first
+  EXPECT_FALSE(at(1, 100));  // the same contact, seen again
+  EXPECT_FALSE(at(1, 102));  // held on
+  EXPECT_FALSE(at(1, 122));  // 20 steps after the last contact: still the same touch
+  EXPECT_TRUE(at(1, 143));   // 21 steps after: a new one
+  EXPECT_TRUE(at(2, 144));   // another robot's
+  EXPECT_TRUE(at(1, 145));   // and back
+}
+
 // Who a goal is credited to, as football counts it. A shot going in that a defender touches on
 // its way is the shooter's goal, in off that defender (the summary's deflected_by); a ball the
 // defender sends into its own goal is an own goal, and so is a shot that goes in more than 2 s
@@ -235,6 +252,9 @@ TEST(MatchSession, AShotInOffADefenderIsTheShootersGoalAndABallAtRestAnOwnGoal) 
     for (int i = 0; i < 200 && session.goals().empty(); ++i) sim.period();
     EXPECT_TRUE(w.lastBallTouch() && w.lastBallTouch()->robot == 2u);
     EXPECT_EQ(session.game().score(0), 1);
+    // One touch each, counted in the records (the attacker's toe held the ball for 5 periods).
+    for (world::RobotId r = 0; r < 4; ++r)
+      EXPECT_EQ(session.robots()[r].touches, r == 1 || r == 2 ? 1 : 0) << r;
     return session.goals();
   };
   // Rolling at the goal at 3 m/s before the touch: the shooter's goal, in off player 1. Too slow
@@ -467,7 +487,8 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
     EXPECT_NE(out.find("every state hash equal"), std::string::npos) << out;
   }
   EXPECT_TRUE(std::filesystem::exists(still));
-  // The re-run's ball touches: at least one, each by a robot of the game, in time order.
+  // The re-run's ball touches: at least one, each by a robot of the game, in time order, as many
+  // as the summary's robots have (the records count them alike).
   const std::string touches = test::runCommand(
       kBin + " replay " + (m.dir / "match.log").string() + " --physics --touches", status);
   ASSERT_EQ(status, 0) << touches;
@@ -481,6 +502,17 @@ TEST(MatchApp, ReplayThroughThePhysicsReproducesEveryStateHash) {
     ++count;
   }
   EXPECT_GE(count, 1) << touches;
+  std::ifstream summary_file(m.dir / "summary.json");
+  const std::string summary((std::istreambuf_iterator<char>(summary_file)),
+                            std::istreambuf_iterator<char>());
+  const std::regex touches_field(R"("ball_touches": ([0-9]+))");
+  int in_summary = 0, robots = 0;
+  for (std::sregex_iterator i(summary.begin(), summary.end(), touches_field), end; i != end; ++i) {
+    in_summary += std::stoi((*i)[1].str());
+    ++robots;
+  }
+  EXPECT_EQ(robots, 4);
+  EXPECT_EQ(in_summary, count) << touches;
   // A part of the log as a video: 2 s at 25 fps.
   const auto part = m.dir / "part.mp4";
   test::runCommand(kBin + " replay " + (m.dir / "match.log").string() + " --video " +

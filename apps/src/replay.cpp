@@ -1,6 +1,5 @@
 // simsoccer replay: what a match log holds, its video, and a re-run of the
 // game through the same period pipeline with the recorded commands.
-#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -102,26 +101,19 @@ int replay(int argc, char** argv, int first) {
     simulation.addSource(recorded);
     int checked = 0;
     const world::World& world = session.world();
-    // A touch is a robot's contact with the ball after 0.1 s without one of its own (or after
-    // another robot's): the referee's last touch, period by period.
-    const auto gap = static_cast<uint64_t>(std::lround(0.1 / world.scenario().physics.dt));
-    std::optional<world::BallTouch> shown;
+    // Every touch the match records count (match::BallTouchCounter), as the re-run finds it.
+    match::BallTouchCounter touches(world.scenario().physics.dt);
     auto printTouch = [&] {
-      const auto& touch = world.lastBallTouch();
+      const auto touch = touches.next(world.lastBallTouch());
       if (!opt.flag("touches") || !touch) return;
       const double at = static_cast<double>(touch->step) * world.scenario().physics.dt;
-      const bool fresh = !shown || touch->robot != shown->robot || touch->step > shown->step + gap;
-      if (shown && touch->step == shown->step) return;
-      if (fresh && at >= from && at <= to) {
-        const world::RobotInfo& r = world.robot(touch->robot);
-        const engine::RigidBodyState ball_state = world.ballState();
-        const auto& ball = ball_state.pose.translation();
-        std::printf("  %8.2f s  touch  team %d player %d  %-16s  ball at %.2f %.2f m\n", at, r.team,
-                    r.number,
-                    r.model->body->links.at(static_cast<size_t>(touch->link)).name.c_str(),
-                    ball.x(), ball.y());
-      }
-      shown = touch;
+      if (at < from || at > to) return;
+      const world::RobotInfo& r = world.robot(touch->robot);
+      const engine::RigidBodyState ball_state = world.ballState();
+      const auto& ball = ball_state.pose.translation();
+      std::printf("  %8.2f s  touch  team %d player %d  %-16s  ball at %.2f %.2f m\n", at, r.team,
+                  r.number, r.model->body->links.at(static_cast<size_t>(touch->link)).name.c_str(),
+                  ball.x(), ball.y());
     };
     // Period after period as long as the log has one and every hash agrees.
     sim::RunLoop(simulation, sim::Pacing::Lockstep)

@@ -268,6 +268,7 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
     throw engine::ConfigError(config.scenario.string(), "perception",
                               "a match's agents see through perception: turn it on");
   world_ = std::make_unique<world::World>(s);
+  touches_.emplace(world_->scenario().physics.dt);
   referee::RuleBook rules = referee::loadRuleBook(config.rules);
   if (config.half_duration) rules.half_duration = *config.half_duration;
   if (config.half_time_break) {
@@ -318,6 +319,17 @@ MatchSession::MatchSession(const MatchConfig& config, uint64_t seed, int solver_
 void MatchSession::attach(sim::Simulation& sim) {
   sim.setOfficials(officials_.get());
   sim.addRecorder(*this);
+}
+
+BallTouchCounter::BallTouchCounter(double physics_dt)
+    : gap_steps_(static_cast<uint64_t>(std::lround(0.1 / physics_dt))) {}
+
+std::optional<world::BallTouch> BallTouchCounter::next(
+    const std::optional<world::BallTouch>& last) {
+  if (!last || (seen_ && last->step == seen_->step)) return std::nullopt;
+  const bool fresh = !seen_ || last->robot != seen_->robot || last->step > seen_->step + gap_steps_;
+  seen_ = last;
+  return fresh ? last : std::nullopt;
 }
 
 void MatchSession::record(const sim::PeriodRecord& p) {
@@ -372,8 +384,8 @@ void MatchSession::record(const sim::PeriodRecord& p) {
   if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
   // A touch by the other team's robot than the last toucher's: was the ball, just before it
   // (at the end of the period before), rolling into a goal?
-  const auto& touch = world_->lastBallTouch();
-  if (touch && (!seen_touch_ || touch->step != seen_touch_->step)) {
+  if (const auto touch = touches_->next(world_->lastBallTouch())) {
+    ++records_[touch->robot].touches;
     const auto& info = world_->robot(touch->robot);
     if (last_toucher_.team >= 0 && info.team != last_toucher_.team) {
       before_other_team_ = last_toucher_;
@@ -383,7 +395,6 @@ void MatchSession::record(const sim::PeriodRecord& p) {
           b.x(), b.y(), ball_before_.linear_velocity.x(), ball_before_.linear_velocity.y());
     }
     last_toucher_ = {info.team, info.number};
-    seen_touch_ = touch;
   }
   for (const sim::Event& e : *p.events) {
     if (e.type != sim::EventType::Goal) continue;

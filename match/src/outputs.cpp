@@ -97,7 +97,8 @@ void writeSummary(const std::filesystem::path& file, const MatchSession& s, cons
         << ", \"falls\": " << rec.falls.size() << ", \"get_ups\": "
         << std::count_if(rec.falls.begin(), rec.falls.end(),
                          [](const FallRecord& f) { return f.up_after.has_value(); })
-        << ", \"keeper_dives\": " << rec.dives << ", \"distance_walked\": " << fixedNumber(rec.distance, 2)
+        << ", \"keeper_dives\": " << rec.dives << ", \"ball_touches\": " << rec.touches
+        << ", \"distance_walked\": " << fixedNumber(rec.distance, 2)
         << ", \"missed_commands\": " << (i < r.missed_commands.size() ? r.missed_commands[i] : 0)
         << ", \"fall_records\": [";
     for (size_t k = 0; k < rec.falls.size(); ++k) {

@@ -106,8 +106,22 @@ struct FallRecord {
   std::optional<double> up_after;
 };
 
+// Touches of the ball as a spectator counts them: a robot's contact with the ball after 0.1 s
+// without one of its own, or after another robot's. Fed the world's last touch after every
+// period; gives the touch that begins a new one.
+class BallTouchCounter {
+ public:
+  explicit BallTouchCounter(double physics_dt);
+  std::optional<world::BallTouch> next(const std::optional<world::BallTouch>& last);
+
+ private:
+  uint64_t gap_steps_;
+  std::optional<world::BallTouch> seen_;
+};
+
 struct RobotRecord {
   int team = 0, number = 0;
+  int touches = 0;  // of the ball (BallTouchCounter)
   std::vector<FallRecord> falls;
   int dives = 0;          // the shoot-out keeper going down once the shot is kicked: not a fall
   double distance = 0.0;  // m walked (torso, teleports left out)
@@ -175,7 +189,7 @@ class MatchSession : public sim::Recorder {
   struct Toucher {
     int team = -1, number = 0;
   };
-  std::optional<world::BallTouch> seen_touch_;
+  std::optional<BallTouchCounter> touches_;  // made with the world (its physics step)
   Toucher last_toucher_;
   Toucher before_other_team_;
   int heading_for_goal_ = 0;
