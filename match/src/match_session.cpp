@@ -384,31 +384,33 @@ void MatchSession::record(const sim::PeriodRecord& p) {
   if (nearest[team] < 0.5) possession_[static_cast<size_t>(team)] += dt;
   // A touch by the other team's robot than the last toucher's: was the ball, just before it
   // (at the end of the period before), rolling into a goal?
+  const std::optional<world::BallTouch> previous = touches_->last();
   if (const auto touch = touches_->next(world_->lastBallTouch())) {
     ++records_[touch->robot].touches;
-    const auto& info = world_->robot(touch->robot);
-    if (last_toucher_.team >= 0 && info.team != last_toucher_.team) {
-      before_other_team_ = last_toucher_;
+    if (previous && world_->robot(previous->robot).team != world_->robot(touch->robot).team) {
+      before_other_team_ = previous->robot;
       other_team_since_ = world_->time();
       const engine::Vec3 b = ball_before_.pose.translation();
       heading_for_goal_ = world_->field().goalReachedByRollingBall(
           b.x(), b.y(), ball_before_.linear_velocity.x(), ball_before_.linear_velocity.y());
     }
-    last_toucher_ = {info.team, info.number};
   }
   for (const sim::Event& e : *p.events) {
     if (e.type != sim::EventType::Goal) continue;
     Goal goal{world_->time(), e.team, e.player, false};
-    if (goal.scorer == 0 && e.team >= 0 && last_toucher_.team >= 0) {
+    const auto& last = touches_->last();
+    if (goal.scorer == 0 && e.team >= 0 && last) {
       // The last robot to touch the ball, or the shooter whose shot it deflected.
-      goal.scorer = last_toucher_.number;
-      goal.own_goal = last_toucher_.team != e.team;
+      const world::RobotInfo& toucher = world_->robot(last->robot);
+      goal.scorer = toucher.number;
+      goal.own_goal = toucher.team != e.team;
       // The goal's side: where the ball was the period before (the referee has placed it since).
       const int side = ball_before_.pose.translation().x() > 0 ? 1 : -1;
-      if (goal.own_goal && before_other_team_.team == e.team && heading_for_goal_ == side &&
+      if (goal.own_goal && before_other_team_ &&
+          world_->robot(*before_other_team_).team == e.team && heading_for_goal_ == side &&
           world_->time() - other_team_since_ <= kDeflectedShotSeconds) {
         goal.deflected_by = goal.scorer;
-        goal.scorer = before_other_team_.number;
+        goal.scorer = world_->robot(*before_other_team_).number;
         goal.own_goal = false;
       }
     }

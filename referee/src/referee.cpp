@@ -259,7 +259,8 @@ void Referee::checkPushing() {
         // there. Left rolling, a K1's kick just before the call carried it 6 m on to two
         // opponents, who were called too close to it while the kicking team's touch, before the
         // award, could not end the free kick (K1 5 v 5 seed 57).
-        if (!in_area && world_.ballState().linear_velocity.head<2>().norm() >= config_.ball_stopped_speed)
+        if (!in_area &&
+            world_.ballState().linear_velocity.head<2>().norm() >= config_.ball_stopped_speed)
           placeBall(ball.x(), ball.y());
         set_play_ball_ = ball;
         set_play_step_ = world_.stepCount();

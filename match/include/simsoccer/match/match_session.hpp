@@ -113,6 +113,8 @@ class BallTouchCounter {
  public:
   explicit BallTouchCounter(double physics_dt);
   std::optional<world::BallTouch> next(const std::optional<world::BallTouch>& last);
+  // The last contact seen (the world's last touch as of the last call).
+  const std::optional<world::BallTouch>& last() const { return seen_; }
 
  private:
   uint64_t gap_steps_;
@@ -161,9 +163,8 @@ class MatchSession : public sim::Recorder {
     // a defender (or more) touched on its way in is the shooter's, not an own goal, if it
     // was going in before the first of them touched it (rolling over the goal line between
     // the posts before stopping) and went in within 2 s of that touch; deflected_by: then the
-    // last of them (0: none). The referee
-    // judges the rules (a goal straight from an indirect restart, the HSL's own goal from a
-    // free kick) by the last touch alone.
+    // last of them (0: none). The referee judges the rules (a goal straight from an indirect
+    // restart, the HSL's own goal from a free kick) by the last touch alone.
     int team, scorer;
     bool own_goal;
     int deflected_by = 0;
@@ -184,14 +185,11 @@ class MatchSession : public sim::Recorder {
   std::optional<size_t> diving_keeper_;
   std::array<double, 2> possession_{};
   std::vector<Goal> goals_;
-  // Ball touches seen at the end of each period: the last toucher, and who touched it before
-  // the other team's robots did, with where the ball was heading (a goal's side, 0 none).
-  struct Toucher {
-    int team = -1, number = 0;
-  };
+  // Ball touches seen at the end of each period (the last toucher: touches_->last()), who
+  // touched the ball before the other team's robots did, and where it was heading then (a
+  // goal's side, 0 none).
   std::optional<BallTouchCounter> touches_;  // made with the world (its physics step)
-  Toucher last_toucher_;
-  Toucher before_other_team_;
+  std::optional<world::RobotId> before_other_team_;
   int heading_for_goal_ = 0;
   double other_team_since_ = 0.0;  // s: the other team's first touch
   // A shot in off a defender goes in within this many seconds of the defender's first touch
