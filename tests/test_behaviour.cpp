@@ -229,6 +229,8 @@ TEST(BehaviourConfig, ErrorsNameFileAndKey) {
   EXPECT_EQ(refusedAt("back_off_speed: 0.2"), "");
   EXPECT_EQ(refusedAt("keeper_lane: -0.1"), "keeper_lane");
   EXPECT_EQ(refusedAt("keeper_lane: 0"), "");
+  EXPECT_EQ(refusedAt("goal_clearance: -0.05"), "goal_clearance");
+  EXPECT_EQ(refusedAt("goal_clearance: 0"), "");
 }
 
 TEST(BehaviourConfig, AConfigStartsFromItsBaseAndChangesSomeKeys) {
@@ -726,6 +728,69 @@ TEST(SoccerBehaviour, ABallOnTheOwnGoalLineIsClearedFromTheField) {
     agents::SoccerBehaviour::Input in{.time = 0.1, .perception = &p, .game = &game};
     keeper.update(in);
     EXPECT_NEAR(keeper.target().yaw, yaw_sign * 75.0 * M_PI / 180.0, 1e-6) << robot_y;
+  }
+}
+
+// A walk does not take a robot into a goal or against its posts and nets (goal_clearance); one
+// in a goal walks out through the mouth. Robots walked into their own goal, stepping past a
+// teammate or after a ball beside a post, and fell against the net (K1 5 v 5 seeds 9 and 19).
+TEST(SoccerBehaviour, WalksKeepOutOfTheGoals) {
+  auto cfg = soccerConfig();
+  const auto f = field();  // SPL: goal line at x = -4.5, posts' centres at y = +-0.8, 0.5 m deep
+  const auto game = gameState(3);
+  ASSERT_GT(cfg.goal_clearance, 0.1);
+  // The striker at (x, y, yaw) with the ball at (bx, by): its walk in the field frame.
+  const auto walk = [&](double x, double y, double yaw, double bx, double by) {
+    agents::SoccerBehaviour b(cfg, f, 0, 1, 2, Role::Striker, 1);
+    auto p = seeing(x, y, yaw, bx, by, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    const MotionRequest r = updateSeeing(b, in);
+    EXPECT_EQ(r.kind, MotionRequest::Kind::Walk);
+    const double c = std::cos(yaw), s = std::sin(yaw);
+    return std::pair{r.forward * c - r.left * s, r.forward * s + r.left * c};
+  };
+  // On its own goal line, facing into the goal, a ball in there: the place behind the ball lies
+  // deeper in. Goal_clearance 0 lets it walk in; with it, no further than 0.1 m past the line.
+  const double yaw = M_PI;
+  cfg.goal_clearance = 0.0;
+  const double free = walk(-4.5, 0.0, yaw, -4.8, 0.0).first;
+  ASSERT_LT(free, -0.1);
+  cfg.goal_clearance = 0.25;
+  EXPECT_NEAR(walk(-4.5, 0.0, yaw, -4.8, 0.0).first, free, 1e-9);  // up to the line: as planned
+  EXPECT_NEAR(walk(-4.61, 0.0, yaw, -4.8, 0.0).first, 0.0, 1e-6);
+  // Further in: out through the mouth, backwards, facing the back net.
+  EXPECT_GT(walk(-4.8, 0.0, yaw, -4.9, 0.0).first, 0.05);
+  // In front of a post, 0.2 m off it, walking at it: not a step nearer.
+  EXPECT_GE(walk(-4.3, 0.8, yaw, -4.8, 0.8).first, -1e-6);
+  // Beside the goal behind its line, 0.15 m off the side net, walking across at it.
+  EXPECT_GE(walk(-4.8, 0.95, -M_PI / 2, -4.8, 0.0).second, -1e-6);
+  // The same at the opponents' goal.
+  EXPECT_NEAR(walk(4.61, 0.0, 0.0, 4.8, 0.0).first, 0.0, 1e-6);
+  // Far from the goals the walk is left as planned, bit for bit.
+  cfg.goal_clearance = 0.0;
+  const auto open = walk(-2.0, 0.5, 0.3, 0.0, 0.0);
+  cfg.goal_clearance = 0.25;
+  EXPECT_EQ(walk(-2.0, 0.5, 0.3, 0.0, 0.0), open);
+}
+
+// A ball on the own goal line beside a post is cleared from the side of it outside the goal:
+// the place behind it on the other side lay within the goal's width, behind the line, and a K1
+// goalkeeper walked into the goal for it (K1 5 v 5 seed 9).
+TEST(SoccerBehaviour, ABallOnTheLineBesideThePostIsClearedFromOutsideTheGoal) {
+  auto cfg = soccerConfig();
+  cfg.clear_max_angle = 75.0 * M_PI / 180.0;  // the K1's
+  const auto f = field();
+  const auto game = gameState(3);
+  const double bx = -4.52, by = 1.05;  // on the line, 0.2 m beside the post's centre
+  for (const double robot_y : {0.3, 1.6}) {
+    agents::SoccerBehaviour keeper(cfg, f, 0, 1, 1, Role::Auto, 1);
+    auto p = seeing(-4.1, robot_y, 0.0, bx, by, 0.01);
+    agents::SoccerBehaviour::Input in{.time = 0.02, .perception = &p, .game = &game};
+    updateSeeing(keeper, in);
+    ASSERT_EQ(keeper.role(), Role::Goalkeeper);
+    // Kicked to the right (-75 degrees) from the place on the left, outside the goal; from y
+    // 0.3 the place inside (y 0.71) is the nearer one.
+    EXPECT_NEAR(keeper.target().yaw, -75.0 * M_PI / 180.0, 1e-6) << robot_y;
   }
 }
 

@@ -147,6 +147,7 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
                   "supporter_deepest",
                   "clear_max_angle",
                   "keeper_lane",
+                  "goal_clearance",
                   "sit_when_finished",
                   "goal_kick_avoidance",
                   "pass_after_restart",
@@ -202,6 +203,9 @@ BehaviourConfig loadBehaviourConfig(const std::filesystem::path& file, int depth
   c.keeper_lane = root.number("keeper_lane", c.keeper_lane);
   if (root.has("keeper_lane") && !(c.keeper_lane >= 0))
     root["keeper_lane"].fail("must be >= 0 m (0: in front of the ball)");
+  c.goal_clearance = root.number("goal_clearance", c.goal_clearance);
+  if (root.has("goal_clearance") && !(c.goal_clearance >= 0))
+    root["goal_clearance"].fail("must be >= 0 m (torso to the goal's posts and nets)");
   if (root.has("clear_max_angle") && !(c.clear_max_angle >= 0 && c.clear_max_angle < 0.5 * kPi))
     root["clear_max_angle"].fail("must be from 0 (off) to under pi/2 rad");
   c.sit_when_finished = root.boolean("sit_when_finished", c.sit_when_finished);
@@ -708,6 +712,14 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
     if (clear_side_ == 0.0 || now_ - cleared_at_ > 0.5)
       clear_side_ = to_place(1.0) <= to_place(-1.0) ? 1.0 : -1.0;
     if (to_place(-clear_side_) + 0.3 < to_place(clear_side_)) clear_side_ = -clear_side_;
+    // Not from inside the own goal or against its frame: a ball on the line beside a post has
+    // one place behind the line within the goal's width (a K1 goalkeeper went for it, walked
+    // into the goal and fell against the side net three times, K1 5 v 5 seed 9).
+    const auto in_goal = [&](double side) {
+      return inOwnGoalFrame({ball_.x - std::cos(angle) * config_.approach_distance,
+                             ball_.y - side * std::sin(angle) * config_.approach_distance});
+    };
+    if (in_goal(clear_side_) && !in_goal(-clear_side_)) clear_side_ = -clear_side_;
     cleared_at_ = now_;
     aim = clear_side_ * angle;
   } else {
@@ -1091,6 +1103,7 @@ MotionRequest SoccerBehaviour::update(const Input& in) {
     r = play(in);
   const MotionRequest planned = r;  // the head follows the plan, not the detour
   avoidRobots(r);
+  avoidGoals(r);
   head(r, planned, in);
   return r;
 }
@@ -1121,6 +1134,63 @@ void SoccerBehaviour::avoidRobots(MotionRequest& r) const {
     r.left = std::clamp(r.left + side * share * towards, -config_.max_side, config_.max_side);
     r.forward = std::clamp(r.forward, -0.1, config_.max_forward);
   }
+}
+
+bool SoccerBehaviour::inOwnGoalFrame(const Vec2& p) const {
+  const double post_y = 0.5 * field_.goal.inner_width + 0.5 * field_.goal.post_diameter;
+  return p.x < -field_.halfLength() &&
+         std::abs(p.y) < post_y + 0.5 * field_.goal.post_diameter + config_.goal_clearance;
+}
+
+void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
+  if (r.kind != MotionRequest::Kind::Walk) return;
+  // The goals' frame as the field model builds it: posts centred on the goal lines, side nets
+  // from the posts back to the back net, depth behind the line.
+  const double post_r = 0.5 * field_.goal.post_diameter;
+  const double post_y = 0.5 * field_.goal.inner_width + post_r;
+  const double line = field_.halfLength();
+  const double back = line + field_.goal.depth;
+  const double clear = config_.goal_clearance;
+  // Between the posts the torso may go this far (m) behind the line: lining up to clear a ball
+  // on the line at an angle (clear_max_angle) puts it there. Further in, it walks out.
+  constexpr double kInMouth = 0.15;
+  constexpr double kWalkOut = 0.1;  // m/s
+  const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
+  Vec2 v{r.forward * c - r.left * s, r.forward * s + r.left * c};  // the walk, own frame
+  bool changed = false;
+  for (const double side : {-1.0, 1.0}) {  // the own goal (-x), the opponents' (+x)
+    // In the goal's frame: p.x along the field towards the goal, from the middle.
+    const Vec2 p{side * self_.x, self_.y};
+    Vec2 w{side * v.x, v.y};
+    const Vec2 before = w;
+    // Takes away the walk's speed towards q while q is nearer than `within`.
+    const auto keepFrom = [&](const Vec2& q, double within) {
+      const double dx = q.x - p.x, dy = q.y - p.y, d = std::hypot(dx, dy);
+      if (d >= within || d < 1e-9) return;
+      const double towards = (w.x * dx + w.y * dy) / d;
+      if (towards <= 0.0) return;
+      w.x -= towards * dx / d;
+      w.y -= towards * dy / d;
+    };
+    const bool mouth = std::abs(p.y) < post_y;
+    if (mouth && p.x > line + kInMouth) {
+      w.x = std::min(w.x, -kWalkOut);  // in the goal: out through the mouth
+    } else {
+      if (mouth && p.x > line + kInMouth - 0.05) w.x = std::min(w.x, 0.0);  // no further in
+      for (const double y_side : {-1.0, 1.0}) {
+        keepFrom({line, y_side * post_y}, post_r + clear);                // the post
+        keepFrom({std::clamp(p.x, line, back), y_side * post_y}, clear);  // the side net
+      }
+      keepFrom({back, std::clamp(p.y, -post_y, post_y)}, clear);  // the back net
+    }
+    if (w.x != before.x || w.y != before.y) {
+      v = {side * w.x, w.y};
+      changed = true;
+    }
+  }
+  if (!changed) return;  // a walk left alone stays bit for bit what was planned
+  r.forward = std::clamp(v.x * c + v.y * s, -kMaxBackward, config_.max_forward);
+  r.left = std::clamp(-v.x * s + v.y * c, -config_.max_side, config_.max_side);
 }
 
 std::string SoccerBehaviour::status() const {

@@ -129,6 +129,10 @@ struct BehaviourConfig {
   // stands this far (m) beside the line from the ball to the opponent goal, the keeper's
   // clearance: in front of the ball it stopped the clearances, and some came back into the goal.
   double keeper_lane = 0.6;
+  // A walk keeps the torso this far (m) from the goals' posts and nets and does not cross a goal
+  // line between the posts (one inside walks out through the mouth): robots walked into their
+  // own goal, stepping past a teammate or after a ball beside the post, and fell against the net.
+  double goal_clearance = 0.25;
   // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
   // down at the whistle fell again and again through the half-time).
@@ -240,6 +244,10 @@ class SoccerBehaviour {
   MotionRequest walkTo(const Pose2& target, bool face_ball, double turn_beyond = kTurnToWalkBeyond,
                        double max_backward = kMaxBackward);
   void avoidRobots(MotionRequest& r) const;
+  // Takes away the walk's speed into either goal (goal_clearance).
+  void avoidGoals(MotionRequest& r) const;
+  // Whether the torso at own-frame p would be in the own goal or against its frame.
+  bool inOwnGoalFrame(const Vec2& p) const;
   // The head's angles into r; `planned` is the walk before avoidRobots.
   void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
   Vec2 toOwn(double fx, double fy) const;    // field -> own frame
