@@ -712,9 +712,9 @@ MotionRequest SoccerBehaviour::striker(double aim_y, bool penalty) {
     if (clear_side_ == 0.0 || now_ - cleared_at_ > 0.5)
       clear_side_ = to_place(1.0) <= to_place(-1.0) ? 1.0 : -1.0;
     if (to_place(-clear_side_) + 0.3 < to_place(clear_side_)) clear_side_ = -clear_side_;
-    // Not from inside the own goal or against its frame: a ball on the line beside a post has
-    // one place behind the line within the goal's width (a K1 goalkeeper went for it, walked
-    // into the goal and fell against the side net three times, K1 5 v 5 seed 9).
+    // Not from inside the own goal or against its frame: for a ball on the line outside a post
+    // one place lies behind the line in line with the post (a K1 goalkeeper went for it, walked
+    // into the goal and fell in there three times, K1 5 v 5 seed 9).
     const auto in_goal = [&](double side) {
       return inOwnGoalFrame({ball_.x - std::cos(angle) * config_.approach_distance,
                              ball_.y - side * std::sin(angle) * config_.approach_distance});
@@ -1189,7 +1189,9 @@ void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
     }
   }
   if (!changed) return;  // a walk left alone stays bit for bit what was planned
-  r.forward = std::clamp(v.x * c + v.y * s, -kMaxBackward, config_.max_forward);
+  // Backwards no faster than planned (backing off at back_off_speed) or kMaxBackward.
+  r.forward =
+      std::clamp(v.x * c + v.y * s, std::min(r.forward, -kMaxBackward), config_.max_forward);
   r.left = std::clamp(-v.x * s + v.y * c, -config_.max_side, config_.max_side);
 }
 
