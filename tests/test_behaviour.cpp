@@ -758,8 +758,12 @@ TEST(SoccerBehaviour, WalksKeepOutOfTheGoals) {
   cfg.goal_clearance = 0.25;
   EXPECT_NEAR(walk(-4.5, 0.0, yaw, -4.8, 0.0).first, free, 1e-9);  // up to the line: as planned
   EXPECT_NEAR(walk(-4.61, 0.0, yaw, -4.8, 0.0).first, 0.0, 1e-6);
-  // Further in: out through the mouth, backwards, facing the back net.
+  // Further in: out through the mouth, backwards, facing the back net; also turned diagonally
+  // into it, where clamping forward and sideways speed each on its own turned the walk back in.
   EXPECT_GT(walk(-4.8, 0.0, yaw, -4.9, 0.0).first, 0.05);
+  EXPECT_GT(walk(-4.8, 0.0, 0.75 * M_PI, -4.95, 0.3).first, 0.02);
+  // Behind the back net (0.5 m deep), walking at the field: not into the net.
+  EXPECT_NEAR(walk(-5.1, 0.0, 0.0, -3.0, 0.0).first, 0.0, 1e-6);
   // In front of a post, 0.2 m off it, walking at it: not a step nearer.
   EXPECT_GE(walk(-4.3, 0.8, yaw, -4.8, 0.8).first, -1e-6);
   // Beside the goal behind its line, 0.15 m off the side net, walking across at it.

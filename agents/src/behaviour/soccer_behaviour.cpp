@@ -1151,10 +1151,10 @@ void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
   const double line = field_.halfLength();
   const double back = line + field_.goal.depth;
   const double clear = config_.goal_clearance;
-  // Between the posts the torso may go this far (m) behind the line: lining up to clear a ball
-  // on the line at an angle (clear_max_angle) puts it there. Further in, it walks out.
-  constexpr double kInMouth = 0.15;
-  constexpr double kWalkOut = 0.1;  // m/s
+  // Between the posts the torso may go kNoFurther (m) behind the line: lining up to clear a
+  // ball on the line at an angle (clear_max_angle) puts it there. Beyond kInMouth it walks out.
+  constexpr double kNoFurther = 0.1, kInMouth = 0.15;
+  constexpr double kWalkOut = 0.1;  // m/s, before the walk's limits
   const double c = std::cos(self_.yaw), s = std::sin(self_.yaw);
   Vec2 v{r.forward * c - r.left * s, r.forward * s + r.left * c};  // the walk, own frame
   bool changed = false;
@@ -1172,11 +1172,14 @@ void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
       w.x -= towards * dx / d;
       w.y -= towards * dy / d;
     };
-    const bool mouth = std::abs(p.y) < post_y;
+    // Between the posts, in front of the back net (behind it, the back net is in the way).
+    const bool mouth = std::abs(p.y) < post_y && p.x < back;
     if (mouth && p.x > line + kInMouth) {
-      w.x = std::min(w.x, -kWalkOut);  // in the goal: out through the mouth
+      // In the goal: not into its side nets, and out through the mouth.
+      for (const double y_side : {-1.0, 1.0}) keepFrom({p.x, y_side * post_y}, clear);
+      w.x = std::min(w.x, -kWalkOut);
     } else {
-      if (mouth && p.x > line + kInMouth - 0.05) w.x = std::min(w.x, 0.0);  // no further in
+      if (mouth && p.x > line + kNoFurther) w.x = std::min(w.x, 0.0);  // no further in
       for (const double y_side : {-1.0, 1.0}) {
         keepFrom({line, y_side * post_y}, post_r + clear);                // the post
         keepFrom({std::clamp(p.x, line, back), y_side * post_y}, clear);  // the side net
@@ -1189,10 +1192,16 @@ void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
     }
   }
   if (!changed) return;  // a walk left alone stays bit for bit what was planned
-  // Backwards no faster than planned (backing off at back_off_speed) or kMaxBackward.
-  r.forward =
-      std::clamp(v.x * c + v.y * s, std::min(r.forward, -kMaxBackward), config_.max_forward);
-  r.left = std::clamp(-v.x * s + v.y * c, -config_.max_side, config_.max_side);
+  // Within the walk's limits, scaled as a whole: clamped axis by axis, the walk turned back
+  // towards the goal. Backwards no faster than planned (back_off_speed) or kMaxBackward.
+  const double forward = v.x * c + v.y * s, left = -v.x * s + v.y * c;
+  const double backward = std::max(-r.forward, kMaxBackward);
+  double scale = 1.0;
+  if (forward > config_.max_forward) scale = std::min(scale, config_.max_forward / forward);
+  if (forward < -backward) scale = std::min(scale, backward / -forward);
+  if (std::abs(left) > config_.max_side) scale = std::min(scale, config_.max_side / std::abs(left));
+  r.forward = scale * forward;
+  r.left = scale * left;
 }
 
 std::string SoccerBehaviour::status() const {

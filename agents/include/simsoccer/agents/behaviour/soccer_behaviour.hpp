@@ -129,9 +129,10 @@ struct BehaviourConfig {
   // stands this far (m) beside the line from the ball to the opponent goal, the keeper's
   // clearance: in front of the ball it stopped the clearances, and some came back into the goal.
   double keeper_lane = 0.6;
-  // A walk keeps the torso this far (m) from the goals' posts and nets and does not cross a goal
-  // line between the posts (one inside walks out through the mouth): robots walked into their
-  // own goal, stepping past a teammate or after a ball beside the post, and fell against the net.
+  // A walk keeps the torso this far (m) from the goals' posts and nets, and between the posts
+  // no further than 0.1 m behind a goal line (one further in than 0.15 m walks out through the
+  // mouth): robots walked into their own goal, stepping past a teammate or after a ball beside
+  // the post, and fell against the net.
   double goal_clearance = 0.25;
   // When a half or the game is over: sit down and rest, as Naos do (the SPL's habit: cool
   // joints), or stand (the K1: its crouch right after a get-up tips it forward, and a robot
@@ -246,7 +247,8 @@ class SoccerBehaviour {
   void avoidRobots(MotionRequest& r) const;
   // Takes away the walk's speed into either goal (goal_clearance).
   void avoidGoals(MotionRequest& r) const;
-  // Whether the torso at own-frame p would be in the own goal or against its frame.
+  // Whether own-frame p lies behind the own goal line within the goal's width, its posts and
+  // goal_clearance (a place to line up from there is in the goal or against its frame).
   bool inOwnGoalFrame(const Vec2& p) const;
   // The head's angles into r; `planned` is the walk before avoidRobots.
   void head(MotionRequest& r, const MotionRequest& planned, const Input& in);
