@@ -750,7 +750,7 @@ TEST(SoccerBehaviour, WalksKeepOutOfTheGoals) {
     return std::pair{r.forward * c - r.left * s, r.forward * s + r.left * c};
   };
   // On its own goal line, facing into the goal, a ball in there: the place behind the ball lies
-  // deeper in. Goal_clearance 0 lets it walk in; with it, no further than 0.1 m past the line.
+  // deeper in. goal_clearance 0 lets it walk in; with it, no further than 0.1 m past the line.
   const double yaw = M_PI;
   cfg.goal_clearance = 0.0;
   const double free = walk(-4.5, 0.0, yaw, -4.8, 0.0).first;

@@ -75,7 +75,7 @@ bool FieldModel::onCarpet(double x, double y) const {
 std::vector<Shape> FieldModel::goalShapes(int side) const {
   const double s = side >= 0 ? 1.0 : -1.0;
   const double r = 0.5 * goal.post_diameter;
-  const double post_y = 0.5 * goal.inner_width + r;           // post centres
+  const double post_y = postCentreY();
   const double top = goal.clear_height + goal.post_diameter;  // top of the crossbar
   const double x_line = s * halfLength();
   const double t = goal.net_thickness;

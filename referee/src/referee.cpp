@@ -825,7 +825,7 @@ void Referee::checkShot() {
   // Off a post: the ball came within touching distance of one.
   const double post_r = 0.5 * f.goal.post_diameter;
   for (double py : {-1.0, 1.0}) {
-    const Vec3 post(side * f.halfLength(), py * (0.5 * f.goal.inner_width + post_r), 0.0);
+    const Vec3 post(side * f.halfLength(), py * f.postCentreY(), 0.0);
     if ((p - post).head<2>().norm() <= r + post_r + 0.005) hit_post_ = true;
   }
   if (!striker_touched_) return;  // the shot clock ends a kick that never comes

@@ -1137,9 +1137,9 @@ void SoccerBehaviour::avoidRobots(MotionRequest& r) const {
 }
 
 bool SoccerBehaviour::inOwnGoalFrame(const Vec2& p) const {
-  const double post_y = 0.5 * field_.goal.inner_width + 0.5 * field_.goal.post_diameter;
-  return p.x < -field_.halfLength() &&
-         std::abs(p.y) < post_y + 0.5 * field_.goal.post_diameter + config_.goal_clearance;
+  return p.x < -field_.halfLength() && std::abs(p.y) < field_.postCentreY() +
+                                                           0.5 * field_.goal.post_diameter +
+                                                           config_.goal_clearance;
 }
 
 void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
@@ -1147,7 +1147,7 @@ void SoccerBehaviour::avoidGoals(MotionRequest& r) const {
   // The goals' frame as the field model builds it: posts centred on the goal lines, side nets
   // from the posts back to the back net, depth behind the line.
   const double post_r = 0.5 * field_.goal.post_diameter;
-  const double post_y = 0.5 * field_.goal.inner_width + post_r;
+  const double post_y = field_.postCentreY();
   const double line = field_.halfLength();
   const double back = line + field_.goal.depth;
   const double clear = config_.goal_clearance;

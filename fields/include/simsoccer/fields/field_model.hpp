@@ -64,6 +64,8 @@ struct FieldModel {
 
   double halfLength() const { return 0.5 * length; }
   double halfWidth() const { return 0.5 * width; }
+  // The goal posts' centres lie on the goal lines at y = +-postCentreY().
+  double postCentreY() const { return 0.5 * goal.inner_width + 0.5 * goal.post_diameter; }
   // Inside the carpet (field plus border).
   bool onCarpet(double x, double y) const;
   // The ball's deceleration rolling on the carpet, m/s^2: a solid sphere with Bullet's
